@@ -1,0 +1,142 @@
+# sandslide - plain GNU Makefile.
+#
+#   make            build build/sandslide and build/libsandslide.a
+#   make deps       install the missing Debian packages (apt-get)
+#   make test       build and run every test (C programs, then CLI tests)
+#   make demo       run the default case (cases/door.ini -> out/door.h5)
+#   make OPENMP=0   build without OpenMP (pragmas must still compile)
+#   make SANITIZE=1 AddressSanitizer + UndefinedBehaviorSanitizer
+#   make V=1        show the full commands
+#
+# User CFLAGS/LDFLAGS are appended last, never overwritten.
+
+BUILD      ?= build
+PKG_CONFIG ?= pkg-config
+PYTHON     ?= /usr/bin/python3
+CC         ?= cc
+OPENMP     ?= 1
+SANITIZE   ?= 0
+VERSION    := 0.1.0
+
+.DELETE_ON_ERROR:
+.DEFAULT_GOAL := all
+
+# Debian package that provides each pkg-config module we need.
+DEB_hdf5   := libhdf5-dev
+DEB_libpng := libpng-dev
+DEB_inih   := libinih-dev
+PC_MODULES := hdf5 libpng inih
+DEB_BUILD  := pkg-config $(foreach m,$(PC_MODULES),$(DEB_$(m)))
+DEB_TEST   := python3-h5py python3-numpy python3-pytest
+
+# Goals that need no library: do not probe pkg-config for them.
+NO_PROBE_GOALS := deps clean help
+ifeq ($(filter-out $(NO_PROBE_GOALS),$(or $(MAKECMDGOALS),all)),)
+else
+  ifeq ($(shell command -v $(PKG_CONFIG) 2>/dev/null),)
+    $(error pkg-config not found: install Debian package 'pkg-config' (or run 'make deps'))
+  endif
+  $(foreach m,$(PC_MODULES),$(if $(shell $(PKG_CONFIG) --exists $(m) && echo y),,\
+    $(error library '$(m)' not found by pkg-config: install Debian package '$(DEB_$(m))' (or run 'make deps'))))
+  DEP_CFLAGS := $(shell $(PKG_CONFIG) --cflags $(PC_MODULES))
+  # The HDF5 high-level library (H5DS dimension scales) has no .pc file of
+  # its own on Debian; it sits beside libhdf5.
+  DEP_LIBS   := $(shell $(PKG_CONFIG) --libs $(PC_MODULES)) -lhdf5_hl
+endif
+
+WARN     := -Wall -Wextra -Wpedantic -Wstrict-prototypes -Wshadow
+BASE     := -std=c11 -D_XOPEN_SOURCE=700 -O3 -march=native -g
+ifeq ($(OPENMP),1)
+  OMPFLAG := -fopenmp
+else
+  OMPFLAG := -Wno-unknown-pragmas
+endif
+ifeq ($(SANITIZE),1)
+  SANFLAG := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
+endif
+ALL_CFLAGS  := $(BASE) $(WARN) $(OMPFLAG) $(SANFLAG) -Iinclude -DSS_VERSION='"$(VERSION)"' \
+               $(DEP_CFLAGS) -MMD -MP $(CFLAGS)
+ALL_LDFLAGS := $(OMPFLAG) $(SANFLAG) $(LDFLAGS)
+LIBS        := $(DEP_LIBS) -lm
+
+ifeq ($(V),1)
+  Q :=
+else
+  Q := @
+endif
+
+LIB_SRC  := $(filter-out src/main.c,$(wildcard src/*.c))
+LIB_OBJ  := $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o)
+MAIN_OBJ := $(BUILD)/obj/main.o
+TEST_SRC := $(wildcard tests/test_*.c)
+TEST_BIN := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
+HEADERS  := $(wildcard include/sandslide/*.h)
+
+.PHONY: all deps test check demo clean headers-check help
+all: $(BUILD)/sandslide $(BUILD)/libsandslide.a
+
+# A flags stamp: objects rebuild when the flags change (git's GIT-CFLAGS).
+$(BUILD)/.flags: FORCE
+	@mkdir -p $(@D)
+	@echo '$(ALL_CFLAGS) $(ALL_LDFLAGS) $(LIBS)' | cmp -s - $@ || echo '$(ALL_CFLAGS) $(ALL_LDFLAGS) $(LIBS)' > $@
+FORCE:
+
+$(BUILD)/obj/%.o: src/%.c $(BUILD)/.flags
+	@mkdir -p $(@D)
+	@$(if $(Q),echo '  CC      $<')
+	$(Q)$(CC) $(ALL_CFLAGS) -c $< -o $@
+
+$(BUILD)/libsandslide.a: $(LIB_OBJ)
+	@$(if $(Q),echo '  AR      $@')
+	$(Q)rm -f $@ && ar rcs $@ $^
+
+$(BUILD)/sandslide: $(MAIN_OBJ) $(BUILD)/libsandslide.a
+	@$(if $(Q),echo '  LINK    $@')
+	$(Q)$(CC) $(ALL_LDFLAGS) $^ $(LIBS) -o $@
+
+$(BUILD)/tests/%: tests/%.c tests/check.h $(BUILD)/libsandslide.a $(BUILD)/.flags
+	@mkdir -p $(@D)
+	@$(if $(Q),echo '  CC      $<')
+	$(Q)$(CC) $(ALL_CFLAGS) -Itests $< $(BUILD)/libsandslide.a $(ALL_LDFLAGS) $(LIBS) -o $@
+
+# Every public header compiles on its own.
+headers-check: $(BUILD)/.flags
+	@mkdir -p $(BUILD)/hdrcheck
+	$(Q)for h in $(HEADERS); do \
+	  printf '#include "%s"\n' "$${h#include/}" > $(BUILD)/hdrcheck/t.c && \
+	  $(CC) $(filter-out -MMD -MP,$(ALL_CFLAGS)) -fsyntax-only $(BUILD)/hdrcheck/t.c || exit 1; \
+	done; echo "  headers compile on their own"
+
+# The README's test command.  C test programs first (each prints
+# "N passed, M failed"), then the CLI/file tests with pytest.
+test check: all $(TEST_BIN) headers-check
+	@fail=0; for t in $(TEST_BIN); do \
+	  echo "== $$t"; OMP_NUM_THREADS=$${OMP_NUM_THREADS:-2} ./$$t || fail=1; \
+	done; \
+	echo "== tests/cli (pytest)"; \
+	SANDSLIDE=$(abspath $(BUILD)/sandslide) $(PYTHON) -m pytest -q tests/cli || fail=1; \
+	exit $$fail
+
+demo: all
+	@mkdir -p out
+	./$(BUILD)/sandslide run cases/door.ini -o out/door.h5
+
+deps:
+	@missing=""; for p in $(DEB_BUILD) $(DEB_TEST); do \
+	  dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q 'ok installed' || missing="$$missing $$p"; \
+	done; \
+	if [ -z "$$missing" ]; then echo "deps: all Debian packages present ($(DEB_BUILD) $(DEB_TEST))"; \
+	else \
+	  echo "deps: installing missing Debian packages:$$missing"; \
+	  SUDO=""; [ "$$(id -u)" = 0 ] || SUDO=sudo; \
+	  $$SUDO apt-get update -qq && \
+	  DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq --no-install-recommends $$missing; \
+	fi
+
+clean:
+	rm -rf $(BUILD)
+
+help:
+	@sed -n '3,12p' Makefile | sed 's/^# \{0,1\}//'
+
+-include $(LIB_OBJ:.o=.d) $(MAIN_OBJ:.o=.d) $(TEST_BIN:=.d)

@@ -1,0 +1,51 @@
+/*
+ * boundary.h - the halo ring of a block: the four sides of the grid are
+ * wall, open or periodic (SPEC section 1).
+ *
+ *   wall      ghost cells are walls: no flux, mirror ghost for gradients
+ *   open      ghost cells are open cells held at open_level (Dirichlet)
+ *   periodic  ghost cells copy type and height of the opposite edge
+ *
+ * Types are filled once, heights before every sweep.  A distributed run
+ * would replace the periodic copies and the block-internal sides by halo
+ * exchanges; the kernels do not change.
+ */
+#ifndef SANDSLIDE_BOUNDARY_H
+#define SANDSLIDE_BOUNDARY_H
+
+#include <stdint.h>
+
+#include "sandslide/grid.h"
+
+enum ss_side_kind {
+	SS_SIDE_WALL,
+	SS_SIDE_OPEN,
+	SS_SIDE_PERIODIC,
+};
+
+enum ss_side { SS_WEST, SS_EAST, SS_SOUTH, SS_NORTH };
+
+struct ss_boundary {
+	enum ss_side_kind side[4];  /* indexed by enum ss_side */
+	double open_level;          /* height held on open cells and ghosts, m */
+};
+
+/* "wall", "open", "periodic"; parse returns 0 or -1. */
+const char *ss_side_kind_name(enum ss_side_kind kind);
+int ss_side_kind_parse(const char *name, enum ss_side_kind *kind);
+const char *ss_side_name(enum ss_side side);
+
+/* SS_ERR_INPUT unless opposite sides are both periodic or both not. */
+int ss_boundary_check(const struct ss_boundary *b);
+
+/* Ghost cell types.  The x sides are filled for rows 0..ny-1, then the y
+ * sides for the whole width, so a corner takes the y side's rule (periodic
+ * in both directions copies the diagonal corner). */
+void ss_boundary_fill_types(const struct ss_grid *g, const struct ss_boundary *b,
+                            uint8_t *cell_type);
+
+/* Ghost heights, in the same order. */
+void ss_boundary_fill_heights(const struct ss_grid *g, const struct ss_boundary *b,
+                              double *height);
+
+#endif

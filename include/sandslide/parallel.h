@@ -1,0 +1,15 @@
+/*
+ * parallel.h - the only place that calls omp_* (so the code builds with
+ * OPENMP=0, where these report one thread).
+ */
+#ifndef SANDSLIDE_PARALLEL_H
+#define SANDSLIDE_PARALLEL_H
+
+/* Threads the next parallel region will use. */
+int ss_parallel_max_threads(void);
+/* Use n threads (n >= 1) from now on. */
+void ss_parallel_set_threads(int n);
+/* Processors available to this process. */
+int ss_parallel_processors(void);
+
+#endif

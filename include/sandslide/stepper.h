@@ -1,0 +1,123 @@
+/*
+ * stepper.h - time integration of the DPSM on one block (SPEC section 2).
+ *
+ * Each substep: fill the halo -> face fluxes and the largest face slope S
+ * (sweep pass 1) -> dt from the CFL bound -> clip dt to the next event
+ * (target time, a source switching on or off) -> update (sweep pass 2) ->
+ * account inflow and outflow.  The step is forward Euler with
+ *
+ *   dt = cfl / (2 nu Lambda(S) (1/dx^2 + 1/dy^2))              [SPEC 2]
+ *
+ * where Lambda(S) >= max(f_sl', f_sl/s) over [0, S] (closure.h).  While a
+ * source is on, dt is also limited so that it raises a cell by at most
+ * cfl tan(a_cr) min(dx, dy): the step then cannot jump over the onset of
+ * sliding.  A state with no face above the critical slope and no source
+ * does not change, so the stepper jumps straight to the next event.
+ *
+ * The stepper owns its arrays; it knows nothing of files.
+ */
+#ifndef SANDSLIDE_STEPPER_H
+#define SANDSLIDE_STEPPER_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "sandslide/boundary.h"
+#include "sandslide/closure.h"
+#include "sandslide/diagnostics.h"
+#include "sandslide/grid.h"
+#include "sandslide/sweep.h"
+
+struct ss_source {
+	double rate;            /* m/s of height added on each covered flow cell */
+	double start, stop;     /* active for start <= t < stop, s */
+	ptrdiff_t *cells;       /* storage indices of the flow cells covered */
+	size_t cell_count;
+};
+
+/* A face between an interior flow cell and an open cell. */
+struct ss_open_face {
+	ptrdiff_t index;        /* index into flux_x or flux_y */
+	int8_t axis;            /* 0: flux_x, 1: flux_y */
+	int8_t sign;            /* +1 if positive flux leaves the flow cell */
+};
+
+struct ss_stepper {
+	struct ss_grid grid;
+	struct ss_tiling tiling;
+	struct ss_closure closure;
+	struct ss_cfl_bound cfl_bound;
+	struct ss_boundary boundary;
+	double cfl;                   /* in (0, 1] */
+
+	double *height;               /* m, cells with halo (ss_grid_index) */
+	uint8_t *cell_type;           /* enum ss_cell_type, with halo */
+	double *flux_x, *flux_y;      /* m^2/s per face, see sweep.h */
+	double *source_rate;          /* m/s, with halo; NULL until a source runs */
+	double *row_scratch;          /* ny per-row partial sums */
+
+	struct ss_source *sources;
+	int source_count;
+	uint64_t sources_on;          /* bit k: source k is active now */
+	double source_rate_max;       /* largest rate of any cell now, m/s */
+	double source_volume_rate;    /* sum of rate dx dy now, m^3/s */
+
+	struct ss_open_face *open_faces;
+	size_t open_face_count;
+
+	double time;                  /* s */
+	long long steps;              /* substeps taken */
+	double inflow, outflow;       /* cumulative, m^3 */
+	double rate_max;              /* max |dh/dt| of the last substep, m/s */
+	double tile_sweeps, tile_slots; /* for active_fraction, since last reset */
+	double seconds_fluxes, seconds_update; /* kernel wall time, s */
+};
+
+#define SS_MAX_SOURCES 64
+
+/* Allocate the arrays for grid g (zero heights, all flow cells).  Returns
+ * SS_ERR_INPUT with the memory needed when it exceeds what the machine has,
+ * SS_ERR_FAIL when an allocation fails. */
+int ss_stepper_init(struct ss_stepper *st, const struct ss_grid *g,
+                    const struct ss_closure *c, const struct ss_boundary *b,
+                    double cfl, int tile_nx, int tile_ny);
+void ss_stepper_release(struct ss_stepper *st);
+
+/* Bytes ss_stepper_init allocates for grid g (for the memory check). */
+double ss_stepper_memory_bytes(const struct ss_grid *g);
+
+/* Add a source of rate m/s on the cells where mask (nx * ny, row-major,
+ * south row first) is non-zero; call after the cell types are final.
+ * Cells that are not flow cells are ignored. */
+int ss_stepper_add_source(struct ss_stepper *st, const uint8_t *mask,
+                          double rate, double start, double stop);
+
+/* Call once heights and interior cell types are set: fills the halo types,
+ * holds open cells at the open level, lists the outflow faces.  Returns
+ * SS_ERR_INPUT naming the first non-finite height. */
+int ss_stepper_prepare(struct ss_stepper *st);
+
+/* How ss_stepper_advance ended. */
+enum ss_advance_end {
+	SS_ADVANCE_REACHED,     /* time == t_target */
+	SS_ADVANCE_STEADY,      /* max |dh/dt| < steady_tol (when requested) */
+	SS_ADVANCE_NONFINITE,   /* a rate or height became NaN or infinite */
+};
+
+struct ss_advance_options {
+	double steady_tol;      /* m/s; stop when max |dh/dt| < it; <= 0: never */
+	void (*progress)(void *context, const struct ss_stepper *st);
+	void *context;          /* passed to progress, called after each substep */
+};
+
+enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,
+                                       const struct ss_advance_options *o);
+
+/* Volume, maxima and counters of the current state; wall_seconds is left to
+ * the caller.  Resets the active_fraction counters. */
+void ss_stepper_diagnostics(struct ss_stepper *st, struct ss_diagnostics *d);
+
+/* Time of the next source switch after t (INFINITY if none). */
+double ss_stepper_next_source_event(const struct ss_stepper *st, double t);
+
+#endif

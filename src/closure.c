@@ -1,0 +1,99 @@
+/*
+ * closure.c - closure set-up, names and the tabulated CFL bound.
+ * The point-wise formulas are static inline in closure.h.
+ */
+#include "sandslide/closure.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "sandslide/error.h"
+
+static const char *const closure_names[] = {
+	[SS_CLOSURE_COULOMB] = "coulomb",
+	[SS_CLOSURE_BINGHAM] = "bingham",
+	[SS_CLOSURE_HERSCHEL_BULKLEY] = "herschel-bulkley",
+	[SS_CLOSURE_CASSON] = "casson",
+};
+
+const char *ss_closure_name(enum ss_closure_kind kind)
+{
+	if ((unsigned)kind >= sizeof closure_names / sizeof *closure_names)
+		SS_BUG("unknown closure kind %d", (int)kind);
+	return closure_names[kind];
+}
+
+int ss_closure_parse(const char *name, enum ss_closure_kind *kind)
+{
+	for (unsigned k = 0; k < sizeof closure_names / sizeof *closure_names; k++) {
+		if (strcmp(name, closure_names[k]) == 0) {
+			*kind = (enum ss_closure_kind)k;
+			return 0;
+		}
+	}
+	return -1;
+}
+
+int ss_closure_init(struct ss_closure *c, enum ss_closure_kind kind,
+                    double repose_angle_deg, double gamma, double nu)
+{
+	if (!(repose_angle_deg > 0.0 && repose_angle_deg < 90.0))
+		return ss_error_input("repose angle %g deg is outside (0, 90)",
+		                      repose_angle_deg);
+	if (!(gamma > 0.0) || !isfinite(gamma))
+		return ss_error_input("gamma %g must be finite and > 0", gamma);
+	if (!(nu > 0.0) || !isfinite(nu))
+		return ss_error_input("nu %g m^2/s must be finite and > 0", nu);
+	const double a = repose_angle_deg * (M_PI / 180.0);
+	c->kind = kind;
+	c->repose_angle_deg = repose_angle_deg;
+	c->tan_cr = tan(a);
+	c->sin_cr = sin(a);
+	c->gamma = kind == SS_CLOSURE_HERSCHEL_BULKLEY ? gamma : 1.0;
+	c->power = 1.0 + 1.0 / c->gamma;
+	c->nu = nu;
+	return SS_OK;
+}
+
+enum { SAMPLES_PER_INTERVAL = 16 };
+
+void ss_cfl_bound_init(struct ss_cfl_bound *t, const struct ss_closure *c)
+{
+	const double dangle = (M_PI / 2.0) / SS_CFL_TABLE_SIZE;
+	double running = 0.0;
+	t->tan_cr = c->tan_cr;
+	t->lambda_max[0] = 0.0;
+	for (int k = 1; k <= SS_CFL_TABLE_SIZE; k++) {
+		/* samples in ((k-1) da, k da]; the last interval stops short of
+		 * 90 deg where s is infinite and lambda tends to 0 */
+		for (int m = 1; m <= SAMPLES_PER_INTERVAL; m++) {
+			double a = ((k - 1) + (double)m / SAMPLES_PER_INTERVAL) * dangle;
+			if (a >= M_PI / 2.0)
+				a = M_PI / 2.0 - 1e-9;
+			double lam = ss_closure_lambda(c, tan(a));
+			if (lam > running)
+				running = lam;
+		}
+		/* the one-sided limit just above tan a_cr, where Coulomb's f'
+		 * jumps from 0 to cos a_cr */
+		double a_lo = (k - 1) * dangle, a_hi = k * dangle;
+		double a_cr = c->repose_angle_deg * (M_PI / 180.0);
+		if (a_cr >= a_lo && a_cr < a_hi) {
+			double lam = ss_closure_lambda(c, nextafter(c->tan_cr, INFINITY));
+			if (lam > running)
+				running = lam;
+		}
+		t->lambda_max[k] = running;
+	}
+}
+
+double ss_cfl_bound_lookup(const struct ss_cfl_bound *t, double s_max)
+{
+	if (!(s_max > t->tan_cr))
+		return 0.0;
+	const double dangle = (M_PI / 2.0) / SS_CFL_TABLE_SIZE;
+	double k = ceil(atan(s_max) / dangle);
+	if (k > SS_CFL_TABLE_SIZE)
+		k = SS_CFL_TABLE_SIZE;
+	return t->lambda_max[(int)k];
+}

@@ -1,0 +1,110 @@
+/*
+ * error.c - one message per error, programmer-error aborts, checked
+ * allocation.  See error.h for the conventions.
+ */
+#include "sandslide/error.h"
+
+#include <stdarg.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static int vreport(int status, const char *fmt, va_list ap)
+{
+	fflush(stdout);
+	fputs("sandslide: ", stderr);
+	vfprintf(stderr, fmt, ap);
+	fputc('\n', stderr);
+	return status;
+}
+
+int ss_error_input(const char *fmt, ...)
+{
+	va_list ap;
+	va_start(ap, fmt);
+	int r = vreport(SS_ERR_INPUT, fmt, ap);
+	va_end(ap);
+	return r;
+}
+
+int ss_error_fail(const char *fmt, ...)
+{
+	va_list ap;
+	va_start(ap, fmt);
+	int r = vreport(SS_ERR_FAIL, fmt, ap);
+	va_end(ap);
+	return r;
+}
+
+int ss_status_exit_code(int status)
+{
+	if (status == SS_OK)
+		return 0;
+	return status == SS_ERR_INPUT ? 2 : 1;
+}
+
+_Noreturn void ss_bug_at(const char *file, int line, const char *fmt, ...)
+{
+	va_list ap;
+	fflush(stdout);
+	fprintf(stderr, "sandslide: BUG at %s:%d: ", file, line);
+	va_start(ap, fmt);
+	vfprintf(stderr, fmt, ap);
+	va_end(ap);
+	fputc('\n', stderr);
+	abort();
+}
+
+void *ss_alloc(size_t count, size_t size, const char *what)
+{
+	char buf[32];
+	if (size != 0 && count > (SIZE_MAX - 63) / size) {
+		ss_error_fail("cannot allocate %s: size overflows", what);
+		return NULL;
+	}
+	size_t bytes = count * size;
+	bytes = (bytes + 63) / 64 * 64;   /* aligned_alloc wants a multiple */
+	if (bytes == 0)
+		bytes = 64;
+	void *p = aligned_alloc(64, bytes);
+	if (!p) {
+		ss_error_fail("cannot allocate %s: %s", what,
+		              ss_format_bytes((double)bytes, buf));
+		return NULL;
+	}
+	memset(p, 0, bytes);
+	return p;
+}
+
+void ss_free(void *p)
+{
+	free(p);
+}
+
+const char *ss_format_bytes(double bytes, char buf[32])
+{
+	static const char *unit[] = {"B", "KiB", "MiB", "GiB", "TiB", "PiB"};
+	int u = 0;
+	while (bytes >= 1024.0 && u < 5) {
+		bytes /= 1024.0;
+		u++;
+	}
+	snprintf(buf, 32, u ? "%.1f %s" : "%.0f %s", bytes, unit[u]);
+	return buf;
+}
+
+double ss_memory_available_bytes(void)
+{
+	FILE *f = fopen("/proc/meminfo", "r");
+	if (!f)
+		return 0.0;
+	char line[256];
+	double kib = 0.0;
+	while (fgets(line, sizeof line, f)) {
+		if (sscanf(line, "MemAvailable: %lf kB", &kib) == 1)
+			break;
+	}
+	fclose(f);
+	return kib * 1024.0;
+}

@@ -1,0 +1,35 @@
+/*
+ * parallel.c - thin wrapper over the OpenMP runtime (see parallel.h).
+ */
+#include "sandslide/parallel.h"
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+int ss_parallel_max_threads(void)
+{
+#ifdef _OPENMP
+	return omp_get_max_threads();
+#else
+	return 1;
+#endif
+}
+
+void ss_parallel_set_threads(int n)
+{
+#ifdef _OPENMP
+	omp_set_num_threads(n > 0 ? n : 1);
+#else
+	(void)n;
+#endif
+}
+
+int ss_parallel_processors(void)
+{
+#ifdef _OPENMP
+	return omp_get_num_procs();
+#else
+	return 1;
+#endif
+}

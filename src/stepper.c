@@ -1,0 +1,358 @@
+/*
+ * stepper.c - adaptive forward-Euler substeps, events and accounting (see
+ * stepper.h for the rules).
+ */
+#include "sandslide/stepper.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+#include <time.h>
+
+#include "sandslide/error.h"
+
+static double now_seconds(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+double ss_stepper_memory_bytes(const struct ss_grid *g)
+{
+	/* height, flux_x, flux_y, source_rate (doubles) and the type byte */
+	return (double)ss_grid_storage_cells(g) * (4.0 * sizeof(double) + 1.0);
+}
+
+int ss_stepper_init(struct ss_stepper *st, const struct ss_grid *g,
+                    const struct ss_closure *c, const struct ss_boundary *b,
+                    double cfl, int tile_nx, int tile_ny)
+{
+	memset(st, 0, sizeof *st);
+	if (!(cfl > 0.0 && cfl <= 1.0))
+		return ss_error_input("cfl %g is outside (0, 1]", cfl);
+	int err = ss_boundary_check(b);
+	if (err)
+		return err;
+
+	const double need = ss_stepper_memory_bytes(g);
+	const double have = ss_memory_available_bytes();
+	if (have > 0.0 && need > have) {
+		char nb[32], hb[32];
+		return ss_error_input("grid %d x %d needs %s of memory; this machine has %s "
+		                      "available (reduce nx, ny)", g->nx, g->ny,
+		                      ss_format_bytes(need, nb), ss_format_bytes(have, hb));
+	}
+
+	st->grid = *g;
+	st->closure = *c;
+	st->boundary = *b;
+	st->cfl = cfl;
+	ss_cfl_bound_init(&st->cfl_bound, c);
+	ss_tiling_init(&st->tiling, g, tile_nx, tile_ny);
+
+	const size_t n = ss_grid_storage_cells(g);
+	st->height = ss_alloc(n, sizeof(double), "heights");
+	st->cell_type = ss_alloc(n, sizeof(uint8_t), "cell types");
+	st->flux_x = ss_alloc(n, sizeof(double), "x-face fluxes");
+	st->flux_y = ss_alloc(n, sizeof(double), "y-face fluxes");
+	st->row_scratch = ss_alloc((size_t)g->ny, sizeof(double), "row sums");
+	if (!st->height || !st->cell_type || !st->flux_x || !st->flux_y ||
+	    !st->row_scratch) {
+		ss_stepper_release(st);
+		return SS_ERR_FAIL;
+	}
+	return SS_OK;
+}
+
+void ss_stepper_release(struct ss_stepper *st)
+{
+	for (int k = 0; k < st->source_count; k++)
+		ss_free(st->sources[k].cells);
+	ss_free(st->sources);
+	ss_free(st->open_faces);
+	ss_free(st->source_rate);
+	ss_free(st->row_scratch);
+	ss_free(st->flux_y);
+	ss_free(st->flux_x);
+	ss_free(st->cell_type);
+	ss_free(st->height);
+	memset(st, 0, sizeof *st);
+}
+
+int ss_stepper_add_source(struct ss_stepper *st, const uint8_t *mask,
+                          double rate, double start, double stop)
+{
+	const struct ss_grid *g = &st->grid;
+	if (st->source_count >= SS_MAX_SOURCES)
+		return ss_error_input("at most %d sources are supported", SS_MAX_SOURCES);
+	if (!st->sources) {
+		st->sources = ss_alloc(SS_MAX_SOURCES, sizeof *st->sources, "sources");
+		if (!st->sources)
+			return SS_ERR_FAIL;
+	}
+	size_t count = 0;
+	for (int j = 0; j < g->ny; j++)
+		for (int i = 0; i < g->nx; i++)
+			count += mask[(size_t)j * g->nx + i] &&
+			         st->cell_type[ss_grid_index(g, i, j)] == SS_CELL_FLOW;
+	struct ss_source *s = &st->sources[st->source_count];
+	s->cells = ss_alloc(count ? count : 1, sizeof *s->cells, "source cells");
+	if (!s->cells)
+		return SS_ERR_FAIL;
+	size_t n = 0;
+	for (int j = 0; j < g->ny; j++) {
+		for (int i = 0; i < g->nx; i++) {
+			const ptrdiff_t k = ss_grid_index(g, i, j);
+			if (mask[(size_t)j * g->nx + i] && st->cell_type[k] == SS_CELL_FLOW)
+				s->cells[n++] = k;
+		}
+	}
+	s->cell_count = n;
+	s->rate = rate;
+	s->start = start;
+	s->stop = stop;
+	st->source_count++;
+	return SS_OK;
+}
+
+static int open_faces_build(struct ss_stepper *st)
+{
+	const struct ss_grid *g = &st->grid;
+	const uint8_t *t = st->cell_type;
+	const ptrdiff_t stride = g->stride;
+	/* two passes: count, then fill (axis, neighbour offset, sign) */
+	for (int pass = 0; pass < 2; pass++) {
+		size_t n = 0;
+		for (int j = 0; j < g->ny; j++) {
+			for (int i = 0; i < g->nx; i++) {
+				const ptrdiff_t k = ss_grid_index(g, i, j);
+				if (t[k] != SS_CELL_FLOW)
+					continue;
+				/* west, east, south, north faces of flow cell k */
+				const struct ss_open_face f[4] = {
+					{k, 0, -1}, {k + 1, 0, +1},
+					{k, 1, -1}, {k + stride, 1, +1},
+				};
+				const ptrdiff_t nb[4] = {k - 1, k + 1, k - stride, k + stride};
+				for (int m = 0; m < 4; m++) {
+					if (t[nb[m]] != SS_CELL_OPEN)
+						continue;
+					if (pass == 1)
+						st->open_faces[n] = f[m];
+					n++;
+				}
+			}
+		}
+		if (pass == 0) {
+			st->open_face_count = n;
+			st->open_faces = ss_alloc(n ? n : 1, sizeof *st->open_faces,
+			                          "open face list");
+			if (!st->open_faces)
+				return SS_ERR_FAIL;
+		}
+	}
+	return SS_OK;
+}
+
+int ss_stepper_prepare(struct ss_stepper *st)
+{
+	const struct ss_grid *g = &st->grid;
+	ss_boundary_fill_types(g, &st->boundary, st->cell_type);
+	for (int j = 0; j < g->ny; j++) {
+		for (int i = 0; i < g->nx; i++) {
+			const ptrdiff_t k = ss_grid_index(g, i, j);
+			if (st->cell_type[k] == SS_CELL_OPEN)
+				st->height[k] = st->boundary.open_level;
+			else if (st->cell_type[k] == SS_CELL_WALL)
+				st->height[k] = 0.0;
+			if (!isfinite(st->height[k]))
+				return ss_error_input("initial height of cell (%d, %d) at x = %g m, "
+				                      "y = %g m is %g: heights must be finite",
+				                      i, j, ss_grid_x(g, i), ss_grid_y(g, j),
+				                      st->height[k]);
+		}
+	}
+	ss_boundary_fill_heights(g, &st->boundary, st->height);
+	return open_faces_build(st);
+}
+
+double ss_stepper_next_source_event(const struct ss_stepper *st, double t)
+{
+	double next = INFINITY;
+	for (int k = 0; k < st->source_count; k++) {
+		const struct ss_source *s = &st->sources[k];
+		if (s->start > t && s->start < next)
+			next = s->start;
+		if (s->stop > t && s->stop < next)
+			next = s->stop;
+	}
+	return next;
+}
+
+/* Rebuild the source field when the set of active sources changes; sources
+ * are summed in file order, so the field has the same bits every run. */
+static int sources_update(struct ss_stepper *st)
+{
+	uint64_t on = 0;
+	for (int k = 0; k < st->source_count; k++) {
+		const struct ss_source *s = &st->sources[k];
+		if (s->start <= st->time && st->time < s->stop && s->cell_count > 0)
+			on |= UINT64_C(1) << k;
+	}
+	if (on == st->sources_on)
+		return SS_OK;
+	st->sources_on = on;
+	if (!on) {
+		st->source_rate_max = 0.0;
+		st->source_volume_rate = 0.0;
+		return SS_OK;
+	}
+	const size_t n = ss_grid_storage_cells(&st->grid);
+	if (!st->source_rate) {
+		st->source_rate = ss_alloc(n, sizeof(double), "source rates");
+		if (!st->source_rate)
+			return SS_ERR_FAIL;
+	} else {
+		memset(st->source_rate, 0, n * sizeof(double));
+	}
+	for (int k = 0; k < st->source_count; k++) {
+		if (!(on >> k & 1))
+			continue;
+		const struct ss_source *s = &st->sources[k];
+		for (size_t m = 0; m < s->cell_count; m++)
+			st->source_rate[s->cells[m]] += s->rate;
+	}
+	/* the volume rate in storage order, deterministic */
+	double rate_max = 0.0, volume_rate = 0.0;
+	for (size_t k = 0; k < n; k++) {
+		const double q = st->source_rate[k];
+		volume_rate += q;
+		if (fabs(q) > rate_max)
+			rate_max = fabs(q);
+	}
+	st->source_rate_max = rate_max;
+	st->source_volume_rate = volume_rate * st->grid.dx * st->grid.dy;
+	return SS_OK;
+}
+
+/* Volume leaving through open faces per second with the current fluxes;
+ * summed in list order, so the same bits for any thread count. */
+static double outflow_rate(const struct ss_stepper *st)
+{
+	double sum_x = 0.0, sum_y = 0.0;
+	for (size_t m = 0; m < st->open_face_count; m++) {
+		const struct ss_open_face *f = &st->open_faces[m];
+		if (f->axis == 0)
+			sum_x += f->sign * st->flux_x[f->index];
+		else
+			sum_y += f->sign * st->flux_y[f->index];
+	}
+	return sum_x * st->grid.dy + sum_y * st->grid.dx;
+}
+
+enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,
+                                       const struct ss_advance_options *o)
+{
+	const struct ss_grid *g = &st->grid;
+	const double inv_d2 = 1.0 / (g->dx * g->dx) + 1.0 / (g->dy * g->dy);
+	const double tiles = (double)st->tiling.tiles_x * st->tiling.tiles_y;
+	const double source_rise = st->cfl * st->closure.tan_cr * fmin(g->dx, g->dy);
+
+	while (st->time < t_target) {
+		if (sources_update(st))
+			return SS_ADVANCE_NONFINITE;
+		double next_event = ss_stepper_next_source_event(st, st->time);
+		if (next_event > t_target)
+			next_event = t_target;
+
+		ss_boundary_fill_heights(g, &st->boundary, st->height);
+		double t0 = now_seconds();
+		const double s_max = ss_sweep_fluxes(g, &st->tiling, &st->closure,
+		                                     st->height, st->cell_type,
+		                                     st->flux_x, st->flux_y);
+		st->seconds_fluxes += now_seconds() - t0;
+		st->tile_slots += tiles;
+		if (!isfinite(s_max)) {
+			st->rate_max = NAN;
+			return SS_ADVANCE_NONFINITE;
+		}
+
+		const double lambda = st->closure.nu * ss_cfl_bound_lookup(&st->cfl_bound, s_max);
+		double dt = lambda > 0.0 ? st->cfl / (2.0 * lambda * inv_d2) : INFINITY;
+		if (st->sources_on && source_rise / st->source_rate_max < dt)
+			dt = source_rise / st->source_rate_max;
+
+		if (isinf(dt)) {
+			/* nothing slides and nothing is poured: the state is
+			 * stationary until the next event */
+			st->rate_max = 0.0;
+			if (o->steady_tol > 0.0)
+				return SS_ADVANCE_STEADY;
+			st->time = next_event;
+			continue;
+		}
+
+		int lands = st->time + dt >= next_event;
+		if (lands)
+			dt = next_event - st->time;
+
+		t0 = now_seconds();
+		st->rate_max = ss_sweep_update(g, &st->tiling, dt, st->flux_x, st->flux_y,
+		                               st->sources_on ? st->source_rate : NULL,
+		                               st->cell_type, st->height);
+		st->seconds_update += now_seconds() - t0;
+		st->tile_sweeps += tiles;
+		st->outflow += dt * outflow_rate(st);
+		st->inflow += dt * st->source_volume_rate;
+		st->time = lands ? next_event : st->time + dt;
+		st->steps++;
+
+		if (o->progress)
+			o->progress(o->context, st);
+		if (!isfinite(st->rate_max))
+			return SS_ADVANCE_NONFINITE;
+		if (o->steady_tol > 0.0 && st->rate_max < o->steady_tol)
+			return SS_ADVANCE_STEADY;
+	}
+	return SS_ADVANCE_REACHED;
+}
+
+void ss_stepper_diagnostics(struct ss_stepper *st, struct ss_diagnostics *d)
+{
+	const struct ss_grid *g = &st->grid;
+	double *row_volume = st->row_scratch, max_height = -INFINITY;
+
+	/* rows summed in parallel, then the row sums in order: the same bits
+	 * for any thread count */
+	#pragma omp parallel for schedule(static) reduction(max:max_height)
+	for (int j = 0; j < g->ny; j++) {
+		double row = 0.0, top = -INFINITY;
+		for (int i = 0; i < g->nx; i++) {
+			const ptrdiff_t k = ss_grid_index(g, i, j);
+			if (st->cell_type[k] != SS_CELL_FLOW)
+				continue;
+			const double h = st->height[k];
+			row += h;
+			top = h > top || h != h ? (h != h ? INFINITY : h) : top;
+		}
+		row_volume[j] = row;
+		if (top > max_height)
+			max_height = top;
+	}
+	double volume = 0.0;
+	for (int j = 0; j < g->ny; j++)
+		volume += row_volume[j];
+
+	ss_boundary_fill_heights(g, &st->boundary, st->height);
+	const double s_max = ss_sweep_fluxes(g, &st->tiling, &st->closure, st->height,
+	                                     st->cell_type, st->flux_x, st->flux_y);
+	d->volume = volume * g->dx * g->dy;
+	d->inflow = st->inflow;
+	d->outflow = st->outflow;
+	d->max_height = max_height;
+	d->max_slope_deg = atan(s_max) * (180.0 / M_PI);
+	d->steps = (double)st->steps;
+	d->active_fraction = st->tile_slots > 0.0 ? st->tile_sweeps / st->tile_slots : 0.0;
+	st->tile_sweeps = st->tile_slots = 0.0;
+}

@@ -1,0 +1,186 @@
+/*
+ * sweep.c - the reference two-pass stencil (see sweep.h for the scheme).
+ *
+ * The closure is a compile-time constant inside each tile routine: the
+ * switch on the closure kind happens once per tile, not once per face.
+ */
+#include "sandslide/sweep.h"
+
+#include <math.h>
+#include <stddef.h>
+
+void ss_tiling_init(struct ss_tiling *t, const struct ss_grid *g,
+                    int tile_nx, int tile_ny)
+{
+	t->tile_nx = tile_nx > 0 ? tile_nx : SS_TILE_NX_DEFAULT;
+	t->tile_ny = tile_ny > 0 ? tile_ny : SS_TILE_NY_DEFAULT;
+	t->tiles_x = (g->nx + t->tile_nx - 1) / t->tile_nx;
+	t->tiles_y = (g->ny + t->tile_ny - 1) / t->tile_ny;
+}
+
+struct tile_span {
+	int i0, i1, j0, j1;   /* cells [i0, i1) x [j0, j1) */
+};
+
+static struct tile_span tile_span(const struct ss_grid *g,
+                                  const struct ss_tiling *t, int tile)
+{
+	const int tx = tile % t->tiles_x, ty = tile / t->tiles_x;
+	struct tile_span s;
+	s.i0 = tx * t->tile_nx;
+	s.j0 = ty * t->tile_ny;
+	s.i1 = s.i0 + t->tile_nx < g->nx ? s.i0 + t->tile_nx : g->nx;
+	s.j1 = s.j0 + t->tile_ny < g->ny ? s.j0 + t->tile_ny : g->ny;
+	return s;
+}
+
+/* A face carries flux when neither side is a wall and one side flows. */
+static inline int face_is_active(uint8_t a, uint8_t b)
+{
+	return a != SS_CELL_WALL && b != SS_CELL_WALL &&
+	       (a == SS_CELL_FLOW || b == SS_CELL_FLOW);
+}
+
+/* Central difference of h at cell k along the direction with neighbour
+ * offset `step`, a wall neighbour replaced by the cell itself (SPEC section
+ * 2, mirror ghost), times 1/(2 spacing). */
+static inline double central_difference(const double *restrict h,
+                                        const uint8_t *restrict type,
+                                        ptrdiff_t k, ptrdiff_t step,
+                                        double inv_2spacing)
+{
+	const double hp = type[k + step] == SS_CELL_WALL ? h[k] : h[k + step];
+	const double hm = type[k - step] == SS_CELL_WALL ? h[k] : h[k - step];
+	return (hp - hm) * inv_2spacing;
+}
+
+/*
+ * The flux through the face between cells a (west/south) and b = a + normal
+ * (east/north): g_n across the face, g_t the mean of both cells' central
+ * differences along it (offset `along`).
+ */
+static inline double face_flux(enum ss_closure_kind kind,
+                               const struct ss_closure *c,
+                               const double *restrict h,
+                               const uint8_t *restrict type, ptrdiff_t a,
+                               ptrdiff_t normal, ptrdiff_t along,
+                               double inv_spacing, double inv_2along,
+                               double *restrict s2_max)
+{
+	const ptrdiff_t b = a + normal;
+	if (!face_is_active(type[a], type[b]))
+		return 0.0;
+	const double g_n = (h[b] - h[a]) * inv_spacing;
+	const double g_t = 0.5 * (central_difference(h, type, a, along, inv_2along) +
+	                          central_difference(h, type, b, along, inv_2along));
+	const double s2 = g_n * g_n + g_t * g_t;
+	if (s2 > *s2_max)
+		*s2_max = s2;
+	return c->nu * ss_closure_face_flux_kind(kind, c, g_n, g_t);
+}
+
+static inline double flux_tile(enum ss_closure_kind kind,
+                               const struct ss_grid *g,
+                               const struct ss_closure *c,
+                               struct tile_span sp,
+                               const double *restrict h,
+                               const uint8_t *restrict type,
+                               double *restrict flux_x,
+                               double *restrict flux_y)
+{
+	const ptrdiff_t stride = g->stride;
+	const double inv_dx = 1.0 / g->dx, inv_dy = 1.0 / g->dy;
+	const double inv_2dx = 0.5 / g->dx, inv_2dy = 0.5 / g->dy;
+	/* the last tile of a row (column) also owns the east (north) face */
+	const int x_end = sp.i1 == g->nx ? sp.i1 + 1 : sp.i1;
+	const int y_end = sp.j1 == g->ny ? sp.j1 + 1 : sp.j1;
+	double s2_max = 0.0;
+
+	for (int j = sp.j0; j < sp.j1; j++) {
+		for (int i = sp.i0; i < x_end; i++) {
+			const ptrdiff_t k = ss_grid_index(g, i, j);
+			flux_x[k] = face_flux(kind, c, h, type, k - 1, 1, stride,
+			                      inv_dx, inv_2dy, &s2_max);
+		}
+	}
+	for (int j = sp.j0; j < y_end; j++) {
+		for (int i = sp.i0; i < sp.i1; i++) {
+			const ptrdiff_t k = ss_grid_index(g, i, j);
+			flux_y[k] = face_flux(kind, c, h, type, k - stride, stride, 1,
+			                      inv_dy, inv_2dx, &s2_max);
+		}
+	}
+	return s2_max;
+}
+
+double ss_sweep_fluxes(const struct ss_grid *g, const struct ss_tiling *t,
+                       const struct ss_closure *c,
+                       const double *restrict height,
+                       const uint8_t *restrict cell_type,
+                       double *restrict flux_x, double *restrict flux_y)
+{
+	const int tiles = t->tiles_x * t->tiles_y;
+	const enum ss_closure_kind kind = c->kind;
+	double s2_max = 0.0;
+
+	#pragma omp parallel for schedule(static) reduction(max:s2_max)
+	for (int tile = 0; tile < tiles; tile++) {
+		const struct tile_span sp = tile_span(g, t, tile);
+		double s2 = 0.0;
+		switch (kind) {
+		case SS_CLOSURE_COULOMB:
+			s2 = flux_tile(SS_CLOSURE_COULOMB, g, c, sp, height,
+			               cell_type, flux_x, flux_y);
+			break;
+		case SS_CLOSURE_BINGHAM:
+			s2 = flux_tile(SS_CLOSURE_BINGHAM, g, c, sp, height,
+			               cell_type, flux_x, flux_y);
+			break;
+		case SS_CLOSURE_HERSCHEL_BULKLEY:
+			s2 = flux_tile(SS_CLOSURE_HERSCHEL_BULKLEY, g, c, sp, height,
+			               cell_type, flux_x, flux_y);
+			break;
+		case SS_CLOSURE_CASSON:
+			s2 = flux_tile(SS_CLOSURE_CASSON, g, c, sp, height,
+			               cell_type, flux_x, flux_y);
+			break;
+		}
+		if (s2 > s2_max)
+			s2_max = s2;
+	}
+	return sqrt(s2_max);
+}
+
+double ss_sweep_update(const struct ss_grid *g, const struct ss_tiling *t,
+                       double dt, const double *restrict flux_x,
+                       const double *restrict flux_y,
+                       const double *restrict source_rate,
+                       const uint8_t *restrict cell_type,
+                       double *restrict height)
+{
+	const int tiles = t->tiles_x * t->tiles_y;
+	const ptrdiff_t stride = g->stride;
+	const double inv_dx = 1.0 / g->dx, inv_dy = 1.0 / g->dy;
+	double rate_max = 0.0;
+
+	#pragma omp parallel for schedule(static) reduction(max:rate_max)
+	for (int tile = 0; tile < tiles; tile++) {
+		const struct tile_span sp = tile_span(g, t, tile);
+		for (int j = sp.j0; j < sp.j1; j++) {
+			for (int i = sp.i0; i < sp.i1; i++) {
+				const ptrdiff_t k = ss_grid_index(g, i, j);
+				double rate = (flux_x[k] - flux_x[k + 1]) * inv_dx +
+				              (flux_y[k] - flux_y[k + stride]) * inv_dy;
+				if (source_rate)
+					rate += source_rate[k];
+				const int flows = cell_type[k] == SS_CELL_FLOW;
+				height[k] = flows ? height[k] + dt * rate : height[k];
+				const double a = flows ? fabs(rate) : 0.0;
+				/* a NaN rate must not vanish in the maximum */
+				if (a > rate_max || a != a)
+					rate_max = a != a ? INFINITY : a;
+			}
+		}
+	}
+	return rate_max;
+}
