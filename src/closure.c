@@ -56,34 +56,31 @@ int ss_closure_init(struct ss_closure *c, enum ss_closure_kind kind,
 }
 
 enum { SAMPLES_PER_INTERVAL = 16 };
+#define CFL_TABLE_MARGIN 1e-6
 
 void ss_cfl_bound_init(struct ss_cfl_bound *t, const struct ss_closure *c)
 {
 	const double dangle = (M_PI / 2.0) / SS_CFL_TABLE_SIZE;
+	/* Coulomb's f' jumps from 0 to cos a_cr just above tan a_cr: that
+	 * one-sided limit enters the entry the lookup picks for such a slope */
+	const double s_cr = nextafter(c->tan_cr, INFINITY);
+	const double k_cr = ceil(atan(s_cr) / dangle);
+	const double lambda_cr = ss_closure_lambda(c, s_cr);
 	double running = 0.0;
 	t->tan_cr = c->tan_cr;
 	t->lambda_max[0] = 0.0;
 	for (int k = 1; k <= SS_CFL_TABLE_SIZE; k++) {
-		/* samples in ((k-1) da, k da]; the last interval stops short of
-		 * 90 deg where s is infinite and lambda tends to 0 */
+		/* samples in ((k-1) da, k da]; the last one stops short of
+		 * 90 deg, where s is infinite and lambda tends to 0 */
 		for (int m = 1; m <= SAMPLES_PER_INTERVAL; m++) {
 			double a = ((k - 1) + (double)m / SAMPLES_PER_INTERVAL) * dangle;
 			if (a >= M_PI / 2.0)
 				a = M_PI / 2.0 - 1e-9;
-			double lam = ss_closure_lambda(c, tan(a));
-			if (lam > running)
-				running = lam;
+			running = fmax(running, ss_closure_lambda(c, tan(a)));
 		}
-		/* the one-sided limit just above tan a_cr, where Coulomb's f'
-		 * jumps from 0 to cos a_cr */
-		double a_lo = (k - 1) * dangle, a_hi = k * dangle;
-		double a_cr = c->repose_angle_deg * (M_PI / 180.0);
-		if (a_cr >= a_lo && a_cr < a_hi) {
-			double lam = ss_closure_lambda(c, nextafter(c->tan_cr, INFINITY));
-			if (lam > running)
-				running = lam;
-		}
-		t->lambda_max[k] = running;
+		if (k >= k_cr)
+			running = fmax(running, lambda_cr);
+		t->lambda_max[k] = running * (1.0 + CFL_TABLE_MARGIN);
 	}
 }
 

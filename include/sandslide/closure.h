@@ -63,14 +63,16 @@ static inline double ss_closure_eval_kind(enum ss_closure_kind kind,
 	switch (kind) {
 	case SS_CLOSURE_COULOMB:
 		return (s - c->tan_cr) / sqrt(1.0 + s * s);
+	/* s > tan a_cr can still round to b < 1 by an ulp at steep repose
+	 * angles: max(., 0) as in SPEC section 1 keeps pow() away from NaN */
 	case SS_CLOSURE_BINGHAM: {
-		const double e = b - 1.0;
+		const double e = fmax(b - 1.0, 0.0);
 		return r * (2.0 + r) * (e * e);
 	}
 	case SS_CLOSURE_HERSCHEL_BULKLEY:
-		return r * (1.0 + c->gamma + c->gamma * r) * pow(b - 1.0, c->power);
+		return r * (1.0 + c->gamma + c->gamma * r) * pow(fmax(b - 1.0, 0.0), c->power);
 	case SS_CLOSURE_CASSON: {
-		const double q = sqrt(b), e = q - 1.0;
+		const double q = sqrt(b), e = fmax(q - 1.0, 0.0);
 		return r * r * (10.0 * b * q + 6.0 * b + 3.0 * q + 1.0) * (e * e * e);
 	}
 	}
@@ -102,7 +104,7 @@ static inline double ss_closure_derivative(const struct ss_closure *c, double s)
 		/* f = (A/b + G/b^2) e^p, e = b - 1, A = 1 + gamma, G = gamma */
 		const double g = c->kind == SS_CLOSURE_BINGHAM ? 1.0 : c->gamma;
 		const double p = c->kind == SS_CLOSURE_BINGHAM ? 2.0 : c->power;
-		const double A = 1.0 + g, e = b - 1.0;
+		const double A = 1.0 + g, e = fmax(b - 1.0, 0.0);
 		const double ep1 = pow(e, p - 1.0);
 		df_db = (-A / (b * b) - 2.0 * g / (b * b * b)) * ep1 * e
 		        + (A / b + g / (b * b)) * p * ep1;
@@ -110,7 +112,7 @@ static inline double ss_closure_derivative(const struct ss_closure *c, double s)
 	}
 	case SS_CLOSURE_CASSON: {
 		/* with r = sqrt b: f = P(r) (r - 1)^3 / r^4 */
-		const double r = sqrt(b), e = r - 1.0;
+		const double r = sqrt(b), e = fmax(r - 1.0, 0.0);
 		const double P = 10.0 * r * r * r + 6.0 * r * r + 3.0 * r + 1.0;
 		const double dP = 30.0 * r * r + 12.0 * r + 3.0;
 		const double r4 = r * r * r * r;
@@ -160,8 +162,10 @@ static inline double ss_closure_face_flux(const struct ss_closure *c,
  * The CFL rule every kernel uses (SPEC section 2 allows an upper bound of
  * lambda_max): Lambda(S) = max of lambda(s)/nu over s in [0, S], tabulated
  * once per closure at angles k * (90 deg / SS_CFL_TABLE_SIZE), each entry the
- * maximum over 16 samples per interval up to that angle.  A sweep only needs
- * the largest face slope S; the table is indexed by the angle atan(S)
+ * maximum over 16 samples per interval up to that angle (and the one-sided
+ * limit just above tan a_cr), raised by a relative margin of 1e-6 that covers
+ * the peak falling between samples (measured: below 1e-8).  A sweep only
+ * needs the largest face slope S; the table is indexed by the angle atan(S)
  * rounded up, so the bound holds for every face of the state.
  */
 #define SS_CFL_TABLE_SIZE 4096

@@ -1,0 +1,101 @@
+/*
+ * case.h - the case file (SPEC section 4): an INI file parsed with inih,
+ * plus command-line overrides "SECTION.KEY=VALUE".
+ *
+ *   [grid]      nx, ny, dx, dy (default dx), origin = X Y
+ *   [model]     closure, repose_angle (deg), nu (m^2/s) or the physical
+ *               parameters delta, density, gravity, viscosity | consistency;
+ *               gamma (herschel-bulkley)
+ *   [time]      end (s) | end = steady, output_every (s), cfl, steady_tol,
+ *               max_time (s, with end = steady)
+ *   [boundary]  west, east, south, north = wall|open|periodic; open_level (m)
+ *   [initial]   type = flat|cone|file; height; center, radius, angle; file
+ *   [wall NAME] [open NAME] [source NAME]
+ *               rect = X0 Y0 X1 Y1 | disk = X Y R | polygon = X Y X Y ... |
+ *               mask = PNG; sources also rate (m/s), start, stop (s)
+ *
+ * cases/reference.ini documents every key with units and defaults.  Every
+ * error names file:line (or the --set argument) and what is accepted.
+ */
+#ifndef SANDSLIDE_CASE_H
+#define SANDSLIDE_CASE_H
+
+#include "sandslide/boundary.h"
+#include "sandslide/closure.h"
+#include "sandslide/shape.h"
+
+
+enum ss_region_role { SS_REGION_WALL, SS_REGION_OPEN, SS_REGION_SOURCE };
+
+struct ss_region {
+	enum ss_region_role role;
+	char name[64];
+	char where[SS_CASE_WHERE_SIZE];        /* "file:line" of the section header */
+	struct ss_shape shape;
+	double rate;            /* source: m/s */
+	double start, stop;     /* source: s (stop INFINITY = never) */
+	int has_rate;
+};
+
+enum ss_initial_type { SS_INITIAL_FLAT, SS_INITIAL_CONE, SS_INITIAL_FILE };
+
+struct ss_case {
+	char *path;             /* as given */
+	char *text;             /* the whole file */
+
+	/* [grid] */
+	int nx, ny;
+	double dx, dy;          /* m */
+	double origin_x, origin_y; /* lower-left corner, m */
+
+	/* [model] */
+	enum ss_closure_kind closure;
+	double repose_angle_deg;
+	double nu;              /* m^2/s, given or derived */
+	double gamma;           /* herschel-bulkley exponent (1 otherwise) */
+	double delta;           /* sliding layer thickness, m */
+	double density;         /* kg/m^3 */
+	double gravity;         /* m/s^2 */
+	double viscosity;       /* Pa s (bingham, casson) */
+	double consistency;     /* Pa s^gamma (herschel-bulkley) */
+
+	/* [time] */
+	double end;             /* s; INFINITY when steady */
+	int steady;             /* end = steady */
+	double output_every;    /* s */
+	double cfl;
+	double steady_tol;      /* m/s */
+	double max_time;        /* s, INFINITY by default */
+
+	/* [boundary] */
+	struct ss_boundary boundary;
+
+	/* [initial] */
+	enum ss_initial_type initial;
+	double initial_height;  /* m: flat level, or the floor under a cone */
+	double cone_x, cone_y, cone_radius; /* m */
+	double cone_angle_deg;
+	char *initial_file;     /* resolved against the case file's folder */
+	char initial_where[SS_CASE_WHERE_SIZE];
+
+	struct ss_region *regions; /* in file order */
+	int region_count;
+};
+
+/*
+ * Read and validate the case file at path, then apply the overrides
+ * ("SECTION.KEY=VALUE", e.g. "model.closure=casson" or
+ * "source pour.rate=0.002").  Returns SS_OK, SS_ERR_INPUT (message names the
+ * file:line or override) or SS_ERR_FAIL.  Release with ss_case_release()
+ * whatever the result.
+ */
+int ss_case_load(struct ss_case *c, const char *path,
+                 const char *const *overrides, int override_count);
+void ss_case_release(struct ss_case *c);
+
+/* Parse a whole case from text (path is only used in messages and to
+ * resolve relative file names). */
+int ss_case_parse(struct ss_case *c, const char *path, const char *text,
+                  const char *const *overrides, int override_count);
+
+#endif

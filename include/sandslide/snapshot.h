@@ -1,0 +1,85 @@
+/*
+ * snapshot.h - the HDF5 output of a run (SPEC section 5) and its XDMF
+ * sidecar.  This module is the only code that includes <hdf5.h>.
+ *
+ * Layout (netCDF-4 / CF-1.8 compatible, dimensions as HDF5 dimension scales):
+ *   /height      float64 (time, y, x), chunked, extendible in time
+ *   /time        float64 (time), s
+ *   /x, /y       float64 cell centres, m
+ *   /cell_type   uint8 (y, x), flag_values 0 1 2, "flow wall open"
+ *   /volume /inflow /outflow /max_height /max_slope_deg /steps
+ *   /active_fraction /wall_seconds      float64 (time)
+ *   root attributes: Conventions, title, history, source, closure,
+ *   repose_angle_deg, nu, gamma, dx, dy, case
+ * The file is flushed after every snapshot and the sidecar OUT.xmf is
+ * rewritten (temporary file + rename), so a run killed at any moment leaves
+ * a readable file with every snapshot already reported.
+ */
+#ifndef SANDSLIDE_SNAPSHOT_H
+#define SANDSLIDE_SNAPSHOT_H
+
+#include <stdint.h>
+
+#include "sandslide/diagnostics.h"
+#include "sandslide/grid.h"
+
+struct ss_snapshot;   /* opaque: owns the HDF5 handles */
+
+struct ss_snapshot_meta {
+	const char *title;
+	const char *history;     /* the command line */
+	const char *case_text;   /* the whole case file */
+	const char *closure;     /* closure name */
+	double repose_angle_deg;
+	double nu;               /* m^2/s */
+	double gamma;
+	int deflate;             /* 0 (none) .. 9 */
+};
+
+/* Create (truncate) path and write the static variables; cell_type has the
+ * grid's halo layout.  SS_ERR_FAIL with a message on any HDF5 error. */
+int ss_snapshot_create(struct ss_snapshot **out, const char *path,
+                       const struct ss_grid *g, const uint8_t *cell_type,
+                       const struct ss_snapshot_meta *meta);
+
+/* Append one snapshot (height with the grid's halo layout), flush the file
+ * and rewrite the XDMF sidecar. */
+int ss_snapshot_append(struct ss_snapshot *s, double time_s, const double *height,
+                       const struct ss_diagnostics *d);
+
+/* Snapshots written so far. */
+long long ss_snapshot_count(const struct ss_snapshot *s);
+
+/* Close the file; returns SS_ERR_FAIL if the final close fails.
+ * ss_snapshot_destroy(NULL) is a no-op. */
+int ss_snapshot_destroy(struct ss_snapshot *s);
+
+/* Path of the XDMF sidecar for an output path: "run.h5" -> "run.xmf". */
+void ss_snapshot_sidecar_path(const char *path, char *out, size_t size);
+
+/* What `sandslide info` prints.  Arrays have `count` entries. */
+struct ss_snapshot_summary {
+	int nx, ny;
+	long long count;         /* snapshots */
+	double dx, dy, origin_x, origin_y;
+	char closure[64], source[64], title[256];
+	double repose_angle_deg, nu, gamma;
+	double *time;
+	struct ss_diagnostics *diag;
+	long long flow_cells, wall_cells, open_cells;
+};
+
+/* Read the summary of a sandslide file; SS_ERR_INPUT if it is not one. */
+int ss_snapshot_read_summary(const char *path, struct ss_snapshot_summary *sum);
+void ss_snapshot_summary_release(struct ss_snapshot_summary *sum);
+
+/*
+ * Read a 2-D field from an HDF5 file: dataset (default "/height") is either
+ * (time, y, x), in which case snapshot `index` is read (negative: from the
+ * end, -1 the last), or (y, x).  *values is allocated (nx * ny, south row
+ * first) and owned by the caller (ss_free).
+ */
+int ss_snapshot_read_field(const char *path, const char *dataset, long long index,
+                           int *nx, int *ny, double **values);
+
+#endif

@@ -1,0 +1,661 @@
+/*
+ * snapshot.c - HDF5 + XDMF output (see snapshot.h for the layout).
+ *
+ * File types are explicit little-endian IEEE (H5T_IEEE_F64LE, H5T_STD_U8LE),
+ * memory types native.  Heights are written straight from the halo layout
+ * through a memory hyperslab, so no copy of the grid is made.  HDF5's own
+ * error stack printing is off: each failure prints one sandslide message.
+ */
+#include "sandslide/snapshot.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <hdf5.h>
+#include <hdf5_hl.h>
+
+#include "sandslide/error.h"
+
+static const char *const diag_names[] = {
+	"volume", "inflow", "outflow", "max_height", "max_slope_deg", "steps",
+	"active_fraction", "wall_seconds",
+};
+static const char *const diag_units[] = {"m3", "m3", "m3", "m", "degree", "1", "1", "s"};
+static const char *const diag_long_names[] = {
+	"volume of sand on flow cells",
+	"cumulative volume added by sources",
+	"cumulative volume that left through open cells",
+	"highest sand surface on flow cells",
+	"steepest face slope that can carry flux",
+	"cumulative forward-Euler substeps",
+	"fraction of tiles swept since the previous snapshot",
+	"wall-clock time since the run started",
+};
+enum { DIAG_COUNT = 8 };
+
+static double diag_get(const struct ss_diagnostics *d, int k)
+{
+	const double v[DIAG_COUNT] = {d->volume, d->inflow, d->outflow, d->max_height,
+	                              d->max_slope_deg, d->steps, d->active_fraction,
+	                              d->wall_seconds};
+	return v[k];
+}
+
+static void diag_set(struct ss_diagnostics *d, int k, double v)
+{
+	double *f[DIAG_COUNT] = {&d->volume, &d->inflow, &d->outflow, &d->max_height,
+	                         &d->max_slope_deg, &d->steps, &d->active_fraction,
+	                         &d->wall_seconds};
+	*f[k] = v;
+}
+
+struct ss_snapshot {
+	char *path;
+	char *xmf_path;
+	hid_t file;
+	hid_t height, time, diag[DIAG_COUNT];
+	struct ss_grid grid;
+	long long count;
+	double *times;          /* for the sidecar */
+	long long times_cap;
+};
+
+static void quiet_hdf5(void)
+{
+	H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+}
+
+/* ---- attributes ------------------------------------------------------ */
+
+static int attr_string(hid_t obj, const char *name, const char *value)
+{
+	hid_t type = H5Tcopy(H5T_C_S1);
+	size_t len = strlen(value);
+	H5Tset_size(type, len ? len : 1);
+	H5Tset_strpad(type, H5T_STR_NULLTERM);
+	hid_t space = H5Screate(H5S_SCALAR);
+	hid_t a = H5Acreate2(obj, name, type, space, H5P_DEFAULT, H5P_DEFAULT);
+	herr_t r = a < 0 ? -1 : H5Awrite(a, type, len ? value : "");
+	if (a >= 0)
+		H5Aclose(a);
+	H5Sclose(space);
+	H5Tclose(type);
+	return r < 0 ? -1 : 0;
+}
+
+static int attr_doubles(hid_t obj, const char *name, const double *v, hsize_t n)
+{
+	hid_t space = n == 1 ? H5Screate(H5S_SCALAR) : H5Screate_simple(1, &n, NULL);
+	hid_t a = H5Acreate2(obj, name, H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT);
+	herr_t r = a < 0 ? -1 : H5Awrite(a, H5T_NATIVE_DOUBLE, v);
+	if (a >= 0)
+		H5Aclose(a);
+	H5Sclose(space);
+	return r < 0 ? -1 : 0;
+}
+
+static int attr_units(hid_t obj, const char *units, const char *long_name)
+{
+	return attr_string(obj, "units", units) || attr_string(obj, "long_name", long_name);
+}
+
+/* ---- creation -------------------------------------------------------- */
+
+/* An extendible 1-D float64 variable along time. */
+static hid_t create_series(hid_t file, const char *name, const char *units,
+                           const char *long_name)
+{
+	hsize_t dim = 0, maxdim = H5S_UNLIMITED, chunk = 256;
+	hid_t space = H5Screate_simple(1, &dim, &maxdim);
+	hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
+	H5Pset_chunk(dcpl, 1, &chunk);
+	hid_t d = H5Dcreate2(file, name, H5T_IEEE_F64LE, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
+	H5Pclose(dcpl);
+	H5Sclose(space);
+	if (d >= 0 && attr_units(d, units, long_name)) {
+		H5Dclose(d);
+		return -1;
+	}
+	return d;
+}
+
+static hid_t create_coordinate(hid_t file, const char *name, int n, double origin,
+                               double spacing, const char *long_name, const char *axis)
+{
+	hsize_t dim = (hsize_t)n;
+	double *v = ss_alloc((size_t)n, sizeof *v, "coordinates");
+	if (!v)
+		return -1;
+	for (int k = 0; k < n; k++)
+		v[k] = origin + (k + 0.5) * spacing;
+	hid_t space = H5Screate_simple(1, &dim, NULL);
+	hid_t d = H5Dcreate2(file, name, H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT,
+	                     H5P_DEFAULT);
+	int bad = d < 0 || H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v) < 0 ||
+	          attr_units(d, "m", long_name) || attr_string(d, "axis", axis);
+	ss_free(v);
+	H5Sclose(space);
+	if (bad && d >= 0) {
+		H5Dclose(d);
+		return -1;
+	}
+	return d;
+}
+
+/* The memory space of a halo-layout field with the interior selected. */
+static hid_t interior_space(const struct ss_grid *g)
+{
+	hsize_t dims[2] = {(hsize_t)g->ny + 2 * SS_GRID_GHOST, (hsize_t)g->stride};
+	hsize_t start[2] = {SS_GRID_GHOST, SS_GRID_GHOST};
+	hsize_t count[2] = {(hsize_t)g->ny, (hsize_t)g->nx};
+	hid_t m = H5Screate_simple(2, dims, NULL);
+	H5Sselect_hyperslab(m, H5S_SELECT_SET, start, NULL, count, NULL);
+	return m;
+}
+
+static int write_static(struct ss_snapshot *s, const uint8_t *cell_type,
+                        const struct ss_snapshot_meta *meta)
+{
+	const struct ss_grid *g = &s->grid;
+	hid_t f = s->file;
+	int bad = 0;
+
+	hid_t x = create_coordinate(f, "x", g->nx, g->origin_x, g->dx,
+	                            "x coordinate of cell centre (west to east)", "X");
+	hid_t y = create_coordinate(f, "y", g->ny, g->origin_y, g->dy,
+	                            "y coordinate of cell centre (south to north)", "Y");
+	s->time = create_series(f, "time", "s", "simulated time");
+	if (x < 0 || y < 0 || s->time < 0)
+		bad = 1;
+	bad = bad || attr_string(s->time, "axis", "T");
+	bad = bad || H5DSset_scale(x, "x") < 0 || H5DSset_scale(y, "y") < 0 ||
+	      H5DSset_scale(s->time, "time") < 0;
+
+	/* height (time, y, x) */
+	hsize_t dims[3] = {0, (hsize_t)g->ny, (hsize_t)g->nx};
+	hsize_t maxdims[3] = {H5S_UNLIMITED, (hsize_t)g->ny, (hsize_t)g->nx};
+	hsize_t chunk[3] = {1, (hsize_t)(g->ny < 256 ? g->ny : 256),
+	                    (hsize_t)(g->nx < 256 ? g->nx : 256)};
+	hid_t space = H5Screate_simple(3, dims, maxdims);
+	hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
+	H5Pset_chunk(dcpl, 3, chunk);
+	if (meta->deflate > 0) {
+		H5Pset_shuffle(dcpl);
+		H5Pset_deflate(dcpl, (unsigned)meta->deflate);
+	}
+	H5Pset_fletcher32(dcpl);
+	s->height = bad ? -1 : H5Dcreate2(f, "height", H5T_IEEE_F64LE, space, H5P_DEFAULT,
+	                                  dcpl, H5P_DEFAULT);
+	H5Pclose(dcpl);
+	H5Sclose(space);
+	bad = bad || s->height < 0 || attr_units(s->height, "m", "height of the sand surface") ||
+	      attr_string(s->height, "standard_name", "surface_altitude") ||
+	      H5DSattach_scale(s->height, s->time, 0) < 0 ||
+	      H5DSattach_scale(s->height, y, 1) < 0 || H5DSattach_scale(s->height, x, 2) < 0;
+
+	/* cell_type (y, x) */
+	hsize_t dims2[2] = {(hsize_t)g->ny, (hsize_t)g->nx};
+	space = H5Screate_simple(2, dims2, NULL);
+	hid_t ct = bad ? -1 : H5Dcreate2(f, "cell_type", H5T_STD_U8LE, space, H5P_DEFAULT,
+	                                 H5P_DEFAULT, H5P_DEFAULT);
+	hid_t mem = interior_space(g);
+	bad = bad || ct < 0 ||
+	      H5Dwrite(ct, H5T_NATIVE_UINT8, mem, space, H5P_DEFAULT, cell_type) < 0 ||
+	      attr_units(ct, "1", "cell type") ||
+	      attr_string(ct, "flag_meanings", "flow wall open") ||
+	      H5DSattach_scale(ct, y, 0) < 0 || H5DSattach_scale(ct, x, 1) < 0;
+	if (!bad) {
+		const uint8_t flags[3] = {SS_CELL_FLOW, SS_CELL_WALL, SS_CELL_OPEN};
+		hsize_t n = 3;
+		hid_t as = H5Screate_simple(1, &n, NULL);
+		hid_t a = H5Acreate2(ct, "flag_values", H5T_STD_U8LE, as, H5P_DEFAULT, H5P_DEFAULT);
+		bad = a < 0 || H5Awrite(a, H5T_NATIVE_UINT8, flags) < 0;
+		if (a >= 0)
+			H5Aclose(a);
+		H5Sclose(as);
+	}
+	H5Sclose(mem);
+	H5Sclose(space);
+	if (ct >= 0)
+		H5Dclose(ct);
+
+	for (int k = 0; k < DIAG_COUNT && !bad; k++) {
+		s->diag[k] = create_series(f, diag_names[k], diag_units[k], diag_long_names[k]);
+		bad = s->diag[k] < 0 || H5DSattach_scale(s->diag[k], s->time, 0) < 0;
+	}
+
+	/* global attributes */
+	char source[64];
+	snprintf(source, sizeof source, "sandslide %s", SS_VERSION);
+	bad = bad || attr_string(f, "Conventions", "CF-1.8") ||
+	      attr_string(f, "title", meta->title) || attr_string(f, "history", meta->history) ||
+	      attr_string(f, "source", source) || attr_string(f, "closure", meta->closure) ||
+	      attr_doubles(f, "repose_angle_deg", &meta->repose_angle_deg, 1) ||
+	      attr_doubles(f, "nu", &meta->nu, 1) || attr_doubles(f, "gamma", &meta->gamma, 1) ||
+	      attr_doubles(f, "dx", &g->dx, 1) || attr_doubles(f, "dy", &g->dy, 1) ||
+	      attr_string(f, "case", meta->case_text);
+	if (x >= 0)
+		H5Dclose(x);
+	if (y >= 0)
+		H5Dclose(y);
+	return bad ? -1 : 0;
+}
+
+void ss_snapshot_sidecar_path(const char *path, char *out, size_t size)
+{
+	const char *slash = strrchr(path, '/');
+	const char *dot = strrchr(path, '.');
+	size_t stem = dot && (!slash || dot > slash) ? (size_t)(dot - path) : strlen(path);
+	snprintf(out, size, "%.*s.xmf", (int)stem, path);
+}
+
+static void close_handles(struct ss_snapshot *s)
+{
+	for (int k = 0; k < DIAG_COUNT; k++)
+		if (s->diag[k] >= 0)
+			H5Dclose(s->diag[k]);
+	if (s->time >= 0)
+		H5Dclose(s->time);
+	if (s->height >= 0)
+		H5Dclose(s->height);
+}
+
+int ss_snapshot_destroy(struct ss_snapshot *s)
+{
+	if (!s)
+		return SS_OK;
+	int err = SS_OK;
+	close_handles(s);
+	if (s->file >= 0 && H5Fclose(s->file) < 0)
+		err = ss_error_fail("cannot close '%s'", s->path);
+	free(s->times);
+	free(s->xmf_path);
+	free(s->path);
+	free(s);
+	return err;
+}
+
+int ss_snapshot_create(struct ss_snapshot **out, const char *path,
+                       const struct ss_grid *g, const uint8_t *cell_type,
+                       const struct ss_snapshot_meta *meta)
+{
+	quiet_hdf5();
+	*out = NULL;
+	struct ss_snapshot *s = calloc(1, sizeof *s);
+	if (!s)
+		return ss_error_fail("out of memory");
+	s->file = s->height = s->time = -1;
+	for (int k = 0; k < DIAG_COUNT; k++)
+		s->diag[k] = -1;
+	s->grid = *g;
+	s->path = strdup(path);
+	s->xmf_path = malloc(strlen(path) + 8);
+	if (!s->path || !s->xmf_path) {
+		ss_snapshot_destroy(s);
+		return ss_error_fail("out of memory");
+	}
+	ss_snapshot_sidecar_path(path, s->xmf_path, strlen(path) + 8);
+
+	hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+	/* v1.8 format: readable by every netCDF-4 and HDF5 >= 1.8 reader */
+	H5Pset_libver_bounds(fapl, H5F_LIBVER_EARLIEST, H5F_LIBVER_V18);
+	s->file = H5Fcreate(path, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
+	H5Pclose(fapl);
+	if (s->file < 0) {
+		int e = errno;
+		ss_snapshot_destroy(s);
+		return ss_error_fail("cannot create '%s'%s%s", path, e ? ": " : "",
+		                     e ? strerror(e) : "");
+	}
+	if (write_static(s, cell_type, meta) || H5Fflush(s->file, H5F_SCOPE_GLOBAL) < 0) {
+		ss_snapshot_destroy(s);
+		return ss_error_fail("cannot write the static variables of '%s'", path);
+	}
+	*out = s;
+	return SS_OK;
+}
+
+static int append_value(hid_t d, long long index, double v)
+{
+	hsize_t n = (hsize_t)index + 1, start = (hsize_t)index, one = 1;
+	if (H5Dset_extent(d, &n) < 0)
+		return -1;
+	hid_t fs = H5Dget_space(d);
+	hid_t ms = H5Screate_simple(1, &one, NULL);
+	H5Sselect_hyperslab(fs, H5S_SELECT_SET, &start, NULL, &one, NULL);
+	herr_t r = H5Dwrite(d, H5T_NATIVE_DOUBLE, ms, fs, H5P_DEFAULT, &v);
+	H5Sclose(ms);
+	H5Sclose(fs);
+	return r < 0 ? -1 : 0;
+}
+
+static int write_sidecar(const struct ss_snapshot *s)
+{
+	const struct ss_grid *g = &s->grid;
+	char tmp[4200];
+	snprintf(tmp, sizeof tmp, "%s.tmp", s->xmf_path);
+	FILE *f = fopen(tmp, "w");
+	if (!f)
+		return -1;
+	const char *base = strrchr(s->path, '/') ? strrchr(s->path, '/') + 1 : s->path;
+	fprintf(f, "<?xml version=\"1.0\" ?>\n<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n"
+	           "<Xdmf Version=\"3.0\">\n <Domain>\n"
+	           "  <Grid Name=\"sand\" GridType=\"Collection\" CollectionType=\"Temporal\">\n");
+	for (long long k = 0; k < s->count; k++) {
+		fprintf(f, "   <Grid Name=\"snapshot_%lld\" GridType=\"Uniform\">\n"
+		           "    <Time Value=\"%.17g\"/>\n"
+		           "    <Topology TopologyType=\"2DCoRectMesh\" Dimensions=\"%d %d\"/>\n"
+		           "    <Geometry GeometryType=\"ORIGIN_DXDY\">\n"
+		           "     <DataItem Format=\"XML\" Dimensions=\"2\">%.17g %.17g</DataItem>\n"
+		           "     <DataItem Format=\"XML\" Dimensions=\"2\">%.17g %.17g</DataItem>\n"
+		           "    </Geometry>\n"
+		           "    <Attribute Name=\"height\" AttributeType=\"Scalar\" Center=\"Cell\">\n"
+		           "     <DataItem ItemType=\"HyperSlab\" Dimensions=\"1 %d %d\" Type=\"HyperSlab\">\n"
+		           "      <DataItem Dimensions=\"3 3\" Format=\"XML\">%lld 0 0 1 1 1 1 %d %d</DataItem>\n"
+		           "      <DataItem Format=\"HDF\" NumberType=\"Float\" Precision=\"8\" "
+		           "Dimensions=\"%lld %d %d\">%s:/height</DataItem>\n"
+		           "     </DataItem>\n    </Attribute>\n"
+		           "    <Attribute Name=\"cell_type\" AttributeType=\"Scalar\" Center=\"Cell\">\n"
+		           "     <DataItem Format=\"HDF\" NumberType=\"UChar\" Precision=\"1\" "
+		           "Dimensions=\"%d %d\">%s:/cell_type</DataItem>\n"
+		           "    </Attribute>\n   </Grid>\n",
+		        k, s->times[k], g->ny + 1, g->nx + 1, g->origin_y, g->origin_x, g->dy, g->dx,
+		        g->ny, g->nx, k, g->ny, g->nx, s->count, g->ny, g->nx, base,
+		        g->ny, g->nx, base);
+	}
+	fprintf(f, "  </Grid>\n </Domain>\n</Xdmf>\n");
+	int bad = ferror(f);
+	bad |= fclose(f) != 0;
+	if (bad || rename(tmp, s->xmf_path) != 0) {
+		remove(tmp);
+		return -1;
+	}
+	return 0;
+}
+
+int ss_snapshot_append(struct ss_snapshot *s, double time_s, const double *height,
+                       const struct ss_diagnostics *d)
+{
+	const struct ss_grid *g = &s->grid;
+	const long long k = s->count;
+	hsize_t dims[3] = {(hsize_t)k + 1, (hsize_t)g->ny, (hsize_t)g->nx};
+	hsize_t start[3] = {(hsize_t)k, 0, 0};
+	hsize_t count[3] = {1, (hsize_t)g->ny, (hsize_t)g->nx};
+
+	if (H5Dset_extent(s->height, dims) < 0)
+		goto fail;
+	hid_t fs = H5Dget_space(s->height);
+	H5Sselect_hyperslab(fs, H5S_SELECT_SET, start, NULL, count, NULL);
+	hid_t ms = interior_space(g);
+	herr_t r = H5Dwrite(s->height, H5T_NATIVE_DOUBLE, ms, fs, H5P_DEFAULT, height);
+	H5Sclose(ms);
+	H5Sclose(fs);
+	if (r < 0 || append_value(s->time, k, time_s))
+		goto fail;
+	for (int m = 0; m < DIAG_COUNT; m++)
+		if (append_value(s->diag[m], k, diag_get(d, m)))
+			goto fail;
+	if (H5Fflush(s->file, H5F_SCOPE_GLOBAL) < 0)
+		goto fail;
+
+	if (k + 1 > s->times_cap) {
+		long long cap = s->times_cap ? 2 * s->times_cap : 64;
+		double *t = realloc(s->times, (size_t)cap * sizeof *t);
+		if (!t)
+			return ss_error_fail("out of memory");
+		s->times = t;
+		s->times_cap = cap;
+	}
+	s->times[k] = time_s;
+	s->count = k + 1;
+	if (write_sidecar(s))
+		return ss_error_fail("cannot write the XDMF sidecar '%s': %s", s->xmf_path,
+		                     strerror(errno));
+	return SS_OK;
+fail:
+	return ss_error_fail("cannot write snapshot %lld (t = %g s) to '%s'%s%s", k, time_s,
+	                     s->path, errno ? ": " : "", errno ? strerror(errno) : "");
+}
+
+long long ss_snapshot_count(const struct ss_snapshot *s)
+{
+	return s->count;
+}
+
+/* ---- reading --------------------------------------------------------- */
+
+static int read_attr_string(hid_t obj, const char *name, char *out, size_t size)
+{
+	out[0] = '\0';
+	if (H5Aexists(obj, name) <= 0)
+		return -1;
+	hid_t a = H5Aopen(obj, name, H5P_DEFAULT);
+	hid_t ft = H5Aget_type(a);
+	int r = -1;
+	if (H5Tget_class(ft) == H5T_STRING && !H5Tis_variable_str(ft)) {
+		size_t n = H5Tget_size(ft);
+		char *buf = calloc(1, n + 1);
+		if (buf && H5Aread(a, ft, buf) >= 0) {
+			snprintf(out, size, "%s", buf);
+			r = 0;
+		}
+		free(buf);
+	}
+	H5Tclose(ft);
+	H5Aclose(a);
+	return r;
+}
+
+static double read_attr_double(hid_t obj, const char *name)
+{
+	double v = NAN;
+	if (H5Aexists(obj, name) > 0) {
+		hid_t a = H5Aopen(obj, name, H5P_DEFAULT);
+		if (H5Aread(a, H5T_NATIVE_DOUBLE, &v) < 0)
+			v = NAN;
+		H5Aclose(a);
+	}
+	return v;
+}
+
+static hid_t open_file(const char *path)
+{
+	quiet_hdf5();
+	FILE *f = fopen(path, "rb");
+	if (!f) {
+		ss_error_input("cannot open '%s': %s", path, strerror(errno));
+		return -1;
+	}
+	fclose(f);
+	if (H5Fis_hdf5(path) <= 0) {
+		ss_error_input("'%s' is not an HDF5 file", path);
+		return -1;
+	}
+	hid_t file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+	if (file < 0)
+		ss_error_input("cannot open HDF5 file '%s'", path);
+	return file;
+}
+
+static int read_series(hid_t file, const char *name, long long count, double *out)
+{
+	hid_t d = H5Dopen2(file, name, H5P_DEFAULT);
+	if (d < 0)
+		return -1;
+	hid_t fs = H5Dget_space(d);
+	hsize_t n = 0;
+	int ok = H5Sget_simple_extent_ndims(fs) == 1 &&
+	         H5Sget_simple_extent_dims(fs, &n, NULL) == 1 && n == (hsize_t)count;
+	herr_t r = ok ? H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, out) : -1;
+	H5Sclose(fs);
+	H5Dclose(d);
+	return r < 0 ? -1 : 0;
+}
+
+int ss_snapshot_read_summary(const char *path, struct ss_snapshot_summary *sum)
+{
+	memset(sum, 0, sizeof *sum);
+	hid_t file = open_file(path);
+	if (file < 0)
+		return SS_ERR_INPUT;
+	int err = SS_OK;
+	if (read_attr_string(file, "source", sum->source, sizeof sum->source) ||
+	    strncmp(sum->source, "sandslide", 9) != 0 || H5Lexists(file, "height", H5P_DEFAULT) <= 0) {
+		err = ss_error_input("'%s' is not a sandslide output file (no 'source = sandslide' "
+		                     "attribute or no /height)", path);
+		goto out;
+	}
+	read_attr_string(file, "closure", sum->closure, sizeof sum->closure);
+	read_attr_string(file, "title", sum->title, sizeof sum->title);
+	sum->repose_angle_deg = read_attr_double(file, "repose_angle_deg");
+	sum->nu = read_attr_double(file, "nu");
+	sum->gamma = read_attr_double(file, "gamma");
+	sum->dx = read_attr_double(file, "dx");
+	sum->dy = read_attr_double(file, "dy");
+
+	hid_t d = H5Dopen2(file, "height", H5P_DEFAULT);
+	hid_t fs = H5Dget_space(d);
+	hsize_t dims[3] = {0, 0, 0};
+	int rank = H5Sget_simple_extent_ndims(fs);
+	if (rank == 3)
+		H5Sget_simple_extent_dims(fs, dims, NULL);
+	H5Sclose(fs);
+	H5Dclose(d);
+	if (rank != 3) {
+		err = ss_error_input("'%s': /height is not a (time, y, x) variable", path);
+		goto out;
+	}
+	sum->count = (long long)dims[0];
+	sum->ny = (int)dims[1];
+	sum->nx = (int)dims[2];
+
+	const long long n = sum->count;
+	sum->time = calloc((size_t)(n ? n : 1), sizeof *sum->time);
+	sum->diag = calloc((size_t)(n ? n : 1), sizeof *sum->diag);
+	double *col = calloc((size_t)(n ? n : 1), sizeof *col);
+	if (!sum->time || !sum->diag || !col) {
+		free(col);
+		err = ss_error_fail("out of memory");
+		goto out;
+	}
+	if (read_series(file, "time", n, sum->time)) {
+		free(col);
+		err = ss_error_input("'%s': cannot read /time", path);
+		goto out;
+	}
+	for (int k = 0; k < DIAG_COUNT; k++) {
+		if (read_series(file, diag_names[k], n, col)) {
+			free(col);
+			err = ss_error_input("'%s': cannot read /%s", path, diag_names[k]);
+			goto out;
+		}
+		for (long long m = 0; m < n; m++)
+			diag_set(&sum->diag[m], k, col[m]);
+	}
+	free(col);
+
+	/* the origin from the first cell centres */
+	double xy[2];
+	hsize_t one = 1, zero = 0;
+	hid_t ms = H5Screate_simple(1, &one, NULL);
+	for (int a = 0; a < 2; a++) {
+		hid_t ds = H5Dopen2(file, a ? "y" : "x", H5P_DEFAULT);
+		hid_t sp = ds >= 0 ? H5Dget_space(ds) : -1;
+		if (sp < 0 || H5Sselect_hyperslab(sp, H5S_SELECT_SET, &zero, NULL, &one, NULL) < 0 ||
+		    H5Dread(ds, H5T_NATIVE_DOUBLE, ms, sp, H5P_DEFAULT, &xy[a]) < 0)
+			xy[a] = NAN;
+		if (sp >= 0)
+			H5Sclose(sp);
+		if (ds >= 0)
+			H5Dclose(ds);
+	}
+	H5Sclose(ms);
+	sum->origin_x = xy[0] - 0.5 * sum->dx;
+	sum->origin_y = xy[1] - 0.5 * sum->dy;
+
+	uint8_t *types = malloc((size_t)sum->nx * (size_t)sum->ny);
+	hid_t ct = H5Dopen2(file, "cell_type", H5P_DEFAULT);
+	if (types && ct >= 0 &&
+	    H5Dread(ct, H5T_NATIVE_UINT8, H5S_ALL, H5S_ALL, H5P_DEFAULT, types) >= 0) {
+		for (size_t k = 0; k < (size_t)sum->nx * (size_t)sum->ny; k++) {
+			sum->flow_cells += types[k] == SS_CELL_FLOW;
+			sum->wall_cells += types[k] == SS_CELL_WALL;
+			sum->open_cells += types[k] == SS_CELL_OPEN;
+		}
+	}
+	if (ct >= 0)
+		H5Dclose(ct);
+	free(types);
+out:
+	H5Fclose(file);
+	if (err)
+		ss_snapshot_summary_release(sum);
+	return err;
+}
+
+void ss_snapshot_summary_release(struct ss_snapshot_summary *sum)
+{
+	free(sum->time);
+	free(sum->diag);
+	sum->time = NULL;
+	sum->diag = NULL;
+}
+
+int ss_snapshot_read_field(const char *path, const char *dataset, long long index,
+                           int *nx, int *ny, double **values)
+{
+	*values = NULL;
+	hid_t file = open_file(path);
+	if (file < 0)
+		return SS_ERR_INPUT;
+	const char *name = dataset && *dataset ? dataset : "/height";
+	int err = SS_OK;
+	hid_t d = H5Lexists(file, name[0] == '/' ? name + 1 : name, H5P_DEFAULT) > 0
+	          ? H5Dopen2(file, name, H5P_DEFAULT) : -1;
+	if (d < 0) {
+		H5Fclose(file);
+		return ss_error_input("'%s' has no dataset '%s'", path, name);
+	}
+	hid_t fs = H5Dget_space(d);
+	int rank = H5Sget_simple_extent_ndims(fs);
+	hsize_t dims[3] = {1, 0, 0};
+	if (rank == 2 || rank == 3)
+		H5Sget_simple_extent_dims(fs, rank == 3 ? dims : dims + 1, NULL);
+	if ((rank != 2 && rank != 3) || dims[1] < 1 || dims[2] < 1 || dims[0] < 1 ||
+	    dims[1] > (1u << 30) || dims[2] > (1u << 30)) {
+		err = ss_error_input("'%s:%s' is not a (y, x) or non-empty (time, y, x) variable",
+		                     path, name);
+		goto out;
+	}
+	long long t = index < 0 ? (long long)dims[0] + index : index;
+	if (t < 0 || t >= (long long)dims[0]) {
+		err = ss_error_input("'%s:%s' has %llu snapshots: index %lld is out of range", path,
+		                     name, (unsigned long long)dims[0], index);
+		goto out;
+	}
+	*ny = (int)dims[1];
+	*nx = (int)dims[2];
+	*values = ss_alloc((size_t)dims[1] * dims[2], sizeof(double), "input heights");
+	if (!*values) {
+		err = SS_ERR_FAIL;
+		goto out;
+	}
+	hsize_t start[3] = {(hsize_t)t, 0, 0}, count[3] = {1, dims[1], dims[2]};
+	if (rank == 3)
+		H5Sselect_hyperslab(fs, H5S_SELECT_SET, start, NULL, count, NULL);
+	hid_t ms = H5Screate_simple(2, dims + 1, NULL);
+	if (H5Dread(d, H5T_NATIVE_DOUBLE, ms, fs, H5P_DEFAULT, *values) < 0) {
+		ss_free(*values);
+		*values = NULL;
+		err = ss_error_input("cannot read '%s:%s' as numbers", path, name);
+	}
+	H5Sclose(ms);
+out:
+	H5Sclose(fs);
+	H5Dclose(d);
+	H5Fclose(file);
+	return err;
+}
