@@ -208,7 +208,7 @@ static void conservation_case(enum ss_closure_kind kind)
 	/* the run must exercise what it claims to: both sources and outflow */
 	const double in1 = 2e-3 * T / 3.0 * 8 * 6 * dx * dx - 2e-3 * T / 3.0 * 5 * 2 * dx * dx;
 	const double in2 = 1e-3 * (0.9 * T - T / 2.0) * 8 * 6 * dx * dx;
-	CHECK_REL(d.inflow, in1 + in2, 1e-12,
+	CHECK_REL(d.inflow, in1 + in2, 1e-9,
 	          "%s: inflow should be source 1 on its 38 flow cells for T/3 plus "
 	          "source 2 on 48 cells from T/2 to 0.9 T", ss_closure_name(kind));
 	CHECK(d.outflow > 0.05 * v0, "%s: hardly any outflow (%g of %g m^3): the "
@@ -382,11 +382,17 @@ static void test_cone(void)
 	CHECK_REL(d.volume, v0, 1e-12, "cone volume not conserved inside walls");
 	CHECK(d.outflow == 0.0, "outflow %g through wall sides", d.outflow);
 
-	/* footprint: cells that hold sand */
-	long cells = 0;
-	for (int j = 0; j < n; j++)
-		for (int i = 0; i < n; i++)
-			cells += *hp(&st, i, j) > 1e-9;
+	/* footprint: cells that hold sand; none may touch the walls */
+	long cells = 0, at_wall = 0;
+	for (int j = 0; j < n; j++) {
+		for (int i = 0; i < n; i++) {
+			const int sand = *hp(&st, i, j) > 1e-9;
+			cells += sand;
+			at_wall += sand && (i == 0 || j == 0 || i == n - 1 || j == n - 1);
+		}
+	}
+	CHECK(at_wall == 0, "test set-up: the relaxed cone reaches the walls (%ld cells)",
+	      at_wall);
 	const double r_foot = sqrt((double)cells / M_PI) * dx;
 	const double r_theory = R * cbrt(t50 / tc);
 	/* least squares of h against r on the flank */
@@ -419,7 +425,7 @@ out:
 /* ---- 4. open table -------------------------------------------------------- */
 
 struct table_result {
-	double err_max, err_mean, excess_max;
+	double err_max, err_mean, excess_max, excess_half;
 	double t, secs;
 	long long steps;
 };
@@ -427,7 +433,7 @@ struct table_result {
 static struct table_result open_table(int n)
 {
 	const double L = 1.0, H = 0.5, dx = L / n, nu = 0.01;
-	struct table_result res = {NAN, NAN, NAN, 0, 0, 0};
+	struct table_result res = {NAN, NAN, NAN, NAN, 0, 0, 0};
 	struct ss_stepper st;
 	if (setup(&st, n, n, dx, SS_CLOSURE_COULOMB, 1.0, nu,
 	          sides(SS_SIDE_OPEN, SS_SIDE_OPEN, SS_SIDE_OPEN, SS_SIDE_OPEN, 0.0), 0, 0))
@@ -445,7 +451,7 @@ static struct table_result open_table(int n)
 	const double tc = st.closure.tan_cr;
 	double sum = 0.0;
 	res.err_max = 0.0;
-	res.excess_max = -INFINITY;
+	res.excess_max = res.excess_half = -INFINITY;
 	int bad_i = -1, bad_j = -1;
 	for (int j = 0; j < n; j++) {
 		for (int i = 0; i < n; i++) {
@@ -456,6 +462,7 @@ static struct table_result open_table(int n)
 			if (e > res.err_max)
 				res.err_max = e;
 			const double excess = h - tc * (d + dx);
+			res.excess_half = fmax(res.excess_half, h - tc * (d + 0.5 * dx));
 			if (excess > res.excess_max) {
 				res.excess_max = excess;
 				bad_i = i, bad_j = j;
@@ -465,6 +472,12 @@ static struct table_result open_table(int n)
 	res.err_mean = sum / ((double)n * n);
 	CHECK(res.excess_max <= 1e-9, "open table %d x %d: cell (%d, %d) is %g m above the "
 	      "discrete pyramid tan a_cr (d + dx)", n, n, bad_i, bad_j, res.excess_max);
+	/* at rest every face is at most critical, so from the open ghost (0 at
+	 * distance dx/2 outside the edge) h <= tan a_cr (d + dx/2); the steady
+	 * tolerance 1e-10 m/s leaves ~1e-9 m of sand still above it */
+	CHECK(res.excess_half <= 1e-7, "open table %d x %d: a cell is %g m above tan a_cr "
+	      "(d + dx/2), the highest surface whose faces are all subcritical", n, n,
+	      res.excess_half);
 	res.t = st.time;
 	res.steps = st.steps;
 out:
@@ -474,18 +487,26 @@ out:
 
 static void test_open_table(void)
 {
-	const struct table_result a = open_table(20), b = open_table(40);
-	const double ratio_mean = a.err_mean / b.err_mean, ratio_max = a.err_max / b.err_max;
-	CHECK(ratio_mean >= 1.6 && ratio_mean <= 2.5,
-	      "mean error against tan a_cr * distance to the edge does not halve with dx: "
-	      "%.4g (20x20) / %.4g (40x40) = %.3f", a.err_mean, b.err_mean, ratio_mean);
-	printf("  open table 20x20: mean |h - h*| %.5f m, max %.5f m, max h - tc(d+dx) %.2e m, "
-	       "t_steady %.1f s, %lld steps, %.2f s wall\n", a.err_mean, a.err_max, a.excess_max,
-	       a.t, a.steps, a.secs);
-	printf("  open table 40x40: mean |h - h*| %.5f m, max %.5f m, max h - tc(d+dx) %.2e m, "
-	       "t_steady %.1f s, %lld steps, %.2f s wall\n", b.err_mean, b.err_max, b.excess_max,
-	       b.t, b.steps, b.secs);
-	printf("  open table ratios (20/40): mean %.3f, max %.3f\n", ratio_mean, ratio_max);
+	const int n[2] = {20, 40};
+	struct table_result r[2];
+	for (int k = 0; k < 2; k++) {
+		r[k] = open_table(n[k]);
+		printf("  open table %dx%d: mean |h - h*| %.6f m, max %.6f m (tc dx/2 = %.6f m); "
+		       "max h - tc(d + dx) %.3e m, max h - tc(d + dx/2) %.3e m; t_steady %.1f s, "
+		       "%lld steps, %.2f s wall\n", n[k], n[k], r[k].err_mean, r[k].err_max,
+		       0.5 * tan(REPOSE * DEG) / n[k], r[k].excess_max, r[k].excess_half,
+		       r[k].t, r[k].steps, r[k].secs);
+	}
+	for (int k = 0; k < 1; k++) {
+		const double ratio_mean = r[k].err_mean / r[k + 1].err_mean;
+		const double ratio_max = r[k].err_max / r[k + 1].err_max;
+		CHECK(ratio_mean >= 1.6 && ratio_mean <= 2.5,
+		      "mean error against tan a_cr * distance to the edge does not halve with "
+		      "dx: %.4g (%dx%d) / %.4g (%dx%d) = %.3f", r[k].err_mean, n[k], n[k],
+		      r[k + 1].err_mean, n[k + 1], n[k + 1], ratio_mean);
+		printf("  open table error ratios %d/%d: mean %.3f, max %.3f\n", n[k], n[k + 1],
+		       ratio_mean, ratio_max);
+	}
 }
 
 /* ---- 5. walls met obliquely ----------------------------------------------- */
@@ -636,14 +657,18 @@ static void oblique_room(int rx, int ry, int door_east, int door_at, int door_w,
 	}
 	CHECK(margin >= -1e-9, "room: cell (%d, %d) drained %g m below the continuum "
 	      "stationary state tan a_cr * (distance to the door)", mi, mj, -margin);
+	CHECK(excess <= 2.0 * tc * fmax(dx, dy), "room: sand stays %g m above the continuum "
+	      "stationary state, more than 2 tan a_cr max(dx, dy) = %g m", excess,
+	      2.0 * tc * fmax(dx, dy));
 	printf("  oblique walls, %dx%d room, door %s, dx %.3f dy %.3f m: t_steady %.1f s, "
 	       "%lld steps, %.2f s wall, last max |dh/dt| %.2e m/s, max face slope %.6f deg\n"
 	       "    min h - tc d = %.4e m at (%d, %d) = %.3f tc min(dx, dy); along the walls "
-	       "%.4e m; max h - tc d %.4e m; outflow %.4f of %.4f m^3; Dijkstra - Euclid "
-	       "in [%.1e, %.4f] m\n",
+	       "%.4e m; max h - tc d %.4e m; outflow %.4f of %.4f m^3, |dV + out| / V0 "
+	       "%.2e; Dijkstra - Euclid in [%.1e, %.4f] m\n",
 	       rx, ry, door_east ? "east" : "south", dx, dy, st.time, st.steps, secs,
 	       st.rate_max, d.max_slope_deg, margin, mi, mj, margin / (tc * fmin(dx, dy)),
-	       margin_wall, excess, d.outflow, v0, geo_low, geo_high);
+	       margin_wall, excess, d.outflow, v0, fabs(d.volume - v0 + d.outflow) / v0,
+	       geo_low, geo_high);
 out:
 	ss_stepper_release(&st);
 }
@@ -750,11 +775,11 @@ static struct det_result determinism_run(int threads, int tile_nx, int tile_ny)
 
 static void test_determinism(void)
 {
-	const int nx = 53, ny = 41;
+	const int nx = 53, ny = 41, threads = ss_parallel_max_threads();
 	const struct det_result a = determinism_run(1, 256, 32);
 	const struct det_result b = determinism_run(2, 7, 5);
 	const struct det_result c = determinism_run(2, 16, 64);
-	ss_parallel_set_threads(2);
+	ss_parallel_set_threads(threads);
 	if (!a.h || !b.h || !c.h)
 		goto out;
 	const size_t bytes = (size_t)nx * ny * sizeof *a.h;
@@ -793,13 +818,19 @@ static void periodic_case(int axis)
 	const char *name = axis == 0 ? "x" : "y";
 	struct ss_stepper st;
 
-	/* a random supercritical state: volume conserved, sand crosses the seam */
+	/* a flat layer with a random supercritical patch away from the seam and
+	 * a ridge on the first periodic column (row): volume is conserved, and
+	 * the flat cells on the far side of the seam fill only through it */
 	if (setup(&st, nx, ny, dx, SS_CLOSURE_COULOMB, 1.0, 0.01, b, 8, 8))
 		return;
 	struct rng r = {seed + 8 + (uint64_t)axis};
-	for (int j = 0; j < ny; j++)
-		for (int i = 0; i < nx; i++)
-			*hp(&st, i, j) = 0.3 * rng_uniform(&r) + 0.3 * ((axis == 0 ? i : j) == 0);
+	for (int j = 0; j < ny; j++) {
+		for (int i = 0; i < nx; i++) {
+			const int k = axis == 0 ? i : j;
+			*hp(&st, i, j) = 0.3 + 0.3 * (k == 0) +
+			                 (k >= 8 && k < n_per - 8 ? 0.3 * rng_uniform(&r) : 0.0);
+		}
+	}
 	if (prepare(&st) == 0) {
 		const double v0 = diag(&st).volume;
 		const double seam0 = axis == 0 ? *hp(&st, nx - 1, 5) : *hp(&st, 5, ny - 1);
@@ -809,7 +840,8 @@ static void periodic_case(int axis)
 		CHECK_REL(d.volume, v0, 1e-12, "%s-periodic run lost volume", name);
 		CHECK(d.outflow == 0.0, "%s-periodic run with wall sides had outflow %g", name,
 		      d.outflow);
-		CHECK(seam1 != seam0, "%s-periodic: the cell by the seam did not change", name);
+		CHECK(seam1 > seam0, "%s-periodic: the last cell did not fill from the ridge "
+		      "across the seam (%.17g -> %.17g m)", name, seam0, seam1);
 		printf("  periodic %s: |dV|/V %.2e over %lld steps\n", name,
 		       fabs(d.volume - v0) / v0, st.steps);
 	}

@@ -1,0 +1,27 @@
+/*
+ * run.h - `sandslide run`: case file in, HDF5 snapshots out.
+ *
+ * Everything that can be checked is checked before the output file is
+ * touched: the case, the set-up (regions, initial file, memory) and the
+ * output folder.  Then snapshot 0 is written at t = 0 and one every
+ * output_every seconds (and at the end, or when the state is steady).
+ */
+#ifndef SANDSLIDE_RUN_H
+#define SANDSLIDE_RUN_H
+
+struct ss_run_options {
+	const char *case_path;
+	const char *output;          /* NULL: out/<case name>.h5 */
+	const char *const *overrides; /* "SECTION.KEY=VALUE" */
+	int override_count;
+	int threads;                 /* <= 0: all processors */
+	int tile_nx, tile_ny;        /* <= 0: defaults */
+	int deflate;                 /* HDF5 deflate level 0..9 */
+	int quiet;                   /* no progress, no summary */
+	const char *history;         /* the command line, for the file */
+};
+
+/* Returns SS_OK, SS_ERR_INPUT or SS_ERR_FAIL (message already printed). */
+int ss_run_case(const struct ss_run_options *o);
+
+#endif

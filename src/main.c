@@ -1,0 +1,266 @@
+/*
+ * main.c - the `sandslide` command line (SPEC section 3): parse the
+ * arguments, dispatch to the library, turn its status into the exit code
+ * (0 success, 1 failure while running, 2 bad usage or bad input).
+ */
+#include <errno.h>
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "sandslide/error.h"
+#include "sandslide/parallel.h"
+#include "sandslide/run.h"
+#include "sandslide/snapshot.h"
+
+static const char usage_main[] =
+	"usage: sandslide <command> [options]\n"
+	"\n"
+	"Sand slides on raster grids: the degenerate parabolic sliding model\n"
+	"dh/dt = nu div[f_sl(|grad h|) grad h / |grad h|] + q.\n"
+	"\n"
+	"commands:\n"
+	"  run CASE.ini     run a case, writing HDF5 snapshots\n"
+	"  info FILE.h5     summarise an output file\n"
+	"\n"
+	"  sandslide --version    print the version\n"
+	"  sandslide CMD --help   options of a command\n";
+
+static const char usage_run[] =
+	"usage: sandslide run CASE.ini [-o OUT.h5] [--threads N] [--set SECTION.KEY=VALUE ...]\n"
+	"\n"
+	"  -o, --output OUT.h5   output file (default out/<case name>.h5; its folder\n"
+	"                        must exist unless it is the default out/)\n"
+	"  --threads N           OpenMP threads (default: all processors)\n"
+	"  --set S.K=VALUE       override key K of section S of the case, e.g.\n"
+	"                        --set model.closure=casson, --set 'source pour.rate=0.002'\n"
+	"  --tile NXxNY          cells per tile of the sweep (default 256x32); results\n"
+	"                        are the same bits for any tile size and thread count\n"
+	"  --deflate N           HDF5 deflate level of /height, 0 (off, default) to 9\n"
+	"  -q, --quiet           no progress line and no summary\n"
+	"\n"
+	"Writes OUT.h5 (SPEC section 5) and the XDMF sidecar OUT.xmf, flushed after\n"
+	"every snapshot.  Exit status: 0 done, 1 failure while running, 2 bad input.\n";
+
+static const char usage_info[] =
+	"usage: sandslide info FILE.h5\n"
+	"\n"
+	"Prints the grid, model, cell counts and the diagnostics of every snapshot\n"
+	"(first and last ten when there are more than twenty).\n";
+
+static int usage_error(const char *usage, const char *fmt, const char *arg)
+{
+	fflush(stdout);
+	fputs("sandslide: ", stderr);
+	fprintf(stderr, fmt, arg);
+	fprintf(stderr, "\n\n%s", usage);
+	return 2;
+}
+
+static int parse_int(const char *s, int lo, int hi, int *out)
+{
+	char *end;
+	errno = 0;
+	long v = strtol(s, &end, 10);
+	if (end == s || *end || errno || v < lo || v > hi)
+		return -1;
+	*out = (int)v;
+	return 0;
+}
+
+/* The command line as one string, for the history attribute. */
+static char *join_args(int argc, char **argv)
+{
+	size_t n = 1;
+	for (int k = 0; k < argc; k++)
+		n += strlen(argv[k]) + 1;
+	char *s = malloc(n);
+	if (!s)
+		return NULL;
+	s[0] = '\0';
+	for (int k = 0; k < argc; k++) {
+		if (k)
+			strcat(s, " ");
+		strcat(s, argv[k]);
+	}
+	return s;
+}
+
+static int cmd_run(int argc, char **argv)
+{
+	struct ss_run_options o = {0};
+	const char **overrides = calloc((size_t)argc, sizeof *overrides);
+	if (!overrides)
+		return ss_status_exit_code(ss_error_fail("out of memory"));
+	int status = 2;
+
+	for (int k = 2; k < argc; k++) {
+		const char *a = argv[k];
+		const char *next = k + 1 < argc ? argv[k + 1] : NULL;
+		if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+			fputs(usage_run, stdout);
+			status = 0;
+			goto out;
+		} else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
+			if (!next) {
+				status = usage_error(usage_run, "%s needs a file name", a);
+				goto out;
+			}
+			o.output = argv[++k];
+		} else if (!strcmp(a, "--threads")) {
+			if (!next || parse_int(next, 1, 4096, &o.threads)) {
+				status = usage_error(usage_run, "--threads '%s': expected an integer "
+				                     "from 1 to 4096", next ? next : "");
+				goto out;
+			}
+			k++;
+		} else if (!strcmp(a, "--set") || !strcmp(a, "-P")) {
+			if (!next) {
+				status = usage_error(usage_run, "%s needs SECTION.KEY=VALUE", a);
+				goto out;
+			}
+			overrides[o.override_count++] = argv[++k];
+		} else if (!strncmp(a, "--set=", 6)) {
+			overrides[o.override_count++] = a + 6;
+		} else if (!strcmp(a, "--tile")) {
+			char *x = next ? strchr(next, 'x') : NULL;
+			int tx = 0, ty = 0;
+			if (x) {
+				char buf[32];
+				snprintf(buf, sizeof buf, "%.*s", (int)(x - next), next);
+				if (parse_int(buf, 1, 1 << 20, &tx) || parse_int(x + 1, 1, 1 << 20, &ty))
+					x = NULL;
+			}
+			if (!x) {
+				status = usage_error(usage_run, "--tile '%s': expected NXxNY, e.g. 256x32",
+				                     next ? next : "");
+				goto out;
+			}
+			o.tile_nx = tx;
+			o.tile_ny = ty;
+			k++;
+		} else if (!strcmp(a, "--deflate")) {
+			if (!next || parse_int(next, 0, 9, &o.deflate)) {
+				status = usage_error(usage_run, "--deflate '%s': expected 0 to 9",
+				                     next ? next : "");
+				goto out;
+			}
+			k++;
+		} else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
+			o.quiet = 1;
+		} else if (a[0] == '-' && a[1]) {
+			status = usage_error(usage_run, "unknown option '%s'", a);
+			goto out;
+		} else if (o.case_path) {
+			status = usage_error(usage_run, "one case file only (got a second: '%s')", a);
+			goto out;
+		} else {
+			o.case_path = a;
+		}
+	}
+	if (!o.case_path) {
+		status = usage_error(usage_run, "%s", "run needs a case file");
+		goto out;
+	}
+	o.overrides = overrides;
+	char *history = join_args(argc, argv);
+	o.history = history;
+	status = ss_status_exit_code(ss_run_case(&o));
+	free(history);
+out:
+	free(overrides);
+	return status;
+}
+
+static void print_diag_row(const struct ss_snapshot_summary *s, long long k)
+{
+	const struct ss_diagnostics *d = &s->diag[k];
+	printf("  %5lld %12.6g %13.6e %11.4e %11.4e %10.5g %9.4f %9.0f %7.3f %9.3f\n", k,
+	       s->time[k], d->volume, d->inflow, d->outflow, d->max_height, d->max_slope_deg,
+	       d->steps, d->active_fraction, d->wall_seconds);
+}
+
+static int cmd_info(int argc, char **argv)
+{
+	const char *path = NULL;
+	for (int k = 2; k < argc; k++) {
+		if (!strcmp(argv[k], "-h") || !strcmp(argv[k], "--help")) {
+			fputs(usage_info, stdout);
+			return 0;
+		}
+		if (argv[k][0] == '-' && argv[k][1])
+			return usage_error(usage_info, "unknown option '%s'", argv[k]);
+		if (path)
+			return usage_error(usage_info, "one file only (got a second: '%s')", argv[k]);
+		path = argv[k];
+	}
+	if (!path)
+		return usage_error(usage_info, "%s", "info needs a file");
+
+	struct ss_snapshot_summary s;
+	int err = ss_snapshot_read_summary(path, &s);
+	if (err)
+		return ss_status_exit_code(err);
+	printf("file       %s (%s)\n", path, s.source);
+	printf("title      %s\n", s.title);
+	printf("grid       %d x %d cells, dx = %g m, dy = %g m, lower-left corner (%g, %g) m\n",
+	       s.nx, s.ny, s.dx, s.dy, s.origin_x, s.origin_y);
+	printf("cells      %lld flow, %lld wall, %lld open\n", s.flow_cells, s.wall_cells,
+	       s.open_cells);
+	printf("model      %s, repose angle %g deg, nu = %g m^2/s", s.closure,
+	       s.repose_angle_deg, s.nu);
+	if (!strcmp(s.closure, "herschel-bulkley"))
+		printf(", gamma = %g", s.gamma);
+	printf("\n");
+	if (s.count == 0) {
+		printf("snapshots  none\n");
+	} else {
+		printf("snapshots  %lld, t = %g .. %g s\n", s.count, s.time[0], s.time[s.count - 1]);
+		printf("  %5s %12s %13s %11s %11s %10s %9s %9s %7s %9s\n", "index", "time_s",
+		       "volume_m3", "inflow_m3", "outflow_m3", "max_h_m", "slope_deg", "steps",
+		       "active", "wall_s");
+		for (long long k = 0; k < s.count; k++) {
+			if (s.count > 20 && k == 10) {
+				printf("  %5s (%lld more)\n", "...", s.count - 20);
+				k = s.count - 10;
+			}
+			print_diag_row(&s, k);
+		}
+		const struct ss_diagnostics *first = &s.diag[0], *last = &s.diag[s.count - 1];
+		const double balance = (last->volume - first->volume) - (last->inflow - last->outflow);
+		const double scale = fmax(fmax(fabs(last->volume), fabs(first->volume)),
+		                          fmax(last->inflow, last->outflow));
+		printf("volume balance  (V_last - V_0) - (inflow - outflow) = %.3e m^3 "
+		       "(%.2e relative)\n", balance, scale > 0 ? fabs(balance) / scale : 0.0);
+	}
+	ss_snapshot_summary_release(&s);
+	return 0;
+}
+
+int main(int argc, char **argv)
+{
+	if (argc < 2)
+		return usage_error(usage_main, "%s", "no command given");
+	const char *cmd = argv[1];
+	if (!strcmp(cmd, "-h") || !strcmp(cmd, "--help") || !strcmp(cmd, "help")) {
+		fputs(usage_main, stdout);
+		return 0;
+	}
+	if (!strcmp(cmd, "--version") || !strcmp(cmd, "version")) {
+		printf("sandslide %s (OpenMP: %s, %d processors)\n", SS_VERSION,
+#ifdef _OPENMP
+		       "on",
+#else
+		       "off",
+#endif
+		       ss_parallel_processors());
+		return 0;
+	}
+	if (!strcmp(cmd, "run"))
+		return cmd_run(argc, argv);
+	if (!strcmp(cmd, "info"))
+		return cmd_info(argc, argv);
+	return usage_error(usage_main, "unknown command '%s': expected run or info", cmd);
+}

@@ -1,0 +1,208 @@
+/*
+ * run.c - the `sandslide run` driver: case -> stepper -> snapshots, with a
+ * progress line on a terminal (see run.h).
+ */
+#include "sandslide/run.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "sandslide/case.h"
+#include "sandslide/error.h"
+#include "sandslide/parallel.h"
+#include "sandslide/setup.h"
+#include "sandslide/snapshot.h"
+#include "sandslide/stepper.h"
+
+static double now_seconds(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* "cases/door.ini" -> "out/door.h5" */
+static void default_output(const char *case_path, char *out, size_t size)
+{
+	const char *base = strrchr(case_path, '/') ? strrchr(case_path, '/') + 1 : case_path;
+	const char *dot = strrchr(base, '.');
+	int stem = dot && dot != base ? (int)(dot - base) : (int)strlen(base);
+	snprintf(out, size, "out/%.*s.h5", stem, base);
+}
+
+/* The output's folder must exist and be writable, and the output itself
+ * must not be a folder: checked before anything is written. */
+static int check_output(const char *path, int create_folder)
+{
+	char dir[4096];
+	const char *slash = strrchr(path, '/');
+	if (slash)
+		snprintf(dir, sizeof dir, "%.*s", (int)(slash - path) + (slash == path), path);
+	else
+		snprintf(dir, sizeof dir, ".");
+	struct stat sb;
+	if (create_folder && stat(dir, &sb) != 0 && mkdir(dir, 0777) != 0)
+		return ss_error_input("cannot create output folder '%s': %s", dir, strerror(errno));
+	if (stat(dir, &sb) != 0 || !S_ISDIR(sb.st_mode))
+		return ss_error_input("cannot write '%s': folder '%s' does not exist", path, dir);
+	if (access(dir, W_OK) != 0)
+		return ss_error_input("cannot write '%s': folder '%s' is not writable", path, dir);
+	if (stat(path, &sb) == 0 && S_ISDIR(sb.st_mode))
+		return ss_error_input("cannot write '%s': it is a folder", path);
+	return SS_OK;
+}
+
+struct progress {
+	int enabled;
+	double started, last_print;
+	double end;          /* INFINITY when steady */
+	double steady_tol;   /* m/s */
+	double cells;
+};
+
+static void format_duration(double s, char *buf, size_t size)
+{
+	if (!isfinite(s) || s < 0)
+		snprintf(buf, size, "?");
+	else if (s < 60)
+		snprintf(buf, size, "%.0fs", s);
+	else if (s < 3600)
+		snprintf(buf, size, "%dm%02ds", (int)(s / 60), (int)fmod(s, 60));
+	else
+		snprintf(buf, size, "%dh%02dm", (int)(s / 3600), (int)fmod(s / 60, 60));
+}
+
+static void progress_print(void *context, const struct ss_stepper *st)
+{
+	struct progress *p = context;
+	const double now = now_seconds();
+	if (now - p->last_print < 0.5)
+		return;
+	p->last_print = now;
+	const double elapsed = now - p->started;
+	const double rate = (double)st->steps * p->cells / fmax(elapsed, 1e-9);
+	char tail[64];
+	if (isfinite(p->end)) {
+		char d[24];
+		format_duration(st->time > 0.0 ? elapsed * (p->end - st->time) / st->time : NAN,
+		                d, sizeof d);
+		snprintf(tail, sizeof tail, "/ %.6g s  ETA %s", p->end, d);
+	} else {
+		snprintf(tail, sizeof tail, "s (steady below %.1e m/s)", p->steady_tol);
+	}
+	fprintf(stderr, "\r  t = %.6g %s  steps %lld  %.3g cells/s  max|dh/dt| %.2e m/s   ",
+	        st->time, tail, st->steps, rate, st->rate_max);
+	fflush(stderr);
+}
+
+static int write_snapshot(struct ss_snapshot *snap, struct ss_stepper *st, double started,
+                          double *seconds_output)
+{
+	struct ss_diagnostics d;
+	const double t0 = now_seconds();
+	ss_stepper_diagnostics(st, &d);
+	d.wall_seconds = t0 - started;
+	if (!isfinite(d.volume) || !isfinite(d.max_height))
+		return ss_error_fail("the height became non-finite by t = %g s (step %lld): "
+		                     "not writing this snapshot", st->time, st->steps);
+	int err = ss_snapshot_append(snap, st->time, st->height, &d);
+	*seconds_output += now_seconds() - t0;
+	return err;
+}
+
+int ss_run_case(const struct ss_run_options *o)
+{
+	const double started = now_seconds();
+	struct ss_case c;
+	struct ss_stepper st;
+	struct ss_snapshot *snap = NULL;
+	char output[4096];
+	double seconds_output = 0.0;
+
+	ss_parallel_set_threads(o->threads > 0 ? o->threads : ss_parallel_processors());
+	int err = ss_case_load(&c, o->case_path, o->overrides, o->override_count);
+	if (err)
+		goto out_case;
+	if (o->output)
+		snprintf(output, sizeof output, "%s", o->output);
+	else
+		default_output(o->case_path, output, sizeof output);
+	if ((err = check_output(output, o->output == NULL)))
+		goto out_case;
+	if ((err = ss_setup_stepper(&c, o->tile_nx, o->tile_ny, &st)))
+		goto out_case;
+
+	/* the run starts: from here on the output file is written */
+	struct ss_snapshot_meta meta = {
+		.title = c.path, .history = o->history ? o->history : "",
+		.case_text = c.text, .closure = ss_closure_name(c.closure),
+		.repose_angle_deg = c.repose_angle_deg, .nu = c.nu, .gamma = c.gamma,
+		.deflate = o->deflate,
+	};
+	if ((err = ss_snapshot_create(&snap, output, &st.grid, st.cell_type, &meta)))
+		goto out_stepper;
+	if ((err = write_snapshot(snap, &st, started, &seconds_output)))
+		goto out_snapshot;
+
+	struct progress prog = {
+		.enabled = !o->quiet && isatty(fileno(stderr)),
+		.started = started, .last_print = started,
+		.end = c.steady ? c.max_time : c.end,
+		.steady_tol = c.steady_tol,
+		.cells = (double)st.grid.nx * st.grid.ny,
+	};
+	struct ss_advance_options adv = {
+		.steady_tol = c.steady ? c.steady_tol : 0.0,
+		.progress = prog.enabled ? progress_print : NULL,
+		.context = &prog,
+	};
+	const double stop = c.steady ? c.max_time : c.end;
+	enum ss_advance_end end = SS_ADVANCE_REACHED;
+	for (long long k = 1; st.time < stop; k++) {
+		double target = fmin((double)k * c.output_every, stop);
+		if (target <= st.time)
+			continue;
+		end = ss_stepper_advance(&st, target, &adv);
+		if (end == SS_ADVANCE_NONFINITE) {
+			err = ss_error_fail("the height became non-finite at t = %g s (step %lld); "
+			                    "%lld snapshots before it are in '%s'", st.time, st.steps,
+			                    ss_snapshot_count(snap), output);
+			goto out_snapshot;
+		}
+		if ((err = write_snapshot(snap, &st, started, &seconds_output)))
+			goto out_snapshot;
+		if (end == SS_ADVANCE_STEADY)
+			break;
+	}
+	if (prog.enabled)
+		fputc('\n', stderr);
+
+	if (!o->quiet) {
+		const double wall = now_seconds() - started;
+		const double updates = (double)st.steps * st.grid.nx * st.grid.ny;
+		printf("wrote %s: %lld snapshots to t = %g s, %lld steps%s\n", output,
+		       ss_snapshot_count(snap), st.time, st.steps,
+		       end == SS_ADVANCE_STEADY ? " (steady)" :
+		       c.steady ? " (not steady by max_time)" : "");
+		printf("wall %.3f s: fluxes %.3f s, update %.3f s, output %.3f s; "
+		       "%.3g cell-updates/s on %d threads\n", wall, st.seconds_fluxes,
+		       st.seconds_update, seconds_output,
+		       updates / fmax(st.seconds_fluxes + st.seconds_update, 1e-9),
+		       ss_parallel_max_threads());
+	}
+
+out_snapshot:
+	if (ss_snapshot_destroy(snap) && !err)
+		err = SS_ERR_FAIL;
+out_stepper:
+	ss_stepper_release(&st);
+out_case:
+	ss_case_release(&c);
+	return err;
+}

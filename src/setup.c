@@ -1,0 +1,119 @@
+/*
+ * setup.c - from a case to a ready stepper (see setup.h).
+ */
+#include "sandslide/setup.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "sandslide/dem.h"
+#include "sandslide/error.h"
+#include "sandslide/shape.h"
+
+static const char *const role_names[] = {"wall", "open", "source"};
+
+static int initial_heights(const struct ss_case *c, struct ss_stepper *st)
+{
+	const struct ss_grid *g = &st->grid;
+	if (c->initial == SS_INITIAL_FILE) {
+		struct ss_raster r;
+		int err = ss_dem_read(c->initial_file, &r);
+		if (!err && (r.nx != g->nx || r.ny != g->ny))
+			err = ss_error_input("%s: initial file '%s' is %d x %d cells: expected the "
+			                     "grid's %d x %d (nx x ny)", c->initial_where,
+			                     c->initial_file, r.nx, r.ny, g->nx, g->ny);
+		if (!err && !isnan(r.cellsize) &&
+		    (fabs(r.cellsize - g->dx) > 1e-9 * g->dx || fabs(r.cellsize - g->dy) > 1e-9 * g->dy))
+			err = ss_error_input("%s: initial file '%s' has cellsize %g m: expected the "
+			                     "grid's dx = %g m, dy = %g m", c->initial_where,
+			                     c->initial_file, r.cellsize, g->dx, g->dy);
+		if (err) {
+			ss_raster_release(&r);
+			return err;
+		}
+		for (int j = 0; j < g->ny; j++) {
+			for (int i = 0; i < g->nx; i++) {
+				const size_t m = (size_t)j * g->nx + i;
+				const ptrdiff_t k = ss_grid_index(g, i, j);
+				st->height[k] = r.values[m];
+				if (r.nodata && r.nodata[m] && st->cell_type[k] == SS_CELL_FLOW)
+					st->cell_type[k] = SS_CELL_OPEN;   /* nodata: sand leaves */
+			}
+		}
+		ss_raster_release(&r);
+		return SS_OK;
+	}
+
+	const double slope = c->initial == SS_INITIAL_CONE
+	                     ? tan(c->cone_angle_deg * M_PI / 180.0) : 0.0;
+	#pragma omp parallel for schedule(static)
+	for (int j = 0; j < g->ny; j++) {
+		const double y = ss_grid_y(g, j);
+		for (int i = 0; i < g->nx; i++) {
+			double h = c->initial_height;
+			if (c->initial == SS_INITIAL_CONE) {
+				const double x = ss_grid_x(g, i);
+				const double r = hypot(x - c->cone_x, y - c->cone_y);
+				h += slope * fmax(c->cone_radius - r, 0.0);
+			}
+			st->height[ss_grid_index(g, i, j)] = h;
+		}
+	}
+	return SS_OK;
+}
+
+int ss_setup_stepper(const struct ss_case *c, int tile_nx, int tile_ny,
+                     struct ss_stepper *st)
+{
+	struct ss_grid g;
+	struct ss_closure closure;
+	memset(st, 0, sizeof *st);
+	int err = ss_grid_init(&g, c->nx, c->ny, c->dx, c->dy, c->origin_x, c->origin_y);
+	if (!err)
+		err = ss_closure_init(&closure, c->closure, c->repose_angle_deg, c->gamma, c->nu);
+	if (!err)
+		err = ss_stepper_init(st, &g, &closure, &c->boundary, c->cfl, tile_nx, tile_ny);
+	if (err)
+		return err;
+
+	uint8_t *mask = ss_alloc((size_t)g.nx * (size_t)g.ny, 1, "region mask");
+	if (!mask) {
+		ss_stepper_release(st);
+		return SS_ERR_FAIL;
+	}
+	/* walls and open cells first, so that sources see the final types */
+	for (int pass = 0; pass < 2 && !err; pass++) {
+		for (int k = 0; k < c->region_count && !err; k++) {
+			const struct ss_region *r = &c->regions[k];
+			if ((r->role == SS_REGION_SOURCE) != (pass == 1))
+				continue;
+			long long covered = 0;
+			memset(mask, 0, (size_t)g.nx * (size_t)g.ny);
+			err = ss_shape_rasterize(&r->shape, &g, mask, &covered);
+			if (!err && covered == 0)
+				err = ss_error_input("%s: [%s %s] covers no cell centre: enlarge it or "
+				                     "refine the grid (dx = %g m, dy = %g m)",
+				                     r->shape.where, role_names[r->role], r->name,
+				                     g.dx, g.dy);
+			if (err)
+				break;
+			if (r->role == SS_REGION_SOURCE) {
+				err = ss_stepper_add_source(st, mask, r->rate, r->start, r->stop);
+				continue;
+			}
+			const uint8_t type = r->role == SS_REGION_WALL ? SS_CELL_WALL : SS_CELL_OPEN;
+			for (int j = 0; j < g.ny; j++)
+				for (int i = 0; i < g.nx; i++)
+					if (mask[(size_t)j * g.nx + i])
+						st->cell_type[ss_grid_index(&g, i, j)] = type;
+		}
+		if (pass == 0 && !err)
+			err = initial_heights(c, st);
+	}
+	ss_free(mask);
+	if (!err)
+		err = ss_stepper_prepare(st);
+	if (err)
+		ss_stepper_release(st);
+	return err;
+}
