@@ -492,7 +492,22 @@ static int handler(void *user, const char *section, const char *name, const char
 	if (p->failed)
 		return 1;   /* report the first error only */
 	snprintf(p->where, sizeof p->where, "%s:%d", p->path, p->line);
-	return apply(p, section, name, value, 0) == SS_OK;
+	if (!p->continuation)
+		return apply(p, section, name, value, 0) == SS_OK;
+	/* inih leaves inline comments on continuation lines: cut them as it
+	 * does on "key = value" lines (';' after white space) */
+	char buf[256];
+	snprintf(buf, sizeof buf, "%s", value);
+	for (char *q = buf + 1; *q; q++) {
+		if (*q == ';' && isspace((unsigned char)q[-1])) {
+			*q = '\0';
+			break;
+		}
+	}
+	size_t n = strlen(buf);
+	while (n && isspace((unsigned char)buf[n - 1]))
+		buf[--n] = '\0';
+	return apply(p, section, name, buf, 0) == SS_OK;
 }
 
 /* What inih would skip or misread: checked first, with line numbers. */

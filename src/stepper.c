@@ -236,6 +236,18 @@ static int sources_update(struct ss_stepper *st)
 	return SS_OK;
 }
 
+/* Neumaier's compensated sum: *sum + *carry holds the total of every term
+ * to about one rounding, however many substeps are added up. */
+static void add_compensated(double *sum, double *carry, double term)
+{
+	const double t = *sum + term;
+	if (fabs(*sum) >= fabs(term))
+		*carry += (*sum - t) + term;
+	else
+		*carry += (term - t) + *sum;
+	*sum = t;
+}
+
 /* Volume leaving through open faces per second with the current fluxes;
  * summed in list order, so the same bits for any thread count. */
 static double outflow_rate(const struct ss_stepper *st)
@@ -303,8 +315,11 @@ enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,
 		                               st->cell_type, st->height);
 		st->seconds_update += now_seconds() - t0;
 		st->tile_sweeps += tiles;
-		st->outflow += dt * outflow_rate(st);
-		st->inflow += dt * st->source_volume_rate;
+		add_compensated(&st->outflow_sum, &st->outflow_carry, dt * outflow_rate(st));
+		add_compensated(&st->inflow_sum, &st->inflow_carry,
+		                dt * st->source_volume_rate);
+		st->outflow = st->outflow_sum + st->outflow_carry;
+		st->inflow = st->inflow_sum + st->inflow_carry;
 		st->time = lands ? next_event : st->time + dt;
 		st->steps++;
 

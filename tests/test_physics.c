@@ -211,7 +211,7 @@ static void conservation_case(enum ss_closure_kind kind)
 	CHECK_REL(d.inflow, in1 + in2, 1e-9,
 	          "%s: inflow should be source 1 on its 38 flow cells for T/3 plus "
 	          "source 2 on 48 cells from T/2 to 0.9 T", ss_closure_name(kind));
-	CHECK(d.outflow > 0.05 * v0, "%s: hardly any outflow (%g of %g m^3): the "
+	CHECK(d.outflow > 0.01 * v0, "%s: hardly any outflow (%g of %g m^3): the "
 	      "open side and pit are not draining", ss_closure_name(kind), d.outflow, v0);
 	printf("  conservation %-8s: V0 %.6f, V %.6f, in %.6f, out %.6f m^3, %.0f steps, "
 	       "worst |dV - (in - out)| / max = %.2e (seed %llu)\n",
@@ -231,8 +231,9 @@ static void test_conservation(void)
 
 /* The largest face slope as SPEC section 2 defines it, computed here
  * independently: faces between two non-wall cells of which one flows, wall
- * neighbours mirrored, open cells and ghosts at their held height. */
-static double max_face_slope(struct ss_stepper *st)
+ * neighbours mirrored, open cells and ghosts at their held height.  Only
+ * faces whose cells both lie west of column i_limit count. */
+static double max_face_slope(struct ss_stepper *st, int i_limit)
 {
 	const struct ss_grid *g = &st->grid;
 	ss_boundary_fill_types(g, &st->boundary, st->cell_type);
@@ -246,7 +247,8 @@ static double max_face_slope(struct ss_stepper *st)
 		const double dn = axis == 0 ? g->dx : g->dy, da = axis == 0 ? g->dy : g->dx;
 		for (int j = 0; j <= g->ny; j++) {
 			for (int i = 0; i <= g->nx; i++) {
-				if ((axis == 0 && j == g->ny) || (axis == 1 && i == g->nx))
+				if ((axis == 0 && j == g->ny) || (axis == 1 && i == g->nx) ||
+				    i >= i_limit)
 					continue;
 				const ptrdiff_t kb = ss_grid_index(g, i, j), ka = kb - n;
 				if (t[ka] == SS_CELL_WALL || t[kb] == SS_CELL_WALL ||
@@ -302,7 +304,7 @@ static void test_subcritical_unchanged(void)
 			*hp(&st, i, j) -= level;
 	struct ss_boundary b0 = st.boundary;
 	st.boundary.open_level = 0.0;
-	const double s_unit = max_face_slope(&st);
+	const double s_unit = max_face_slope(&st, nx + 1);
 	st.boundary = b0;
 	const double tc = st.closure.tan_cr, scale = 0.8 * tc / s_unit;
 	for (int j = 0; j < ny; j++)
@@ -312,7 +314,7 @@ static void test_subcritical_unchanged(void)
 	free(p);
 	if (prepare(&st))
 		goto out;
-	const double s_test = max_face_slope(&st);
+	const double s_test = max_face_slope(&st, nx + 1);
 	struct ss_diagnostics d0 = diag(&st);
 	CHECK(s_test < 0.81 * tc && s_test > 0.79 * tc,
 	      "test set-up: steepest face %g is not 0.8 tan a_cr = %g", s_test, 0.8 * tc);
@@ -346,8 +348,59 @@ static void test_subcritical_unchanged(void)
 	      "a subcritical state changed in steady mode");
 	printf("  subcritical: steepest face %.4f deg (0.8 tan a_cr), %lld substeps over 100 s, "
 	       "heights unchanged\n", d0.max_slope_deg, st.steps);
+	ss_stepper_release(&st);
+
+	/* the same surface west of a wall across the grid at column 30, with a
+	 * supercritical random state east of it: the sweeps now run, and the
+	 * subcritical part must still keep its bits */
+	const int cut = 30;
+	if (setup(&st, nx, ny, dx, SS_CLOSURE_COULOMB, 1.0, 0.01,
+	          sides(SS_SIDE_OPEN, SS_SIDE_OPEN, SS_SIDE_WALL, SS_SIDE_WALL, level), 16, 8))
+		goto out_free;
+	for (int j = 0; j < ny; j++) {
+		for (int i = 0; i < nx; i++) {
+			const int wall = i == cut || (i >= 20 && i < 26 && j >= 10 && j < 15) ||
+			                 (j == 25 && i >= 5 && i < 30);
+			const int open = i >= 36 && i < 40 && j >= 24 && j < 28;
+			*tp(&st, i, j) = wall ? SS_CELL_WALL : open ? SS_CELL_OPEN : SS_CELL_FLOW;
+			*hp(&st, i, j) = i < cut ? before[j * nx + i] : level + 0.3 * rng_uniform(&r);
+		}
+	}
+	/* rescale the west part so that its own steepest face is 0.8 tc again */
+	const double s_cut = max_face_slope(&st, cut);
+	for (int j = 0; j < ny; j++)
+		for (int i = 0; i < cut; i++)
+			*hp(&st, i, j) = level + (*hp(&st, i, j) - level) * (0.8 * tc / s_cut);
+	if (prepare(&st) == 0) {
+		const double s_west = max_face_slope(&st, cut);
+		CHECK(s_west < tc, "test set-up: the west part has a face at slope %g >= tan "
+		      "a_cr", s_west);
+		interior(&st, before);
+		advance_to(&st, 20.0);
+		interior(&st, after);
+		int west_same = 1, east_moved = 0;
+		for (int j = 0; j < ny; j++) {
+			for (int i = 0; i < nx; i++) {
+				const size_t k = (size_t)j * nx + i;
+				const int same = memcmp(&before[k], &after[k], sizeof *before) == 0;
+				if (i < cut)
+					west_same &= same;
+				else
+					east_moved |= !same;
+			}
+		}
+		CHECK(st.steps > 0 && east_moved, "test set-up: the supercritical east part did "
+		      "not move (%lld steps)", st.steps);
+		CHECK(west_same, "a subcritical region (steepest face %.2f deg) changed while "
+		      "the sweeps ran for the sliding region beside it", atan(s_west) / DEG);
+		printf("  subcritical beside sliding: west part (steepest face %.4f deg) kept its "
+		       "bits over %lld substeps\n", atan(s_west) / DEG, st.steps);
+	}
+	ss_stepper_release(&st);
+out_free:
 	free(before);
 	free(after);
+	return;
 out:
 	ss_stepper_release(&st);
 }
@@ -736,9 +789,15 @@ struct det_result {
 	long long steps;
 };
 
+/* The grid must exceed the size below which the library runs a pass on one
+ * thread (16384 cells in sweep.c when written), or the thread count is not
+ * tested at all; 203 x 131 is not a multiple of any tile size used. */
+#define DET_NX 203
+#define DET_NY 131
+
 static struct det_result determinism_run(int threads, int tile_nx, int tile_ny)
 {
-	const int nx = 53, ny = 41;   /* not multiples of any tile size */
+	const int nx = DET_NX, ny = DET_NY;
 	const double dx = 0.05;
 	struct det_result res = {NULL, 0, 0, 0};
 	struct ss_stepper st;
@@ -751,18 +810,18 @@ static struct det_result determinism_run(int threads, int tile_nx, int tile_ny)
 	uint8_t *mask = calloc((size_t)nx * ny, 1);
 	for (int j = 0; j < ny; j++) {
 		for (int i = 0; i < nx; i++) {
-			*hp(&st, i, j) = 0.2 + 0.01 * i + 0.25 * rng_uniform(&r);
-			const int wall = (i - 30) * (i - 30) + (j - 15) * (j - 15) < 25 ||
-			                 (i == 10 && j > 5 && j < 35);
-			const int open = i >= 40 && i < 44 && j >= 30 && j < 35;
+			*hp(&st, i, j) = 0.2 + 0.0025 * i + 0.25 * rng_uniform(&r);
+			const int wall = (i - 115) * (i - 115) + (j - 48) * (j - 48) < 256 ||
+			                 (i == 38 && j > 18 && j < 113);
+			const int open = i >= 153 && i < 169 && j >= 96 && j < 113;
 			*tp(&st, i, j) = wall ? SS_CELL_WALL : open ? SS_CELL_OPEN : SS_CELL_FLOW;
-			mask[j * nx + i] = i >= 15 && i < 22 && j >= 25 && j < 33;
+			mask[j * nx + i] = i >= 57 && i < 85 && j >= 80 && j < 107;
 		}
 	}
 	CHECK(ss_stepper_add_source(&st, mask, 3e-3, 2.0, 25.0) == 0, "source refused");
 	free(mask);
 	if (prepare(&st) == 0) {
-		advance_to(&st, 150.0);
+		advance_to(&st, 60.0);
 		res.h = malloc((size_t)nx * ny * sizeof *res.h);
 		interior(&st, res.h);
 		res.inflow = st.inflow;
@@ -775,7 +834,7 @@ static struct det_result determinism_run(int threads, int tile_nx, int tile_ny)
 
 static void test_determinism(void)
 {
-	const int nx = 53, ny = 41, threads = ss_parallel_max_threads();
+	const int nx = DET_NX, ny = DET_NY, threads = ss_parallel_max_threads();
 	const struct det_result a = determinism_run(1, 256, 32);
 	const struct det_result b = determinism_run(2, 7, 5);
 	const struct det_result c = determinism_run(2, 16, 64);
@@ -796,9 +855,9 @@ static void test_determinism(void)
 	CHECK(a.steps == b.steps && a.steps == c.steps, "substep counts differ: %lld %lld %lld",
 	      a.steps, b.steps, c.steps);
 	CHECK(a.outflow > 0.0 && a.inflow > 0.0, "determinism run is trivial");
-	printf("  determinism (herschel-bulkley 0.5, %lld steps): in %.17g, out %.17g m^3, "
-	       "identical for 1 thread 256x32, 2 threads 7x5 and 16x64\n", a.steps, a.inflow,
-	       a.outflow);
+	printf("  determinism (herschel-bulkley 0.5, %dx%d cells, %lld steps): in %.17g, "
+	       "out %.17g m^3, identical for 1 thread 256x32, 2 threads 7x5 and 16x64\n",
+	       nx, ny, a.steps, a.inflow, a.outflow);
 out:
 	free(a.h);
 	free(b.h);

@@ -68,6 +68,8 @@ struct ss_stepper {
 	double time;                  /* s */
 	long long steps;              /* substeps taken */
 	double inflow, outflow;       /* cumulative, m^3 */
+	double inflow_sum, inflow_carry;   /* compensated partial sums of them */
+	double outflow_sum, outflow_carry;
 	double rate_max;              /* max |dh/dt| of the last substep, m/s */
 	double tile_sweeps, tile_slots; /* for active_fraction, since last reset */
 	double seconds_fluxes, seconds_update; /* kernel wall time, s */

@@ -1,0 +1,167 @@
+"""Shared helpers for the sandslide command-line and file-format tests.
+
+The binary is found through the environment variable SANDSLIDE (an
+absolute path); it defaults to build/sandslide of this checkout.  Every
+test writes its files under pytest's tmp_path.
+"""
+import os
+import struct
+import subprocess
+import time
+import zlib
+
+import h5py
+import numpy as np
+import pytest
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+SANDSLIDE = os.environ.get("SANDSLIDE", os.path.join(ROOT, "build", "sandslide"))
+CASES = os.path.join(ROOT, "cases")
+
+# A small valid case: 20 x 16 cells of 0.1 m, grid [0, 2] x [0, 1.6] m.
+# Flat sand 0.2 m high next to an open east side: it slides a little.
+BASE = """\
+# base case for the CLI tests
+[grid]
+nx = 20
+ny = 16
+dx = 0.1
+origin = 0 0
+
+[model]
+closure = coulomb
+repose_angle = 35
+nu = 0.1
+
+[time]
+end = 1
+output_every = 0.5
+
+[boundary]
+west = wall
+east = open
+south = wall
+north = wall
+
+[initial]
+type = flat
+height = 0.2
+"""
+
+
+def pytest_configure(config):
+    if not os.path.isfile(SANDSLIDE) or not os.access(SANDSLIDE, os.X_OK):
+        raise pytest.UsageError(
+            f"sandslide binary not found at {SANDSLIDE!r}: run 'make' or set SANDSLIDE")
+
+
+def run(args, cwd=None, timeout=120, **kw):
+    """Run sandslide with args; returns the CompletedProcess (text mode)."""
+    return subprocess.run([SANDSLIDE] + [str(a) for a in args], cwd=cwd,
+                          capture_output=True, text=True, timeout=timeout, **kw)
+
+
+def run_ok(args, cwd=None, timeout=120):
+    r = run(args, cwd=cwd, timeout=timeout)
+    assert r.returncode == 0, (
+        f"sandslide {' '.join(map(str, args))} exited {r.returncode}\n"
+        f"stdout:\n{r.stdout}\nstderr:\n{r.stderr}")
+    return r
+
+
+def edit(text, old, new, count=1):
+    """Replace old by new in text; old must occur exactly `count` times."""
+    n = text.count(old)
+    assert n == count, f"test bug: {old!r} occurs {n} times in the case text"
+    return text.replace(old, new)
+
+
+def drop_line(text, prefix):
+    """Remove the one line that starts with prefix."""
+    lines = text.splitlines(keepends=True)
+    hits = [k for k, l in enumerate(lines) if l.startswith(prefix)]
+    assert len(hits) == 1, f"test bug: {len(hits)} lines start with {prefix!r}"
+    del lines[hits[0]]
+    return "".join(lines)
+
+
+def line_of(text, needle, occurrence=1):
+    """1-based number of the line holding the occurrence-th match of needle."""
+    seen = 0
+    for k, line in enumerate(text.splitlines(), 1):
+        if needle in line:
+            seen += 1
+            if seen == occurrence:
+                return k
+    raise AssertionError(f"test bug: {needle!r} (occurrence {occurrence}) not in the case")
+
+
+def png_bytes(rows, bit_depth=8):
+    """An 8-bit greyscale PNG, rows top (north) first, values 0..255."""
+    height, width = len(rows), len(rows[0])
+
+    def chunk(kind, data):
+        return (struct.pack(">I", len(data)) + kind + data +
+                struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF))
+
+    raw = b"".join(b"\x00" + bytes(int(v) for v in row) for row in rows)
+    return (b"\x89PNG\r\n\x1a\n" +
+            chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, bit_depth, 0, 0, 0, 0)) +
+            chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
+
+
+def write_png(path, rows):
+    with open(path, "wb") as f:
+        f.write(png_bytes(rows))
+
+
+def asc_text(values, cellsize=0.1, x0=0.0, y0=0.0):
+    """ESRI ASCII grid text; values is a list of rows, north row first, as strings
+    or numbers."""
+    rows = len(values)
+    cols = len(values[0])
+    head = (f"ncols {cols}\nnrows {rows}\nxllcorner {x0}\nyllcorner {y0}\n"
+            f"cellsize {cellsize}\n")
+    return head + "".join(" ".join(str(v) for v in row) + "\n" for row in values)
+
+
+def h5open(path):
+    """Open read-only without HDF5 file locking (a writer may hold the lock)."""
+    try:
+        return h5py.File(path, "r", locking=False)
+    except TypeError:   # old h5py without the locking keyword
+        return h5py.File(path, "r")
+
+
+def text_attr(obj, name):
+    v = obj.attrs[name]
+    if isinstance(v, np.ndarray) and v.shape == ():
+        v = v[()]
+    if isinstance(v, (bytes, np.bytes_)):
+        v = bytes(v).decode("utf-8")
+    return str(v)
+
+
+def files_under(path):
+    """Every file and folder below path, as relative paths."""
+    out = set()
+    for dirpath, dirnames, filenames in os.walk(path):
+        for name in dirnames + filenames:
+            out.add(os.path.relpath(os.path.join(dirpath, name), path))
+    return out
+
+
+def wait_for(predicate, timeout, interval=0.02):
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        v = predicate()
+        if v:
+            return v
+        time.sleep(interval)
+    return predicate()
+
+
+@pytest.fixture
+def base_case():
+    return BASE
