@@ -110,6 +110,7 @@ struct parse {
 	const char *text, *cursor; /* reader state */
 	int line;                  /* line inih is handling */
 	int continuation;          /* that line starts with white space */
+	int overriding;            /* applying --set: later values replace */
 	int failed;
 	char where[SS_CASE_WHERE_SIZE];           /* location of the value being applied */
 	int key_set[KEY_COUNT];
@@ -338,6 +339,11 @@ static int region_shape(struct parse *p, struct ss_region *r, const char *key,
 	int polygon_more = p->continuation && strcmp(key, "polygon") == 0 &&
 	                   sh->kind == SS_SHAPE_POLYGON &&
 	                   strcmp(p->last_region_key, "polygon") == 0;
+	if (p->overriding && !polygon_more) {
+		free(sh->polygon);
+		free(sh->mask_path);
+		memset(sh, 0, sizeof *sh);
+	}
 	if (sh->kind != SS_SHAPE_NONE && !polygon_more)
 		return fail_at(p, "[%s] has two shapes (the first is at %s): give one of "
 		               "rect, disk, polygon, mask", section, sh->where);
@@ -399,20 +405,18 @@ static int apply_region_key(struct parse *p, const char *section, const char *ke
 	if (!strcmp(key, "rect") || !strcmp(key, "disk") || !strcmp(key, "polygon") ||
 	    !strcmp(key, "mask")) {
 		err = region_shape(p, r, key, value, section);
-	} else if (role == SS_REGION_SOURCE && !strcmp(key, "rate")) {
+	} else if (role == SS_REGION_SOURCE &&
+	           (!strcmp(key, "rate") || !strcmp(key, "start") || !strcmp(key, "stop"))) {
+		const int is_rate = key[0] == 'r', is_start = key[2] == 'a';
+		char *where = is_rate ? r->rate_where : is_start ? r->start_where : r->stop_where;
 		double v;
-		if (parse_double(value, &v) || !(v > 0.0))
-			return fail_at(p, "[%s] rate = '%s': expected a finite number > 0 (m/s)",
-			               section, value);
-		r->rate = v;
-		r->has_rate = 1;
-		err = SS_OK;
-	} else if (role == SS_REGION_SOURCE && (!strcmp(key, "start") || !strcmp(key, "stop"))) {
-		double v;
-		if (parse_double(value, &v) || !(v >= 0.0))
-			return fail_at(p, "[%s] %s = '%s': expected a time in s >= 0",
-			               section, key, value);
-		*(key[2] == 'a' ? &r->start : &r->stop) = v;
+		if (where[0] && !p->overriding)
+			return fail_at(p, "[%s] %s is set twice (first at %s)", section, key, where);
+		if (parse_double(value, &v) || (is_rate ? !(v > 0.0) : !(v >= 0.0)))
+			return fail_at(p, "[%s] %s = '%s': expected %s", section, key, value,
+			               is_rate ? "a finite number > 0 (m/s)" : "a time in s >= 0");
+		*(is_rate ? &r->rate : is_start ? &r->start : &r->stop) = v;
+		snprintf(where, SS_CASE_WHERE_SIZE, "%s", p->where);
 		err = SS_OK;
 	} else {
 		return fail_at(p, "unknown key '%s' in [%s]: expected %s", key, section,
@@ -427,7 +431,7 @@ static int apply_region_key(struct parse *p, const char *section, const char *ke
 /* ---- one key = value ------------------------------------------------- */
 
 static int apply(struct parse *p, const char *section, const char *key,
-                 const char *value, int is_override)
+                 const char *value)
 {
 	int fixed = 0;
 	for (size_t s = 0; s < sizeof fixed_sections / sizeof *fixed_sections; s++)
@@ -444,7 +448,7 @@ static int apply(struct parse *p, const char *section, const char *key,
 	for (int k = 0; k < KEY_COUNT; k++) {
 		if (strcmp(keys[k].section, section) || strcmp(keys[k].key, key))
 			continue;
-		if (p->key_set[k] && !is_override)
+		if (p->key_set[k] && !p->overriding)
 			return fail_at(p, "[%s] %s is set twice (first at %s)", section, key,
 			               p->key_where[k]);
 		int err = store_value(p, &keys[k], value);
@@ -493,7 +497,7 @@ static int handler(void *user, const char *section, const char *name, const char
 		return 1;   /* report the first error only */
 	snprintf(p->where, sizeof p->where, "%s:%d", p->path, p->line);
 	if (!p->continuation)
-		return apply(p, section, name, value, 0) == SS_OK;
+		return apply(p, section, name, value) == SS_OK;
 	/* inih leaves inline comments on continuation lines: cut them as it
 	 * does on "key = value" lines (';' after white space) */
 	char buf[256];
@@ -507,7 +511,7 @@ static int handler(void *user, const char *section, const char *name, const char
 	size_t n = strlen(buf);
 	while (n && isspace((unsigned char)buf[n - 1]))
 		buf[--n] = '\0';
-	return apply(p, section, name, buf, 0) == SS_OK;
+	return apply(p, section, name, buf) == SS_OK;
 }
 
 /* What inih would skip or misread: checked first, with line numbers. */
@@ -574,6 +578,13 @@ static int prescan(struct parse *p)
 			snprintf(seen[seen_count].name, sizeof seen[seen_count].name, "%s", name);
 			seen[seen_count++].line = line;
 			seen_section = 1;
+			/* regions exist from their header on, so an empty one is
+			 * reported (it has no shape) */
+			if (region_section(name, &role, &rname) == 0 &&
+			    !region_find(p, role, rname, 1)) {
+				err = SS_ERR_INPUT;
+				break;
+			}
 		} else if (t != buf && seen_section) {
 			/* an indented line continues the previous value */
 		} else if (!strchr(t, '=')) {
@@ -730,13 +741,23 @@ static int finish(struct parse *p)
 		return err;
 	if (!is_set(p, "grid", "dy"))
 		c->dy = c->dx;
+	snprintf(c->grid_where, sizeof c->grid_where, "%s", where_of(p, "grid", "nx"));
 	if ((err = finish_model(p)))
 		return err;
 	if (is_set(p, "time", "max_time") && !c->steady)
 		return ss_error_input("%s: [time] max_time applies to end = steady: the run "
 		                      "already stops at end", where_of(p, "time", "max_time"));
-	if ((err = ss_boundary_check(&c->boundary)))
-		return err;
+	static const char *const sides[] = {"west", "east", "south", "north"};
+	for (int side = 0; side < 4; side++) {
+		const int opposite = side ^ 1;
+		if ((c->boundary.side[side] == SS_SIDE_PERIODIC) !=
+		    (c->boundary.side[opposite] == SS_SIDE_PERIODIC) &&
+		    c->boundary.side[side] == SS_SIDE_PERIODIC)
+			return ss_error_input("%s: [boundary] %s = periodic needs %s = periodic too "
+			                      "(opposite sides wrap together)",
+			                      where_of(p, "boundary", sides[side]), sides[side],
+			                      sides[opposite]);
+	}
 
 	/* [initial]: keys that belong to another type are mistakes */
 	static const char *const cone_keys[] = {"center", "radius", "angle"};
@@ -769,7 +790,7 @@ static int finish(struct parse *p)
 			return ss_error_input("%s: [%s %s] polygon has %d points: expected at least 3",
 			                      r->shape.where, region_prefix[r->role], r->name,
 			                      r->shape.polygon_points);
-		if (r->role == SS_REGION_SOURCE && !r->has_rate)
+		if (r->role == SS_REGION_SOURCE && !r->rate_where[0])
 			return ss_error_input("%s: [source %s] is missing 'rate' (m/s, > 0)",
 			                      r->where, r->name);
 		if (r->role == SS_REGION_SOURCE && !(r->stop > r->start))
@@ -798,6 +819,15 @@ static void set_defaults(struct ss_case *c)
 	c->initial = SS_INITIAL_FLAT;
 }
 
+static char *trim(char *s)
+{
+	s += strspn(s, " \t");
+	size_t n = strlen(s);
+	while (n && isspace((unsigned char)s[n - 1]))
+		s[--n] = '\0';
+	return s;
+}
+
 static int apply_override(struct parse *p, const char *arg)
 {
 	snprintf(p->where, sizeof p->where, "--set %s", arg);
@@ -814,13 +844,10 @@ static int apply_override(struct parse *p, const char *arg)
 	*dot = '\0';
 	char value[512];
 	snprintf(value, sizeof value, "%s", eq + 1);
-	/* the same trimming inih applies to file values */
-	char *v = value + strspn(value, " \t");
-	size_t len = strlen(v);
-	while (len && isspace((unsigned char)v[len - 1]))
-		v[--len] = '\0';
+	/* the same trimming inih applies to file sections, keys and values */
 	p->continuation = 0;
-	return apply(p, lhs, dot + 1, v, 1);
+	p->overriding = 1;
+	return apply(p, trim(lhs), trim(dot + 1), trim(value));
 }
 
 int ss_case_parse(struct ss_case *c, const char *path, const char *text,

@@ -4,6 +4,7 @@
 #include "sandslide/dem.h"
 
 #include <ctype.h>
+#include <stdarg.h>
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -13,6 +14,20 @@
 
 #include "sandslide/error.h"
 #include "sandslide/snapshot.h"
+
+/* An input error, prefixed with where the file was named ("case.ini:25: "
+ * or ""). */
+static int dem_error(const char *prefix, const char *fmt, ...)
+	__attribute__((format(printf, 2, 3)));
+static int dem_error(const char *prefix, const char *fmt, ...)
+{
+	char msg[1024];
+	va_list ap;
+	va_start(ap, fmt);
+	vsnprintf(msg, sizeof msg, fmt, ap);
+	va_end(ap);
+	return ss_error_input("%s%s", prefix, msg);
+}
 
 void ss_raster_release(struct ss_raster *r)
 {
@@ -55,11 +70,11 @@ static int to_double(const char *t, double *v)
 	return end != t && *end == '\0' && errno != ERANGE ? 0 : -1;
 }
 
-static char *read_text(const char *path, int *err)
+static char *read_text(const char *path, const char *prefix, int *err)
 {
 	FILE *f = fopen(path, "rb");
 	if (!f) {
-		*err = ss_error_input("cannot open '%s': %s", path, strerror(errno));
+		*err = dem_error(prefix, "cannot open '%s': %s", path, strerror(errno));
 		return NULL;
 	}
 	char *text = NULL;
@@ -85,17 +100,17 @@ static char *read_text(const char *path, int *err)
 	fclose(f);
 	if (bad) {
 		free(text);
-		*err = ss_error_input("cannot read '%s'", path);
+		*err = dem_error(prefix, "cannot read '%s'", path);
 		return NULL;
 	}
 	text[size] = '\0';
 	return text;
 }
 
-static int read_asc(const char *path, struct ss_raster *r)
+static int read_asc(const char *path, const char *prefix, struct ss_raster *r)
 {
 	int err = SS_OK;
-	char *text = read_text(path, &err);
+	char *text = read_text(path, prefix, &err);
 	if (!text)
 		return err;
 	struct scan sc = {text, 1};
@@ -118,7 +133,7 @@ static int read_asc(const char *path, struct ss_raster *r)
 		snprintf(key, sizeof key, "%s", tok);
 		int key_line = sc.line;
 		if (!next_token(&sc, tok, sizeof tok) || to_double(tok, &v)) {
-			err = ss_error_input("%s:%d: header key '%s' has no numeric value", path,
+			err = dem_error(prefix, "%s:%d: header key '%s' has no numeric value", path,
 			                     key_line, key);
 			goto out;
 		}
@@ -135,7 +150,7 @@ static int read_asc(const char *path, struct ss_raster *r)
 		else if (!strcasecmp(key, "nodata_value"))
 			nodata = v, have_nodata = 1;
 		else {
-			err = ss_error_input("%s:%d: unknown header key '%s': expected ncols, nrows, "
+			err = dem_error(prefix, "%s:%d: unknown header key '%s': expected ncols, nrows, "
 			                     "xllcorner, yllcorner, cellsize, NODATA_value", path,
 			                     key_line, key);
 			goto out;
@@ -145,12 +160,12 @@ static int read_asc(const char *path, struct ss_raster *r)
 	}
 	if (!(ncols >= 1 && ncols <= 1 << 30 && ncols == floor(ncols)) ||
 	    !(nrows >= 1 && nrows <= 1 << 30 && nrows == floor(nrows))) {
-		err = ss_error_input("%s: ESRI ASCII header needs ncols and nrows, integers >= 1",
+		err = dem_error(prefix, "%s: ESRI ASCII header needs ncols and nrows, integers >= 1",
 		                     path);
 		goto out;
 	}
 	if (!(cell > 0.0)) {
-		err = ss_error_input("%s: ESRI ASCII header needs cellsize > 0", path);
+		err = dem_error(prefix, "%s: ESRI ASCII header needs cellsize > 0", path);
 		goto out;
 	}
 	r->nx = (int)ncols;
@@ -169,12 +184,12 @@ static int read_asc(const char *path, struct ss_raster *r)
 		for (int i = 0; i < r->nx; i++) {
 			double v;
 			if (!next_token(&sc, tok, sizeof tok)) {
-				err = ss_error_input("%s: ends after %d of %d x %d values", path,
+				err = dem_error(prefix, "%s: ends after %d of %d x %d values", path,
 				                     row * r->nx + i, r->nx, r->ny);
 				goto out;
 			}
 			if (to_double(tok, &v)) {
-				err = ss_error_input("%s:%d: '%s' (row %d, column %d) is not a number",
+				err = dem_error(prefix, "%s:%d: '%s' (row %d, column %d) is not a number",
 				                     path, sc.line, tok, row + 1, i + 1);
 				goto out;
 			}
@@ -186,7 +201,7 @@ static int read_asc(const char *path, struct ss_raster *r)
 				r->nodata[(size_t)j * r->nx + i] = 1;
 				v = 0.0;
 			} else if (!isfinite(v)) {
-				err = ss_error_input("%s:%d: height '%s' (row %d, column %d) is not "
+				err = dem_error(prefix, "%s:%d: height '%s' (row %d, column %d) is not "
 				                     "finite: heights must be finite numbers (mark "
 				                     "missing cells with NODATA_value)", path, sc.line,
 				                     tok, row + 1, i + 1);
@@ -196,14 +211,14 @@ static int read_asc(const char *path, struct ss_raster *r)
 		}
 	}
 	if (next_token(&sc, tok, sizeof tok))
-		err = ss_error_input("%s:%d: more values than ncols x nrows = %d x %d", path,
+		err = dem_error(prefix, "%s:%d: more values than ncols x nrows = %d x %d", path,
 		                     sc.line, r->nx, r->ny);
 out:
 	free(text);
 	return err;
 }
 
-static int read_h5(const char *spec, struct ss_raster *r)
+static int read_h5(const char *spec, const char *prefix, struct ss_raster *r)
 {
 	/* "file.h5" or "file.h5:/dataset" */
 	char path[4096];
@@ -216,6 +231,10 @@ static int read_h5(const char *spec, struct ss_raster *r)
 	} else {
 		snprintf(path, sizeof path, "%s", spec);
 	}
+	FILE *f = fopen(path, "rb");
+	if (!f)
+		return dem_error(prefix, "cannot open '%s': %s", path, strerror(errno));
+	fclose(f);
 	int err = ss_snapshot_read_field(path, dataset, -1, &r->nx, &r->ny, &r->values);
 	if (err)
 		return err;
@@ -223,7 +242,7 @@ static int read_h5(const char *spec, struct ss_raster *r)
 	const size_t n = (size_t)r->nx * (size_t)r->ny;
 	for (size_t k = 0; k < n; k++) {
 		if (!isfinite(r->values[k]))
-			return ss_error_input("%s: height %g at column %zu, row %zu (from the south) "
+			return dem_error(prefix, "%s: height %g at column %zu, row %zu (from the south) "
 			                      "is not finite: heights must be finite numbers", spec,
 			                      r->values[k], k % (size_t)r->nx + 1,
 			                      k / (size_t)r->nx + 1);
@@ -237,13 +256,16 @@ static int has_suffix(const char *s, const char *suffix)
 	return a >= b && strcasecmp(s + a - b, suffix) == 0;
 }
 
-int ss_dem_read(const char *spec, struct ss_raster *r)
+int ss_dem_read(const char *spec, const char *context, struct ss_raster *r)
 {
+	char prefix[512] = "";
+	if (context && *context)
+		snprintf(prefix, sizeof prefix, "%s: ", context);
 	memset(r, 0, sizeof *r);
 	if (has_suffix(spec, ".asc"))
-		return read_asc(spec, r);
+		return read_asc(spec, prefix, r);
 	if (has_suffix(spec, ".h5") || strstr(spec, ".h5:"))
-		return read_h5(spec, r);
-	return ss_error_input("'%s': unknown raster format: expected an ESRI ASCII grid "
+		return read_h5(spec, prefix, r);
+	return dem_error(prefix, "'%s': unknown raster format: expected an ESRI ASCII grid "
 	                      "(.asc) or a sandslide HDF5 file (.h5 or .h5:/dataset)", spec);
 }

@@ -36,9 +36,10 @@ static void default_output(const char *case_path, char *out, size_t size)
 	snprintf(out, size, "out/%.*s.h5", stem, base);
 }
 
-/* The output's folder must exist and be writable, and the output itself
- * must not be a folder: checked before anything is written. */
-static int check_output(const char *path, int create_folder)
+/* The output's folder must exist and be writable (the default folder out/
+ * may be missing: it is created when the run starts, in a writable working
+ * folder), and the output itself must not be a folder. */
+static int check_output(const char *path, int is_default)
 {
 	char dir[4096];
 	const char *slash = strrchr(path, '/');
@@ -47,8 +48,12 @@ static int check_output(const char *path, int create_folder)
 	else
 		snprintf(dir, sizeof dir, ".");
 	struct stat sb;
-	if (create_folder && stat(dir, &sb) != 0 && mkdir(dir, 0777) != 0)
-		return ss_error_input("cannot create output folder '%s': %s", dir, strerror(errno));
+	if (is_default && stat(dir, &sb) != 0) {
+		if (access(".", W_OK) != 0)
+			return ss_error_input("cannot create output folder '%s': the working folder "
+			                      "is not writable", dir);
+		return SS_OK;
+	}
 	if (stat(dir, &sb) != 0 || !S_ISDIR(sb.st_mode))
 		return ss_error_input("cannot write '%s': folder '%s' does not exist", path, dir);
 	if (access(dir, W_OK) != 0)
@@ -139,6 +144,10 @@ int ss_run_case(const struct ss_run_options *o)
 		goto out_case;
 
 	/* the run starts: from here on the output file is written */
+	if (!o->output && mkdir("out", 0777) != 0 && errno != EEXIST) {
+		err = ss_error_fail("cannot create output folder 'out': %s", strerror(errno));
+		goto out_stepper;
+	}
 	struct ss_snapshot_meta meta = {
 		.title = c.path, .history = o->history ? o->history : "",
 		.case_text = c.text, .closure = ss_closure_name(c.closure),

@@ -17,7 +17,7 @@ static int initial_heights(const struct ss_case *c, struct ss_stepper *st)
 	const struct ss_grid *g = &st->grid;
 	if (c->initial == SS_INITIAL_FILE) {
 		struct ss_raster r;
-		int err = ss_dem_read(c->initial_file, &r);
+		int err = ss_dem_read(c->initial_file, c->initial_where, &r);
 		if (!err && (r.nx != g->nx || r.ny != g->ny))
 			err = ss_error_input("%s: initial file '%s' is %d x %d cells: expected the "
 			                     "grid's %d x %d (nx x ny)", c->initial_where,
@@ -69,6 +69,14 @@ int ss_setup_stepper(const struct ss_case *c, int tile_nx, int tile_ny,
 	struct ss_closure closure;
 	memset(st, 0, sizeof *st);
 	int err = ss_grid_init(&g, c->nx, c->ny, c->dx, c->dy, c->origin_x, c->origin_y);
+	const double need = ss_stepper_memory_bytes(&g), have = ss_memory_available_bytes();
+	if (!err && have > 0.0 && need > have) {
+		char nb[32], hb[32];
+		return ss_error_input("%s: [grid] nx = %d, ny = %d needs %s of memory; this "
+		                      "machine has %s available (reduce nx and ny)", c->grid_where,
+		                      c->nx, c->ny, ss_format_bytes(need, nb),
+		                      ss_format_bytes(have, hb));
+	}
 	if (!err)
 		err = ss_closure_init(&closure, c->closure, c->repose_angle_deg, c->gamma, c->nu);
 	if (!err)

@@ -54,6 +54,7 @@ static void diag_set(struct ss_diagnostics *d, int k, double v)
 
 struct ss_snapshot {
 	char *path;
+	char *partial_path;     /* written here until snapshot 0 is complete */
 	char *xmf_path;
 	hid_t file;
 	hid_t height, time, diag[DIAG_COUNT];
@@ -271,8 +272,11 @@ int ss_snapshot_destroy(struct ss_snapshot *s)
 	close_handles(s);
 	if (s->file >= 0 && H5Fclose(s->file) < 0)
 		err = ss_error_fail("cannot close '%s'", s->path);
+	if (s->count == 0 && s->partial_path)
+		remove(s->partial_path);   /* never complete: leave nothing */
 	free(s->times);
 	free(s->xmf_path);
+	free(s->partial_path);
 	free(s->path);
 	free(s);
 	return err;
@@ -293,16 +297,18 @@ int ss_snapshot_create(struct ss_snapshot **out, const char *path,
 	s->grid = *g;
 	s->path = strdup(path);
 	s->xmf_path = malloc(strlen(path) + 8);
-	if (!s->path || !s->xmf_path) {
+	s->partial_path = malloc(strlen(path) + 16);
+	if (!s->path || !s->xmf_path || !s->partial_path) {
 		ss_snapshot_destroy(s);
 		return ss_error_fail("out of memory");
 	}
 	ss_snapshot_sidecar_path(path, s->xmf_path, strlen(path) + 8);
+	snprintf(s->partial_path, strlen(path) + 16, "%s.partial", path);
 
 	hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
 	/* v1.8 format: readable by every netCDF-4 and HDF5 >= 1.8 reader */
 	H5Pset_libver_bounds(fapl, H5F_LIBVER_EARLIEST, H5F_LIBVER_V18);
-	s->file = H5Fcreate(path, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
+	s->file = H5Fcreate(s->partial_path, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
 	H5Pclose(fapl);
 	if (s->file < 0) {
 		int e = errno;
@@ -399,6 +405,11 @@ int ss_snapshot_append(struct ss_snapshot *s, double time_s, const double *heigh
 		if (append_value(s->diag[m], k, diag_get(d, m)))
 			goto fail;
 	if (H5Fflush(s->file, H5F_SCOPE_GLOBAL) < 0)
+		goto fail;
+	/* the file takes its name only once it holds a complete snapshot, so
+	 * a run killed while it starts leaves no half-written file (and an
+	 * existing file of that name intact) */
+	if (k == 0 && rename(s->partial_path, s->path) != 0)
 		goto fail;
 
 	if (k + 1 > s->times_cap) {

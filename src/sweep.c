@@ -127,6 +127,7 @@ double ss_sweep_fluxes(const struct ss_grid *g, const struct ss_tiling *t,
 	const int tiles = t->tiles_x * t->tiles_y;
 	const enum ss_closure_kind kind = c->kind;
 	const int parallel = (long long)g->nx * g->ny >= PARALLEL_MIN_CELLS;
+	(void)parallel;   /* unused without OpenMP */
 	double s2_max = 0.0;
 
 	#pragma omp parallel for schedule(static) reduction(max:s2_max) if(parallel)
@@ -168,6 +169,7 @@ double ss_sweep_update(const struct ss_grid *g, const struct ss_tiling *t,
 	const ptrdiff_t stride = g->stride;
 	const double inv_dx = 1.0 / g->dx, inv_dy = 1.0 / g->dy;
 	const int parallel = (long long)g->nx * g->ny >= PARALLEL_MIN_CELLS;
+	(void)parallel;   /* unused without OpenMP */
 	double rate_max = 0.0;
 
 	#pragma omp parallel for schedule(static) reduction(max:rate_max) if(parallel)

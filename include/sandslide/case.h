@@ -34,7 +34,9 @@ struct ss_region {
 	struct ss_shape shape;
 	double rate;            /* source: m/s */
 	double start, stop;     /* source: s (stop INFINITY = never) */
-	int has_rate;
+	char rate_where[SS_CASE_WHERE_SIZE];  /* where rate, start, stop were set */
+	char start_where[SS_CASE_WHERE_SIZE]; /* ("" when not set) */
+	char stop_where[SS_CASE_WHERE_SIZE];
 };
 
 enum ss_initial_type { SS_INITIAL_FLAT, SS_INITIAL_CONE, SS_INITIAL_FILE };
@@ -44,6 +46,7 @@ struct ss_case {
 	char *text;             /* the whole file */
 
 	/* [grid] */
+	char grid_where[SS_CASE_WHERE_SIZE]; /* where nx was set, for messages */
 	int nx, ny;
 	double dx, dy;          /* m */
 	double origin_x, origin_y; /* lower-left corner, m */

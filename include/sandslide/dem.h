@@ -19,8 +19,10 @@ struct ss_raster {
 
 /* Read spec into r.  SS_ERR_INPUT names the file (and line for text
  * formats) for an unreadable file, a malformed header, a missing value or a
- * NaN or infinite height.  Release r with ss_raster_release either way. */
-int ss_dem_read(const char *spec, struct ss_raster *r);
+ * NaN or infinite height, after `context` (where the file was named, e.g.
+ * "case.ini:25"; may be NULL).  Release r with ss_raster_release either way.
+ */
+int ss_dem_read(const char *spec, const char *context, struct ss_raster *r);
 void ss_raster_release(struct ss_raster *r);
 
 #endif

@@ -1,0 +1,428 @@
+"""Runs through the command line: --set, help and version, info, quiet and
+progress, default output, crash safety, determinism, the shipped cases."""
+import os
+import pty
+import re
+import select
+import shutil
+import signal
+import subprocess
+import time
+import xml.etree.ElementTree as ET
+
+import numpy as np
+import pytest
+
+from conftest import (BASE, CASES, SANDSLIDE, edit, h5open, run, run_ok, text_attr,
+                      wait_for)
+
+SOURCE = "\n[source pour]\nrect = 0.5 0.5 0.9 0.9\nrate = 0.001\n"   # 16 cells of 0.1 m
+DIAGNOSTICS = ["volume", "inflow", "outflow", "max_height", "max_slope_deg", "steps",
+               "active_fraction", "wall_seconds"]
+
+# A 200 x 200 cone at 60 degrees on a walled floor: it slides for a long time
+# and writes a snapshot every few hundredths of a second of wall time.
+SLOW = """\
+[grid]
+nx = 200
+ny = 200
+dx = 0.01
+origin = -1 -1
+
+[model]
+closure = coulomb
+repose_angle = 35
+nu = 0.1
+
+[time]
+end = {end}
+output_every = {every}
+
+[boundary]
+west = wall
+east = wall
+south = wall
+north = wall
+
+[initial]
+type = cone
+center = 0 0
+radius = 0.9
+angle = 60
+height = 0
+"""
+
+
+def write(tmp_path, text, name="case.ini"):
+    (tmp_path / name).write_text(text)
+    return name
+
+
+# ---- --set ---------------------------------------------------------------
+
+def test_set_closure(tmp_path):
+    write(tmp_path, BASE)
+    run_ok(["run", "case.ini", "-o", "a.h5", "-q"], cwd=tmp_path)
+    run_ok(["run", "case.ini", "-o", "b.h5", "-q", "--set", "model.closure=casson"],
+           cwd=tmp_path)
+    with h5open(tmp_path / "a.h5") as a, h5open(tmp_path / "b.h5") as b:
+        assert text_attr(a, "closure") == "coulomb"
+        assert text_attr(b, "closure") == "casson", "--set model.closure=casson ignored"
+        assert not np.array_equal(a["height"][-1], b["height"][-1]), \
+            "a different closure must give a different surface"
+
+
+def test_set_source_rate(tmp_path):
+    write(tmp_path, BASE + SOURCE)
+    run_ok(["run", "case.ini", "-o", "a.h5", "-q"], cwd=tmp_path)
+    run_ok(["run", "case.ini", "-o", "b.h5", "-q", "--set", "source pour.rate=0.002"],
+           cwd=tmp_path)
+    with h5open(tmp_path / "a.h5") as a, h5open(tmp_path / "b.h5") as b:
+        t = a["time"][...]
+        np.testing.assert_allclose(a["inflow"][...], 1e-3 * 16 * 0.01 * t, rtol=1e-9, atol=1e-15)
+        np.testing.assert_allclose(b["inflow"][...], 2e-3 * 16 * 0.01 * t, rtol=1e-9, atol=1e-15,
+                                   err_msg="--set 'source pour.rate=0.002' did not double the inflow")
+
+
+def test_set_keys_absent_from_file(tmp_path):
+    write(tmp_path, BASE)
+    run_ok(["run", "case.ini", "-o", "o.h5", "-q", "--set", "grid.dy=0.05",
+            "--set", "model.closure=herschel-bulkley", "--set=model.gamma=0.5"], cwd=tmp_path)
+    with h5open(tmp_path / "o.h5") as f:
+        assert float(f.attrs["dy"]) == 0.05, "--set grid.dy (absent from the file) ignored"
+        np.testing.assert_allclose(f["y"][...], (np.arange(16) + 0.5) * 0.05, atol=1e-12)
+        assert text_attr(f, "closure") == "herschel-bulkley"
+        assert float(f.attrs["gamma"]) == 0.5, "--set model.gamma (absent) ignored"
+
+
+def test_set_overrides_value_in_file(tmp_path):
+    write(tmp_path, BASE)
+    run_ok(["run", "case.ini", "-o", "o.h5", "-q", "--set", "time.output_every=0.25",
+            "--set", "time.end=0.75"], cwd=tmp_path)
+    with h5open(tmp_path / "o.h5") as f:
+        assert list(f["time"][...]) == [0.0, 0.25, 0.5, 0.75]
+        # the case attribute is the file text; the overrides are in history
+        assert text_attr(f, "case") == BASE
+        assert "time.output_every=0.25" in text_attr(f, "history")
+
+
+def test_end_not_multiple_of_output_every(tmp_path):
+    write(tmp_path, edit(BASE, "end = 1\n", "end = 1.2\n"))
+    run_ok(["run", "case.ini", "-o", "o.h5", "-q"], cwd=tmp_path)
+    with h5open(tmp_path / "o.h5") as f:
+        assert list(f["time"][...]) == [0.0, 0.5, 1.0, 1.2]
+
+
+# ---- help, version, info ---------------------------------------------------
+
+@pytest.mark.parametrize("args,words", [
+    (["--help"], ["usage: sandslide", "run", "info"]),
+    (["-h"], ["usage: sandslide"]),
+    (["run", "--help"], ["usage: sandslide run", "-o", "--threads", "--set", "--quiet"]),
+    (["info", "--help"], ["usage: sandslide info"]),
+])
+def test_help(tmp_path, args, words):
+    r = run(args, cwd=tmp_path)
+    assert r.returncode == 0, f"{args}: exit {r.returncode}, stderr {r.stderr!r}"
+    for w in words:
+        assert w in r.stdout, f"{args}: {w!r} not in the usage: {r.stdout!r}"
+    assert os.listdir(tmp_path) == []
+
+
+def test_version(tmp_path):
+    r = run(["--version"], cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert re.match(r"sandslide \d+\.\d+(\.\d+)?", r.stdout), r.stdout
+
+
+def test_info(tmp_path):
+    write(tmp_path, edit(BASE, "closure = coulomb\n", "closure = bingham\n"))
+    run_ok(["run", "case.ini", "-o", "o.h5", "-q"], cwd=tmp_path)
+    r = run_ok(["info", "o.h5"], cwd=tmp_path)
+    assert "20 x 16" in r.stdout, f"grid size missing: {r.stdout}"
+    assert "bingham" in r.stdout, f"closure missing: {r.stdout}"
+    assert re.search(r"snapshots\s+3\b", r.stdout), f"snapshot count missing: {r.stdout}"
+    assert r.stderr == ""
+
+
+# ---- quiet, progress, default output ----------------------------------------
+
+def test_not_a_terminal_no_progress(tmp_path):
+    write(tmp_path, SLOW.format(end=1.0, every=0.5))
+    r = run_ok(["run", "case.ini", "-o", "o.h5"], cwd=tmp_path)
+    assert "\r" not in r.stderr, "progress line written although stderr is not a terminal"
+    assert r.stderr == "", f"unexpected stderr: {r.stderr!r}"
+    assert "o.h5" in r.stdout, "without --quiet a summary names the output"
+
+
+def test_quiet(tmp_path):
+    write(tmp_path, BASE)
+    for flag in ("--quiet", "-q"):
+        r = run_ok(["run", "case.ini", "-o", "o.h5", flag], cwd=tmp_path)
+        assert r.stdout == "", f"{flag}: stdout must be empty, got {r.stdout!r}"
+        assert r.stderr == "", f"{flag}: stderr must be empty, got {r.stderr!r}"
+    assert (tmp_path / "o.h5").exists()
+
+
+def run_on_terminal(args, cwd, timeout=60):
+    """Run with stderr on a pseudo-terminal; returns (exit code, stderr bytes)."""
+    master, slave = pty.openpty()
+    p = subprocess.Popen([SANDSLIDE] + args, cwd=cwd, stdout=subprocess.DEVNULL,
+                         stderr=slave, stdin=subprocess.DEVNULL)
+    os.close(slave)
+    chunks = []
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        ready, _, _ = select.select([master], [], [], 0.1)
+        if ready:
+            try:
+                data = os.read(master, 4096)
+            except OSError:
+                break
+            if not data:
+                break
+            chunks.append(data)
+        elif p.poll() is not None:
+            break
+    rc = p.wait(timeout=10)
+    os.close(master)
+    return rc, b"".join(chunks)
+
+
+def test_progress_on_terminal_and_quiet(tmp_path):
+    write(tmp_path, SLOW.format(end=1.0, every=0.5))
+    rc, err = run_on_terminal(["run", "case.ini", "-o", "o.h5"], tmp_path)
+    assert rc == 0, err
+    assert b"\r" in err and b"t = " in err, \
+        f"a run of over a second on a terminal shows a progress line: {err!r}"
+    rc, err = run_on_terminal(["run", "case.ini", "-o", "q.h5", "--quiet"], tmp_path)
+    assert rc == 0, err
+    assert err == b"", f"--quiet must print nothing on a terminal either: {err!r}"
+
+
+def test_default_output(tmp_path):
+    write(tmp_path, BASE, "my-case.ini")
+    run_ok(["run", "my-case.ini", "-q"], cwd=tmp_path)
+    assert (tmp_path / "out" / "my-case.h5").is_file(), os.listdir(tmp_path)
+    assert (tmp_path / "out" / "my-case.xmf").is_file()
+    # a case in another folder still writes to out/ of the working directory
+    (tmp_path / "cases").mkdir()
+    write(tmp_path, BASE, "cases/other.ini")
+    run_ok(["run", "cases/other.ini", "-q"], cwd=tmp_path)
+    assert (tmp_path / "out" / "other.h5").is_file(), os.listdir(tmp_path / "out")
+    assert not (tmp_path / "cases" / "out").exists()
+    with h5open(tmp_path / "out" / "other.h5") as f:
+        assert f["height"].shape == (3, 16, 20)
+
+
+def test_rerun_replaces_output(tmp_path):
+    write(tmp_path, BASE)
+    (tmp_path / "o.h5").write_bytes(b"old contents")
+    run_ok(["run", "case.ini", "-o", "o.h5", "-q"], cwd=tmp_path)
+    with h5open(tmp_path / "o.h5") as f:
+        assert f["height"].shape[0] == 3
+
+
+# ---- crash safety ------------------------------------------------------------
+
+def snapshot_count(path):
+    try:
+        with h5open(path) as f:
+            return f["time"].shape[0]
+    except Exception:   # being written: try again
+        return 0
+
+
+def check_consistent(path, every, min_count=0):
+    with h5open(path) as f:
+        nt = f["height"].shape[0]
+        assert nt >= min_count, f"{nt} snapshots, at least {min_count} had been written"
+        assert f["time"].shape == (nt,), "time and height lengths differ"
+        for name in DIAGNOSTICS:
+            assert f[name].shape == (nt,), f"{name} has {f[name].shape}, height {nt}"
+            assert np.all(np.isfinite(f[name][...])), name
+        t = f["time"][...]
+        assert np.all(np.diff(t) > 0), f"times not strictly increasing: {t}"
+        if nt:
+            np.testing.assert_allclose(t, every * np.arange(nt), rtol=1e-12, atol=0)
+            assert np.all(np.isfinite(f["height"][...])), "non-finite heights"
+            assert f["height"][0].max() > 0.9, "the first snapshot is the initial cone"
+    return nt
+
+
+def test_sigkill_after_snapshots(tmp_path):
+    every = 0.02
+    write(tmp_path, SLOW.format(end=1000, every=every))
+    out = tmp_path / "crash.h5"
+    p = subprocess.Popen([SANDSLIDE, "run", "case.ini", "-o", "crash.h5", "--threads", "2"],
+                         cwd=tmp_path, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    try:
+        seen = wait_for(lambda: snapshot_count(out) >= 3 or p.poll() is not None, 30)
+        assert p.poll() is None, f"the run ended before it could be killed: {p.stderr.read()!r}"
+        assert seen, "no 3 snapshots within 30 s"
+        seen = snapshot_count(out)
+        time.sleep(0.1)   # kill it in the middle of later snapshots
+        assert p.poll() is None, "the run ended before it could be killed"
+    finally:
+        p.send_signal(signal.SIGKILL)
+        p.wait(timeout=10)
+        p.stderr.close()
+    assert p.returncode == -signal.SIGKILL
+    nt = check_consistent(out, every, min_count=max(seen, 3))
+    xmf = out.with_suffix(".xmf")
+    root = ET.parse(xmf).getroot()   # the sidecar is replaced atomically
+    n_grids = sum(1 for g in root.iter("Grid") if g.find("Time") is not None)
+    assert nt - 1 <= n_grids <= nt, f"sidecar has {n_grids} grids, file {nt}"
+
+
+def kill_after(tmp_path, delay, every, after_create=False):
+    """Start the slow run and SIGKILL it delay seconds after the start (or,
+    with after_create, after its output file appears).  Returns None if the
+    file is missing or readable and consistent, else the error."""
+    out = tmp_path / "early.h5"
+    if out.exists():
+        out.unlink()
+    p = subprocess.Popen([SANDSLIDE, "run", "case.ini", "-o", "early.h5"],
+                         cwd=tmp_path, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        if after_create:
+            deadline = time.monotonic() + 20
+            while not out.exists() and p.poll() is None and time.monotonic() < deadline:
+                pass   # spin: catch the first moments of the file
+            assert out.exists(), "the run did not create its output"
+        if delay:
+            time.sleep(delay)
+        alive = p.poll() is None
+    finally:
+        p.send_signal(signal.SIGKILL)
+        p.wait(timeout=10)
+    assert alive, f"the run ended within {delay} s, before it was killed"
+    if not out.exists():
+        return None     # the run had not created it yet
+    try:
+        check_consistent(out, every)
+    except Exception as e:   # unreadable or inconsistent
+        return f"{type(e).__name__}: {e}"
+    return None
+
+
+def test_sigkill_at_0_3_s(tmp_path):
+    every = 0.02
+    write(tmp_path, SLOW.format(end=1000, every=every))
+    err = kill_after(tmp_path, 0.3, every)
+    assert err is None, f"killed after 0.3 s the output is not readable: {err}"
+    assert (tmp_path / "early.h5").exists(), "after 0.3 s the run has created its output"
+
+
+def test_sigkill_early_sweep(tmp_path):
+    """Killed at any moment of its start-up (0 to 40 ms, every 2 ms), a run
+    leaves no output file or a readable one (SPEC section 5)."""
+    every = 0.02
+    write(tmp_path, SLOW.format(end=1000, every=every))
+    failures = []
+    for ms in range(0, 41, 2):
+        err = kill_after(tmp_path, ms / 1000.0, every)
+        if err:
+            failures.append(f"killed {ms} ms after the start: {err}")
+    assert not failures, ("a run killed early left an unreadable output file:\n" +
+                          "\n".join(failures))
+
+
+@pytest.mark.parametrize("delay_ms", [0, 1, 2, 5, 10, 20])
+def test_sigkill_just_after_output_created(tmp_path, delay_ms):
+    """The moments right after the output file appears (static variables and
+    the first snapshot being written) are the riskiest: killed then, the run
+    must still leave a readable file."""
+    every = 0.02
+    write(tmp_path, SLOW.format(end=1000, every=every))
+    err = kill_after(tmp_path, delay_ms / 1000.0, every, after_create=True)
+    assert err is None, (f"killed {delay_ms} ms after '{'early.h5'}' appeared, the run left "
+                         f"an unreadable file: {err}")
+
+
+# ---- determinism ---------------------------------------------------------------
+
+# 130 x 128 = 16640 cells: above the size below which the sweeps run on one
+# thread (src/sweep.c PARALLEL_MIN_CELLS), so --threads 2 really splits work.
+DETERMINISM = """\
+[grid]
+nx = 130
+ny = 128
+dx = 0.01
+origin = 0 0
+
+[model]
+closure = coulomb
+repose_angle = 35
+nu = 0.1
+
+[time]
+end = 0.4
+output_every = 0.2
+
+[boundary]
+west = wall
+east = open
+south = wall
+north = wall
+
+[initial]
+type = cone
+center = 0.9 0.64
+radius = 0.45
+angle = 55
+height = 0.02
+
+[wall column]
+rect = 0.3 0.3 0.45 0.5
+[wall strip]
+polygon = 0.1 0.9 0.6 0.95 0.6 1.0 0.1 1.0
+
+[source pour]
+disk = 0.25 0.7 0.08
+rate = 0.01
+"""
+
+
+def test_determinism_threads_and_tiles(tmp_path):
+    write(tmp_path, DETERMINISM)
+    variants = {
+        "t1": ["--threads", "1"],
+        "t2": ["--threads", "2"],
+        "t2-tile8": ["--threads", "2", "--tile", "8x8"],
+        "t1-tile3x5": ["--threads", "1", "--tile", "3x5"],
+    }
+    results = {}
+    for name, extra in variants.items():
+        run_ok(["run", "case.ini", "-o", f"{name}.h5", "-q"] + extra, cwd=tmp_path)
+        with h5open(tmp_path / f"{name}.h5") as f:
+            results[name] = {k: f[k][...] for k in
+                             ["height", "time", "volume", "inflow", "outflow", "steps"]}
+    ref = results["t1"]
+    h = ref["height"]
+    assert h.shape[0] == 3
+    assert np.max(np.abs(h[-1] - h[0])) > 0.05, "the case must actually slide"
+    assert ref["inflow"][-1] > 0 and ref["outflow"][-1] > 0, \
+        "the case must have inflow and outflow to test them"
+    for name, res in results.items():
+        for key, arr in res.items():
+            assert arr.shape == ref[key].shape
+            assert np.array_equal(arr.view(np.uint64), ref[key].view(np.uint64)), \
+                f"{key} of {name} ({variants[name]}) differs from --threads 1 in its bits"
+
+
+# ---- the shipped cases -----------------------------------------------------------
+
+@pytest.mark.parametrize("name", ["table", "cone"])
+def test_shipped_case_reaches_repose_angle(tmp_path, name):
+    shutil.copy(os.path.join(CASES, f"{name}.ini"), tmp_path / f"{name}.ini")
+    run_ok(["run", f"{name}.ini", "-o", f"{name}.h5", "-q"], cwd=tmp_path, timeout=120)
+    with h5open(tmp_path / f"{name}.h5") as f:
+        slope = f["max_slope_deg"][...]
+        t = f["time"][...]
+        assert f["height"].shape[0] == len(t) >= 2
+        assert np.all(np.diff(t) > 0)
+        assert slope[0] > 40, f"{name} starts supercritical ({slope[0]} deg)"
+        assert abs(slope[-1] - 35.0) < 0.5, \
+            f"{name}: final max_slope_deg {slope[-1]} is not within 0.5 deg of 35"
+        assert np.all(np.isfinite(f["height"][-1]))
