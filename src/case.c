@@ -642,7 +642,7 @@ static int finish_model(struct parse *p)
 	static const char *const physical[] = {"delta", "density", "viscosity", "consistency",
 	                                       "gravity"};
 	const char *given = NULL;
-	for (int k = 0; k < 5; k++)
+	for (int k = 0; k < 5 && !given; k++)
 		if (is_set(p, "model", physical[k]))
 			given = physical[k];
 	if (is_set(p, "model", "nu")) {
