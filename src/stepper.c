@@ -35,15 +35,6 @@ int ss_stepper_init(struct ss_stepper *st, const struct ss_grid *g,
 	if (err)
 		return err;
 
-	const double need = ss_stepper_memory_bytes(g);
-	const double have = ss_memory_available_bytes();
-	if (have > 0.0 && need > have) {
-		char nb[32], hb[32];
-		return ss_error_input("grid %d x %d needs %s of memory; this machine has %s "
-		                      "available (reduce nx, ny)", g->nx, g->ny,
-		                      ss_format_bytes(need, nb), ss_format_bytes(have, hb));
-	}
-
 	st->grid = *g;
 	st->closure = *c;
 	st->boundary = *b;
@@ -174,6 +165,12 @@ int ss_stepper_prepare(struct ss_stepper *st)
 		}
 	}
 	ss_boundary_fill_heights(g, &st->boundary, st->height);
+	if (st->source_count > 0) {
+		st->source_rate = ss_alloc(ss_grid_storage_cells(g), sizeof(double),
+		                           "source rates");
+		if (!st->source_rate)
+			return SS_ERR_FAIL;
+	}
 	return open_faces_build(st);
 }
 
@@ -192,7 +189,7 @@ double ss_stepper_next_source_event(const struct ss_stepper *st, double t)
 
 /* Rebuild the source field when the set of active sources changes; sources
  * are summed in file order, so the field has the same bits every run. */
-static int sources_update(struct ss_stepper *st)
+static void sources_update(struct ss_stepper *st)
 {
 	uint64_t on = 0;
 	for (int k = 0; k < st->source_count; k++) {
@@ -201,21 +198,14 @@ static int sources_update(struct ss_stepper *st)
 			on |= UINT64_C(1) << k;
 	}
 	if (on == st->sources_on)
-		return SS_OK;
+		return;
 	st->sources_on = on;
-	if (!on) {
-		st->source_rate_max = 0.0;
-		st->source_volume_rate = 0.0;
-		return SS_OK;
-	}
+	st->source_rate_max = 0.0;
+	st->source_volume_rate = 0.0;
+	if (!on)
+		return;
 	const size_t n = ss_grid_storage_cells(&st->grid);
-	if (!st->source_rate) {
-		st->source_rate = ss_alloc(n, sizeof(double), "source rates");
-		if (!st->source_rate)
-			return SS_ERR_FAIL;
-	} else {
-		memset(st->source_rate, 0, n * sizeof(double));
-	}
+	memset(st->source_rate, 0, n * sizeof(double));
 	for (int k = 0; k < st->source_count; k++) {
 		if (!(on >> k & 1))
 			continue;
@@ -226,14 +216,11 @@ static int sources_update(struct ss_stepper *st)
 	/* the volume rate in storage order, deterministic */
 	double rate_max = 0.0, volume_rate = 0.0;
 	for (size_t k = 0; k < n; k++) {
-		const double q = st->source_rate[k];
-		volume_rate += q;
-		if (fabs(q) > rate_max)
-			rate_max = fabs(q);
+		volume_rate += st->source_rate[k];
+		rate_max = fmax(rate_max, st->source_rate[k]);
 	}
 	st->source_rate_max = rate_max;
 	st->source_volume_rate = volume_rate * st->grid.dx * st->grid.dy;
-	return SS_OK;
 }
 
 /* Neumaier's compensated sum: *sum + *carry holds the total of every term
@@ -272,11 +259,11 @@ enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,
 	const double source_rise = st->cfl * st->closure.tan_cr * fmin(g->dx, g->dy);
 
 	while (st->time < t_target) {
-		if (sources_update(st))
-			return SS_ADVANCE_NONFINITE;
-		double next_event = ss_stepper_next_source_event(st, st->time);
-		if (next_event > t_target)
-			next_event = t_target;
+		sources_update(st);
+		const double next_switch = ss_stepper_next_source_event(st, st->time);
+		/* a state is steady only if no source will switch on later */
+		const int may_be_steady = o->steady_tol > 0.0 && isinf(next_switch);
+		const double next_event = fmin(next_switch, t_target);
 
 		ss_boundary_fill_heights(g, &st->boundary, st->height);
 		double t0 = now_seconds();
@@ -299,7 +286,7 @@ enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,
 			/* nothing slides and nothing is poured: the state is
 			 * stationary until the next event */
 			st->rate_max = 0.0;
-			if (o->steady_tol > 0.0)
+			if (may_be_steady)
 				return SS_ADVANCE_STEADY;
 			st->time = next_event;
 			continue;
@@ -327,7 +314,7 @@ enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,
 			o->progress(o->context, st);
 		if (!isfinite(st->rate_max))
 			return SS_ADVANCE_NONFINITE;
-		if (o->steady_tol > 0.0 && st->rate_max < o->steady_tol)
+		if (may_be_steady && st->rate_max < o->steady_tol)
 			return SS_ADVANCE_STEADY;
 	}
 	return SS_ADVANCE_REACHED;

@@ -53,7 +53,7 @@ struct ss_stepper {
 	double *height;               /* m, cells with halo (ss_grid_index) */
 	uint8_t *cell_type;           /* enum ss_cell_type, with halo */
 	double *flux_x, *flux_y;      /* m^2/s per face, see sweep.h */
-	double *source_rate;          /* m/s, with halo; NULL until a source runs */
+	double *source_rate;          /* m/s, with halo; NULL without sources */
 	double *row_scratch;          /* ny per-row partial sums */
 
 	struct ss_source *sources;
@@ -78,8 +78,8 @@ struct ss_stepper {
 #define SS_MAX_SOURCES 64
 
 /* Allocate the arrays for grid g (zero heights, all flow cells).  Returns
- * SS_ERR_INPUT with the memory needed when it exceeds what the machine has,
- * SS_ERR_FAIL when an allocation fails. */
+ * SS_ERR_INPUT for a bad cfl or boundary, SS_ERR_FAIL when an allocation
+ * fails (callers that know the case check ss_stepper_memory_bytes first). */
 int ss_stepper_init(struct ss_stepper *st, const struct ss_grid *g,
                     const struct ss_closure *c, const struct ss_boundary *b,
                     double cfl, int tile_nx, int tile_ny);
@@ -99,7 +99,8 @@ int ss_stepper_add_source(struct ss_stepper *st, const uint8_t *mask,
  * SS_ERR_INPUT naming the first non-finite height. */
 int ss_stepper_prepare(struct ss_stepper *st);
 
-/* How ss_stepper_advance ended. */
+/* How ss_stepper_advance ended.  Steady needs max |dh/dt| < steady_tol and
+ * no source still to switch on. */
 enum ss_advance_end {
 	SS_ADVANCE_REACHED,     /* time == t_target */
 	SS_ADVANCE_STEADY,      /* max |dh/dt| < steady_tol (when requested) */
