@@ -77,6 +77,7 @@ static int attr_string(hid_t obj, const char *name, const char *value)
 	size_t len = strlen(value);
 	H5Tset_size(type, len ? len : 1);
 	H5Tset_strpad(type, H5T_STR_NULLTERM);
+	H5Tset_cset(type, H5T_CSET_UTF8);   /* the case text may hold any UTF-8 */
 	hid_t space = H5Screate(H5S_SCALAR);
 	hid_t a = H5Acreate2(obj, name, type, space, H5P_DEFAULT, H5P_DEFAULT);
 	herr_t r = a < 0 ? -1 : H5Awrite(a, type, len ? value : "");
