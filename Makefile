@@ -27,7 +27,7 @@ DEB_libpng := libpng-dev
 DEB_inih   := libinih-dev
 PC_MODULES := hdf5 libpng inih
 DEB_BUILD  := pkg-config $(foreach m,$(PC_MODULES),$(DEB_$(m)))
-DEB_TEST   := python3-h5py python3-numpy python3-pytest
+DEB_TEST   := python3-h5py python3-numpy python3-pytest netcdf-bin
 
 # Goals that need no library: do not probe pkg-config for them.
 NO_PROBE_GOALS := deps clean help
