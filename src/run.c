@@ -184,6 +184,13 @@ int ss_run_case(const struct ss_run_options *o)
 			                    ss_snapshot_count(snap), output);
 			goto out_snapshot;
 		}
+		if (end == SS_ADVANCE_STALLED) {
+			err = ss_error_fail("the time step fell below the resolution of t = %g s "
+			                    "(step %lld): the surface is too steep for this grid; "
+			                    "%lld snapshots are in '%s'", st.time, st.steps,
+			                    ss_snapshot_count(snap), output);
+			goto out_snapshot;
+		}
 		if ((err = write_snapshot(snap, &st, started, &seconds_output)))
 			goto out_snapshot;
 		if (end == SS_ADVANCE_STEADY)

@@ -292,9 +292,11 @@ enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,
 			continue;
 		}
 
-		int lands = st->time + dt >= next_event;
+		const int lands = st->time + dt >= next_event;
 		if (lands)
 			dt = next_event - st->time;
+		else if (st->time + dt == st->time)
+			return SS_ADVANCE_STALLED;
 
 		t0 = now_seconds();
 		st->rate_max = ss_sweep_update(g, &st->tiling, dt, st->flux_x, st->flux_y,

@@ -105,6 +105,7 @@ enum ss_advance_end {
 	SS_ADVANCE_REACHED,     /* time == t_target */
 	SS_ADVANCE_STEADY,      /* max |dh/dt| < steady_tol (when requested) */
 	SS_ADVANCE_NONFINITE,   /* a rate or height became NaN or infinite */
+	SS_ADVANCE_STALLED,     /* dt fell below the resolution of the clock */
 };
 
 struct ss_advance_options {
