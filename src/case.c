@@ -118,18 +118,9 @@ struct parse {
 	char last_region_key[16];  /* for polygon continuation lines */
 };
 
-static int fail_at(struct parse *p, const char *fmt, ...)
-	__attribute__((format(printf, 2, 3)));
-static int fail_at(struct parse *p, const char *fmt, ...)
-{
-	char msg[768];
-	va_list ap;
-	va_start(ap, fmt);
-	vsnprintf(msg, sizeof msg, fmt, ap);
-	va_end(ap);
-	p->failed = 1;
-	return ss_error_input("%s: %s", p->where, msg);
-}
+/* An error in the value being applied: named by its location, and the
+ * first error is the only one reported. */
+#define fail_at(p, ...) ((p)->failed = 1, ss_error_input_at((p)->where, __VA_ARGS__))
 
 /* ---- values ---------------------------------------------------------- */
 

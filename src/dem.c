@@ -4,7 +4,6 @@
 #include "sandslide/dem.h"
 
 #include <ctype.h>
-#include <stdarg.h>
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -14,20 +13,6 @@
 
 #include "sandslide/error.h"
 #include "sandslide/snapshot.h"
-
-/* An input error, prefixed with where the file was named ("case.ini:25: "
- * or ""). */
-static int dem_error(const char *prefix, const char *fmt, ...)
-	__attribute__((format(printf, 2, 3)));
-static int dem_error(const char *prefix, const char *fmt, ...)
-{
-	char msg[1024];
-	va_list ap;
-	va_start(ap, fmt);
-	vsnprintf(msg, sizeof msg, fmt, ap);
-	va_end(ap);
-	return ss_error_input("%s%s", prefix, msg);
-}
 
 void ss_raster_release(struct ss_raster *r)
 {
@@ -70,11 +55,11 @@ static int to_double(const char *t, double *v)
 	return end != t && *end == '\0' && errno != ERANGE ? 0 : -1;
 }
 
-static char *read_text(const char *path, const char *prefix, int *err)
+static char *read_text(const char *path, const char *context, int *err)
 {
 	FILE *f = fopen(path, "rb");
 	if (!f) {
-		*err = dem_error(prefix, "cannot open '%s': %s", path, strerror(errno));
+		*err = ss_error_input_at(context, "cannot open '%s': %s", path, strerror(errno));
 		return NULL;
 	}
 	char *text = NULL;
@@ -100,17 +85,17 @@ static char *read_text(const char *path, const char *prefix, int *err)
 	fclose(f);
 	if (bad) {
 		free(text);
-		*err = dem_error(prefix, "cannot read '%s'", path);
+		*err = ss_error_input_at(context, "cannot read '%s'", path);
 		return NULL;
 	}
 	text[size] = '\0';
 	return text;
 }
 
-static int read_asc(const char *path, const char *prefix, struct ss_raster *r)
+static int read_asc(const char *path, const char *context, struct ss_raster *r)
 {
 	int err = SS_OK;
-	char *text = read_text(path, prefix, &err);
+	char *text = read_text(path, context, &err);
 	if (!text)
 		return err;
 	struct scan sc = {text, 1};
@@ -133,7 +118,7 @@ static int read_asc(const char *path, const char *prefix, struct ss_raster *r)
 		snprintf(key, sizeof key, "%s", tok);
 		int key_line = sc.line;
 		if (!next_token(&sc, tok, sizeof tok) || to_double(tok, &v)) {
-			err = dem_error(prefix, "%s:%d: header key '%s' has no numeric value", path,
+			err = ss_error_input_at(context, "%s:%d: header key '%s' has no numeric value", path,
 			                     key_line, key);
 			goto out;
 		}
@@ -150,7 +135,7 @@ static int read_asc(const char *path, const char *prefix, struct ss_raster *r)
 		else if (!strcasecmp(key, "nodata_value"))
 			nodata = v, have_nodata = 1;
 		else {
-			err = dem_error(prefix, "%s:%d: unknown header key '%s': expected ncols, nrows, "
+			err = ss_error_input_at(context, "%s:%d: unknown header key '%s': expected ncols, nrows, "
 			                     "xllcorner, yllcorner, cellsize, NODATA_value", path,
 			                     key_line, key);
 			goto out;
@@ -160,12 +145,12 @@ static int read_asc(const char *path, const char *prefix, struct ss_raster *r)
 	}
 	if (!(ncols >= 1 && ncols <= 1 << 30 && ncols == floor(ncols)) ||
 	    !(nrows >= 1 && nrows <= 1 << 30 && nrows == floor(nrows))) {
-		err = dem_error(prefix, "%s: ESRI ASCII header needs ncols and nrows, integers >= 1",
+		err = ss_error_input_at(context, "%s: ESRI ASCII header needs ncols and nrows, integers >= 1",
 		                     path);
 		goto out;
 	}
 	if (!(cell > 0.0)) {
-		err = dem_error(prefix, "%s: ESRI ASCII header needs cellsize > 0", path);
+		err = ss_error_input_at(context, "%s: ESRI ASCII header needs cellsize > 0", path);
 		goto out;
 	}
 	r->nx = (int)ncols;
@@ -184,12 +169,12 @@ static int read_asc(const char *path, const char *prefix, struct ss_raster *r)
 		for (int i = 0; i < r->nx; i++) {
 			double v;
 			if (!next_token(&sc, tok, sizeof tok)) {
-				err = dem_error(prefix, "%s: ends after %d of %d x %d values", path,
+				err = ss_error_input_at(context, "%s: ends after %d of %d x %d values", path,
 				                     row * r->nx + i, r->nx, r->ny);
 				goto out;
 			}
 			if (to_double(tok, &v)) {
-				err = dem_error(prefix, "%s:%d: '%s' (row %d, column %d) is not a number",
+				err = ss_error_input_at(context, "%s:%d: '%s' (row %d, column %d) is not a number",
 				                     path, sc.line, tok, row + 1, i + 1);
 				goto out;
 			}
@@ -201,7 +186,7 @@ static int read_asc(const char *path, const char *prefix, struct ss_raster *r)
 				r->nodata[(size_t)j * r->nx + i] = 1;
 				v = 0.0;
 			} else if (!isfinite(v)) {
-				err = dem_error(prefix, "%s:%d: height '%s' (row %d, column %d) is not "
+				err = ss_error_input_at(context, "%s:%d: height '%s' (row %d, column %d) is not "
 				                     "finite: heights must be finite numbers (mark "
 				                     "missing cells with NODATA_value)", path, sc.line,
 				                     tok, row + 1, i + 1);
@@ -211,14 +196,14 @@ static int read_asc(const char *path, const char *prefix, struct ss_raster *r)
 		}
 	}
 	if (next_token(&sc, tok, sizeof tok))
-		err = dem_error(prefix, "%s:%d: more values than ncols x nrows = %d x %d", path,
+		err = ss_error_input_at(context, "%s:%d: more values than ncols x nrows = %d x %d", path,
 		                     sc.line, r->nx, r->ny);
 out:
 	free(text);
 	return err;
 }
 
-static int read_h5(const char *spec, const char *prefix, struct ss_raster *r)
+static int read_h5(const char *spec, const char *context, struct ss_raster *r)
 {
 	/* "file.h5" or "file.h5:/dataset" */
 	char path[4096];
@@ -233,7 +218,7 @@ static int read_h5(const char *spec, const char *prefix, struct ss_raster *r)
 	}
 	FILE *f = fopen(path, "rb");
 	if (!f)
-		return dem_error(prefix, "cannot open '%s': %s", path, strerror(errno));
+		return ss_error_input_at(context, "cannot open '%s': %s", path, strerror(errno));
 	fclose(f);
 	int err = ss_snapshot_read_field(path, dataset, -1, &r->nx, &r->ny, &r->values);
 	if (err)
@@ -242,7 +227,7 @@ static int read_h5(const char *spec, const char *prefix, struct ss_raster *r)
 	const size_t n = (size_t)r->nx * (size_t)r->ny;
 	for (size_t k = 0; k < n; k++) {
 		if (!isfinite(r->values[k]))
-			return dem_error(prefix, "%s: height %g at column %zu, row %zu (from the south) "
+			return ss_error_input_at(context, "%s: height %g at column %zu, row %zu (from the south) "
 			                      "is not finite: heights must be finite numbers", spec,
 			                      r->values[k], k % (size_t)r->nx + 1,
 			                      k / (size_t)r->nx + 1);
@@ -258,14 +243,11 @@ static int has_suffix(const char *s, const char *suffix)
 
 int ss_dem_read(const char *spec, const char *context, struct ss_raster *r)
 {
-	char prefix[512] = "";
-	if (context && *context)
-		snprintf(prefix, sizeof prefix, "%s: ", context);
 	memset(r, 0, sizeof *r);
 	if (has_suffix(spec, ".asc"))
-		return read_asc(spec, prefix, r);
+		return read_asc(spec, context, r);
 	if (has_suffix(spec, ".h5") || strstr(spec, ".h5:"))
-		return read_h5(spec, prefix, r);
-	return dem_error(prefix, "'%s': unknown raster format: expected an ESRI ASCII grid "
+		return read_h5(spec, context, r);
+	return ss_error_input_at(context, "'%s': unknown raster format: expected an ESRI ASCII grid "
 	                      "(.asc) or a sandslide HDF5 file (.h5 or .h5:/dataset)", spec);
 }

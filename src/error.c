@@ -37,6 +37,18 @@ int ss_error_fail(const char *fmt, ...)
 	return r;
 }
 
+int ss_error_input_at(const char *where, const char *fmt, ...)
+{
+	char msg[1024];
+	va_list ap;
+	va_start(ap, fmt);
+	vsnprintf(msg, sizeof msg, fmt, ap);
+	va_end(ap);
+	if (where && *where)
+		return ss_error_input("%s: %s", where, msg);
+	return ss_error_input("%s", msg);
+}
+
 int ss_status_exit_code(int status)
 {
 	if (status == SS_OK)

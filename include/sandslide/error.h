@@ -24,6 +24,11 @@ enum ss_status {
 int ss_error_input(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
 int ss_error_fail(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
 
+/* ss_error_input with a location first: "sandslide: <where>: <message>"
+ * (no location when where is NULL or ""), e.g. where = "case.ini:12". */
+int ss_error_input_at(const char *where, const char *fmt, ...)
+	__attribute__((format(printf, 2, 3)));
+
 /* Exit status of the CLI for a status code: 0, 1 or 2. */
 int ss_status_exit_code(int status);
 
