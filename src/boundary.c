@@ -13,16 +13,6 @@
 static const char *const side_kind_names[] = {"wall", "open", "periodic"};
 static const char *const side_names[] = {"west", "east", "south", "north"};
 
-const char *ss_side_kind_name(enum ss_side_kind kind)
-{
-	return side_kind_names[kind];
-}
-
-const char *ss_side_name(enum ss_side side)
-{
-	return side_names[side];
-}
-
 int ss_side_kind_parse(const char *name, enum ss_side_kind *kind)
 {
 	for (int k = 0; k < 3; k++) {

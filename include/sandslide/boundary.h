@@ -30,10 +30,8 @@ struct ss_boundary {
 	double open_level;          /* height held on open cells and ghosts, m */
 };
 
-/* "wall", "open", "periodic"; parse returns 0 or -1. */
-const char *ss_side_kind_name(enum ss_side_kind kind);
+/* Parse "wall", "open" or "periodic"; returns 0, or -1 if unknown. */
 int ss_side_kind_parse(const char *name, enum ss_side_kind *kind);
-const char *ss_side_name(enum ss_side side);
 
 /* SS_ERR_INPUT unless opposite sides are both periodic or both not. */
 int ss_boundary_check(const struct ss_boundary *b);
