@@ -9,11 +9,6 @@
 #include <math.h>
 #include <stddef.h>
 
-/* Below this many cells a pass runs on one thread: forking and joining the
- * team would cost more than the sweep (measured on cases/door.ini, 2400
- * cells).  The result is the same bits either way. */
-#define PARALLEL_MIN_CELLS 16384
-
 void ss_tiling_init(struct ss_tiling *t, const struct ss_grid *g,
                     int tile_nx, int tile_ny)
 {
@@ -126,11 +121,9 @@ double ss_sweep_fluxes(const struct ss_grid *g, const struct ss_tiling *t,
 {
 	const int tiles = t->tiles_x * t->tiles_y;
 	const enum ss_closure_kind kind = c->kind;
-	const int parallel = (long long)g->nx * g->ny >= PARALLEL_MIN_CELLS;
-	(void)parallel;   /* unused without OpenMP */
 	double s2_max = 0.0;
 
-	#pragma omp parallel for schedule(static) reduction(max:s2_max) if(parallel)
+	#pragma omp parallel for schedule(static) reduction(max:s2_max)
 	for (int tile = 0; tile < tiles; tile++) {
 		const struct tile_span sp = tile_span(g, t, tile);
 		double s2 = 0.0;
@@ -168,11 +161,9 @@ double ss_sweep_update(const struct ss_grid *g, const struct ss_tiling *t,
 	const int tiles = t->tiles_x * t->tiles_y;
 	const ptrdiff_t stride = g->stride;
 	const double inv_dx = 1.0 / g->dx, inv_dy = 1.0 / g->dy;
-	const int parallel = (long long)g->nx * g->ny >= PARALLEL_MIN_CELLS;
-	(void)parallel;   /* unused without OpenMP */
 	double rate_max = 0.0;
 
-	#pragma omp parallel for schedule(static) reduction(max:rate_max) if(parallel)
+	#pragma omp parallel for schedule(static) reduction(max:rate_max)
 	for (int tile = 0; tile < tiles; tile++) {
 		const struct tile_span sp = tile_span(g, t, tile);
 		for (int j = sp.j0; j < sp.j1; j++) {

@@ -789,9 +789,8 @@ struct det_result {
 	long long steps;
 };
 
-/* The grid must exceed the size below which the library runs a pass on one
- * thread (16384 cells in sweep.c when written), or the thread count is not
- * tested at all; 203 x 131 is not a multiple of any tile size used. */
+/* Large enough for several tiles per thread; 203 x 131 is not a multiple
+ * of any tile size used. */
 #define DET_NX 203
 #define DET_NY 131
 

@@ -342,8 +342,8 @@ def test_sigkill_just_after_output_created(tmp_path, delay_ms):
 
 # ---- determinism ---------------------------------------------------------------
 
-# 130 x 128 = 16640 cells: above the size below which the sweeps run on one
-# thread (src/sweep.c PARALLEL_MIN_CELLS), so --threads 2 really splits work.
+# 130 x 128 cells: several default tiles (256 x 32), so --threads 2 really
+# splits the work between threads.
 DETERMINISM = """\
 [grid]
 nx = 130
