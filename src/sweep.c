@@ -1,8 +1,8 @@
 /*
  * sweep.c - the reference two-pass stencil (see sweep.h for the scheme).
  *
- * The closure is a compile-time constant inside each tile routine: the
- * switch on the closure kind happens once per tile, not once per face.
+ * Deliberately plain: one face per call of the face function, fluxes kept
+ * in two full arrays.  The tests hold the fast sweep to it bit for bit.
  */
 #include "sandslide/sweep.h"
 
@@ -59,8 +59,7 @@ static inline double central_difference(const double *restrict h,
  * (east/north): g_n across the face, g_t the mean of both cells' central
  * differences along it (offset `along`).
  */
-static inline double face_flux(enum ss_closure_kind kind,
-                               const struct ss_closure *c,
+static inline double face_flux(const struct ss_face_rule *rule,
                                const double *restrict h,
                                const uint8_t *restrict type, ptrdiff_t a,
                                ptrdiff_t normal, ptrdiff_t along,
@@ -76,74 +75,43 @@ static inline double face_flux(enum ss_closure_kind kind,
 	const double s2 = g_n * g_n + g_t * g_t;
 	if (s2 > *s2_max)
 		*s2_max = s2;
-	return c->nu * ss_closure_face_flux_kind(kind, c, g_n, g_t);
-}
-
-static inline double flux_tile(enum ss_closure_kind kind,
-                               const struct ss_grid *g,
-                               const struct ss_closure *c,
-                               struct tile_span sp,
-                               const double *restrict h,
-                               const uint8_t *restrict type,
-                               double *restrict flux_x,
-                               double *restrict flux_y)
-{
-	const ptrdiff_t stride = g->stride;
-	const double inv_dx = 1.0 / g->dx, inv_dy = 1.0 / g->dy;
-	const double inv_2dx = 0.5 / g->dx, inv_2dy = 0.5 / g->dy;
-	/* the last tile of a row (column) also owns the east (north) face */
-	const int x_end = sp.i1 == g->nx ? sp.i1 + 1 : sp.i1;
-	const int y_end = sp.j1 == g->ny ? sp.j1 + 1 : sp.j1;
-	double s2_max = 0.0;
-
-	for (int j = sp.j0; j < sp.j1; j++) {
-		for (int i = sp.i0; i < x_end; i++) {
-			const ptrdiff_t k = ss_grid_index(g, i, j);
-			flux_x[k] = face_flux(kind, c, h, type, k - 1, 1, stride,
-			                      inv_dx, inv_2dy, &s2_max);
-		}
-	}
-	for (int j = sp.j0; j < y_end; j++) {
-		for (int i = sp.i0; i < sp.i1; i++) {
-			const ptrdiff_t k = ss_grid_index(g, i, j);
-			flux_y[k] = face_flux(kind, c, h, type, k - stride, stride, 1,
-			                      inv_dy, inv_2dx, &s2_max);
-		}
-	}
-	return s2_max;
+	double flux;
+	ss_face_fluxes(rule, 1, &g_n, &g_t, &flux);
+	return flux;
 }
 
 double ss_sweep_fluxes(const struct ss_grid *g, const struct ss_tiling *t,
-                       const struct ss_closure *c,
-                       const double *restrict height,
-                       const uint8_t *restrict cell_type,
+                       const struct ss_face_rule *rule,
+                       const double *restrict h,
+                       const uint8_t *restrict type,
                        double *restrict flux_x, double *restrict flux_y)
 {
 	const int tiles = t->tiles_x * t->tiles_y;
-	const enum ss_closure_kind kind = c->kind;
+	const ptrdiff_t stride = g->stride;
+	const double inv_dx = 1.0 / g->dx, inv_dy = 1.0 / g->dy;
+	const double inv_2dx = 0.5 / g->dx, inv_2dy = 0.5 / g->dy;
 	double s2_max = 0.0;
 
 	#pragma omp parallel for schedule(static) reduction(max:s2_max)
 	for (int tile = 0; tile < tiles; tile++) {
 		const struct tile_span sp = tile_span(g, t, tile);
+		/* the last tile of a row (column) also owns the east (north) face */
+		const int x_end = sp.i1 == g->nx ? sp.i1 + 1 : sp.i1;
+		const int y_end = sp.j1 == g->ny ? sp.j1 + 1 : sp.j1;
 		double s2 = 0.0;
-		switch (kind) {
-		case SS_CLOSURE_COULOMB:
-			s2 = flux_tile(SS_CLOSURE_COULOMB, g, c, sp, height,
-			               cell_type, flux_x, flux_y);
-			break;
-		case SS_CLOSURE_BINGHAM:
-			s2 = flux_tile(SS_CLOSURE_BINGHAM, g, c, sp, height,
-			               cell_type, flux_x, flux_y);
-			break;
-		case SS_CLOSURE_HERSCHEL_BULKLEY:
-			s2 = flux_tile(SS_CLOSURE_HERSCHEL_BULKLEY, g, c, sp, height,
-			               cell_type, flux_x, flux_y);
-			break;
-		case SS_CLOSURE_CASSON:
-			s2 = flux_tile(SS_CLOSURE_CASSON, g, c, sp, height,
-			               cell_type, flux_x, flux_y);
-			break;
+		for (int j = sp.j0; j < sp.j1; j++) {
+			for (int i = sp.i0; i < x_end; i++) {
+				const ptrdiff_t k = ss_grid_index(g, i, j);
+				flux_x[k] = face_flux(rule, h, type, k - 1, 1, stride,
+				                      inv_dx, inv_2dy, &s2);
+			}
+		}
+		for (int j = sp.j0; j < y_end; j++) {
+			for (int i = sp.i0; i < sp.i1; i++) {
+				const ptrdiff_t k = ss_grid_index(g, i, j);
+				flux_y[k] = face_flux(rule, h, type, k - stride, stride, 1,
+				                      inv_dy, inv_2dx, &s2);
+			}
 		}
 		if (s2 > s2_max)
 			s2_max = s2;

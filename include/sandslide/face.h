@@ -1,0 +1,66 @@
+/*
+ * face.h - the point-wise face flux that every sweep calls (SPEC section 2):
+ *
+ *   F = -nu f_sl(s) g_n / s,   s = sqrt(g_n^2 + g_t^2),   0 when s <= tan a_cr
+ *
+ * rewritten so that a face needs no division and no square root, only the
+ * two reciprocal square roots 1/s and 1/w, w = sqrt(1 + s^2):
+ *
+ *   sin a = s / w,  b = sin a / sin a_cr,  1/b = w sin a_cr / s
+ *   coulomb      f/s = max(s - tan a_cr, 0) / (w s)
+ *   bingham      f/s = (1/b)(2 + 1/b) e^2 / s,                 e = max(b - 1, 0)
+ *   h-bulkley    f/s = (1/b)(1 + gamma + gamma/b) e^(1+1/gamma) / s
+ *   casson       f/s = (1/b)^2 (10 b q + 6 b + 3 q + 1) e^3 / s, q = sqrt b,
+ *                                                                e = max(q - 1, 0)
+ *
+ * With AVX-512 the reciprocal square roots are vrsqrt14pd refined by two
+ * Newton steps (relative error below 1e-15 against 1/sqrt); elsewhere they
+ * are 1/sqrt.  Herschel-Bulkley with gamma = 1/2 (e^3) and gamma = 2
+ * (e sqrt e) avoids pow().  tests/test_face.c holds these to the formulas of
+ * closure.h (SPEC section 1).
+ *
+ * The function is compiled once (face.c) and works on a row of faces, so the
+ * reference sweep (one face per call) and the fast sweep (a row per call)
+ * run the same instructions on every face: the same bits.
+ */
+#ifndef SANDSLIDE_FACE_H
+#define SANDSLIDE_FACE_H
+
+#include "sandslide/closure.h"
+
+/* The formula a sweep instantiates; a Herschel-Bulkley power with a short
+ * exact form gets its own. */
+enum ss_face_form {
+	SS_FACE_COULOMB,
+	SS_FACE_BINGHAM,
+	SS_FACE_HB_POW,            /* e^p by pow() */
+	SS_FACE_HB_CUBE,           /* gamma = 1/2: e^3 */
+	SS_FACE_HB_THREE_HALVES,   /* gamma = 2: e sqrt(e) */
+	SS_FACE_CASSON,
+};
+
+struct ss_face_rule {
+	enum ss_face_form form;
+	double nu;                 /* m^2/s */
+	double tan_cr, tan_cr2;    /* tan a_cr and its square */
+	double sin_cr, inv_sin_cr;
+	double gamma, power;       /* Herschel-Bulkley */
+};
+
+void ss_face_rule_init(struct ss_face_rule *r, const struct ss_closure *c);
+
+/* flux[k] = F of the face with normal gradient g_n[k] and tangential
+ * gradient g_t[k], k < n (m^2/s; g dimensionless).  Exactly 0 where
+ * g_n^2 + g_t^2 <= tan^2 a_cr.  Returns 1 if some face is above that
+ * slope, else 0. */
+int ss_face_fluxes(const struct ss_face_rule *r, int n,
+                    const double *restrict g_n, const double *restrict g_t,
+                    double *restrict flux);
+
+/* y[k] = 1/sqrt(x[k]) for x[k] > 0, k < n, as the face flux computes it. */
+void ss_face_rsqrt(int n, const double *restrict x, double *restrict y);
+
+/* "vrsqrt14pd + 2 Newton steps (AVX-512)" or "1/sqrt", for reports. */
+const char *ss_face_rsqrt_method(void);
+
+#endif
