@@ -6,10 +6,12 @@
 #include <errno.h>
 #include <limits.h>
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "sandslide/bench.h"
 #include "sandslide/error.h"
 #include "sandslide/parallel.h"
 #include "sandslide/run.h"
@@ -24,6 +26,7 @@ static const char usage_main[] =
 	"commands:\n"
 	"  run CASE.ini     run a case, writing HDF5 snapshots\n"
 	"  info FILE.h5     summarise an output file\n"
+	"  bench            measure the sweep's throughput on synthetic surfaces\n"
 	"\n"
 	"  sandslide --version    print the version\n"
 	"  sandslide CMD --help   options of a command\n";
@@ -36,8 +39,10 @@ static const char usage_run[] =
 	"  --threads N           OpenMP threads (default: all processors)\n"
 	"  --set S.K=VALUE       override key K of section S of the case, e.g.\n"
 	"                        --set model.closure=casson, --set 'source pour.rate=0.002'\n"
-	"  --tile NXxNY          cells per tile of the sweep (default 256x32); results\n"
+	"  --tile NXxNY          cells per tile of the sweep (default 256x64); results\n"
 	"                        are the same bits for any tile size and thread count\n"
+	"  --reference-kernel    use the plain two-pass sweep the fast one is tested\n"
+	"                        against (same bits, several times slower)\n"
 	"  --deflate N           HDF5 deflate level of /height, 0 (off, default) to 9\n"
 	"  -q, --quiet           no progress line and no summary\n"
 	"\n"
@@ -49,6 +54,25 @@ static const char usage_info[] =
 	"\n"
 	"Prints the grid, model, cell counts and the diagnostics of every snapshot\n"
 	"(first and last ten when there are more than twenty).\n";
+
+static const char usage_bench[] =
+	"usage: sandslide bench [--nx N] [--ny N] [--closure NAME|all] [--threads 1,2]\n"
+	"                       [--surface NAME|all] [--repeats N] [--steps N] [--tile NXxNY]\n"
+	"                       [--json]\n"
+	"\n"
+	"  --nx N, --ny N        grid size (default 8192 x 8192)\n"
+	"  --closure NAME|all    coulomb, bingham, herschel-bulkley (gamma 0.5 and 2),\n"
+	"                        casson, or all (default)\n"
+	"  --threads LIST        thread counts, comma-separated (default 1,2)\n"
+	"  --surface NAME|all    supercritical (every face slides), subcritical (none\n"
+	"                        does), patch (a 512 x 512 ramp on a flat floor), all\n"
+	"  --repeats N           timings per case (default 5); median, min and max\n"
+	"  --steps N             steps per timing (default: about 0.3 s worth)\n"
+	"  --tile NXxNY          tile size of the sweep (default 256x64)\n"
+	"  --json                one JSON document instead of a table\n"
+	"\n"
+	"Also measures the memory bandwidth (read+write of one array) in the same run\n"
+	"and reports the fraction of that roofline each case reaches.\n";
 
 static int usage_error(const char *usage, const char *fmt, const char *arg)
 {
@@ -88,6 +112,117 @@ static char *join_args(int argc, char **argv)
 	return s;
 }
 
+/* "NXxNY" into two positive ints; -1 if malformed. */
+static int parse_tile(const char *s, int *tx, int *ty)
+{
+	const char *x = s ? strchr(s, 'x') : NULL;
+	char buf[32];
+	if (!x || x - s >= (ptrdiff_t)sizeof buf)
+		return -1;
+	snprintf(buf, sizeof buf, "%.*s", (int)(x - s), s);
+	return parse_int(buf, 1, 1 << 20, tx) || parse_int(x + 1, 1, 1 << 20, ty) ? -1 : 0;
+}
+
+static int add_bench_closure(struct ss_bench_options *o, enum ss_closure_kind kind,
+                             double gamma)
+{
+	struct ss_bench_closure *c = &o->closures[o->closure_count++];
+	c->kind = kind;
+	c->gamma = gamma;
+	if (kind == SS_CLOSURE_HERSCHEL_BULKLEY)
+		snprintf(c->label, sizeof c->label, "herschel-bulkley(%g)", gamma);
+	else
+		snprintf(c->label, sizeof c->label, "%s", ss_closure_name(kind));
+	return 0;
+}
+
+static int cmd_bench(int argc, char **argv)
+{
+	struct ss_bench_options o = {0};
+	const char *closure = "all", *surface = "all", *threads = "1,2";
+	o.nx = o.ny = 8192;
+	o.repeats = 5;
+	for (int k = 2; k < argc; k++) {
+		const char *a = argv[k], *next = k + 1 < argc ? argv[k + 1] : NULL;
+		if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+			fputs(usage_bench, stdout);
+			return 0;
+		} else if (!strcmp(a, "--json")) {
+			o.json = 1;
+		} else if (!strcmp(a, "--nx") || !strcmp(a, "--ny")) {
+			if (!next || parse_int(next, 1, 1 << 20, a[3] == 'x' ? &o.nx : &o.ny))
+				return usage_error(usage_bench, "%s: expected a cell count from 1 to "
+				                   "1048576", a);
+			k++;
+		} else if (!strcmp(a, "--repeats")) {
+			if (!next || parse_int(next, 1, 64, &o.repeats))
+				return usage_error(usage_bench, "--repeats '%s': expected 1 to 64",
+				                   next ? next : "");
+			k++;
+		} else if (!strcmp(a, "--steps")) {
+			if (!next || parse_int(next, 1, 1000000, &o.steps))
+				return usage_error(usage_bench, "--steps '%s': expected 1 to 1000000",
+				                   next ? next : "");
+			k++;
+		} else if (!strcmp(a, "--tile")) {
+			if (!next || parse_tile(next, &o.tile_nx, &o.tile_ny))
+				return usage_error(usage_bench, "--tile '%s': expected NXxNY, e.g. 256x64",
+				                   next ? next : "");
+			k++;
+		} else if (!strcmp(a, "--closure") && next) {
+			closure = argv[++k];
+		} else if (!strcmp(a, "--surface") && next) {
+			surface = argv[++k];
+		} else if (!strcmp(a, "--threads") && next) {
+			threads = argv[++k];
+		} else {
+			return usage_error(usage_bench, "unknown option or missing value: '%s'", a);
+		}
+	}
+
+	enum ss_closure_kind kind;
+	if (!strcmp(closure, "all")) {
+		add_bench_closure(&o, SS_CLOSURE_COULOMB, 1.0);
+		add_bench_closure(&o, SS_CLOSURE_BINGHAM, 1.0);
+		add_bench_closure(&o, SS_CLOSURE_HERSCHEL_BULKLEY, 0.5);
+		add_bench_closure(&o, SS_CLOSURE_HERSCHEL_BULKLEY, 2.0);
+		add_bench_closure(&o, SS_CLOSURE_CASSON, 1.0);
+	} else if (!strcmp(closure, "herschel-bulkley")) {
+		add_bench_closure(&o, SS_CLOSURE_HERSCHEL_BULKLEY, 0.5);
+		add_bench_closure(&o, SS_CLOSURE_HERSCHEL_BULKLEY, 2.0);
+	} else if (ss_closure_parse(closure, &kind) == 0) {
+		add_bench_closure(&o, kind, 1.0);
+	} else {
+		return usage_error(usage_bench, "--closure '%s': expected all, "
+		                   SS_CLOSURE_NAMES, closure);
+	}
+
+	int matched = 0;
+	for (int s = 0; s < SS_BENCH_SURFACES; s++) {
+		o.surfaces[s] = !strcmp(surface, "all") ||
+		                !strcmp(surface, ss_bench_surface_name((enum ss_bench_surface)s));
+		matched |= o.surfaces[s];
+	}
+	if (!matched)
+		return usage_error(usage_bench, "--surface '%s': expected all, supercritical, "
+		                   "subcritical or patch", surface);
+
+	for (const char *p = threads; *p;) {
+		char buf[16];
+		size_t len = strcspn(p, ",");
+		if (len == 0 || len >= sizeof buf || o.thread_count == SS_BENCH_MAX_CASES)
+			return usage_error(usage_bench, "--threads '%s': expected a list such as "
+			                   "1,2 (at most 8 entries)", threads);
+		memcpy(buf, p, len);
+		buf[len] = '\0';
+		if (parse_int(buf, 1, 4096, &o.threads[o.thread_count++]))
+			return usage_error(usage_bench, "--threads '%s': expected a list such as "
+			                   "1,2 (at most 8 entries)", threads);
+		p += len + (p[len] == ',');
+	}
+	return ss_status_exit_code(ss_bench_run(&o));
+}
+
 static int cmd_run(int argc, char **argv)
 {
 	struct ss_run_options o = {0};
@@ -125,21 +260,11 @@ static int cmd_run(int argc, char **argv)
 		} else if (!strncmp(a, "--set=", 6)) {
 			overrides[o.override_count++] = a + 6;
 		} else if (!strcmp(a, "--tile")) {
-			char *x = next ? strchr(next, 'x') : NULL;
-			int tx = 0, ty = 0;
-			if (x) {
-				char buf[32];
-				snprintf(buf, sizeof buf, "%.*s", (int)(x - next), next);
-				if (parse_int(buf, 1, 1 << 20, &tx) || parse_int(x + 1, 1, 1 << 20, &ty))
-					x = NULL;
-			}
-			if (!x) {
-				status = usage_error(usage_run, "--tile '%s': expected NXxNY, e.g. 256x32",
+			if (!next || parse_tile(next, &o.tile_nx, &o.tile_ny)) {
+				status = usage_error(usage_run, "--tile '%s': expected NXxNY, e.g. 256x64",
 				                     next ? next : "");
 				goto out;
 			}
-			o.tile_nx = tx;
-			o.tile_ny = ty;
 			k++;
 		} else if (!strcmp(a, "--deflate")) {
 			if (!next || parse_int(next, 0, 9, &o.deflate)) {
@@ -150,6 +275,8 @@ static int cmd_run(int argc, char **argv)
 			k++;
 		} else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
 			o.quiet = 1;
+		} else if (!strcmp(a, "--reference-kernel")) {
+			o.reference_kernel = 1;
 		} else if (a[0] == '-' && a[1]) {
 			status = usage_error(usage_run, "unknown option '%s'", a);
 			goto out;
@@ -262,5 +389,8 @@ int main(int argc, char **argv)
 		return cmd_run(argc, argv);
 	if (!strcmp(cmd, "info"))
 		return cmd_info(argc, argv);
-	return usage_error(usage_main, "unknown command '%s': expected run or info", cmd);
+	if (!strcmp(cmd, "bench"))
+		return cmd_bench(argc, argv);
+	return usage_error(usage_main, "unknown command '%s': expected run, info or bench",
+	                   cmd);
 }

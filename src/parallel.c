@@ -33,3 +33,12 @@ int ss_parallel_processors(void)
 	return 1;
 #endif
 }
+
+int ss_parallel_thread_id(void)
+{
+#ifdef _OPENMP
+	return omp_get_thread_num();
+#else
+	return 0;
+#endif
+}

@@ -63,7 +63,7 @@ static int initial_heights(const struct ss_case *c, struct ss_stepper *st)
 }
 
 int ss_setup_stepper(const struct ss_case *c, int tile_nx, int tile_ny,
-                     struct ss_stepper *st)
+                     enum ss_kernel kernel, struct ss_stepper *st)
 {
 	struct ss_grid g;
 	struct ss_closure closure;
@@ -83,6 +83,7 @@ int ss_setup_stepper(const struct ss_case *c, int tile_nx, int tile_ny,
 		err = ss_stepper_init(st, &g, &closure, &c->boundary, c->cfl, tile_nx, tile_ny);
 	if (err)
 		return err;
+	st->kernel = kernel;
 
 	uint8_t *mask = ss_alloc((size_t)g.nx * (size_t)g.ny, 1, "region mask");
 	if (!mask) {

@@ -10,6 +10,7 @@
 #include <time.h>
 
 #include "sandslide/error.h"
+#include "sandslide/parallel.h"
 
 static double now_seconds(void)
 {
@@ -20,8 +21,9 @@ static double now_seconds(void)
 
 double ss_stepper_memory_bytes(const struct ss_grid *g)
 {
-	/* height, flux_x, flux_y, source_rate (doubles) and the type byte */
-	return (double)ss_grid_storage_cells(g) * (4.0 * sizeof(double) + 1.0);
+	/* height and source_rate (doubles) and the type byte; the fast sweep's
+	 * ring rows and buffers are below 1 % of that */
+	return (double)ss_grid_storage_cells(g) * (2.0 * sizeof(double) + 1.0);
 }
 
 int ss_stepper_init(struct ss_stepper *st, const struct ss_grid *g,
@@ -40,16 +42,16 @@ int ss_stepper_init(struct ss_stepper *st, const struct ss_grid *g,
 	st->boundary = *b;
 	st->cfl = cfl;
 	ss_cfl_bound_init(&st->cfl_bound, c);
+	ss_face_rule_init(&st->face_rule, c);
 	ss_tiling_init(&st->tiling, g, tile_nx, tile_ny);
+	st->tile_nx = tile_nx;
+	st->tile_ny = tile_ny;
 
 	const size_t n = ss_grid_storage_cells(g);
 	st->height = ss_alloc(n, sizeof(double), "heights");
 	st->cell_type = ss_alloc(n, sizeof(uint8_t), "cell types");
-	st->flux_x = ss_alloc(n, sizeof(double), "x-face fluxes");
-	st->flux_y = ss_alloc(n, sizeof(double), "y-face fluxes");
 	st->row_scratch = ss_alloc((size_t)g->ny, sizeof(double), "row sums");
-	if (!st->height || !st->cell_type || !st->flux_x || !st->flux_y ||
-	    !st->row_scratch) {
+	if (!st->height || !st->cell_type || !st->row_scratch) {
 		ss_stepper_release(st);
 		return SS_ERR_FAIL;
 	}
@@ -62,6 +64,8 @@ void ss_stepper_release(struct ss_stepper *st)
 		ss_free(st->sources[k].cells);
 	ss_free(st->sources);
 	ss_free(st->open_faces);
+	ss_free(st->open_flux);
+	ss_fast_sweep_release(&st->fast);
 	ss_free(st->source_rate);
 	ss_free(st->row_scratch);
 	ss_free(st->flux_y);
@@ -157,6 +161,8 @@ int ss_stepper_prepare(struct ss_stepper *st)
 				st->height[k] = st->boundary.open_level;
 			else if (st->cell_type[k] == SS_CELL_WALL)
 				st->height[k] = 0.0;
+			else if (st->height[k] == 0.0)
+				st->height[k] = 0.0;   /* no -0: h + 0 then keeps every bit */
 			if (!isfinite(st->height[k]))
 				return ss_error_input("initial height of cell (%d, %d) at x = %g m, "
 				                      "y = %g m is %g: heights must be finite",
@@ -171,7 +177,36 @@ int ss_stepper_prepare(struct ss_stepper *st)
 		if (!st->source_rate)
 			return SS_ERR_FAIL;
 	}
-	return open_faces_build(st);
+	int err = open_faces_build(st);
+	if (err)
+		return err;
+	if (st->kernel == SS_KERNEL_REFERENCE) {
+		const size_t n = ss_grid_storage_cells(g);
+		st->flux_x = ss_alloc(n, sizeof(double), "x-face fluxes");
+		st->flux_y = ss_alloc(n, sizeof(double), "y-face fluxes");
+		return st->flux_x && st->flux_y ? SS_OK : SS_ERR_FAIL;
+	}
+	st->open_flux = ss_alloc(st->open_face_count ? st->open_face_count : 1,
+	                         sizeof(double), "open-face fluxes");
+	if (!st->open_flux)
+		return SS_ERR_FAIL;
+	err = ss_fast_sweep_init(&st->fast, g, st->tile_nx, st->tile_ny,
+	                         ss_parallel_max_threads(),
+	                         st->boundary.side[SS_WEST] == SS_SIDE_PERIODIC,
+	                         st->boundary.side[SS_SOUTH] == SS_SIDE_PERIODIC,
+	                         st->cell_type, st->open_faces, st->open_face_count);
+	if (err)
+		return err;
+	st->tiling = st->fast.tiling;
+	ss_fast_sweep_wake_all(&st->fast, g, st->height, st->cell_type);
+	return SS_OK;
+}
+
+void ss_stepper_heights_changed(struct ss_stepper *st)
+{
+	ss_boundary_fill_heights(&st->grid, &st->boundary, st->height);
+	if (st->kernel == SS_KERNEL_FAST)
+		ss_fast_sweep_wake_all(&st->fast, &st->grid, st->height, st->cell_type);
 }
 
 double ss_stepper_next_source_event(const struct ss_stepper *st, double t)
@@ -202,8 +237,11 @@ static void sources_update(struct ss_stepper *st)
 	st->sources_on = on;
 	st->source_rate_max = 0.0;
 	st->source_volume_rate = 0.0;
-	if (!on)
+	if (!on) {
+		if (st->kernel == SS_KERNEL_FAST)
+			ss_fast_sweep_mark_sources(&st->fast, &st->grid, NULL);
 		return;
+	}
 	const size_t n = ss_grid_storage_cells(&st->grid);
 	memset(st->source_rate, 0, n * sizeof(double));
 	for (int k = 0; k < st->source_count; k++) {
@@ -221,6 +259,8 @@ static void sources_update(struct ss_stepper *st)
 	}
 	st->source_rate_max = rate_max;
 	st->source_volume_rate = volume_rate * st->grid.dx * st->grid.dy;
+	if (st->kernel == SS_KERNEL_FAST)
+		ss_fast_sweep_mark_sources(&st->fast, &st->grid, st->source_rate);
 }
 
 /* Neumaier's compensated sum: *sum + *carry holds the total of every term
@@ -236,16 +276,18 @@ static void add_compensated(double *sum, double *carry, double term)
 }
 
 /* Volume leaving through open faces per second with the current fluxes;
- * summed in list order, so the same bits for any thread count. */
+ * summed in list order, so the same bits for any thread count and kernel. */
 static double outflow_rate(const struct ss_stepper *st)
 {
 	double sum_x = 0.0, sum_y = 0.0;
 	for (size_t m = 0; m < st->open_face_count; m++) {
 		const struct ss_open_face *f = &st->open_faces[m];
+		const double flux = st->kernel == SS_KERNEL_FAST ? st->open_flux[m]
+		                  : f->axis == 0 ? st->flux_x[f->index] : st->flux_y[f->index];
 		if (f->axis == 0)
-			sum_x += f->sign * st->flux_x[f->index];
+			sum_x += f->sign * flux;
 		else
-			sum_y += f->sign * st->flux_y[f->index];
+			sum_y += f->sign * flux;
 	}
 	return sum_x * st->grid.dy + sum_y * st->grid.dx;
 }
@@ -258,7 +300,10 @@ enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,
 	const double tiles = (double)st->tiling.tiles_x * st->tiling.tiles_y;
 	const double source_rise = st->cfl * st->closure.tan_cr * fmin(g->dx, g->dy);
 
+	long long steps_left = o->max_steps > 0 ? o->max_steps : -1;
 	while (st->time < t_target) {
+		if (steps_left == 0)
+			return SS_ADVANCE_STEPS;
 		sources_update(st);
 		const double next_switch = ss_stepper_next_source_event(st, st->time);
 		/* a state is steady only if no source will switch on later */
@@ -267,11 +312,11 @@ enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,
 
 		ss_boundary_fill_heights(g, &st->boundary, st->height);
 		double t0 = now_seconds();
-		const double s_max = ss_sweep_fluxes(g, &st->tiling, &st->closure,
-		                                     st->height, st->cell_type,
-		                                     st->flux_x, st->flux_y);
-		st->seconds_fluxes += now_seconds() - t0;
-		st->tile_slots += tiles;
+		const double s_max = st->kernel == SS_KERNEL_FAST
+			? ss_fast_sweep_begin(&st->fast, g, st->height, st->cell_type)
+			: ss_sweep_fluxes(g, &st->tiling, &st->face_rule, st->height,
+			                  st->cell_type, st->flux_x, st->flux_y);
+		st->seconds_measure += now_seconds() - t0;
 		if (!isfinite(s_max)) {
 			st->rate_max = NAN;
 			return SS_ADVANCE_NONFINITE;
@@ -299,11 +344,19 @@ enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,
 			return SS_ADVANCE_STALLED;
 
 		t0 = now_seconds();
-		st->rate_max = ss_sweep_update(g, &st->tiling, dt, st->flux_x, st->flux_y,
-		                               st->sources_on ? st->source_rate : NULL,
-		                               st->cell_type, st->height);
-		st->seconds_update += now_seconds() - t0;
-		st->tile_sweeps += tiles;
+		if (st->kernel == SS_KERNEL_FAST) {
+			st->tile_sweeps += ss_fast_sweep_awake(&st->fast);
+			st->rate_max = ss_fast_sweep_step(&st->fast, g, &st->face_rule, dt,
+			                                  st->sources_on ? st->source_rate : NULL,
+			                                  st->cell_type, st->height, st->open_flux);
+		} else {
+			st->tile_sweeps += tiles;
+			st->rate_max = ss_sweep_update(g, &st->tiling, dt, st->flux_x, st->flux_y,
+			                               st->sources_on ? st->source_rate : NULL,
+			                               st->cell_type, st->height);
+		}
+		st->seconds_sweep += now_seconds() - t0;
+		st->tile_slots += tiles;
 		add_compensated(&st->outflow_sum, &st->outflow_carry, dt * outflow_rate(st));
 		add_compensated(&st->inflow_sum, &st->inflow_carry,
 		                dt * st->source_volume_rate);
@@ -311,6 +364,7 @@ enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,
 		st->inflow = st->inflow_sum + st->inflow_carry;
 		st->time = lands ? next_event : st->time + dt;
 		st->steps++;
+		steps_left--;
 
 		if (o->progress)
 			o->progress(o->context, st);
@@ -349,8 +403,7 @@ void ss_stepper_diagnostics(struct ss_stepper *st, struct ss_diagnostics *d)
 		volume += row_volume[j];
 
 	ss_boundary_fill_heights(g, &st->boundary, st->height);
-	const double s_max = ss_sweep_fluxes(g, &st->tiling, &st->closure, st->height,
-	                                     st->cell_type, st->flux_x, st->flux_y);
+	const double s_max = ss_sweep_max_slope(g, st->height, st->cell_type);
 	d->volume = volume * g->dx * g->dy;
 	d->inflow = st->inflow;
 	d->outflow = st->outflow;

@@ -9,6 +9,8 @@
 int ss_parallel_max_threads(void);
 /* Use n threads (n >= 1) from now on. */
 void ss_parallel_set_threads(int n);
+/* Number of the calling thread in its parallel region (0 outside). */
+int ss_parallel_thread_id(void);
 /* Processors available to this process. */
 int ss_parallel_processors(void);
 

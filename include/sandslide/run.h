@@ -16,6 +16,7 @@ struct ss_run_options {
 	int override_count;
 	int threads;                 /* <= 0: all processors */
 	int tile_nx, tile_ny;        /* <= 0: defaults */
+	int reference_kernel;        /* use the reference sweep (sweep.h) */
 	int deflate;                 /* HDF5 deflate level 0..9 */
 	int quiet;                   /* no progress, no summary */
 	const char *history;         /* the command line, for the file */

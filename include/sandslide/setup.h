@@ -10,10 +10,10 @@
 #include "sandslide/stepper.h"
 
 /* Initialise st for case c with tiles of tile_nx x tile_ny cells (<= 0:
- * defaults).  SS_ERR_INPUT names the key at fault (a region that covers no
+ * defaults) and the given kernel.  SS_ERR_INPUT names the key at fault (a region that covers no
  * cell, an initial file of the wrong size, too little memory).  On error st
  * is released. */
 int ss_setup_stepper(const struct ss_case *c, int tile_nx, int tile_ny,
-                     struct ss_stepper *st);
+                     enum ss_kernel kernel, struct ss_stepper *st);
 
 #endif

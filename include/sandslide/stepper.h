@@ -1,10 +1,13 @@
 /*
  * stepper.h - time integration of the DPSM on one block (SPEC section 2).
  *
- * Each substep: fill the halo -> face fluxes and the largest face slope S
- * (sweep pass 1) -> dt from the CFL bound -> clip dt to the next event
- * (target time, a source switching on or off) -> update (sweep pass 2) ->
- * account inflow and outflow.  The step is forward Euler with
+ * Each substep: fill the halo -> the largest face slope S of the current
+ * state -> dt from the CFL bound -> clip dt to the next event (target time,
+ * a source switching on or off) -> the sweep -> account inflow and outflow.
+ * The fast sweep (default) measures S as a by-product of the previous sweep
+ * and updates in place over the active tiles; the reference sweep computes
+ * every flux into two arrays, then updates (sweep.h).  Both give the same
+ * bits.  The step is forward Euler with
  *
  *   dt = cfl / (2 nu Lambda(S) (1/dx^2 + 1/dy^2))              [SPEC 2]
  *
@@ -35,24 +38,27 @@ struct ss_source {
 	size_t cell_count;
 };
 
-/* A face between an interior flow cell and an open cell. */
-struct ss_open_face {
-	ptrdiff_t index;        /* index into flux_x or flux_y */
-	int8_t axis;            /* 0: flux_x, 1: flux_y */
-	int8_t sign;            /* +1 if positive flux leaves the flow cell */
+enum ss_kernel {
+	SS_KERNEL_FAST,         /* in place, active tiles (sweep_fast.c) */
+	SS_KERNEL_REFERENCE,    /* two passes, two flux arrays (sweep.c) */
 };
 
 struct ss_stepper {
 	struct ss_grid grid;
 	struct ss_tiling tiling;
 	struct ss_closure closure;
+	struct ss_face_rule face_rule;
+	enum ss_kernel kernel;        /* set before ss_stepper_prepare */
+	int tile_nx, tile_ny;         /* as requested (< 1: defaults) */
+	struct ss_fast_sweep fast;
 	struct ss_cfl_bound cfl_bound;
 	struct ss_boundary boundary;
 	double cfl;                   /* in (0, 1] */
 
 	double *height;               /* m, cells with halo (ss_grid_index) */
 	uint8_t *cell_type;           /* enum ss_cell_type, with halo */
-	double *flux_x, *flux_y;      /* m^2/s per face, see sweep.h */
+	double *flux_x, *flux_y;      /* m^2/s per face (reference kernel only) */
+	double *open_flux;            /* m^2/s per open face (fast kernel only) */
 	double *source_rate;          /* m/s, with halo; NULL without sources */
 	double *row_scratch;          /* ny per-row partial sums */
 
@@ -72,7 +78,8 @@ struct ss_stepper {
 	double outflow_sum, outflow_carry;
 	double rate_max;              /* max |dh/dt| of the last substep, m/s */
 	double tile_sweeps, tile_slots; /* for active_fraction, since last reset */
-	double seconds_fluxes, seconds_update; /* kernel wall time, s */
+	double seconds_measure;       /* kernel wall time, s: measuring S */
+	double seconds_sweep;         /*   and sweeping */
 };
 
 #define SS_MAX_SOURCES 64
@@ -85,7 +92,8 @@ int ss_stepper_init(struct ss_stepper *st, const struct ss_grid *g,
                     double cfl, int tile_nx, int tile_ny);
 void ss_stepper_release(struct ss_stepper *st);
 
-/* Bytes ss_stepper_init allocates for grid g (for the memory check). */
+/* Bytes the stepper allocates for grid g with the fast kernel (for the
+ * memory check). */
 double ss_stepper_memory_bytes(const struct ss_grid *g);
 
 /* Add a source of rate m/s on the cells where mask (nx * ny, row-major,
@@ -95,8 +103,9 @@ int ss_stepper_add_source(struct ss_stepper *st, const uint8_t *mask,
                           double rate, double start, double stop);
 
 /* Call once heights and interior cell types are set: fills the halo types,
- * holds open cells at the open level, lists the outflow faces.  Returns
- * SS_ERR_INPUT naming the first non-finite height. */
+ * holds open cells at the open level, lists the outflow faces, sets up the
+ * kernel chosen in st->kernel.  Returns SS_ERR_INPUT naming the first
+ * non-finite height. */
 int ss_stepper_prepare(struct ss_stepper *st);
 
 /* How ss_stepper_advance ended.  Steady needs max |dh/dt| < steady_tol and
@@ -106,10 +115,12 @@ enum ss_advance_end {
 	SS_ADVANCE_STEADY,      /* max |dh/dt| < steady_tol (when requested) */
 	SS_ADVANCE_NONFINITE,   /* a rate or height became NaN or infinite */
 	SS_ADVANCE_STALLED,     /* dt fell below the resolution of the clock */
+	SS_ADVANCE_STEPS,       /* took max_steps substeps */
 };
 
 struct ss_advance_options {
 	double steady_tol;      /* m/s; stop when max |dh/dt| < it; <= 0: never */
+	long long max_steps;    /* > 0: stop after this many substeps */
 	void (*progress)(void *context, const struct ss_stepper *st);
 	void *context;          /* passed to progress, called after each substep */
 };
@@ -120,6 +131,10 @@ enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,
 /* Volume, maxima and counters of the current state; wall_seconds is left to
  * the caller.  Resets the active_fraction counters. */
 void ss_stepper_diagnostics(struct ss_stepper *st, struct ss_diagnostics *d);
+
+/* Tell the stepper that heights were changed from outside (every tile is
+ * swept and measured again). */
+void ss_stepper_heights_changed(struct ss_stepper *st);
 
 /* Time of the next source switch after t (INFINITY if none). */
 double ss_stepper_next_source_event(const struct ss_stepper *st, double t);

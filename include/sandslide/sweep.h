@@ -24,6 +24,7 @@
 #include <stdint.h>
 
 #include "sandslide/closure.h"
+#include "sandslide/face.h"
 #include "sandslide/grid.h"
 
 struct ss_tiling {
@@ -32,7 +33,7 @@ struct ss_tiling {
 };
 
 #define SS_TILE_NX_DEFAULT 256
-#define SS_TILE_NY_DEFAULT 32
+#define SS_TILE_NY_DEFAULT 64
 
 /* Cover g with tiles of tile_nx x tile_ny cells (the last ones may be
  * smaller); sizes < 1 mean the defaults. */
@@ -47,7 +48,7 @@ void ss_tiling_init(struct ss_tiling *t, const struct ss_grid *g,
  * faces that can carry flux (0 when there are none).
  */
 double ss_sweep_fluxes(const struct ss_grid *g, const struct ss_tiling *t,
-                       const struct ss_closure *c,
+                       const struct ss_face_rule *rule,
                        const double *restrict height,
                        const uint8_t *restrict cell_type,
                        double *restrict flux_x, double *restrict flux_y);
@@ -63,5 +64,118 @@ double ss_sweep_update(const struct ss_grid *g, const struct ss_tiling *t,
                        const double *restrict source_rate,
                        const uint8_t *restrict cell_type,
                        double *restrict height);
+
+/*
+ * The largest slope s over the faces that can carry flux (as pass 1 returns
+ * it), without computing fluxes; NaN if a height is NaN.  For diagnostics
+ * and to start the fast sweep's running measure.
+ */
+double ss_sweep_max_slope(const struct ss_grid *g, const double *restrict height,
+                          const uint8_t *restrict cell_type);
+
+/*
+ * The fast sweep (sweep_fast.c): one in-place pass per step over the tiles
+ * that can move, with the same face function and update as the reference.
+ *
+ * Tiles are processed a tile row at a time by one thread, west to east, row
+ * by row, from three old rows held in a small buffer; the old values of the
+ * neighbouring tile rows' edge rows are saved before the pass (ring_south,
+ * ring_north), the old east column of a tile is carried to the next one.
+ * So the heights are the only grid-sized array: 8 B per cell plus the type
+ * byte plus 2 rows per tile row.
+ *
+ * The time step needs the largest face slope of the current state before
+ * the pass.  It is measured without another pass over the grid: a tile
+ * measures its interior faces of the new state one row behind its update,
+ * while the rows are in cache; faces whose stencil reaches into another tile
+ * are measured when the ring rows are saved at the start of the next step.
+ *
+ * Active tiles: a tile with no face above the critical slope and no source
+ * does not change; it is swept again only when a neighbour changes the cells
+ * it sees (its ring) or a source on it starts.  Skipping it changes no bit.
+ */
+/* A face between an interior flow cell and an open cell. */
+struct ss_open_face {
+	ptrdiff_t index;        /* index into flux_x or flux_y */
+	int8_t axis;            /* 0: flux_x, 1: flux_y */
+	int8_t sign;            /* +1 if positive flux leaves the flow cell */
+};
+
+
+struct ss_fast_sweep {
+	struct ss_tiling tiling;
+	int tiles;
+	uint8_t *sweep;          /* per tile: sweep it in the coming step */
+	uint8_t *sweep_next;
+	uint8_t *moving;         /* per tile: the last sweep saw a face above
+	                            the critical slope, or a source */
+	uint8_t *edges_changed;  /* per tile: SS_EDGE_* bits of the last sweep */
+	uint8_t *plain;          /* per tile: it and its ring are all flow cells */
+	uint8_t *has_source;     /* per tile: a source is on over it */
+	int *row_list;           /* tile rows with a tile to sweep */
+	double *ring_south;      /* per tile row: old row j0 - 1, index i + 1 */
+	double *ring_north;      /* per tile row: old row j1 */
+	double *scratch;         /* per thread: row buffers */
+	size_t scratch_doubles;  /* per thread */
+	int threads;
+	int periodic_x, periodic_y;
+	/* faces to open cells, grouped by tile, in row order (see stepper) */
+	struct ss_open_face_slot *open_slots;
+	size_t *open_first;      /* per tile + 1: slots of tile t are
+	                            [open_first[t], open_first[t + 1]) */
+	double s2_interior;      /* max s^2 of faces measured after the last pass */
+	int nonfinite;           /* a NaN slope or rate was seen */
+};
+
+enum { SS_EDGE_WEST = 1, SS_EDGE_EAST = 2, SS_EDGE_SOUTH = 4, SS_EDGE_NORTH = 8 };
+
+/* A face between a flow cell and an open cell, as the fast sweep finds it:
+ * row j, buffer position x of the face in the tile's row (see sweep_fast.c)
+ * and which faces of the row it belongs to. */
+struct ss_open_face_slot {
+	size_t face;             /* index in the stepper's open-face list */
+	int j;                   /* cell row */
+	int x;                   /* x-face: i - i0 + 0..1; y-face: i - i0 + 1 */
+	int which;               /* 0 x-face, 1 y-face south, 2 y-face north */
+};
+
+/* Allocate for grid g, tiles of tile_nx x tile_ny (< 1: defaults), `threads`
+ * OpenMP threads; cell types must be final (halo included).  The fast
+ * sweep writes the flux of open_faces[m] to open_flux[m].  Every tile starts awake. */
+int ss_fast_sweep_init(struct ss_fast_sweep *f, const struct ss_grid *g,
+                       int tile_nx, int tile_ny, int threads,
+                       int periodic_x, int periodic_y,
+                       const uint8_t *cell_type,
+                       const struct ss_open_face *open_faces,
+                       size_t open_face_count);
+void ss_fast_sweep_release(struct ss_fast_sweep *f);
+
+/* Wake every tile and measure the state from scratch (after heights were
+ * changed from outside). */
+void ss_fast_sweep_wake_all(struct ss_fast_sweep *f, const struct ss_grid *g,
+                            const double *height, const uint8_t *cell_type);
+
+/* Mark the tiles holding a cell with a non-zero source rate (NULL: none). */
+void ss_fast_sweep_mark_sources(struct ss_fast_sweep *f, const struct ss_grid *g,
+                                const double *source_rate);
+
+/* Start of a step: save the ring rows of the tiles to sweep and measure the
+ * faces their interior measure could not see.  Returns the largest face
+ * slope of the current state that can matter for the time step (exact when
+ * it is above the critical slope); sets f->nonfinite on NaN. */
+double ss_fast_sweep_begin(struct ss_fast_sweep *f, const struct ss_grid *g,
+                           const double *height, const uint8_t *cell_type);
+
+/* The step: advance the tiles to sweep by dt, in place.  Returns max |dh/dt|
+ * over the flow cells (INFINITY on NaN); open_flux gets the fluxes of the
+ * faces to open cells.  Then plans which tiles the next step sweeps. */
+double ss_fast_sweep_step(struct ss_fast_sweep *f, const struct ss_grid *g,
+                          const struct ss_face_rule *rule, double dt,
+                          const double *restrict source_rate,
+                          const uint8_t *restrict cell_type,
+                          double *restrict height, double *restrict open_flux);
+
+/* Tiles in the grid and tiles the coming step sweeps. */
+double ss_fast_sweep_awake(const struct ss_fast_sweep *f);
 
 #endif

@@ -1,0 +1,57 @@
+/*
+ * bench.h - `sandslide bench`: throughput of the fast sweep on synthetic
+ * surfaces, next to the machine's memory bandwidth measured in the same run.
+ *
+ *   supercritical  a tilted plane, periodic sides: every face slides
+ *   subcritical    a gentler plane inside walls: nothing slides after the
+ *                  first sweep, so every tile is skipped
+ *   patch          a flat floor with one 512 x 512 supercritical ramp
+ *
+ * A case is one surface, closure and thread count: one warm-up step, then
+ * `repeats` timings of `steps` steps each (cell-updates/s = nx ny steps /
+ * wall time, counting every cell of the grid, swept or skipped).  Bytes
+ * per cell are those the sweep's design moves (heights read and written,
+ * the ring rows, the type byte on tiles that need it); the roofline is the
+ * probe's bandwidth over them.
+ */
+#ifndef SANDSLIDE_BENCH_H
+#define SANDSLIDE_BENCH_H
+
+#include "sandslide/closure.h"
+
+#define SS_BENCH_MAX_CASES 8
+
+enum ss_bench_surface {
+	SS_BENCH_SUPERCRITICAL,
+	SS_BENCH_SUBCRITICAL,
+	SS_BENCH_PATCH,
+	SS_BENCH_SURFACES
+};
+
+struct ss_bench_closure {
+	enum ss_closure_kind kind;
+	double gamma;
+	char label[32];          /* "herschel-bulkley(0.5)" */
+};
+
+struct ss_bench_options {
+	int nx, ny;                                        /* cells */
+	struct ss_bench_closure closures[SS_BENCH_MAX_CASES];
+	int closure_count;
+	int threads[SS_BENCH_MAX_CASES];
+	int thread_count;
+	int surfaces[SS_BENCH_SURFACES];                   /* 1: run it */
+	int repeats;                                       /* timings per case */
+	int steps;                                         /* per timing; 0: auto */
+	int tile_nx, tile_ny;                              /* < 1: defaults */
+	int json;                                          /* JSON instead of a table */
+};
+
+/* The surface names "supercritical", "subcritical", "patch". */
+const char *ss_bench_surface_name(enum ss_bench_surface s);
+
+/* Run the benchmark, print to stdout.  SS_ERR_INPUT for a bad option (a
+ * grid too small for the patch, too little memory), SS_ERR_FAIL otherwise. */
+int ss_bench_run(const struct ss_bench_options *o);
+
+#endif

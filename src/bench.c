@@ -1,0 +1,305 @@
+/*
+ * bench.c - `sandslide bench` (see bench.h).
+ */
+#include "sandslide/bench.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "sandslide/error.h"
+#include "sandslide/face.h"
+#include "sandslide/parallel.h"
+#include "sandslide/boundary.h"
+#include "sandslide/stepper.h"
+
+#define REPOSE_DEG 35.0
+#define SPACING_M 0.01
+#define NU_M2_PER_S 0.1
+#define PATCH_CELLS 512
+
+static const char *const surface_names[] = {"supercritical", "subcritical", "patch"};
+
+const char *ss_bench_surface_name(enum ss_bench_surface s)
+{
+	return surface_names[s];
+}
+
+static double now_seconds(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static int compare_doubles(const void *a, const void *b)
+{
+	const double x = *(const double *)a, y = *(const double *)b;
+	return (x > y) - (x < y);
+}
+
+static double median(double *v, int n)
+{
+	qsort(v, (size_t)n, sizeof *v, compare_doubles);
+	return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+/* A small deterministic hash in [-1, 1) for surface roughness. */
+static double noise(long long i, long long j)
+{
+	unsigned long long z = (unsigned long long)(i * 0x9E3779B97F4A7C15LL ^ j * 0xC2B2AE3D27D4EB4FLL);
+	z ^= z >> 33;
+	z *= 0xFF51AFD7ED558CCDULL;
+	z ^= z >> 33;
+	return (double)(z >> 11) / 4503599627370496.0 - 1.0;
+}
+
+/*
+ * Read+write bandwidth of one array of n doubles with the current thread
+ * count (the access pattern of an in-place sweep), bytes/s, median of 5.
+ */
+static double bandwidth_probe(double *a, size_t n)
+{
+	double rates[5];
+	#pragma omp parallel for schedule(static)
+	for (size_t k = 0; k < n; k++)
+		a[k] = 1.0;
+	for (int r = 0; r < 5; r++) {
+		const double t0 = now_seconds();
+		#pragma omp parallel for schedule(static)
+		for (size_t k = 0; k < n; k++)
+			a[k] = a[k] * 0.999999 + 1e-9;
+		rates[r] = 16.0 * (double)n / (now_seconds() - t0);
+	}
+	return median(rates, 5);
+}
+
+static void set_surface(struct ss_stepper *st, enum ss_bench_surface surface)
+{
+	const struct ss_grid *g = &st->grid;
+	const double tc = st->closure.tan_cr;
+	const int px0 = (g->nx - PATCH_CELLS) / 2, py0 = (g->ny - PATCH_CELLS) / 2;
+	#pragma omp parallel for schedule(static)
+	for (int j = 0; j < g->ny; j++) {
+		for (int i = 0; i < g->nx; i++) {
+			const double x = i * g->dx, y = j * g->dy;
+			double h = 0.0;
+			switch (surface) {
+			case SS_BENCH_SUPERCRITICAL:
+				/* both gradient components tan a_cr: s = 1.41 tan a_cr */
+				h = tc * (x + y) + 1e-3 * g->dx * noise(i, j);
+				break;
+			case SS_BENCH_SUBCRITICAL:
+				h = 0.3 * tc * (x + y) + 1e-3 * g->dx * noise(i, j);
+				break;
+			case SS_BENCH_PATCH:
+				if (i >= px0 && i < px0 + PATCH_CELLS && j >= py0 && j < py0 + PATCH_CELLS)
+					h = 1.5 * tc * (i - px0) * g->dx;
+				break;
+			case SS_BENCH_SURFACES:
+				break;
+			}
+			st->height[ss_grid_index(g, i, j)] = h;
+		}
+	}
+}
+
+struct case_result {
+	double median, min, max;     /* cell-updates/s */
+	double active_fraction;      /* tiles swept / tiles, timed steps */
+	double plain_fraction;       /* tiles without cell-type work */
+	long long steps;             /* timed steps per repeat */
+};
+
+static int run_case(const struct ss_bench_options *o, enum ss_bench_surface surface,
+                    const struct ss_bench_closure *bc, struct case_result *res)
+{
+	struct ss_grid g;
+	struct ss_closure c;
+	struct ss_boundary b;
+	struct ss_stepper st;
+	const enum ss_side_kind side = surface == SS_BENCH_SUPERCRITICAL ? SS_SIDE_PERIODIC
+	                                                                 : SS_SIDE_WALL;
+	memset(&b, 0, sizeof b);
+	for (int k = 0; k < 4; k++)
+		b.side[k] = side;
+	int err = ss_grid_init(&g, o->nx, o->ny, SPACING_M, SPACING_M, 0.0, 0.0);
+	if (!err)
+		err = ss_closure_init(&c, bc->kind, REPOSE_DEG, bc->gamma, NU_M2_PER_S);
+	if (!err)
+		err = ss_stepper_init(&st, &g, &c, &b, 0.9, o->tile_nx, o->tile_ny);
+	if (err)
+		return err;
+	set_surface(&st, surface);
+	if ((err = ss_stepper_prepare(&st))) {
+		ss_stepper_release(&st);
+		return err;
+	}
+
+	/* the stepper's substep without events: a subcritical state, which the
+	 * stepper would skip whole, is swept here (and its tiles skipped) */
+	const double inv_d2 = 1.0 / (g.dx * g.dx) + 1.0 / (g.dy * g.dy);
+	const double lambda_idle = st.closure.nu * ss_cfl_bound_lookup(&st.cfl_bound, 2.0 * c.tan_cr);
+	double *open_flux = st.open_flux;
+	#define BENCH_STEP()                                                              \
+	do {                                                                              \
+		ss_boundary_fill_heights(&g, &st.boundary, st.height);                      \
+		const double s_max = ss_fast_sweep_begin(&st.fast, &g, st.height, st.cell_type); \
+		double lambda = st.closure.nu * ss_cfl_bound_lookup(&st.cfl_bound, s_max); \
+		lambda = lambda > 0.0 ? lambda : lambda_idle;                               \
+		st.tile_sweeps += ss_fast_sweep_awake(&st.fast);                            \
+		st.tile_slots += st.fast.tiles;                                             \
+		ss_fast_sweep_step(&st.fast, &g, &st.face_rule, st.cfl / (2.0 * lambda * inv_d2), \
+		                   NULL, st.cell_type, st.height, open_flux);               \
+	} while (0)
+
+	BENCH_STEP();                                 /* warm-up: every tile */
+	long long steps = o->steps;
+	if (steps <= 0) {
+		/* enough steps for about 0.3 s per timing */
+		const double t0 = now_seconds();
+		BENCH_STEP();
+		const double one = now_seconds() - t0;
+		steps = (long long)ceil(0.3 / fmax(one, 1e-6));
+		steps = steps < 1 ? 1 : steps > 2000 ? 2000 : steps;
+	}
+	double rates[64];
+	const int repeats = o->repeats < 64 ? o->repeats : 64;
+	const double cells = (double)g.nx * g.ny;
+	st.tile_sweeps = st.tile_slots = 0.0;
+	for (int r = 0; r < repeats; r++) {
+		const double t0 = now_seconds();
+		for (long long k = 0; k < steps; k++)
+			BENCH_STEP();
+		rates[r] = cells * (double)steps / (now_seconds() - t0);
+	}
+	#undef BENCH_STEP
+	if (st.fast.nonfinite) {
+		ss_stepper_release(&st);
+		return ss_error_fail("bench %s %s: a height became NaN or infinite",
+		                     surface_names[surface], bc->label);
+	}
+	double plain = 0.0;
+	for (int k = 0; k < st.fast.tiles; k++)
+		plain += st.fast.plain[k];
+	res->active_fraction = st.tile_slots > 0.0 ? st.tile_sweeps / st.tile_slots : 0.0;
+	res->plain_fraction = plain / st.fast.tiles;
+	res->steps = steps;
+	res->min = res->max = rates[0];
+	for (int r = 1; r < repeats; r++) {
+		res->min = fmin(res->min, rates[r]);
+		res->max = fmax(res->max, rates[r]);
+	}
+	res->median = median(rates, repeats);
+	ss_stepper_release(&st);
+	return SS_OK;
+}
+
+/* Bytes per cell update that the fast sweep's design moves: the height read
+ * and written once (16 B), the two ring rows of each tile row saved and read
+ * back (32 B per tile_ny cells of a column), the type byte on tiles with
+ * walls or open cells near them. */
+static double bytes_per_cell(int tile_ny, double plain_fraction)
+{
+	return 16.0 + 32.0 / tile_ny + (1.0 - plain_fraction);
+}
+
+int ss_bench_run(const struct ss_bench_options *o)
+{
+	if (o->nx < PATCH_CELLS + 2 || o->ny < PATCH_CELLS + 2)
+		if (o->surfaces[SS_BENCH_PATCH])
+			return ss_error_input("--nx %d --ny %d: the patch surface needs at least "
+			                      "%d x %d cells", o->nx, o->ny, PATCH_CELLS + 2,
+			                      PATCH_CELLS + 2);
+	const size_t n = (size_t)o->nx * (size_t)o->ny;
+	const double need = (double)n * 2.0 * sizeof(double);
+	const double have = ss_memory_available_bytes();
+	if (have > 0.0 && need > have) {
+		char nb[32], hb[32];
+		return ss_error_input("--nx %d --ny %d needs %s of memory; %s is available",
+		                      o->nx, o->ny, ss_format_bytes(need, nb),
+		                      ss_format_bytes(have, hb));
+	}
+	struct ss_tiling tiling;
+	struct ss_grid g;
+	if (ss_grid_init(&g, o->nx, o->ny, SPACING_M, SPACING_M, 0.0, 0.0))
+		return SS_ERR_INPUT;
+	ss_tiling_init(&tiling, &g, o->tile_nx, o->tile_ny);
+
+	/* the probe first, on an array of the grid's size but at least 256 MiB,
+	 * far above the last-level cache */
+	double bandwidth[SS_BENCH_MAX_CASES];
+	const size_t probe_n = n > ((size_t)1 << 25) ? n : (size_t)1 << 25;
+	double *probe = ss_alloc(probe_n, sizeof(double), "bandwidth probe array");
+	if (!probe)
+		return SS_ERR_FAIL;
+	for (int t = 0; t < o->thread_count; t++) {
+		ss_parallel_set_threads(o->threads[t]);
+		bandwidth[t] = bandwidth_probe(probe, probe_n);
+	}
+	ss_free(probe);
+
+	if (o->json) {
+		printf("{\n  \"nx\": %d, \"ny\": %d, \"tile_nx\": %d, \"tile_ny\": %d,\n"
+		       "  \"repeats\": %d, \"rsqrt\": \"%s\",\n  \"bandwidth_bytes_per_s\": {",
+		       o->nx, o->ny, tiling.tile_nx, tiling.tile_ny, o->repeats,
+		       ss_face_rsqrt_method());
+		for (int t = 0; t < o->thread_count; t++)
+			printf("%s\"%d\": %.4g", t ? ", " : "", o->threads[t], bandwidth[t]);
+		printf("},\n  \"cases\": [");
+	} else {
+		printf("sandslide bench: %d x %d cells, tiles %dx%d, %d repeats per case, "
+		       "reciprocal sqrt: %s\n", o->nx, o->ny, tiling.tile_nx, tiling.tile_ny,
+		       o->repeats, ss_face_rsqrt_method());
+		printf("memory bandwidth (read+write one array of %zu doubles):", probe_n);
+		for (int t = 0; t < o->thread_count; t++)
+			printf(" %d thread%s %.1f GB/s%s", o->threads[t], o->threads[t] > 1 ? "s" : "",
+			       bandwidth[t] * 1e-9, t + 1 < o->thread_count ? "," : "\n");
+		printf("\n%-14s %-22s %7s  %-34s %6s %6s %6s %8s\n", "surface", "closure", "threads",
+		       "cell-updates/s median [min, max]", "steps", "active", "B/cell",
+		       "roofline");
+	}
+	fflush(stdout);
+
+	int first = 1;
+	for (int s = 0; s < SS_BENCH_SURFACES; s++) {
+		if (!o->surfaces[s])
+			continue;
+		for (int c = 0; c < o->closure_count; c++) {
+			for (int t = 0; t < o->thread_count; t++) {
+				struct case_result r;
+				ss_parallel_set_threads(o->threads[t]);
+				int err = run_case(o, (enum ss_bench_surface)s, &o->closures[c], &r);
+				if (err)
+					return err;
+				const double bytes = bytes_per_cell(tiling.tile_ny, r.plain_fraction);
+				const double roofline = bandwidth[t] / bytes;
+				if (o->json) {
+					printf("%s\n    {\"surface\": \"%s\", \"closure\": \"%s\", "
+					       "\"threads\": %d, \"cell_updates_per_s\": {\"median\": %.4g, "
+					       "\"min\": %.4g, \"max\": %.4g}, \"steps_per_repeat\": %lld, "
+					       "\"active_fraction\": %.4g, \"bytes_per_cell\": %.3g, "
+					       "\"roofline_cell_updates_per_s\": %.4g, "
+					       "\"roofline_fraction\": %.4g}", first ? "" : ",",
+					       surface_names[s], o->closures[c].label, o->threads[t],
+					       r.median, r.min, r.max, r.steps, r.active_fraction, bytes,
+					       roofline, r.median / roofline);
+				} else {
+					char range[64];
+					snprintf(range, sizeof range, "%.3g [%.3g, %.3g]", r.median, r.min,
+					         r.max);
+					printf("%-14s %-22s %7d  %-34s %6lld %6.3f %6.2f %8.3f\n",
+					       surface_names[s], o->closures[c].label, o->threads[t], range,
+					       r.steps, r.active_fraction, bytes, r.median / roofline);
+				}
+				fflush(stdout);
+				first = 0;
+			}
+		}
+	}
+	if (o->json)
+		printf("\n  ]\n}\n");
+	return SS_OK;
+}

@@ -1,0 +1,759 @@
+/*
+ * sweep_fast.c - the in-place sweep over active tiles (see sweep.h).
+ *
+ * Row buffers: in a tile of columns [i0, i1) (W = i1 - i0 cells) a buffer
+ * holds cells i0 - 1 .. i1 at positions x = i - i0 + 1 = 0 .. W + 1.  fx[x],
+ * x = 0 .. W, is the flux through the x-face between positions x and x + 1;
+ * fy_south[x] and fy_north[x], x = 1 .. W, through the y-faces below and
+ * above cell x.  The arithmetic of every face and cell is that of the
+ * reference sweep (sweep.c): the same gradients in the same order, the same
+ * face function (face.c), the same update expression.
+ */
+#include "sandslide/sweep.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "sandslide/error.h"
+#include "sandslide/parallel.h"
+
+/* A face carries flux when neither side is a wall and one side flows. */
+static inline int face_carries(uint8_t a, uint8_t b)
+{
+	return a != SS_CELL_WALL && b != SS_CELL_WALL &&
+	       (a == SS_CELL_FLOW || b == SS_CELL_FLOW);
+}
+
+/*
+ * Maxima of values >= +0 (s^2, |dh/dt|) as integer maxima of their bit
+ * patterns: for such doubles the unsigned order of the bits is the numeric
+ * order, and every NaN lies above +infinity.  An integer max vectorises (a
+ * floating-point one does not without -ffast-math), and a NaN wins it.
+ */
+static inline uint64_t bits_of(double x)
+{
+	uint64_t u;
+	memcpy(&u, &x, sizeof u);
+	return u;
+}
+
+static inline double double_of(uint64_t u)
+{
+	double x;
+	memcpy(&x, &u, sizeof x);
+	return x;
+}
+
+/* The larger of a and b as a select (fmax() is a library call). */
+static inline double max2(double a, double b)
+{
+	return b > a ? b : a;
+}
+
+/*
+ * Largest s^2 of the x-faces (i - 1 | i), ia <= i <= ib, of row j, read
+ * from the grid (the rows j - 1 .. j + 1 must hold one state).
+ */
+static double slope2_x_faces(const struct ss_grid *g, const double *h,
+                             const uint8_t *t, int plain, int j, int ia, int ib,
+                             int *bad)
+{
+	const double inv_dx = 1.0 / g->dx, inv_2dy = 0.5 / g->dy;
+	const double *hm = h + ss_grid_index(g, 0, j - 1);
+	const double *h0 = h + ss_grid_index(g, 0, j);
+	const double *hp = h + ss_grid_index(g, 0, j + 1);
+	const uint8_t *tm = t + ss_grid_index(g, 0, j - 1);
+	const uint8_t *t0 = t + ss_grid_index(g, 0, j);
+	const uint8_t *tp = t + ss_grid_index(g, 0, j + 1);
+	uint64_t m = 0;
+	if (plain) {
+		for (int i = ia; i <= ib; i++) {
+			const double cda = (hp[i - 1] - hm[i - 1]) * inv_2dy;
+			const double cdb = (hp[i] - hm[i]) * inv_2dy;
+			const double gn = (h0[i] - h0[i - 1]) * inv_dx, gt = 0.5 * (cda + cdb);
+			const uint64_t q = bits_of(gn * gn + gt * gt);
+			m = q > m ? q : m;
+		}
+	} else {
+		for (int i = ia; i <= ib; i++) {
+			const double cda = ((tp[i - 1] == SS_CELL_WALL ? h0[i - 1] : hp[i - 1]) -
+			                    (tm[i - 1] == SS_CELL_WALL ? h0[i - 1] : hm[i - 1])) * inv_2dy;
+			const double cdb = ((tp[i] == SS_CELL_WALL ? h0[i] : hp[i]) -
+			                    (tm[i] == SS_CELL_WALL ? h0[i] : hm[i])) * inv_2dy;
+			const double gn = (h0[i] - h0[i - 1]) * inv_dx, gt = 0.5 * (cda + cdb);
+			const uint64_t q = face_carries(t0[i - 1], t0[i]) ? bits_of(gn * gn + gt * gt) : 0;
+			m = q > m ? q : m;
+		}
+	}
+	const double max = double_of(m);
+	*bad |= max != max;
+	return max;
+}
+
+/* Largest s^2 of the y-faces (j - 1 | j) of cells ia <= i <= ib. */
+static double slope2_y_faces(const struct ss_grid *g, const double *h,
+                             const uint8_t *t, int plain, int j, int ia, int ib,
+                             int *bad)
+{
+	const double inv_dy = 1.0 / g->dy, inv_2dx = 0.5 / g->dx;
+	const double *ha = h + ss_grid_index(g, 0, j - 1);
+	const double *hb = h + ss_grid_index(g, 0, j);
+	const uint8_t *ta = t + ss_grid_index(g, 0, j - 1);
+	const uint8_t *tb = t + ss_grid_index(g, 0, j);
+	uint64_t m = 0;
+	if (plain) {
+		for (int i = ia; i <= ib; i++) {
+			const double cda = (ha[i + 1] - ha[i - 1]) * inv_2dx;
+			const double cdb = (hb[i + 1] - hb[i - 1]) * inv_2dx;
+			const double gn = (hb[i] - ha[i]) * inv_dy, gt = 0.5 * (cda + cdb);
+			const uint64_t q = bits_of(gn * gn + gt * gt);
+			m = q > m ? q : m;
+		}
+	} else {
+		for (int i = ia; i <= ib; i++) {
+			const double cda = ((ta[i + 1] == SS_CELL_WALL ? ha[i] : ha[i + 1]) -
+			                    (ta[i - 1] == SS_CELL_WALL ? ha[i] : ha[i - 1])) * inv_2dx;
+			const double cdb = ((tb[i + 1] == SS_CELL_WALL ? hb[i] : hb[i + 1]) -
+			                    (tb[i - 1] == SS_CELL_WALL ? hb[i] : hb[i - 1])) * inv_2dx;
+			const double gn = (hb[i] - ha[i]) * inv_dy, gt = 0.5 * (cda + cdb);
+			const uint64_t q = face_carries(ta[i], tb[i]) ? bits_of(gn * gn + gt * gt) : 0;
+			m = q > m ? q : m;
+		}
+	}
+	const double max = double_of(m);
+	*bad |= max != max;
+	return max;
+}
+
+/* Largest s^2 over every face of the grid that can carry flux. */
+static double slope2_all(const struct ss_grid *g, const double *h,
+                         const uint8_t *t, int *bad)
+{
+	double m = 0.0;
+	int nan = 0;
+	#pragma omp parallel for schedule(static) reduction(max:m) reduction(|:nan)
+	for (int j = 0; j <= g->ny; j++) {
+		double q = slope2_y_faces(g, h, t, 0, j, 0, g->nx - 1, &nan);
+		if (j < g->ny)
+			q = max2(q, slope2_x_faces(g, h, t, 0, j, 0, g->nx, &nan));
+		m = q > m ? q : m;
+	}
+	*bad |= nan;
+	return m;
+}
+
+double ss_sweep_max_slope(const struct ss_grid *g, const double *restrict height,
+                          const uint8_t *restrict cell_type)
+{
+	int bad = 0;
+	const double m = slope2_all(g, height, cell_type, &bad);
+	return bad ? NAN : sqrt(m);
+}
+
+/* ---- set-up ---------------------------------------------------------- */
+
+struct tile_span {
+	int i0, i1, j0, j1;
+};
+
+static struct tile_span span_of(const struct ss_fast_sweep *f, const struct ss_grid *g,
+                                int tx, int ty)
+{
+	const struct ss_tiling *t = &f->tiling;
+	struct tile_span s;
+	s.i0 = tx * t->tile_nx;
+	s.j0 = ty * t->tile_ny;
+	s.i1 = s.i0 + t->tile_nx < g->nx ? s.i0 + t->tile_nx : g->nx;
+	s.j1 = s.j0 + t->tile_ny < g->ny ? s.j0 + t->tile_ny : g->ny;
+	return s;
+}
+
+static size_t row_doubles(const struct ss_tiling *t)
+{
+	return ((size_t)t->tile_nx + 2 + 7) / 8 * 8;   /* 64 B aligned rows */
+}
+
+int ss_fast_sweep_init(struct ss_fast_sweep *f, const struct ss_grid *g,
+                       int tile_nx, int tile_ny, int threads,
+                       int periodic_x, int periodic_y,
+                       const uint8_t *cell_type,
+                       const struct ss_open_face *open_faces,
+                       size_t open_face_count)
+{
+	memset(f, 0, sizeof *f);
+	ss_tiling_init(&f->tiling, g, tile_nx, tile_ny);
+	const struct ss_tiling *t = &f->tiling;
+	f->tiles = t->tiles_x * t->tiles_y;
+	f->threads = threads > 0 ? threads : 1;
+	f->periodic_x = periodic_x;
+	f->periodic_y = periodic_y;
+	const size_t tiles = (size_t)f->tiles;
+	f->scratch_doubles = 15 * row_doubles(t) + 2 * (((size_t)t->tile_ny + 7) / 8 * 8);
+	f->sweep = ss_alloc(tiles, 1, "tile flags");
+	f->sweep_next = ss_alloc(tiles, 1, "tile flags");
+	f->moving = ss_alloc(tiles, 1, "tile flags");
+	f->edges_changed = ss_alloc(tiles, 1, "tile flags");
+	f->plain = ss_alloc(tiles, 1, "tile flags");
+	f->has_source = ss_alloc(tiles, 1, "tile flags");
+	f->row_list = ss_alloc((size_t)t->tiles_y, sizeof *f->row_list, "tile rows");
+	f->ring_south = ss_alloc((size_t)t->tiles_y * g->stride, sizeof(double), "ring rows");
+	f->ring_north = ss_alloc((size_t)t->tiles_y * g->stride, sizeof(double), "ring rows");
+	f->scratch = ss_alloc((size_t)f->threads * f->scratch_doubles, sizeof(double),
+	                      "sweep row buffers");
+	f->open_first = ss_alloc(tiles + 1, sizeof *f->open_first, "open faces");
+	f->open_slots = ss_alloc(open_face_count ? open_face_count : 1,
+	                         sizeof *f->open_slots, "open faces");
+	if (!f->sweep || !f->sweep_next || !f->moving || !f->edges_changed || !f->plain ||
+	    !f->has_source || !f->row_list || !f->ring_south || !f->ring_north ||
+	    !f->scratch || !f->open_first || !f->open_slots) {
+		ss_fast_sweep_release(f);
+		return SS_ERR_FAIL;
+	}
+
+	/* plain tiles: every cell of the tile and of its ring flows */
+	for (int ty = 0; ty < t->tiles_y; ty++) {
+		for (int tx = 0; tx < t->tiles_x; tx++) {
+			const struct tile_span s = span_of(f, g, tx, ty);
+			int plain = 1;
+			for (int j = s.j0 - 1; j <= s.j1 && plain; j++)
+				for (int i = s.i0 - 1; i <= s.i1; i++)
+					plain &= cell_type[ss_grid_index(g, i, j)] == SS_CELL_FLOW;
+			f->plain[ty * t->tiles_x + tx] = (uint8_t)plain;
+		}
+	}
+
+	/* open faces: tile of the flow cell, row, position; counting sort by
+	 * tile, then by row within a tile (the list is in row order already) */
+	size_t *tile_of = ss_alloc(open_face_count ? open_face_count : 1, sizeof *tile_of,
+	                           "open faces");
+	if (!tile_of) {
+		ss_fast_sweep_release(f);
+		return SS_ERR_FAIL;
+	}
+	const ptrdiff_t stride = g->stride;
+	for (size_t m = 0; m < open_face_count; m++) {
+		const struct ss_open_face *o = &open_faces[m];
+		const ptrdiff_t step = o->axis == 0 ? 1 : stride;
+		const ptrdiff_t cell = o->sign > 0 ? o->index - step : o->index;
+		const int i = (int)(cell % stride) - SS_GRID_GHOST;
+		const int j = (int)(cell / stride) - SS_GRID_GHOST;
+		const int tx = i / t->tile_nx, ty = j / t->tile_ny;
+		const int i0 = tx * t->tile_nx;
+		struct ss_open_face_slot *slot = &f->open_slots[m];
+		slot->face = m;
+		slot->j = j;
+		if (o->axis == 0) {
+			const int i_east = (int)(o->index % stride) - SS_GRID_GHOST;
+			slot->which = 0;
+			slot->x = i_east - i0;
+		} else {
+			slot->which = o->sign > 0 ? 2 : 1;
+			slot->x = i - i0 + 1;
+		}
+		tile_of[m] = (size_t)ty * t->tiles_x + tx;
+		f->open_first[tile_of[m] + 1]++;
+	}
+	for (size_t k = 0; k < tiles; k++)
+		f->open_first[k + 1] += f->open_first[k];
+	struct ss_open_face_slot *sorted = ss_alloc(open_face_count ? open_face_count : 1,
+	                                            sizeof *sorted, "open faces");
+	size_t *fill = ss_alloc(tiles, sizeof *fill, "open faces");
+	if (!sorted || !fill) {
+		ss_free(sorted);
+		ss_free(fill);
+		ss_free(tile_of);
+		ss_fast_sweep_release(f);
+		return SS_ERR_FAIL;
+	}
+	for (size_t m = 0; m < open_face_count; m++)
+		sorted[f->open_first[tile_of[m]] + fill[tile_of[m]]++] = f->open_slots[m];
+	ss_free(f->open_slots);
+	f->open_slots = sorted;
+	ss_free(fill);
+	ss_free(tile_of);
+	memset(f->sweep, 1, tiles);
+	return SS_OK;
+}
+
+void ss_fast_sweep_release(struct ss_fast_sweep *f)
+{
+	ss_free(f->open_slots);
+	ss_free(f->open_first);
+	ss_free(f->scratch);
+	ss_free(f->ring_north);
+	ss_free(f->ring_south);
+	ss_free(f->row_list);
+	ss_free(f->has_source);
+	ss_free(f->plain);
+	ss_free(f->edges_changed);
+	ss_free(f->moving);
+	ss_free(f->sweep_next);
+	ss_free(f->sweep);
+	memset(f, 0, sizeof *f);
+}
+
+void ss_fast_sweep_wake_all(struct ss_fast_sweep *f, const struct ss_grid *g,
+                            const double *height, const uint8_t *cell_type)
+{
+	int bad = 0;
+	memset(f->sweep, 1, (size_t)f->tiles);
+	f->s2_interior = slope2_all(g, height, cell_type, &bad);
+	f->nonfinite = bad;
+}
+
+void ss_fast_sweep_mark_sources(struct ss_fast_sweep *f, const struct ss_grid *g,
+                                const double *source_rate)
+{
+	const struct ss_tiling *t = &f->tiling;
+	#pragma omp parallel for schedule(static)
+	for (int ty = 0; ty < t->tiles_y; ty++) {
+		for (int tx = 0; tx < t->tiles_x; tx++) {
+			const struct tile_span s = span_of(f, g, tx, ty);
+			int on = 0;
+			for (int j = s.j0; j < s.j1 && source_rate && !on; j++)
+				for (int i = s.i0; i < s.i1; i++)
+					on |= source_rate[ss_grid_index(g, i, j)] != 0.0;
+			f->has_source[ty * t->tiles_x + tx] = (uint8_t)on;
+			if (on)
+				f->sweep[ty * t->tiles_x + tx] = 1;
+		}
+	}
+}
+
+double ss_fast_sweep_awake(const struct ss_fast_sweep *f)
+{
+	double n = 0.0;
+	for (int k = 0; k < f->tiles; k++)
+		n += f->sweep[k];
+	return n;
+}
+
+/* Tile rows holding a tile to sweep, into f->row_list; returns the count. */
+static int list_rows(struct ss_fast_sweep *f)
+{
+	const struct ss_tiling *t = &f->tiling;
+	int n = 0;
+	for (int ty = 0; ty < t->tiles_y; ty++) {
+		const uint8_t *s = f->sweep + (size_t)ty * t->tiles_x;
+		int any = 0;
+		for (int tx = 0; tx < t->tiles_x; tx++)
+			any |= s[tx];
+		if (any)
+			f->row_list[n++] = ty;
+	}
+	return n;
+}
+
+double ss_fast_sweep_begin(struct ss_fast_sweep *f, const struct ss_grid *g,
+                           const double *height, const uint8_t *cell_type)
+{
+	const struct ss_tiling *t = &f->tiling;
+	const int rows = list_rows(f);
+	const ptrdiff_t stride = g->stride;
+	double m = 0.0;
+	int bad = 0;
+
+	#pragma omp parallel for schedule(dynamic, 1) num_threads(f->threads) \
+		reduction(max:m) reduction(|:bad)
+	for (int r = 0; r < rows; r++) {
+		const int ty = f->row_list[r];
+		for (int tx = 0; tx < t->tiles_x; tx++) {
+			const int tile = ty * t->tiles_x + tx;
+			if (!f->sweep[tile])
+				continue;
+			const struct tile_span s = span_of(f, g, tx, ty);
+			const int plain = f->plain[tile];
+			const size_t n = (size_t)(s.i1 - s.i0 + 2);
+			memcpy(f->ring_south + ty * stride + s.i0,
+			       height + ss_grid_index(g, s.i0 - 1, s.j0 - 1), n * sizeof(double));
+			memcpy(f->ring_north + ty * stride + s.i0,
+			       height + ss_grid_index(g, s.i0 - 1, s.j1), n * sizeof(double));
+			/* the faces whose stencil reaches into the ring */
+			double q = slope2_x_faces(g, height, cell_type, plain, s.j0, s.i0, s.i1, &bad);
+			q = max2(q, slope2_x_faces(g, height, cell_type, plain, s.j1 - 1, s.i0, s.i1, &bad));
+			q = max2(q, slope2_y_faces(g, height, cell_type, plain, s.j0, s.i0, s.i1 - 1, &bad));
+			q = max2(q, slope2_y_faces(g, height, cell_type, plain, s.j1, s.i0, s.i1 - 1, &bad));
+			for (int j = s.j0 + 1; j < s.j1; j++) {
+				if (j < s.j1 - 1) {
+					q = max2(q, slope2_x_faces(g, height, cell_type, plain, j, s.i0, s.i0, &bad));
+					q = max2(q, slope2_x_faces(g, height, cell_type, plain, j, s.i1, s.i1, &bad));
+				}
+				q = max2(q, slope2_y_faces(g, height, cell_type, plain, j, s.i0, s.i0, &bad));
+				q = max2(q, slope2_y_faces(g, height, cell_type, plain, j, s.i1 - 1, s.i1 - 1, &bad));
+			}
+			m = q > m ? q : m;
+		}
+	}
+	f->nonfinite |= bad;
+	m = max2(m, f->s2_interior);
+	return f->nonfinite ? NAN : sqrt(m);
+}
+
+/* ---- the tile kernel -------------------------------------------------- */
+
+/* Cell types widened to 64 bits for the row loops: a select between
+ * doubles on a 64-bit condition vectorises, on a byte it does not. */
+typedef int64_t wide_type;
+
+struct row_buffers {
+	double *row[3], *cdx[3], *cdy, *gn, *gt, *fx, *fy[2];
+	wide_type *type[3];
+	double *west_old, *east_save;
+};
+
+static struct row_buffers buffers_of(const struct ss_fast_sweep *f, int thread)
+{
+	const size_t w = row_doubles(&f->tiling);
+	double *p = f->scratch + (size_t)thread * f->scratch_doubles;
+	struct row_buffers b;
+	for (int k = 0; k < 3; k++) {
+		b.row[k] = p + (size_t)k * w;
+		b.cdx[k] = p + (size_t)(3 + k) * w;
+	}
+	b.cdy = p + 6 * w;
+	b.gn = p + 7 * w;
+	b.gt = p + 8 * w;
+	b.fx = p + 9 * w;
+	b.fy[0] = p + 10 * w;
+	b.fy[1] = p + 11 * w;
+	for (int k = 0; k < 3; k++)
+		b.type[k] = (wide_type *)(p + (size_t)(12 + k) * w);
+	b.west_old = p + 15 * w;
+	b.east_save = b.west_old + ((size_t)f->tiling.tile_ny + 7) / 8 * 8;
+	return b;
+}
+
+/* Types of the cells at positions 0 .. W + 1 of grid row t (pointer at
+ * cell (0, j)). */
+static inline void widen_types(int W, int i0, const uint8_t *restrict t,
+                               wide_type *restrict wide)
+{
+	const uint8_t *tt = t + i0 - 1;
+	for (int x = 0; x <= W + 1; x++)
+		wide[x] = tt[x];
+}
+
+/* Central differences along x of buffer row b (types tt by position),
+ * positions 1 .. W; a wall neighbour is replaced by the cell itself (mirror
+ * ghost). */
+static inline void central_x(int plain, int W, double inv_2dx,
+                             const double *restrict b, const wide_type *restrict tt,
+                             double *restrict cd)
+{
+	if (plain) {
+		for (int x = 1; x <= W; x++)
+			cd[x] = (b[x + 1] - b[x - 1]) * inv_2dx;
+	} else {
+		for (int x = 1; x <= W; x++) {
+			const double hp = tt[x + 1] == SS_CELL_WALL ? b[x] : b[x + 1];
+			const double hm = tt[x - 1] == SS_CELL_WALL ? b[x] : b[x - 1];
+			cd[x] = (hp - hm) * inv_2dx;
+		}
+	}
+}
+
+/* Fluxes of n faces from (g_n, g_t); faces that cannot carry flux get 0.
+ * ta, tb: types of the cells on either side (NULL in a plain tile).
+ * Returns whether a face that can carry flux is above the critical slope. */
+static inline int face_row(const struct ss_face_rule *rule, int n,
+                           const double *restrict gn, const double *restrict gt,
+                           const wide_type *restrict ta, const wide_type *restrict tb,
+                           double *restrict flux)
+{
+	const double tan_cr2 = rule->tan_cr2;
+	const int any = ss_face_fluxes(rule, n, gn, gt, flux);
+	int sliding = 0;
+	if (!ta)
+		return any;
+	if (any) {
+		for (int k = 0; k < n; k++) {
+			const int64_t carries = ta[k] != SS_CELL_WALL && tb[k] != SS_CELL_WALL &&
+			                        (ta[k] == SS_CELL_FLOW || tb[k] == SS_CELL_FLOW);
+			flux[k] = carries ? flux[k] : 0.0;
+			sliding |= carries & (gn[k] * gn[k] + gt[k] * gt[k] > tan_cr2);
+		}
+	}
+	return sliding;
+}
+
+/* y-faces between buffer rows a (south) and b (north), positions 1 .. W. */
+static inline int y_faces(const struct ss_face_rule *rule, int plain, int W,
+                          double inv_dy, const double *restrict a,
+                          const double *restrict b, const double *restrict cdx_a,
+                          const double *restrict cdx_b, const wide_type *ta,
+                          const wide_type *tb, struct row_buffers *w,
+                          double *restrict fy)
+{
+	for (int x = 1; x <= W; x++) {
+		w->gn[x] = (b[x] - a[x]) * inv_dy;
+		w->gt[x] = 0.5 * (cdx_a[x] + cdx_b[x]);
+	}
+	return face_row(rule, W, w->gn + 1, w->gt + 1, plain ? NULL : ta + 1,
+	                plain ? NULL : tb + 1, fy + 1);
+}
+
+struct tile_result {
+	double rate_max, s2_max;
+	int bad;
+};
+
+/* Old row j of the tile into buf: the tile's cells and the east neighbour
+ * from the grid (not yet swept this step), the west neighbour from west. */
+static inline void load_row(double *restrict buf, const double *restrict h_row,
+                            int i0, int W, double west)
+{
+	memcpy(buf + 1, h_row + i0, (size_t)W * sizeof(double));
+	buf[0] = west;
+	buf[W + 1] = h_row[i0 + W];
+}
+
+static void sweep_tile(struct ss_fast_sweep *f, const struct ss_grid *g,
+                       const struct ss_face_rule *rule, double dt,
+                       const double *restrict src, const uint8_t *restrict type,
+                       double *restrict h, double *restrict open_flux,
+                       int tx, int ty, int west_swept, struct row_buffers *w,
+                       struct tile_result *res)
+{
+	const int tile = ty * f->tiling.tiles_x + tx;
+	const struct tile_span s = span_of(f, g, tx, ty);
+	const int i0 = s.i0, W = s.i1 - s.i0, j0 = s.j0, j1 = s.j1;
+	const int plain = f->plain[tile];
+	const ptrdiff_t stride = g->stride;
+	const double inv_dx = 1.0 / g->dx, inv_dy = 1.0 / g->dy;
+	const double inv_2dx = 0.5 / g->dx, inv_2dy = 0.5 / g->dy;
+	double *prev = w->row[0], *cur = w->row[1], *next = w->row[2];
+	double *cdx_prev = w->cdx[0], *cdx_cur = w->cdx[1], *cdx_next = w->cdx[2];
+	double *fy_south = w->fy[0], *fy_north = w->fy[1];
+	const struct ss_open_face_slot *slot = f->open_slots + f->open_first[tile];
+	const struct ss_open_face_slot *slot_end = f->open_slots + f->open_first[tile + 1];
+	int moving = f->has_source[tile], edges = 0, bad = 0;
+	double rate_max = 0.0, s2_max = 0.0;
+
+	if (!west_swept)
+		for (int j = j0; j < j1; j++)
+			w->west_old[j - j0] = h[ss_grid_index(g, i0 - 1, j)];
+
+	wide_type *type_prev = w->type[0], *type_cur = w->type[1], *type_next = w->type[2];
+	memcpy(prev, f->ring_south + ty * stride + i0, (size_t)(W + 2) * sizeof(double));
+	load_row(cur, h + ss_grid_index(g, 0, j0), i0, W, w->west_old[0]);
+	if (!plain) {
+		widen_types(W, i0, type + ss_grid_index(g, 0, j0 - 1), type_prev);
+		widen_types(W, i0, type + ss_grid_index(g, 0, j0), type_cur);
+	}
+	central_x(plain, W, inv_2dx, prev, type_prev, cdx_prev);
+	central_x(plain, W, inv_2dx, cur, type_cur, cdx_cur);
+	moving |= y_faces(rule, plain, W, inv_dy, prev, cur, cdx_prev, cdx_cur,
+	                  type_prev, type_cur, w, fy_south);
+
+	for (int j = j0; j < j1; j++) {
+		double *h_row = h + ss_grid_index(g, 0, j);
+		if (j + 2 < j1) {
+			/* each row of a tile starts a new page, where the hardware
+			 * prefetcher starts cold: ask for the row after next */
+			const char *ahead = (const char *)(h + ss_grid_index(g, i0, j + 2));
+			for (size_t b = 0; b < (size_t)W * sizeof(double); b += 64)
+				__builtin_prefetch(ahead + b, 1, 3);
+		}
+		if (j + 1 < j1)
+			load_row(next, h + ss_grid_index(g, 0, j + 1), i0, W, w->west_old[j + 1 - j0]);
+		else
+			memcpy(next, f->ring_north + ty * stride + i0, (size_t)(W + 2) * sizeof(double));
+		if (!plain)
+			widen_types(W, i0, type + ss_grid_index(g, 0, j + 1), type_next);
+
+		/* x-faces of row j, positions 0 .. W */
+		if (plain) {
+			for (int x = 0; x <= W + 1; x++)
+				w->cdy[x] = (next[x] - prev[x]) * inv_2dy;
+		} else {
+			for (int x = 0; x <= W + 1; x++) {
+				const double hp = type_next[x] == SS_CELL_WALL ? cur[x] : next[x];
+				const double hm = type_prev[x] == SS_CELL_WALL ? cur[x] : prev[x];
+				w->cdy[x] = (hp - hm) * inv_2dy;
+			}
+		}
+		for (int x = 0; x <= W; x++) {
+			w->gn[x] = (cur[x + 1] - cur[x]) * inv_dx;
+			w->gt[x] = 0.5 * (w->cdy[x] + w->cdy[x + 1]);
+		}
+		moving |= face_row(rule, W + 1, w->gn, w->gt, plain ? NULL : type_cur,
+		                   plain ? NULL : type_cur + 1, w->fx);
+
+		/* y-faces (j | j + 1) */
+		central_x(plain, W, inv_2dx, next, type_next, cdx_next);
+		moving |= y_faces(rule, plain, W, inv_dy, cur, next, cdx_cur, cdx_next,
+		                  type_cur, type_next, w, fy_north);
+
+		/* forward Euler, as ss_sweep_update */
+		const double *fx = w->fx;
+		double *rate = w->gn + 1;             /* free again: rate of cell x */
+		for (int x = 1; x <= W; x++)
+			rate[x - 1] = (fx[x - 1] - fx[x]) * inv_dx +
+			              (fy_south[x] - fy_north[x]) * inv_dy;
+		if (src) {
+			const double *src_row = src + ss_grid_index(g, i0, j);
+			for (int x = 0; x < W; x++)
+				rate[x] += src_row[x];
+		}
+		w->east_save[j - j0] = cur[W];
+		uint64_t row_max = 0;
+		const wide_type *tc = type_cur + 1;
+		double *hn = h_row + i0;
+		if (plain) {
+			for (int x = 0; x < W; x++) {
+				hn[x] = cur[x + 1] + dt * rate[x];
+				const uint64_t a = bits_of(fabs(rate[x]));
+				row_max = a > row_max ? a : row_max;
+			}
+		} else {
+			for (int x = 0; x < W; x++) {
+				const int flows = tc[x] == SS_CELL_FLOW;
+				hn[x] = flows ? cur[x + 1] + dt * rate[x] : cur[x + 1];
+				const uint64_t a = flows ? bits_of(fabs(rate[x])) : 0;
+				row_max = a > row_max ? a : row_max;
+			}
+		}
+		const double row_rate_max = double_of(row_max);
+		const int row_nan = row_rate_max != row_rate_max;
+		rate_max = row_nan ? INFINITY : max2(rate_max, row_rate_max);
+		bad |= row_nan;
+
+		if (h_row[i0] != cur[1])
+			edges |= SS_EDGE_WEST;
+		if (h_row[i0 + W - 1] != cur[W])
+			edges |= SS_EDGE_EAST;
+		if (j == j0 || j == j1 - 1) {
+			int changed = 0;
+			for (int x = 1; x <= W; x++)
+				changed |= h_row[i0 + x - 1] != cur[x];
+			if (changed)
+				edges |= (j == j0 ? SS_EDGE_SOUTH : 0) | (j == j1 - 1 ? SS_EDGE_NORTH : 0);
+		}
+
+		for (; slot < slot_end && slot->j == j; slot++)
+			open_flux[slot->face] = slot->which == 0 ? fx[slot->x]
+			                      : slot->which == 1 ? fy_south[slot->x] : fy_north[slot->x];
+
+		/* the new state's faces inside the tile, one row behind */
+		if (j >= j0 + 1)
+			s2_max = max2(s2_max, slope2_y_faces(g, h, type, plain, j, i0 + 1, i0 + W - 2, &bad));
+		if (j >= j0 + 2)
+			s2_max = max2(s2_max, slope2_x_faces(g, h, type, plain, j - 1, i0 + 1, i0 + W - 1, &bad));
+
+		double *tmp = prev;
+		prev = cur;
+		cur = next;
+		next = tmp;
+		tmp = cdx_prev;
+		cdx_prev = cdx_cur;
+		cdx_cur = cdx_next;
+		cdx_next = tmp;
+		tmp = fy_south;
+		fy_south = fy_north;
+		fy_north = tmp;
+		wide_type *tt = type_prev;
+		type_prev = type_cur;
+		type_cur = type_next;
+		type_next = tt;
+	}
+	(void)cdx_prev;
+	f->moving[tile] = (uint8_t)(moving != 0);
+	f->edges_changed[tile] = (uint8_t)edges;
+	res->rate_max = rate_max;
+	res->s2_max = s2_max;
+	res->bad = bad;
+}
+
+/* Which tiles the next step sweeps: those that moved, those under a source,
+ * and the neighbours that see a changed edge (diagonal ones when both edges
+ * at the shared corner changed, which includes every changed corner). */
+static void plan_next(struct ss_fast_sweep *f)
+{
+	const int nx = f->tiling.tiles_x, ny = f->tiling.tiles_y;
+	uint8_t *next = f->sweep_next;
+	memset(next, 0, (size_t)f->tiles);
+	for (int ty = 0; ty < ny; ty++) {
+		for (int tx = 0; tx < nx; tx++) {
+			const int tile = ty * nx + tx;
+			if (f->has_source[tile])
+				next[tile] = 1;
+			if (!f->sweep[tile])
+				continue;
+			if (f->moving[tile])
+				next[tile] = 1;
+			const int e = f->edges_changed[tile];
+			if (!e)
+				continue;
+			for (int dy = -1; dy <= 1; dy++) {
+				for (int dx = -1; dx <= 1; dx++) {
+					if (!dx && !dy)
+						continue;
+					const int need = (dx < 0 ? SS_EDGE_WEST : dx > 0 ? SS_EDGE_EAST : 0) |
+					                 (dy < 0 ? SS_EDGE_SOUTH : dy > 0 ? SS_EDGE_NORTH : 0);
+					if ((e & need) != need)
+						continue;
+					int ux = tx + dx, uy = ty + dy;
+					if (ux < 0 || ux >= nx) {
+						if (!f->periodic_x)
+							continue;
+						ux = (ux + nx) % nx;
+					}
+					if (uy < 0 || uy >= ny) {
+						if (!f->periodic_y)
+							continue;
+						uy = (uy + ny) % ny;
+					}
+					next[uy * nx + ux] = 1;
+				}
+			}
+		}
+	}
+	uint8_t *tmp = f->sweep;
+	f->sweep = f->sweep_next;
+	f->sweep_next = tmp;
+}
+
+double ss_fast_sweep_step(struct ss_fast_sweep *f, const struct ss_grid *g,
+                          const struct ss_face_rule *rule, double dt,
+                          const double *restrict source_rate,
+                          const uint8_t *restrict cell_type,
+                          double *restrict height, double *restrict open_flux)
+{
+	const struct ss_tiling *t = &f->tiling;
+	const int rows = list_rows(f);
+	double rate_max = 0.0, s2_max = 0.0;
+	int bad = 0;
+
+	#pragma omp parallel num_threads(f->threads) reduction(max:rate_max, s2_max) \
+		reduction(|:bad)
+	{
+		struct row_buffers w = buffers_of(f, ss_parallel_thread_id());
+		#pragma omp for schedule(dynamic, 1)
+		for (int r = 0; r < rows; r++) {
+			const int ty = f->row_list[r];
+			int west_swept = 0;
+			for (int tx = 0; tx < t->tiles_x; tx++) {
+				const int tile = ty * t->tiles_x + tx;
+				if (!f->sweep[tile]) {
+					west_swept = 0;
+					continue;
+				}
+				struct tile_result res;
+				sweep_tile(f, g, rule, dt, source_rate, cell_type, height, open_flux,
+				           tx, ty, west_swept, &w, &res);
+				rate_max = max2(rate_max, res.rate_max);
+				s2_max = max2(s2_max, res.s2_max);
+				bad |= res.bad;
+				/* this tile's old east column is the next one's west ring */
+				double *tmp = w.west_old;
+				w.west_old = w.east_save;
+				w.east_save = tmp;
+				west_swept = 1;
+			}
+		}
+	}
+	f->s2_interior = s2_max;
+	f->nonfinite |= bad;
+	plan_next(f);
+	return bad ? INFINITY : rate_max;
+}
