@@ -29,7 +29,15 @@ void ss_face_rule_init(struct ss_face_rule *r, const struct ss_closure *c)
 {
 	r->nu = c->nu;
 	r->tan_cr = c->tan_cr;
-	r->tan_cr2 = c->tan_cr * c->tan_cr;
+	/* the largest s^2 whose square root is <= tan a_cr: then s^2 > tan_cr2
+	 * exactly when sqrt(s^2) > tan a_cr, the test of closure.h and of the
+	 * CFL bound, without a square root per face */
+	double q = c->tan_cr * c->tan_cr;
+	while (sqrt(q) > c->tan_cr)
+		q = nextafter(q, 0.0);
+	while (sqrt(nextafter(q, INFINITY)) <= c->tan_cr)
+		q = nextafter(q, INFINITY);
+	r->tan_cr2 = q;
 	r->sin_cr = c->sin_cr;
 	r->inv_sin_cr = 1.0 / c->sin_cr;
 	r->gamma = c->gamma;

@@ -85,8 +85,10 @@ int ss_setup_stepper(const struct ss_case *c, int tile_nx, int tile_ny,
 		return err;
 	st->kernel = kernel;
 
-	uint8_t *mask = ss_alloc((size_t)g.nx * (size_t)g.ny, 1, "region mask");
-	if (!mask) {
+	/* a grid-sized mask only when there are regions to rasterise */
+	uint8_t *mask = c->region_count == 0 ? NULL
+	              : ss_alloc((size_t)g.nx * (size_t)g.ny, 1, "region mask");
+	if (c->region_count > 0 && !mask) {
 		ss_stepper_release(st);
 		return SS_ERR_FAIL;
 	}

@@ -309,6 +309,20 @@ int ss_snapshot_create(struct ss_snapshot **out, const char *path,
 	hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
 	/* v1.8 format: readable by every netCDF-4 and HDF5 >= 1.8 reader */
 	H5Pset_libver_bounds(fapl, H5F_LIBVER_EARLIEST, H5F_LIBVER_V18);
+	/* keep changed metadata in memory until the flush that ends a snapshot:
+	 * evicted early, a chunk index could reach the disk before the
+	 * superblock that covers it, and a run killed in the middle of a
+	 * snapshot would leave an unreadable file.  The file's metadata is a
+	 * few kB, so the cache never needs to evict. */
+	H5AC_cache_config_t mdc;
+	mdc.version = H5AC__CURR_CACHE_CONFIG_VERSION;
+	if (H5Pget_mdc_config(fapl, &mdc) >= 0) {
+		mdc.evictions_enabled = 0;
+		mdc.incr_mode = H5C_incr__off;
+		mdc.flash_incr_mode = H5C_flash_incr__off;
+		mdc.decr_mode = H5C_decr__off;
+		H5Pset_mdc_config(fapl, &mdc);
+	}
 	s->file = H5Fcreate(s->partial_path, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
 	H5Pclose(fapl);
 	if (s->file < 0) {

@@ -73,8 +73,9 @@ static inline double face_flux(const struct ss_face_rule *rule,
 	const double g_t = 0.5 * (central_difference(h, type, a, along, inv_2along) +
 	                          central_difference(h, type, b, along, inv_2along));
 	const double s2 = g_n * g_n + g_t * g_t;
-	if (s2 > *s2_max)
-		*s2_max = s2;
+	/* a NaN slope must not vanish in the maximum */
+	if (s2 > *s2_max || s2 != s2)
+		*s2_max = s2 != s2 ? INFINITY : s2;
 	double flux;
 	ss_face_fluxes(rule, 1, &g_n, &g_t, &flux);
 	return flux;

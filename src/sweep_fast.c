@@ -125,6 +125,38 @@ static double slope2_y_faces(const struct ss_grid *g, const double *h,
 	return max;
 }
 
+/*
+ * In a plain tile, the largest s^2 of the x-faces (i - 1 | i) of row j - 1
+ * and the y-faces (j - 1 | j) of cells i, ia <= i <= ib, in one pass (the
+ * interior measure behind the update; rows j - 2 .. j must be new).  The
+ * same expressions as slope2_x_faces and slope2_y_faces.
+ */
+static double slope2_plain_pair(const struct ss_grid *g, const double *h, int j,
+                                int ia, int ib, int *bad)
+{
+	const double inv_dx = 1.0 / g->dx, inv_dy = 1.0 / g->dy;
+	const double inv_2dx = 0.5 / g->dx, inv_2dy = 0.5 / g->dy;
+	const double *ha = h + ss_grid_index(g, 0, j - 2);
+	const double *hb = h + ss_grid_index(g, 0, j - 1);
+	const double *hc = h + ss_grid_index(g, 0, j);
+	uint64_t m = 0;
+	for (int i = ia; i <= ib; i++) {
+		const double cda = (hc[i - 1] - ha[i - 1]) * inv_2dy;
+		const double cdb = (hc[i] - ha[i]) * inv_2dy;
+		const double gnx = (hb[i] - hb[i - 1]) * inv_dx, gtx = 0.5 * (cda + cdb);
+		const double cxb = (hb[i + 1] - hb[i - 1]) * inv_2dx;
+		const double cxc = (hc[i + 1] - hc[i - 1]) * inv_2dx;
+		const double gny = (hc[i] - hb[i]) * inv_dy, gty = 0.5 * (cxb + cxc);
+		const uint64_t qx = bits_of(gnx * gnx + gtx * gtx);
+		const uint64_t qy = bits_of(gny * gny + gty * gty);
+		const uint64_t q = qx > qy ? qx : qy;
+		m = q > m ? q : m;
+	}
+	const double max = double_of(m);
+	*bad |= max != max;
+	return max;
+}
+
 /* Largest s^2 over every face of the grid that can carry flux. */
 static double slope2_all(const struct ss_grid *g, const double *h,
                          const uint8_t *t, int *bad)
@@ -353,8 +385,9 @@ double ss_fast_sweep_begin(struct ss_fast_sweep *f, const struct ss_grid *g,
 	double m = 0.0;
 	int bad = 0;
 
+	/* no threads for a single tile row: a fork and join would cost more */
 	#pragma omp parallel for schedule(dynamic, 1) num_threads(f->threads) \
-		reduction(max:m) reduction(|:bad)
+		reduction(max:m) reduction(|:bad) if(rows > 1)
 	for (int r = 0; r < rows; r++) {
 		const int ty = f->row_list[r];
 		for (int tx = 0; tx < t->tiles_x; tx++) {
@@ -635,10 +668,19 @@ static void sweep_tile(struct ss_fast_sweep *f, const struct ss_grid *g,
 			                      : slot->which == 1 ? fy_south[slot->x] : fy_north[slot->x];
 
 		/* the new state's faces inside the tile, one row behind */
-		if (j >= j0 + 1)
-			s2_max = max2(s2_max, slope2_y_faces(g, h, type, plain, j, i0 + 1, i0 + W - 2, &bad));
-		if (j >= j0 + 2)
-			s2_max = max2(s2_max, slope2_x_faces(g, h, type, plain, j - 1, i0 + 1, i0 + W - 1, &bad));
+		if (plain && j >= j0 + 2) {
+			s2_max = max2(s2_max, slope2_plain_pair(g, h, j, i0 + 1, i0 + W - 2, &bad));
+			if (W >= 2)   /* the last interior x-face, not paired */
+				s2_max = max2(s2_max, slope2_x_faces(g, h, type, plain, j - 1, i0 + W - 1,
+				                                     i0 + W - 1, &bad));
+		} else {
+			if (j >= j0 + 1)
+				s2_max = max2(s2_max, slope2_y_faces(g, h, type, plain, j, i0 + 1,
+				                                     i0 + W - 2, &bad));
+			if (j >= j0 + 2)
+				s2_max = max2(s2_max, slope2_x_faces(g, h, type, plain, j - 1, i0 + 1,
+				                                     i0 + W - 1, &bad));
+		}
 
 		double *tmp = prev;
 		prev = cur;
@@ -725,7 +767,7 @@ double ss_fast_sweep_step(struct ss_fast_sweep *f, const struct ss_grid *g,
 	int bad = 0;
 
 	#pragma omp parallel num_threads(f->threads) reduction(max:rate_max, s2_max) \
-		reduction(|:bad)
+		reduction(|:bad) if(rows > 1)
 	{
 		struct row_buffers w = buffers_of(f, ss_parallel_thread_id());
 		#pragma omp for schedule(dynamic, 1)

@@ -42,7 +42,8 @@ enum ss_face_form {
 struct ss_face_rule {
 	enum ss_face_form form;
 	double nu;                 /* m^2/s */
-	double tan_cr, tan_cr2;    /* tan a_cr and its square */
+	double tan_cr;             /* tan a_cr */
+	double tan_cr2;            /* largest s^2 with sqrt(s^2) <= tan a_cr */
 	double sin_cr, inv_sin_cr;
 	double gamma, power;       /* Herschel-Bulkley */
 };
@@ -51,8 +52,8 @@ void ss_face_rule_init(struct ss_face_rule *r, const struct ss_closure *c);
 
 /* flux[k] = F of the face with normal gradient g_n[k] and tangential
  * gradient g_t[k], k < n (m^2/s; g dimensionless).  Exactly 0 where
- * g_n^2 + g_t^2 <= tan^2 a_cr.  Returns 1 if some face is above that
- * slope, else 0. */
+ * s = sqrt(g_n^2 + g_t^2) <= tan a_cr (as closure.h).  Returns 1 if some
+ * face is above that slope, else 0. */
 int ss_face_fluxes(const struct ss_face_rule *r, int n,
                     const double *restrict g_n, const double *restrict g_t,
                     double *restrict flux);
