@@ -210,8 +210,9 @@ int ss_bench_run(const struct ss_bench_options *o)
 {
 	if (o->nx < PATCH_CELLS + 2 || o->ny < PATCH_CELLS + 2)
 		if (o->surfaces[SS_BENCH_PATCH])
-			return ss_error_input("--nx %d --ny %d: the patch surface needs at least "
-			                      "%d x %d cells", o->nx, o->ny, PATCH_CELLS + 2,
+			return ss_error_input("--nx %d --ny %d: the patch surface (a %d x %d ramp "
+			                      "inside walls) needs at least %d x %d cells", o->nx,
+			                      o->ny, PATCH_CELLS, PATCH_CELLS, PATCH_CELLS + 2,
 			                      PATCH_CELLS + 2);
 	const size_t n = (size_t)o->nx * (size_t)o->ny;
 	const double need = (double)n * 2.0 * sizeof(double);
