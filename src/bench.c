@@ -146,12 +146,12 @@ static int run_case(const struct ss_bench_options *o, enum ss_bench_surface surf
 	#define BENCH_STEP()                                                              \
 	do {                                                                              \
 		ss_boundary_fill_heights(&g, &st.boundary, st.height);                      \
-		const double s_max = ss_fast_sweep_begin(&st.fast, &g, st.height, st.cell_type); \
+		const double s_max = ss_sweep_fast_begin(&st.fast, &g, st.height, st.cell_type); \
 		double lambda = st.closure.nu * ss_cfl_bound_lookup(&st.cfl_bound, s_max); \
 		lambda = lambda > 0.0 ? lambda : lambda_idle;                               \
-		st.tile_sweeps += ss_fast_sweep_awake(&st.fast);                            \
+		st.tile_sweeps += ss_sweep_fast_awake(&st.fast);                            \
 		st.tile_slots += st.fast.tiles;                                             \
-		ss_fast_sweep_step(&st.fast, &g, &st.face_rule, st.cfl / (2.0 * lambda * inv_d2), \
+		ss_sweep_fast_step(&st.fast, &g, &st.face_rule, st.cfl / (2.0 * lambda * inv_d2), \
 		                   NULL, st.cell_type, st.height, open_flux);               \
 	} while (0)
 

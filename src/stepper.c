@@ -65,7 +65,7 @@ void ss_stepper_release(struct ss_stepper *st)
 	ss_free(st->sources);
 	ss_free(st->open_faces);
 	ss_free(st->open_flux);
-	ss_fast_sweep_release(&st->fast);
+	ss_sweep_fast_release(&st->fast);
 	ss_free(st->source_rate);
 	ss_free(st->row_scratch);
 	ss_free(st->flux_y);
@@ -190,7 +190,7 @@ int ss_stepper_prepare(struct ss_stepper *st)
 	                         sizeof(double), "open-face fluxes");
 	if (!st->open_flux)
 		return SS_ERR_FAIL;
-	err = ss_fast_sweep_init(&st->fast, g, st->tile_nx, st->tile_ny,
+	err = ss_sweep_fast_init(&st->fast, g, st->tile_nx, st->tile_ny,
 	                         ss_parallel_max_threads(),
 	                         st->boundary.side[SS_WEST] == SS_SIDE_PERIODIC,
 	                         st->boundary.side[SS_SOUTH] == SS_SIDE_PERIODIC,
@@ -198,7 +198,7 @@ int ss_stepper_prepare(struct ss_stepper *st)
 	if (err)
 		return err;
 	st->tiling = st->fast.tiling;
-	ss_fast_sweep_wake_all(&st->fast, g, st->height, st->cell_type);
+	ss_sweep_fast_wake_all(&st->fast, g, st->height, st->cell_type);
 	return SS_OK;
 }
 
@@ -206,7 +206,7 @@ void ss_stepper_heights_changed(struct ss_stepper *st)
 {
 	ss_boundary_fill_heights(&st->grid, &st->boundary, st->height);
 	if (st->kernel == SS_KERNEL_FAST)
-		ss_fast_sweep_wake_all(&st->fast, &st->grid, st->height, st->cell_type);
+		ss_sweep_fast_wake_all(&st->fast, &st->grid, st->height, st->cell_type);
 }
 
 double ss_stepper_next_source_event(const struct ss_stepper *st, double t)
@@ -239,7 +239,7 @@ static void sources_update(struct ss_stepper *st)
 	st->source_volume_rate = 0.0;
 	if (!on) {
 		if (st->kernel == SS_KERNEL_FAST)
-			ss_fast_sweep_mark_sources(&st->fast, &st->grid, NULL);
+			ss_sweep_fast_mark_sources(&st->fast, &st->grid, NULL);
 		return;
 	}
 	const size_t n = ss_grid_storage_cells(&st->grid);
@@ -260,7 +260,7 @@ static void sources_update(struct ss_stepper *st)
 	st->source_rate_max = rate_max;
 	st->source_volume_rate = volume_rate * st->grid.dx * st->grid.dy;
 	if (st->kernel == SS_KERNEL_FAST)
-		ss_fast_sweep_mark_sources(&st->fast, &st->grid, st->source_rate);
+		ss_sweep_fast_mark_sources(&st->fast, &st->grid, st->source_rate);
 }
 
 /* Neumaier's compensated sum: *sum + *carry holds the total of every term
@@ -313,7 +313,7 @@ enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,
 		ss_boundary_fill_heights(g, &st->boundary, st->height);
 		double t0 = now_seconds();
 		const double s_max = st->kernel == SS_KERNEL_FAST
-			? ss_fast_sweep_begin(&st->fast, g, st->height, st->cell_type)
+			? ss_sweep_fast_begin(&st->fast, g, st->height, st->cell_type)
 			: ss_sweep_fluxes(g, &st->tiling, &st->face_rule, st->height,
 			                  st->cell_type, st->flux_x, st->flux_y);
 		st->seconds_measure += now_seconds() - t0;
@@ -345,8 +345,8 @@ enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,
 
 		t0 = now_seconds();
 		if (st->kernel == SS_KERNEL_FAST) {
-			st->tile_sweeps += ss_fast_sweep_awake(&st->fast);
-			st->rate_max = ss_fast_sweep_step(&st->fast, g, &st->face_rule, dt,
+			st->tile_sweeps += ss_sweep_fast_awake(&st->fast);
+			st->rate_max = ss_sweep_fast_step(&st->fast, g, &st->face_rule, dt,
 			                                  st->sources_on ? st->source_rate : NULL,
 			                                  st->cell_type, st->height, st->open_flux);
 		} else {

@@ -12,8 +12,18 @@
 void ss_tiling_init(struct ss_tiling *t, const struct ss_grid *g,
                     int tile_nx, int tile_ny)
 {
-	t->tile_nx = tile_nx > 0 ? tile_nx : SS_TILE_NX_DEFAULT;
-	t->tile_ny = tile_ny > 0 ? tile_ny : SS_TILE_NY_DEFAULT;
+	/* default: 256 x 64, smaller on small grids (about 4 x 8 tiles, at
+	 * least 32 x 8) so that settled parts of them can be skipped */
+	if (tile_nx < 1) {
+		const int n = (g->nx / 4 + 7) / 8 * 8;
+		tile_nx = n < 32 ? 32 : n > SS_TILE_NX_DEFAULT ? SS_TILE_NX_DEFAULT : n;
+	}
+	if (tile_ny < 1) {
+		const int n = g->ny / 8;
+		tile_ny = n < 8 ? 8 : n > SS_TILE_NY_DEFAULT ? SS_TILE_NY_DEFAULT : n;
+	}
+	t->tile_nx = tile_nx;
+	t->tile_ny = tile_ny;
 	t->tiles_x = (g->nx + t->tile_nx - 1) / t->tile_nx;
 	t->tiles_y = (g->ny + t->tile_ny - 1) / t->tile_ny;
 }

@@ -24,6 +24,14 @@ static inline int face_carries(uint8_t a, uint8_t b)
 	       (a == SS_CELL_FLOW || b == SS_CELL_FLOW);
 }
 
+/* face_carries for widened types, with no short-circuit (which would be
+ * control flow and stop vectorisation). */
+static inline int64_t wide_carries(int64_t a, int64_t b)
+{
+	return (a != SS_CELL_WALL) & (b != SS_CELL_WALL) &
+	       ((a == SS_CELL_FLOW) | (b == SS_CELL_FLOW));
+}
+
 /*
  * Maxima of values >= +0 (s^2, |dh/dt|) as integer maxima of their bit
  * patterns: for such doubles the unsigned order of the bits is the numeric
@@ -42,6 +50,27 @@ static inline double double_of(uint64_t u)
 	double x;
 	memcpy(&x, &u, sizeof x);
 	return x;
+}
+
+/*
+ * The bits of s^2 of one face, between cells a and b = a + normal (0 if it
+ * cannot carry flux): g_n over the face, g_t the mean of both cells'
+ * central differences along it (neighbour offset `along`), a wall
+ * neighbour replaced by the cell itself.  The expressions of the reference
+ * sweep (sweep.c), for single faces; the row loops below spell them out so
+ * that they vectorise.
+ */
+static inline uint64_t face_slope2_bits(const double *h, const uint8_t *t,
+                                        ptrdiff_t a, ptrdiff_t normal, ptrdiff_t along,
+                                        double inv_spacing, double inv_2along)
+{
+	const ptrdiff_t b = a + normal;
+	const double cda = ((t[a + along] == SS_CELL_WALL ? h[a] : h[a + along]) -
+	                    (t[a - along] == SS_CELL_WALL ? h[a] : h[a - along])) * inv_2along;
+	const double cdb = ((t[b + along] == SS_CELL_WALL ? h[b] : h[b + along]) -
+	                    (t[b - along] == SS_CELL_WALL ? h[b] : h[b - along])) * inv_2along;
+	const double gn = (h[b] - h[a]) * inv_spacing, gt = 0.5 * (cda + cdb);
+	return face_carries(t[a], t[b]) ? bits_of(gn * gn + gt * gt) : 0;
 }
 
 /* The larger of a and b as a select (fmax() is a library call). */
@@ -157,6 +186,77 @@ static double slope2_plain_pair(const struct ss_grid *g, const double *h, int j,
 	return max;
 }
 
+/*
+ * Largest s^2 of the x-face (i - 1 | i) and the y-face (j - 1 | j) of cell i
+ * in rows ja <= j <= jb: a column of a tile's west or east edge in one loop
+ * (x-faces of rows ja .. jb - 1 only when with_x; the same expressions as
+ * slope2_x_faces and slope2_y_faces).
+ */
+static double slope2_column(const struct ss_grid *g, const double *h,
+                            const uint8_t *t, int i_x, int i_y, int ja, int jb,
+                            int *bad)
+{
+	const ptrdiff_t s = g->stride;
+	const double inv_dx = 1.0 / g->dx, inv_dy = 1.0 / g->dy;
+	const double inv_2dx = 0.5 / g->dx, inv_2dy = 0.5 / g->dy;
+	uint64_t m = 0;
+	for (int j = ja; j <= jb; j++) {
+		uint64_t q = face_slope2_bits(h, t, ss_grid_index(g, i_y, j) - s, s, 1,
+		                              inv_dy, inv_2dx);
+		m = q > m ? q : m;
+		if (j < jb) {
+			q = face_slope2_bits(h, t, ss_grid_index(g, i_x, j) - 1, 1, s, inv_dx,
+			                     inv_2dy);
+			m = q > m ? q : m;
+		}
+	}
+	const double max = double_of(m);
+	*bad |= max != max;
+	return max;
+}
+
+/*
+ * The same in a tile with walls or open cells, from the tile's widened type
+ * rows ta, tb, tc of rows j - 2 .. j (by buffer position x = i - i0 + 1),
+ * positions xa .. xb.
+ */
+static double slope2_mixed_pair(const struct ss_grid *g, const double *h, int j,
+                                int i0, int xa, int xb, const int64_t *restrict ta,
+                                const int64_t *restrict tb, const int64_t *restrict tc,
+                                int *bad)
+{
+	const double inv_dx = 1.0 / g->dx, inv_dy = 1.0 / g->dy;
+	const double inv_2dx = 0.5 / g->dx, inv_2dy = 0.5 / g->dy;
+	/* rows by position: cell i0 - 1 + x */
+	const double *ha = h + ss_grid_index(g, i0 - 1, j - 2);
+	const double *hb = h + ss_grid_index(g, i0 - 1, j - 1);
+	const double *hc = h + ss_grid_index(g, i0 - 1, j);
+	uint64_t m = 0;
+	for (int x = xa; x <= xb; x++) {
+		/* x-face (x - 1 | x) of row j - 1 */
+		const double cda = ((tc[x - 1] == SS_CELL_WALL ? hb[x - 1] : hc[x - 1]) -
+		                    (ta[x - 1] == SS_CELL_WALL ? hb[x - 1] : ha[x - 1])) * inv_2dy;
+		const double cdb = ((tc[x] == SS_CELL_WALL ? hb[x] : hc[x]) -
+		                    (ta[x] == SS_CELL_WALL ? hb[x] : ha[x])) * inv_2dy;
+		const double gnx = (hb[x] - hb[x - 1]) * inv_dx, gtx = 0.5 * (cda + cdb);
+		const int64_t cx = wide_carries(tb[x - 1], tb[x]);
+		/* y-face (j - 1 | j) of position x */
+		const double cxb = ((tb[x + 1] == SS_CELL_WALL ? hb[x] : hb[x + 1]) -
+		                    (tb[x - 1] == SS_CELL_WALL ? hb[x] : hb[x - 1])) * inv_2dx;
+		const double cxc = ((tc[x + 1] == SS_CELL_WALL ? hc[x] : hc[x + 1]) -
+		                    (tc[x - 1] == SS_CELL_WALL ? hc[x] : hc[x - 1])) * inv_2dx;
+		const double gny = (hc[x] - hb[x]) * inv_dy, gty = 0.5 * (cxb + cxc);
+		const int64_t cy = wide_carries(tb[x], tc[x]);
+		const uint64_t qx = cx ? bits_of(gnx * gnx + gtx * gtx) : 0;
+		const uint64_t qy = cy ? bits_of(gny * gny + gty * gty) : 0;
+		const uint64_t q = qx > qy ? qx : qy;
+		m = q > m ? q : m;
+	}
+	const double max = double_of(m);
+	*bad |= max != max;
+	return max;
+}
+
 /* Largest s^2 over every face of the grid that can carry flux. */
 static double slope2_all(const struct ss_grid *g, const double *h,
                          const uint8_t *t, int *bad)
@@ -188,7 +288,7 @@ struct tile_span {
 	int i0, i1, j0, j1;
 };
 
-static struct tile_span span_of(const struct ss_fast_sweep *f, const struct ss_grid *g,
+static struct tile_span span_of(const struct ss_sweep_fast *f, const struct ss_grid *g,
                                 int tx, int ty)
 {
 	const struct ss_tiling *t = &f->tiling;
@@ -205,7 +305,7 @@ static size_t row_doubles(const struct ss_tiling *t)
 	return ((size_t)t->tile_nx + 2 + 7) / 8 * 8;   /* 64 B aligned rows */
 }
 
-int ss_fast_sweep_init(struct ss_fast_sweep *f, const struct ss_grid *g,
+int ss_sweep_fast_init(struct ss_sweep_fast *f, const struct ss_grid *g,
                        int tile_nx, int tile_ny, int threads,
                        int periodic_x, int periodic_y,
                        const uint8_t *cell_type,
@@ -220,7 +320,7 @@ int ss_fast_sweep_init(struct ss_fast_sweep *f, const struct ss_grid *g,
 	f->periodic_x = periodic_x;
 	f->periodic_y = periodic_y;
 	const size_t tiles = (size_t)f->tiles;
-	f->scratch_doubles = 15 * row_doubles(t) + 2 * (((size_t)t->tile_ny + 7) / 8 * 8);
+	f->scratch_doubles = 16 * row_doubles(t) + 2 * (((size_t)t->tile_ny + 7) / 8 * 8);
 	f->sweep = ss_alloc(tiles, 1, "tile flags");
 	f->sweep_next = ss_alloc(tiles, 1, "tile flags");
 	f->moving = ss_alloc(tiles, 1, "tile flags");
@@ -238,7 +338,7 @@ int ss_fast_sweep_init(struct ss_fast_sweep *f, const struct ss_grid *g,
 	if (!f->sweep || !f->sweep_next || !f->moving || !f->edges_changed || !f->plain ||
 	    !f->has_source || !f->row_list || !f->ring_south || !f->ring_north ||
 	    !f->scratch || !f->open_first || !f->open_slots) {
-		ss_fast_sweep_release(f);
+		ss_sweep_fast_release(f);
 		return SS_ERR_FAIL;
 	}
 
@@ -259,7 +359,7 @@ int ss_fast_sweep_init(struct ss_fast_sweep *f, const struct ss_grid *g,
 	size_t *tile_of = ss_alloc(open_face_count ? open_face_count : 1, sizeof *tile_of,
 	                           "open faces");
 	if (!tile_of) {
-		ss_fast_sweep_release(f);
+		ss_sweep_fast_release(f);
 		return SS_ERR_FAIL;
 	}
 	const ptrdiff_t stride = g->stride;
@@ -294,7 +394,7 @@ int ss_fast_sweep_init(struct ss_fast_sweep *f, const struct ss_grid *g,
 		ss_free(sorted);
 		ss_free(fill);
 		ss_free(tile_of);
-		ss_fast_sweep_release(f);
+		ss_sweep_fast_release(f);
 		return SS_ERR_FAIL;
 	}
 	for (size_t m = 0; m < open_face_count; m++)
@@ -307,7 +407,7 @@ int ss_fast_sweep_init(struct ss_fast_sweep *f, const struct ss_grid *g,
 	return SS_OK;
 }
 
-void ss_fast_sweep_release(struct ss_fast_sweep *f)
+void ss_sweep_fast_release(struct ss_sweep_fast *f)
 {
 	ss_free(f->open_slots);
 	ss_free(f->open_first);
@@ -324,7 +424,7 @@ void ss_fast_sweep_release(struct ss_fast_sweep *f)
 	memset(f, 0, sizeof *f);
 }
 
-void ss_fast_sweep_wake_all(struct ss_fast_sweep *f, const struct ss_grid *g,
+void ss_sweep_fast_wake_all(struct ss_sweep_fast *f, const struct ss_grid *g,
                             const double *height, const uint8_t *cell_type)
 {
 	int bad = 0;
@@ -333,7 +433,7 @@ void ss_fast_sweep_wake_all(struct ss_fast_sweep *f, const struct ss_grid *g,
 	f->nonfinite = bad;
 }
 
-void ss_fast_sweep_mark_sources(struct ss_fast_sweep *f, const struct ss_grid *g,
+void ss_sweep_fast_mark_sources(struct ss_sweep_fast *f, const struct ss_grid *g,
                                 const double *source_rate)
 {
 	const struct ss_tiling *t = &f->tiling;
@@ -352,7 +452,7 @@ void ss_fast_sweep_mark_sources(struct ss_fast_sweep *f, const struct ss_grid *g
 	}
 }
 
-double ss_fast_sweep_awake(const struct ss_fast_sweep *f)
+double ss_sweep_fast_awake(const struct ss_sweep_fast *f)
 {
 	double n = 0.0;
 	for (int k = 0; k < f->tiles; k++)
@@ -361,7 +461,7 @@ double ss_fast_sweep_awake(const struct ss_fast_sweep *f)
 }
 
 /* Tile rows holding a tile to sweep, into f->row_list; returns the count. */
-static int list_rows(struct ss_fast_sweep *f)
+static int list_rows(struct ss_sweep_fast *f)
 {
 	const struct ss_tiling *t = &f->tiling;
 	int n = 0;
@@ -376,7 +476,7 @@ static int list_rows(struct ss_fast_sweep *f)
 	return n;
 }
 
-double ss_fast_sweep_begin(struct ss_fast_sweep *f, const struct ss_grid *g,
+double ss_sweep_fast_begin(struct ss_sweep_fast *f, const struct ss_grid *g,
                            const double *height, const uint8_t *cell_type)
 {
 	const struct ss_tiling *t = &f->tiling;
@@ -406,13 +506,13 @@ double ss_fast_sweep_begin(struct ss_fast_sweep *f, const struct ss_grid *g,
 			q = max2(q, slope2_x_faces(g, height, cell_type, plain, s.j1 - 1, s.i0, s.i1, &bad));
 			q = max2(q, slope2_y_faces(g, height, cell_type, plain, s.j0, s.i0, s.i1 - 1, &bad));
 			q = max2(q, slope2_y_faces(g, height, cell_type, plain, s.j1, s.i0, s.i1 - 1, &bad));
-			for (int j = s.j0 + 1; j < s.j1; j++) {
-				if (j < s.j1 - 1) {
-					q = max2(q, slope2_x_faces(g, height, cell_type, plain, j, s.i0, s.i0, &bad));
-					q = max2(q, slope2_x_faces(g, height, cell_type, plain, j, s.i1, s.i1, &bad));
-				}
-				q = max2(q, slope2_y_faces(g, height, cell_type, plain, j, s.i0, s.i0, &bad));
-				q = max2(q, slope2_y_faces(g, height, cell_type, plain, j, s.i1 - 1, s.i1 - 1, &bad));
+			/* the west and east columns: x-faces i0 and i1 of rows j0 + 1 ..
+			 * j1 - 2, y-faces of cells i0 and i1 - 1 for j0 + 1 .. j1 - 1 */
+			if (s.j1 - s.j0 >= 2) {
+				q = max2(q, slope2_column(g, height, cell_type, s.i0, s.i0, s.j0 + 1,
+				                          s.j1 - 1, &bad));
+				q = max2(q, slope2_column(g, height, cell_type, s.i1, s.i1 - 1, s.j0 + 1,
+				                          s.j1 - 1, &bad));
 			}
 			m = q > m ? q : m;
 		}
@@ -430,11 +530,11 @@ typedef int64_t wide_type;
 
 struct row_buffers {
 	double *row[3], *cdx[3], *cdy, *gn, *gt, *fx, *fy[2];
-	wide_type *type[3];
+	wide_type *type[4];
 	double *west_old, *east_save;
 };
 
-static struct row_buffers buffers_of(const struct ss_fast_sweep *f, int thread)
+static struct row_buffers buffers_of(const struct ss_sweep_fast *f, int thread)
 {
 	const size_t w = row_doubles(&f->tiling);
 	double *p = f->scratch + (size_t)thread * f->scratch_doubles;
@@ -449,9 +549,9 @@ static struct row_buffers buffers_of(const struct ss_fast_sweep *f, int thread)
 	b.fx = p + 9 * w;
 	b.fy[0] = p + 10 * w;
 	b.fy[1] = p + 11 * w;
-	for (int k = 0; k < 3; k++)
+	for (int k = 0; k < 4; k++)
 		b.type[k] = (wide_type *)(p + (size_t)(12 + k) * w);
-	b.west_old = p + 15 * w;
+	b.west_old = p + 16 * w;
 	b.east_save = b.west_old + ((size_t)f->tiling.tile_ny + 7) / 8 * 8;
 	return b;
 }
@@ -500,8 +600,7 @@ static inline int face_row(const struct ss_face_rule *rule, int n,
 		return any;
 	if (any) {
 		for (int k = 0; k < n; k++) {
-			const int64_t carries = ta[k] != SS_CELL_WALL && tb[k] != SS_CELL_WALL &&
-			                        (ta[k] == SS_CELL_FLOW || tb[k] == SS_CELL_FLOW);
+			const int64_t carries = wide_carries(ta[k], tb[k]);
 			flux[k] = carries ? flux[k] : 0.0;
 			sliding |= carries & (gn[k] * gn[k] + gt[k] * gt[k] > tan_cr2);
 		}
@@ -540,7 +639,7 @@ static inline void load_row(double *restrict buf, const double *restrict h_row,
 	buf[W + 1] = h_row[i0 + W];
 }
 
-static void sweep_tile(struct ss_fast_sweep *f, const struct ss_grid *g,
+static void sweep_tile(struct ss_sweep_fast *f, const struct ss_grid *g,
                        const struct ss_face_rule *rule, double dt,
                        const double *restrict src, const uint8_t *restrict type,
                        double *restrict h, double *restrict open_flux,
@@ -567,6 +666,7 @@ static void sweep_tile(struct ss_fast_sweep *f, const struct ss_grid *g,
 			w->west_old[j - j0] = h[ss_grid_index(g, i0 - 1, j)];
 
 	wide_type *type_prev = w->type[0], *type_cur = w->type[1], *type_next = w->type[2];
+	wide_type *type_back = w->type[3];   /* row j - 2 */
 	memcpy(prev, f->ring_south + ty * stride + i0, (size_t)(W + 2) * sizeof(double));
 	load_row(cur, h + ss_grid_index(g, 0, j0), i0, W, w->west_old[0]);
 	if (!plain) {
@@ -668,8 +768,11 @@ static void sweep_tile(struct ss_fast_sweep *f, const struct ss_grid *g,
 			                      : slot->which == 1 ? fy_south[slot->x] : fy_north[slot->x];
 
 		/* the new state's faces inside the tile, one row behind */
-		if (plain && j >= j0 + 2) {
-			s2_max = max2(s2_max, slope2_plain_pair(g, h, j, i0 + 1, i0 + W - 2, &bad));
+		if (j >= j0 + 2) {
+			s2_max = max2(s2_max, plain
+			              ? slope2_plain_pair(g, h, j, i0 + 1, i0 + W - 2, &bad)
+			              : slope2_mixed_pair(g, h, j, i0, 2, W - 1, type_back,
+			                                  type_prev, type_cur, &bad));
 			if (W >= 2)   /* the last interior x-face, not paired */
 				s2_max = max2(s2_max, slope2_x_faces(g, h, type, plain, j - 1, i0 + W - 1,
 				                                     i0 + W - 1, &bad));
@@ -693,7 +796,8 @@ static void sweep_tile(struct ss_fast_sweep *f, const struct ss_grid *g,
 		tmp = fy_south;
 		fy_south = fy_north;
 		fy_north = tmp;
-		wide_type *tt = type_prev;
+		wide_type *tt = type_back;
+		type_back = type_prev;
 		type_prev = type_cur;
 		type_cur = type_next;
 		type_next = tt;
@@ -709,7 +813,7 @@ static void sweep_tile(struct ss_fast_sweep *f, const struct ss_grid *g,
 /* Which tiles the next step sweeps: those that moved, those under a source,
  * and the neighbours that see a changed edge (diagonal ones when both edges
  * at the shared corner changed, which includes every changed corner). */
-static void plan_next(struct ss_fast_sweep *f)
+static void plan_next(struct ss_sweep_fast *f)
 {
 	const int nx = f->tiling.tiles_x, ny = f->tiling.tiles_y;
 	uint8_t *next = f->sweep_next;
@@ -755,7 +859,7 @@ static void plan_next(struct ss_fast_sweep *f)
 	f->sweep_next = tmp;
 }
 
-double ss_fast_sweep_step(struct ss_fast_sweep *f, const struct ss_grid *g,
+double ss_sweep_fast_step(struct ss_sweep_fast *f, const struct ss_grid *g,
                           const struct ss_face_rule *rule, double dt,
                           const double *restrict source_rate,
                           const uint8_t *restrict cell_type,

@@ -50,7 +50,7 @@ struct ss_stepper {
 	struct ss_face_rule face_rule;
 	enum ss_kernel kernel;        /* set before ss_stepper_prepare */
 	int tile_nx, tile_ny;         /* as requested (< 1: defaults) */
-	struct ss_fast_sweep fast;
+	struct ss_sweep_fast fast;
 	struct ss_cfl_bound cfl_bound;
 	struct ss_boundary boundary;
 	double cfl;                   /* in (0, 1] */

@@ -36,7 +36,9 @@ struct ss_tiling {
 #define SS_TILE_NY_DEFAULT 64
 
 /* Cover g with tiles of tile_nx x tile_ny cells (the last ones may be
- * smaller); sizes < 1 mean the defaults. */
+ * smaller); sizes < 1 mean the defaults: 256 x 64, or on a small grid about
+ * a quarter of its width (a multiple of 8, at least 32) by an eighth of its
+ * height (at least 8). */
 void ss_tiling_init(struct ss_tiling *t, const struct ss_grid *g,
                     int tile_nx, int tile_ny);
 
@@ -102,7 +104,7 @@ struct ss_open_face {
 };
 
 
-struct ss_fast_sweep {
+struct ss_sweep_fast {
 	struct ss_tiling tiling;
 	int tiles;
 	uint8_t *sweep;          /* per tile: sweep it in the coming step */
@@ -142,40 +144,40 @@ struct ss_open_face_slot {
 /* Allocate for grid g, tiles of tile_nx x tile_ny (< 1: defaults), `threads`
  * OpenMP threads; cell types must be final (halo included).  The fast
  * sweep writes the flux of open_faces[m] to open_flux[m].  Every tile starts awake. */
-int ss_fast_sweep_init(struct ss_fast_sweep *f, const struct ss_grid *g,
+int ss_sweep_fast_init(struct ss_sweep_fast *f, const struct ss_grid *g,
                        int tile_nx, int tile_ny, int threads,
                        int periodic_x, int periodic_y,
                        const uint8_t *cell_type,
                        const struct ss_open_face *open_faces,
                        size_t open_face_count);
-void ss_fast_sweep_release(struct ss_fast_sweep *f);
+void ss_sweep_fast_release(struct ss_sweep_fast *f);
 
 /* Wake every tile and measure the state from scratch (after heights were
  * changed from outside). */
-void ss_fast_sweep_wake_all(struct ss_fast_sweep *f, const struct ss_grid *g,
+void ss_sweep_fast_wake_all(struct ss_sweep_fast *f, const struct ss_grid *g,
                             const double *height, const uint8_t *cell_type);
 
 /* Mark the tiles holding a cell with a non-zero source rate (NULL: none). */
-void ss_fast_sweep_mark_sources(struct ss_fast_sweep *f, const struct ss_grid *g,
+void ss_sweep_fast_mark_sources(struct ss_sweep_fast *f, const struct ss_grid *g,
                                 const double *source_rate);
 
 /* Start of a step: save the ring rows of the tiles to sweep and measure the
  * faces their interior measure could not see.  Returns the largest face
  * slope of the current state that can matter for the time step (exact when
  * it is above the critical slope); sets f->nonfinite on NaN. */
-double ss_fast_sweep_begin(struct ss_fast_sweep *f, const struct ss_grid *g,
+double ss_sweep_fast_begin(struct ss_sweep_fast *f, const struct ss_grid *g,
                            const double *height, const uint8_t *cell_type);
 
 /* The step: advance the tiles to sweep by dt, in place.  Returns max |dh/dt|
  * over the flow cells (INFINITY on NaN); open_flux gets the fluxes of the
  * faces to open cells.  Then plans which tiles the next step sweeps. */
-double ss_fast_sweep_step(struct ss_fast_sweep *f, const struct ss_grid *g,
+double ss_sweep_fast_step(struct ss_sweep_fast *f, const struct ss_grid *g,
                           const struct ss_face_rule *rule, double dt,
                           const double *restrict source_rate,
                           const uint8_t *restrict cell_type,
                           double *restrict height, double *restrict open_flux);
 
 /* Tiles in the grid and tiles the coming step sweeps. */
-double ss_fast_sweep_awake(const struct ss_fast_sweep *f);
+double ss_sweep_fast_awake(const struct ss_sweep_fast *f);
 
 #endif
