@@ -608,14 +608,14 @@ static void test_subcritical(void)
 
 	/* the kernel itself, with a large forced dt */
 	const double tiles = (double)st.fast.tiles;
-	const double awake0 = ss_fast_sweep_awake(&st.fast);
+	const double awake0 = ss_sweep_fast_awake(&st.fast);
 	CHECK(awake0 == tiles, "subcritical: %g of %g tiles awake after prepare", awake0, tiles);
 	for (int step = 0; step < 3; step++) {
 		ss_boundary_fill_heights(g, &st.boundary, st.height);
-		const double s = ss_fast_sweep_begin(&st.fast, g, st.height, st.cell_type);
+		const double s = ss_sweep_fast_begin(&st.fast, g, st.height, st.cell_type);
 		CHECK(s <= tc, "subcritical: step %d: the fast sweep measures slope %g > tan "
 		      "a_cr %g", step, s, tc);
-		const double rate = ss_fast_sweep_step(&st.fast, g, &st.face_rule, 1e3, NULL,
+		const double rate = ss_sweep_fast_step(&st.fast, g, &st.face_rule, 1e3, NULL,
 		                                       st.cell_type, st.height, st.open_flux);
 		CHECK(rate == 0.0, "subcritical: step %d: max |dh/dt| %g", step, rate);
 		CHECK(memcmp(before, st.height, storage * sizeof *before) == 0,
@@ -624,7 +624,7 @@ static void test_subcritical(void)
 		for (size_t m = 0; m < st.open_face_count; m++)
 			flux_zero &= st.open_flux[m] == 0.0;
 		CHECK(flux_zero, "subcritical: step %d: an open face carries flux", step);
-		const double awake = ss_fast_sweep_awake(&st.fast);
+		const double awake = ss_sweep_fast_awake(&st.fast);
 		CHECK(awake == 0.0, "subcritical: %g of %g tiles still awake after step %d",
 		      awake, tiles, step);
 	}
@@ -707,8 +707,8 @@ static void test_max_slope(void)
 			const double m = ss_sweep_max_slope(g, ref.height, ref.cell_type);
 			const double f = ss_sweep_fluxes(g, &ref.tiling, &ref.face_rule, ref.height,
 			                                 ref.cell_type, ref.flux_x, ref.flux_y);
-			ss_fast_sweep_wake_all(&fast.fast, g, fast.height, fast.cell_type);
-			const double b = ss_fast_sweep_begin(&fast.fast, g, fast.height, fast.cell_type);
+			ss_sweep_fast_wake_all(&fast.fast, g, fast.height, fast.cell_type);
+			const double b = ss_sweep_fast_begin(&fast.fast, g, fast.height, fast.cell_type);
 			cases++;
 			if (!same_bits(m, f)) {
 				mismatches++;
