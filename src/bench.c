@@ -106,6 +106,25 @@ static void set_surface(struct ss_stepper *st, enum ss_bench_surface surface)
 	}
 }
 
+/*
+ * The stepper's substep without its events: a subcritical state, which
+ * ss_stepper_advance would not sweep at all, is swept here (and its tiles
+ * skipped).  lambda_idle stands in for a CFL rate of 0.
+ */
+static void bench_step(struct ss_stepper *st, double lambda_idle)
+{
+	const struct ss_grid *g = &st->grid;
+	const double inv_d2 = 1.0 / (g->dx * g->dx) + 1.0 / (g->dy * g->dy);
+	ss_boundary_fill_heights(g, &st->boundary, st->height);
+	const double s_max = ss_sweep_fast_begin(&st->fast, g, st->height, st->cell_type);
+	double lambda = st->closure.nu * ss_cfl_bound_lookup(&st->cfl_bound, s_max);
+	lambda = lambda > 0.0 ? lambda : lambda_idle;
+	st->tile_sweeps += ss_sweep_fast_awake(&st->fast);
+	st->tile_slots += st->fast.tiles;
+	ss_sweep_fast_step(&st->fast, g, &st->face_rule, st->cfl / (2.0 * lambda * inv_d2),
+	                   NULL, st->cell_type, st->height, st->open_flux);
+}
+
 struct case_result {
 	double median, min, max;     /* cell-updates/s */
 	double active_fraction;      /* tiles swept / tiles, timed steps */
@@ -138,29 +157,13 @@ static int run_case(const struct ss_bench_options *o, enum ss_bench_surface surf
 		return err;
 	}
 
-	/* the stepper's substep without events: a subcritical state, which the
-	 * stepper would skip whole, is swept here (and its tiles skipped) */
-	const double inv_d2 = 1.0 / (g.dx * g.dx) + 1.0 / (g.dy * g.dy);
 	const double lambda_idle = st.closure.nu * ss_cfl_bound_lookup(&st.cfl_bound, 2.0 * c.tan_cr);
-	double *open_flux = st.open_flux;
-	#define BENCH_STEP()                                                              \
-	do {                                                                              \
-		ss_boundary_fill_heights(&g, &st.boundary, st.height);                      \
-		const double s_max = ss_sweep_fast_begin(&st.fast, &g, st.height, st.cell_type); \
-		double lambda = st.closure.nu * ss_cfl_bound_lookup(&st.cfl_bound, s_max); \
-		lambda = lambda > 0.0 ? lambda : lambda_idle;                               \
-		st.tile_sweeps += ss_sweep_fast_awake(&st.fast);                            \
-		st.tile_slots += st.fast.tiles;                                             \
-		ss_sweep_fast_step(&st.fast, &g, &st.face_rule, st.cfl / (2.0 * lambda * inv_d2), \
-		                   NULL, st.cell_type, st.height, open_flux);               \
-	} while (0)
-
-	BENCH_STEP();                                 /* warm-up: every tile */
+	bench_step(&st, lambda_idle);                 /* warm-up: every tile */
 	long long steps = o->steps;
 	if (steps <= 0) {
 		/* enough steps for about 0.3 s per timing */
 		const double t0 = now_seconds();
-		BENCH_STEP();
+		bench_step(&st, lambda_idle);
 		const double one = now_seconds() - t0;
 		steps = (long long)ceil(0.3 / fmax(one, 1e-6));
 		steps = steps < 1 ? 1 : steps > 2000 ? 2000 : steps;
@@ -172,10 +175,9 @@ static int run_case(const struct ss_bench_options *o, enum ss_bench_surface surf
 	for (int r = 0; r < repeats; r++) {
 		const double t0 = now_seconds();
 		for (long long k = 0; k < steps; k++)
-			BENCH_STEP();
+			bench_step(&st, lambda_idle);
 		rates[r] = cells * (double)steps / (now_seconds() - t0);
 	}
-	#undef BENCH_STEP
 	if (st.fast.nonfinite) {
 		ss_stepper_release(&st);
 		return ss_error_fail("bench %s %s: a height became NaN or infinite",

@@ -44,8 +44,6 @@ int ss_stepper_init(struct ss_stepper *st, const struct ss_grid *g,
 	ss_cfl_bound_init(&st->cfl_bound, c);
 	ss_face_rule_init(&st->face_rule, c);
 	ss_tiling_init(&st->tiling, g, tile_nx, tile_ny);
-	st->tile_nx = tile_nx;
-	st->tile_ny = tile_ny;
 
 	const size_t n = ss_grid_storage_cells(g);
 	st->height = ss_alloc(n, sizeof(double), "heights");
@@ -190,14 +188,13 @@ int ss_stepper_prepare(struct ss_stepper *st)
 	                         sizeof(double), "open-face fluxes");
 	if (!st->open_flux)
 		return SS_ERR_FAIL;
-	err = ss_sweep_fast_init(&st->fast, g, st->tile_nx, st->tile_ny,
+	err = ss_sweep_fast_init(&st->fast, g, &st->tiling,
 	                         ss_parallel_max_threads(),
 	                         st->boundary.side[SS_WEST] == SS_SIDE_PERIODIC,
 	                         st->boundary.side[SS_SOUTH] == SS_SIDE_PERIODIC,
 	                         st->cell_type, st->open_faces, st->open_face_count);
 	if (err)
 		return err;
-	st->tiling = st->fast.tiling;
 	ss_sweep_fast_wake_all(&st->fast, g, st->height, st->cell_type);
 	return SS_OK;
 }

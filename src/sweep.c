@@ -28,22 +28,6 @@ void ss_tiling_init(struct ss_tiling *t, const struct ss_grid *g,
 	t->tiles_y = (g->ny + t->tile_ny - 1) / t->tile_ny;
 }
 
-struct tile_span {
-	int i0, i1, j0, j1;   /* cells [i0, i1) x [j0, j1) */
-};
-
-static struct tile_span tile_span(const struct ss_grid *g,
-                                  const struct ss_tiling *t, int tile)
-{
-	const int tx = tile % t->tiles_x, ty = tile / t->tiles_x;
-	struct tile_span s;
-	s.i0 = tx * t->tile_nx;
-	s.j0 = ty * t->tile_ny;
-	s.i1 = s.i0 + t->tile_nx < g->nx ? s.i0 + t->tile_nx : g->nx;
-	s.j1 = s.j0 + t->tile_ny < g->ny ? s.j0 + t->tile_ny : g->ny;
-	return s;
-}
-
 /* A face carries flux when neither side is a wall and one side flows. */
 static inline int face_is_active(uint8_t a, uint8_t b)
 {
@@ -105,7 +89,8 @@ double ss_sweep_fluxes(const struct ss_grid *g, const struct ss_tiling *t,
 
 	#pragma omp parallel for schedule(static) reduction(max:s2_max)
 	for (int tile = 0; tile < tiles; tile++) {
-		const struct tile_span sp = tile_span(g, t, tile);
+		const struct ss_tile_span sp = ss_tiling_span(t, g, tile % t->tiles_x,
+		                                              tile / t->tiles_x);
 		/* the last tile of a row (column) also owns the east (north) face */
 		const int x_end = sp.i1 == g->nx ? sp.i1 + 1 : sp.i1;
 		const int y_end = sp.j1 == g->ny ? sp.j1 + 1 : sp.j1;
@@ -144,7 +129,8 @@ double ss_sweep_update(const struct ss_grid *g, const struct ss_tiling *t,
 
 	#pragma omp parallel for schedule(static) reduction(max:rate_max)
 	for (int tile = 0; tile < tiles; tile++) {
-		const struct tile_span sp = tile_span(g, t, tile);
+		const struct ss_tile_span sp = ss_tiling_span(t, g, tile % t->tiles_x,
+		                                              tile / t->tiles_x);
 		for (int j = sp.j0; j < sp.j1; j++) {
 			for (int i = sp.i0; i < sp.i1; i++) {
 				const ptrdiff_t k = ss_grid_index(g, i, j);

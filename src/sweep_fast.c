@@ -284,36 +284,20 @@ double ss_sweep_max_slope(const struct ss_grid *g, const double *restrict height
 
 /* ---- set-up ---------------------------------------------------------- */
 
-struct tile_span {
-	int i0, i1, j0, j1;
-};
-
-static struct tile_span span_of(const struct ss_sweep_fast *f, const struct ss_grid *g,
-                                int tx, int ty)
-{
-	const struct ss_tiling *t = &f->tiling;
-	struct tile_span s;
-	s.i0 = tx * t->tile_nx;
-	s.j0 = ty * t->tile_ny;
-	s.i1 = s.i0 + t->tile_nx < g->nx ? s.i0 + t->tile_nx : g->nx;
-	s.j1 = s.j0 + t->tile_ny < g->ny ? s.j0 + t->tile_ny : g->ny;
-	return s;
-}
-
 static size_t row_doubles(const struct ss_tiling *t)
 {
 	return ((size_t)t->tile_nx + 2 + 7) / 8 * 8;   /* 64 B aligned rows */
 }
 
 int ss_sweep_fast_init(struct ss_sweep_fast *f, const struct ss_grid *g,
-                       int tile_nx, int tile_ny, int threads,
+                       const struct ss_tiling *tiling, int threads,
                        int periodic_x, int periodic_y,
                        const uint8_t *cell_type,
                        const struct ss_open_face *open_faces,
                        size_t open_face_count)
 {
 	memset(f, 0, sizeof *f);
-	ss_tiling_init(&f->tiling, g, tile_nx, tile_ny);
+	f->tiling = *tiling;
 	const struct ss_tiling *t = &f->tiling;
 	f->tiles = t->tiles_x * t->tiles_y;
 	f->threads = threads > 0 ? threads : 1;
@@ -345,7 +329,7 @@ int ss_sweep_fast_init(struct ss_sweep_fast *f, const struct ss_grid *g,
 	/* plain tiles: every cell of the tile and of its ring flows */
 	for (int ty = 0; ty < t->tiles_y; ty++) {
 		for (int tx = 0; tx < t->tiles_x; tx++) {
-			const struct tile_span s = span_of(f, g, tx, ty);
+			const struct ss_tile_span s = ss_tiling_span(&f->tiling, g, tx, ty);
 			int plain = 1;
 			for (int j = s.j0 - 1; j <= s.j1 && plain; j++)
 				for (int i = s.i0 - 1; i <= s.i1; i++)
@@ -440,7 +424,7 @@ void ss_sweep_fast_mark_sources(struct ss_sweep_fast *f, const struct ss_grid *g
 	#pragma omp parallel for schedule(static)
 	for (int ty = 0; ty < t->tiles_y; ty++) {
 		for (int tx = 0; tx < t->tiles_x; tx++) {
-			const struct tile_span s = span_of(f, g, tx, ty);
+			const struct ss_tile_span s = ss_tiling_span(&f->tiling, g, tx, ty);
 			int on = 0;
 			for (int j = s.j0; j < s.j1 && source_rate && !on; j++)
 				for (int i = s.i0; i < s.i1; i++)
@@ -494,7 +478,7 @@ double ss_sweep_fast_begin(struct ss_sweep_fast *f, const struct ss_grid *g,
 			const int tile = ty * t->tiles_x + tx;
 			if (!f->sweep[tile])
 				continue;
-			const struct tile_span s = span_of(f, g, tx, ty);
+			const struct ss_tile_span s = ss_tiling_span(&f->tiling, g, tx, ty);
 			const int plain = f->plain[tile];
 			const size_t n = (size_t)(s.i1 - s.i0 + 2);
 			memcpy(f->ring_south + ty * stride + s.i0,
@@ -647,7 +631,7 @@ static void sweep_tile(struct ss_sweep_fast *f, const struct ss_grid *g,
                        struct tile_result *res)
 {
 	const int tile = ty * f->tiling.tiles_x + tx;
-	const struct tile_span s = span_of(f, g, tx, ty);
+	const struct ss_tile_span s = ss_tiling_span(&f->tiling, g, tx, ty);
 	const int i0 = s.i0, W = s.i1 - s.i0, j0 = s.j0, j1 = s.j1;
 	const int plain = f->plain[tile];
 	const ptrdiff_t stride = g->stride;
@@ -802,7 +786,6 @@ static void sweep_tile(struct ss_sweep_fast *f, const struct ss_grid *g,
 		type_cur = type_next;
 		type_next = tt;
 	}
-	(void)cdx_prev;
 	f->moving[tile] = (uint8_t)(moving != 0);
 	f->edges_changed[tile] = (uint8_t)edges;
 	res->rate_max = rate_max;

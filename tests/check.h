@@ -6,6 +6,8 @@
  *   CHECK_REL(a, b, rel, fmt, ...)     |a - b| <= rel * max(|a|, |b|)
  *   RUN(fn)                            runs a test function, names failures
  *   check_report()                     prints "N passed, M failed", exit code
+ *   check_now()                        monotonic clock, s (for timings)
+ *   struct rng, rng_next/uniform/int   splitmix64: reproducible random states
  *
  * Each CHECK counts as one check; a test function may make many.
  */
@@ -13,8 +15,42 @@
 #define SANDSLIDE_TESTS_CHECK_H
 
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <time.h>
+
+static inline double check_now(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* splitmix64: a small reproducible generator, seeded by s */
+struct rng {
+	uint64_t s;
+};
+
+static inline uint64_t rng_next(struct rng *r)
+{
+	uint64_t z = (r->s += UINT64_C(0x9e3779b97f4a7c15));
+	z = (z ^ (z >> 30)) * UINT64_C(0xbf58476d1ce4e5b9);
+	z = (z ^ (z >> 27)) * UINT64_C(0x94d049bb133111eb);
+	return z ^ (z >> 31);
+}
+
+/* uniform in [0, 1) */
+static inline double rng_uniform(struct rng *r)
+{
+	return (double)(rng_next(r) >> 11) * 0x1.0p-53;
+}
+
+/* uniform integer in [0, n) */
+static inline int rng_int(struct rng *r, int n)
+{
+	return (int)(rng_next(r) % (uint64_t)n);
+}
 
 static int check_passed, check_failed;
 static const char *check_current = "";

@@ -41,32 +41,6 @@ static uint64_t seed = 20240611;
 
 /* ---- helpers ------------------------------------------------------------ */
 
-static double now(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-/* splitmix64: a small reproducible generator */
-struct rng {
-	uint64_t s;
-};
-
-static uint64_t rng_next(struct rng *r)
-{
-	uint64_t z = (r->s += UINT64_C(0x9e3779b97f4a7c15));
-	z = (z ^ (z >> 30)) * UINT64_C(0xbf58476d1ce4e5b9);
-	z = (z ^ (z >> 27)) * UINT64_C(0x94d049bb133111eb);
-	return z ^ (z >> 31);
-}
-
-/* uniform in [0, 1) */
-static double rng_uniform(struct rng *r)
-{
-	return (double)(rng_next(r) >> 11) * 0x1.0p-53;
-}
-
 static struct ss_boundary sides(enum ss_side_kind w, enum ss_side_kind e,
                                 enum ss_side_kind s, enum ss_side_kind n,
                                 double open_level)
@@ -424,9 +398,9 @@ static void test_cone(void)
 	if (prepare(&st))
 		goto out;
 	const double v0 = diag(&st).volume;
-	const double t0 = now();
+	const double t0 = check_now();
 	enum ss_advance_end end = advance_steady(&st, 1e-7, 1e5);
-	const double secs = now() - t0;
+	const double secs = check_now() - t0;
 	struct ss_diagnostics d = diag(&st);
 	CHECK(end == SS_ADVANCE_STEADY, "cone did not reach steady (max |dh/dt| %g m/s) by "
 	      "t = %g s", st.rate_max, st.time);
@@ -496,9 +470,9 @@ static struct table_result open_table(int n)
 			*hp(&st, i, j) = H;
 	if (prepare(&st))
 		goto out;
-	const double t0 = now();
+	const double t0 = check_now();
 	enum ss_advance_end end = advance_steady(&st, 1e-10, 1e5);
-	res.secs = now() - t0;
+	res.secs = check_now() - t0;
 	CHECK(end == SS_ADVANCE_STEADY, "open table %d x %d not steady (max |dh/dt| %g m/s) "
 	      "by t = %g s", n, n, st.rate_max, st.time);
 	const double tc = st.closure.tan_cr;
@@ -679,9 +653,9 @@ static void oblique_room(int rx, int ry, int door_east, int door_at, int door_w,
 	if (prepare(&st))
 		goto out;
 	const double v0 = diag(&st).volume;
-	const double t0 = now();
+	const double t0 = check_now();
 	enum ss_advance_end end = advance_steady(&st, 1e-12, 1e6);
-	const double secs = now() - t0;
+	const double secs = check_now() - t0;
 	struct ss_diagnostics d = diag(&st);
 	CHECK(end == SS_ADVANCE_STEADY, "room did not reach steady: max |dh/dt| %g m/s at "
 	      "t = %g s", st.rate_max, st.time);
@@ -943,9 +917,9 @@ static void test_periodic(void)
 
 static double timed(void (*fn)(void))
 {
-	const double t0 = now();
+	const double t0 = check_now();
 	fn();
-	return now() - t0;
+	return check_now() - t0;
 }
 
 #define RUN_TIMED(fn)                                                         \
@@ -966,7 +940,7 @@ int main(void)
 		seed = strtoull(s, NULL, 0);
 	printf("test_physics: seed %llu, %d threads\n", (unsigned long long)seed,
 	       ss_parallel_max_threads());
-	const double t0 = now();
+	const double t0 = check_now();
 	RUN_TIMED(test_conservation);
 	RUN_TIMED(test_subcritical_unchanged);
 	RUN_TIMED(test_cone);
@@ -975,6 +949,6 @@ int main(void)
 	RUN_TIMED(test_symmetry);
 	RUN_TIMED(test_determinism);
 	RUN_TIMED(test_periodic);
-	printf("total %.2f s\n", now() - t0);
+	printf("total %.2f s\n", check_now() - t0);
 	return check_report();
 }

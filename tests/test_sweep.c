@@ -51,38 +51,6 @@ static uint64_t seed = 20240612;
 
 /* ---- helpers ------------------------------------------------------------ */
 
-static double now(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-/* splitmix64 */
-struct rng {
-	uint64_t s;
-};
-
-static uint64_t rng_next(struct rng *r)
-{
-	uint64_t z = (r->s += UINT64_C(0x9e3779b97f4a7c15));
-	z = (z ^ (z >> 30)) * UINT64_C(0xbf58476d1ce4e5b9);
-	z = (z ^ (z >> 27)) * UINT64_C(0x94d049bb133111eb);
-	return z ^ (z >> 31);
-}
-
-/* uniform in [0, 1) */
-static double rng_uniform(struct rng *r)
-{
-	return (double)(rng_next(r) >> 11) * 0x1.0p-53;
-}
-
-/* uniform integer in [0, n) */
-static int rng_int(struct rng *r, int n)
-{
-	return (int)(rng_next(r) % (uint64_t)n);
-}
-
 static int same_bits(double a, double b)
 {
 	return memcmp(&a, &b, sizeof a) == 0;
@@ -1042,55 +1010,55 @@ int main(void)
 	const char *env = getenv("SANDSLIDE_TEST_SEED");
 	if (env && *env)
 		seed = strtoull(env, NULL, 10);
-	const double t0 = now();
+	const double t0 = check_now();
 	ss_parallel_set_threads(2);
 	printf("test_sweep: seed %llu, rsqrt %s\n", (unsigned long long)seed,
 	       ss_face_rsqrt_method());
 	{
-		const double t_ = now();
+		const double t_ = check_now();
 		RUN(test_face_rsqrt);
-		printf("    (%.2f s)\n", now() - t_);
+		printf("    (%.2f s)\n", check_now() - t_);
 	}
 	{
-		const double t_ = now();
+		const double t_ = check_now();
 		RUN(test_face_lanes);
-		printf("    (%.2f s)\n", now() - t_);
+		printf("    (%.2f s)\n", check_now() - t_);
 	}
 	{
-		const double t_ = now();
+		const double t_ = check_now();
 		RUN(test_face_formula);
-		printf("    (%.2f s)\n", now() - t_);
+		printf("    (%.2f s)\n", check_now() - t_);
 	}
 	{
-		const double t_ = now();
+		const double t_ = check_now();
 		RUN(test_max_slope);
-		printf("    (%.2f s)\n", now() - t_);
+		printf("    (%.2f s)\n", check_now() - t_);
 	}
 	{
-		const double t_ = now();
+		const double t_ = check_now();
 		RUN(test_subcritical);
-		printf("    (%.2f s)\n", now() - t_);
+		printf("    (%.2f s)\n", check_now() - t_);
 	}
 	{
-		const double t_ = now();
+		const double t_ = check_now();
 		RUN(test_identity);
-		printf("    (%.2f s)\n", now() - t_);
+		printf("    (%.2f s)\n", check_now() - t_);
 	}
 	{
-		const double t_ = now();
+		const double t_ = check_now();
 		RUN(test_identity_periodic);
-		printf("    (%.2f s)\n", now() - t_);
+		printf("    (%.2f s)\n", check_now() - t_);
 	}
 	{
-		const double t_ = now();
+		const double t_ = check_now();
 		RUN(test_identity_periodic_pile);
-		printf("    (%.2f s)\n", now() - t_);
+		printf("    (%.2f s)\n", check_now() - t_);
 	}
 	{
-		const double t_ = now();
+		const double t_ = check_now();
 		RUN(test_active_tiles);
-		printf("    (%.2f s)\n", now() - t_);
+		printf("    (%.2f s)\n", check_now() - t_);
 	}
-	printf("test_sweep: %.2f s\n", now() - t0);
+	printf("test_sweep: %.2f s\n", check_now() - t0);
 	return check_report();
 }

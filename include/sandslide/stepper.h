@@ -49,7 +49,6 @@ struct ss_stepper {
 	struct ss_closure closure;
 	struct ss_face_rule face_rule;
 	enum ss_kernel kernel;        /* set before ss_stepper_prepare */
-	int tile_nx, tile_ny;         /* as requested (< 1: defaults) */
 	struct ss_sweep_fast fast;
 	struct ss_cfl_bound cfl_bound;
 	struct ss_boundary boundary;

@@ -32,6 +32,24 @@ struct ss_tiling {
 	int tiles_x, tiles_y;    /* tiles covering the block */
 };
 
+/* The cells [i0, i1) x [j0, j1) of tile (tx, ty); the last tiles of a row
+ * or column may be smaller. */
+struct ss_tile_span {
+	int i0, i1, j0, j1;
+};
+
+static inline struct ss_tile_span ss_tiling_span(const struct ss_tiling *t,
+                                                 const struct ss_grid *g,
+                                                 int tx, int ty)
+{
+	struct ss_tile_span s;
+	s.i0 = tx * t->tile_nx;
+	s.j0 = ty * t->tile_ny;
+	s.i1 = s.i0 + t->tile_nx < g->nx ? s.i0 + t->tile_nx : g->nx;
+	s.j1 = s.j0 + t->tile_ny < g->ny ? s.j0 + t->tile_ny : g->ny;
+	return s;
+}
+
 #define SS_TILE_NX_DEFAULT 256
 #define SS_TILE_NY_DEFAULT 64
 
@@ -141,11 +159,10 @@ struct ss_open_face_slot {
 	int which;               /* 0 x-face, 1 y-face south, 2 y-face north */
 };
 
-/* Allocate for grid g, tiles of tile_nx x tile_ny (< 1: defaults), `threads`
- * OpenMP threads; cell types must be final (halo included).  The fast
+/* Allocate for grid g covered by `tiling`, `threads` OpenMP threads; cell types must be final (halo included).  The fast
  * sweep writes the flux of open_faces[m] to open_flux[m].  Every tile starts awake. */
 int ss_sweep_fast_init(struct ss_sweep_fast *f, const struct ss_grid *g,
-                       int tile_nx, int tile_ny, int threads,
+                       const struct ss_tiling *tiling, int threads,
                        int periodic_x, int periodic_y,
                        const uint8_t *cell_type,
                        const struct ss_open_face *open_faces,

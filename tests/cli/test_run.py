@@ -147,8 +147,14 @@ def test_info(tmp_path):
 
 # ---- quiet, progress, default output ----------------------------------------
 
+# Long enough (about 1.8 s of wall time with the fast sweep) that a progress
+# line, first printed 0.5 s after the start, would surely appear; end = 1 took
+# 0.6 s, too close to tell a suppressed line from one not yet due.
+PROGRESS_CASE = SLOW.format(end=3.0, every=1.5)
+
+
 def test_not_a_terminal_no_progress(tmp_path):
-    write(tmp_path, SLOW.format(end=1.0, every=0.5))
+    write(tmp_path, PROGRESS_CASE)
     r = run_ok(["run", "case.ini", "-o", "o.h5"], cwd=tmp_path)
     assert "\r" not in r.stderr, "progress line written although stderr is not a terminal"
     assert r.stderr == "", f"unexpected stderr: {r.stderr!r}"
@@ -190,7 +196,7 @@ def run_on_terminal(args, cwd, timeout=60):
 
 
 def test_progress_on_terminal_and_quiet(tmp_path):
-    write(tmp_path, SLOW.format(end=1.0, every=0.5))
+    write(tmp_path, PROGRESS_CASE)
     rc, err = run_on_terminal(["run", "case.ini", "-o", "o.h5"], tmp_path)
     assert rc == 0, err
     assert b"\r" in err and b"t = " in err, \
