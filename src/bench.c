@@ -116,13 +116,13 @@ static void bench_step(struct ss_stepper *st, double lambda_idle)
 	const struct ss_grid *g = &st->grid;
 	const double inv_d2 = 1.0 / (g->dx * g->dx) + 1.0 / (g->dy * g->dy);
 	ss_boundary_fill_heights(g, &st->boundary, st->height);
-	const double s_max = ss_sweep_fast_begin(&st->fast, g, st->height, st->cell_type);
+	const double s_max = ss_sweep_fast_begin(&st->fast, g, st->height, st->cell_types);
 	double lambda = st->closure.nu * ss_cfl_bound_lookup(&st->cfl_bound, s_max);
 	lambda = lambda > 0.0 ? lambda : lambda_idle;
 	st->tile_sweeps += ss_sweep_fast_awake(&st->fast);
 	st->tile_slots += st->fast.tiles;
 	ss_sweep_fast_step(&st->fast, g, &st->face_rule, st->cfl / (2.0 * lambda * inv_d2),
-	                   NULL, st->cell_type, st->height, st->open_flux);
+	                   NULL, st->cell_types, st->height, st->open_flux);
 }
 
 struct case_result {
@@ -201,11 +201,11 @@ static int run_case(const struct ss_bench_options *o, enum ss_bench_surface surf
 
 /* Bytes per cell update that the fast sweep's design moves: the height read
  * and written once (16 B), the two ring rows of each tile row saved and read
- * back (32 B per tile_ny cells of a column), the type byte on tiles with
- * walls or open cells near them. */
+ * back (32 B per tile_ny cells of a column), the packed type (a quarter
+ * byte, grid.h) on tiles with walls or open cells near them. */
 static double bytes_per_cell(int tile_ny, double plain_fraction)
 {
-	return 16.0 + 32.0 / tile_ny + (1.0 - plain_fraction);
+	return 16.0 + 32.0 / tile_ny + 0.25 * (1.0 - plain_fraction);
 }
 
 int ss_bench_run(const struct ss_bench_options *o)

@@ -47,21 +47,31 @@ int ss_boundary_check(const struct ss_boundary *b)
 			                                        : (open_value);  \
 	} while (0)
 
+/* The type of ghost cell `ghost` on a side of this kind; `wrap` is the
+ * interior cell it copies when the side is periodic. */
+static void fill_type(uint8_t *types, ptrdiff_t ghost, ptrdiff_t wrap,
+                      enum ss_side_kind kind)
+{
+	const enum ss_cell_type t = kind == SS_SIDE_PERIODIC ? ss_cell_type_get(types, wrap)
+	                          : kind == SS_SIDE_WALL ? SS_CELL_WALL : SS_CELL_OPEN;
+	ss_cell_type_set(types, ghost, t);
+}
+
 void ss_boundary_fill_types(const struct ss_grid *g, const struct ss_boundary *b,
-                            uint8_t *cell_type)
+                            uint8_t *cell_types)
 {
 	const int nx = g->nx, ny = g->ny;
 	for (int j = 0; j < ny; j++) {
-		FILL_SIDE(cell_type, ss_grid_index(g, -1, j), ss_grid_index(g, nx - 1, j),
-		          b->side[SS_WEST], SS_CELL_WALL, SS_CELL_OPEN);
-		FILL_SIDE(cell_type, ss_grid_index(g, nx, j), ss_grid_index(g, 0, j),
-		          b->side[SS_EAST], SS_CELL_WALL, SS_CELL_OPEN);
+		fill_type(cell_types, ss_grid_index(g, -1, j), ss_grid_index(g, nx - 1, j),
+		          b->side[SS_WEST]);
+		fill_type(cell_types, ss_grid_index(g, nx, j), ss_grid_index(g, 0, j),
+		          b->side[SS_EAST]);
 	}
 	for (int i = -1; i <= nx; i++) {
-		FILL_SIDE(cell_type, ss_grid_index(g, i, -1), ss_grid_index(g, i, ny - 1),
-		          b->side[SS_SOUTH], SS_CELL_WALL, SS_CELL_OPEN);
-		FILL_SIDE(cell_type, ss_grid_index(g, i, ny), ss_grid_index(g, i, 0),
-		          b->side[SS_NORTH], SS_CELL_WALL, SS_CELL_OPEN);
+		fill_type(cell_types, ss_grid_index(g, i, -1), ss_grid_index(g, i, ny - 1),
+		          b->side[SS_SOUTH]);
+		fill_type(cell_types, ss_grid_index(g, i, ny), ss_grid_index(g, i, 0),
+		          b->side[SS_NORTH]);
 	}
 }
 

@@ -34,3 +34,9 @@ size_t ss_grid_storage_cells(const struct ss_grid *g)
 {
 	return (size_t)g->stride * (size_t)(g->ny + 2 * SS_GRID_GHOST);
 }
+
+void ss_cell_types_unpack(const uint8_t *types, ptrdiff_t k0, size_t n, uint8_t *out)
+{
+	for (size_t m = 0; m < n; m++)
+		out[m] = (uint8_t)ss_cell_type_get(types, k0 + (ptrdiff_t)m);
+}

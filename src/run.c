@@ -155,7 +155,7 @@ int ss_run_case(const struct ss_run_options *o)
 		.repose_angle_deg = c.repose_angle_deg, .nu = c.nu, .gamma = c.gamma,
 		.deflate = o->deflate,
 	};
-	if ((err = ss_snapshot_create(&snap, output, &st.grid, st.cell_type, &meta)))
+	if ((err = ss_snapshot_create(&snap, output, &st.grid, st.cell_types, &meta)))
 		goto out_stepper;
 	if ((err = write_snapshot(snap, &st, started, &seconds_output)))
 		goto out_snapshot;

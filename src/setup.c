@@ -36,8 +36,9 @@ static int initial_heights(const struct ss_case *c, struct ss_stepper *st)
 				const size_t m = (size_t)j * g->nx + i;
 				const ptrdiff_t k = ss_grid_index(g, i, j);
 				st->height[k] = r.values[m];
-				if (r.nodata && r.nodata[m] && st->cell_type[k] == SS_CELL_FLOW)
-					st->cell_type[k] = SS_CELL_OPEN;   /* nodata: sand leaves */
+				if (r.nodata && r.nodata[m] &&
+				    ss_cell_type_get(st->cell_types, k) == SS_CELL_FLOW)
+					ss_cell_type_set(st->cell_types, k, SS_CELL_OPEN);  /* nodata: sand leaves */
 			}
 		}
 		ss_raster_release(&r);
@@ -112,11 +113,13 @@ int ss_setup_stepper(const struct ss_case *c, int tile_nx, int tile_ny,
 				err = ss_stepper_add_source(st, mask, r->rate, r->start, r->stop);
 				continue;
 			}
-			const uint8_t type = r->role == SS_REGION_WALL ? SS_CELL_WALL : SS_CELL_OPEN;
+			const enum ss_cell_type type = r->role == SS_REGION_WALL ? SS_CELL_WALL
+			                                                         : SS_CELL_OPEN;
 			for (int j = 0; j < g.ny; j++)
 				for (int i = 0; i < g.nx; i++)
 					if (mask[(size_t)j * g.nx + i])
-						st->cell_type[ss_grid_index(&g, i, j)] = type;
+						ss_cell_type_set(st->cell_types, ss_grid_index(&g, i, j),
+						                 type);
 		}
 		if (pass == 0 && !err)
 			err = initial_heights(c, st);

@@ -158,7 +158,34 @@ static hid_t interior_space(const struct ss_grid *g)
 	return m;
 }
 
-static int write_static(struct ss_snapshot *s, const uint8_t *cell_type,
+/* The packed cell types (grid.h) as bytes, a block of rows at a time: a
+ * full unpacked copy would cost a byte per cell, 4 times the packed array. */
+static int write_cell_types(hid_t dataset, hid_t file_space, const struct ss_grid *g,
+                            const uint8_t *cell_types)
+{
+	const int rows = g->ny < 64 ? g->ny : 64;
+	uint8_t *block = ss_alloc((size_t)rows * (size_t)g->nx, 1, "cell type rows");
+	if (!block)
+		return 1;
+	int bad = 0;
+	for (int j0 = 0; j0 < g->ny && !bad; j0 += rows) {
+		const int n = g->ny - j0 < rows ? g->ny - j0 : rows;
+		for (int j = 0; j < n; j++)
+			ss_cell_types_unpack(cell_types, ss_grid_index(g, 0, j0 + j), (size_t)g->nx,
+			                     block + (size_t)j * g->nx);
+		hsize_t start[2] = {(hsize_t)j0, 0}, count[2] = {(hsize_t)n, (hsize_t)g->nx};
+		hid_t mem = H5Screate_simple(2, count, NULL);
+		bad = mem < 0 ||
+		      H5Sselect_hyperslab(file_space, H5S_SELECT_SET, start, NULL, count, NULL) < 0 ||
+		      H5Dwrite(dataset, H5T_NATIVE_UINT8, mem, file_space, H5P_DEFAULT, block) < 0;
+		if (mem >= 0)
+			H5Sclose(mem);
+	}
+	ss_free(block);
+	return bad;
+}
+
+static int write_static(struct ss_snapshot *s, const uint8_t *cell_types,
                         const struct ss_snapshot_meta *meta)
 {
 	const struct ss_grid *g = &s->grid;
@@ -203,9 +230,7 @@ static int write_static(struct ss_snapshot *s, const uint8_t *cell_type,
 	space = H5Screate_simple(2, dims2, NULL);
 	hid_t ct = bad ? -1 : H5Dcreate2(f, "cell_type", H5T_STD_U8LE, space, H5P_DEFAULT,
 	                                 H5P_DEFAULT, H5P_DEFAULT);
-	hid_t mem = interior_space(g);
-	bad = bad || ct < 0 ||
-	      H5Dwrite(ct, H5T_NATIVE_UINT8, mem, space, H5P_DEFAULT, cell_type) < 0 ||
+	bad = bad || ct < 0 || write_cell_types(ct, space, g, cell_types) ||
 	      attr_units(ct, "1", "cell type") ||
 	      attr_string(ct, "flag_meanings", "flow wall open") ||
 	      H5DSattach_scale(ct, y, 0) < 0 || H5DSattach_scale(ct, x, 1) < 0;
@@ -219,7 +244,6 @@ static int write_static(struct ss_snapshot *s, const uint8_t *cell_type,
 			H5Aclose(a);
 		H5Sclose(as);
 	}
-	H5Sclose(mem);
 	H5Sclose(space);
 	if (ct >= 0)
 		H5Dclose(ct);
@@ -284,7 +308,7 @@ int ss_snapshot_destroy(struct ss_snapshot *s)
 }
 
 int ss_snapshot_create(struct ss_snapshot **out, const char *path,
-                       const struct ss_grid *g, const uint8_t *cell_type,
+                       const struct ss_grid *g, const uint8_t *cell_types,
                        const struct ss_snapshot_meta *meta)
 {
 	quiet_hdf5();
@@ -331,7 +355,7 @@ int ss_snapshot_create(struct ss_snapshot **out, const char *path,
 		return ss_error_fail("cannot create '%s'%s%s", path, e ? ": " : "",
 		                     e ? strerror(e) : "");
 	}
-	if (write_static(s, cell_type, meta) || H5Fflush(s->file, H5F_SCOPE_GLOBAL) < 0) {
+	if (write_static(s, cell_types, meta) || H5Fflush(s->file, H5F_SCOPE_GLOBAL) < 0) {
 		ss_snapshot_destroy(s);
 		return ss_error_fail("cannot write the static variables of '%s'", path);
 	}

@@ -21,9 +21,9 @@ static double now_seconds(void)
 
 double ss_stepper_memory_bytes(const struct ss_grid *g)
 {
-	/* height and source_rate (doubles) and the type byte; the fast sweep's
-	 * ring rows and buffers are below 1 % of that */
-	return (double)ss_grid_storage_cells(g) * (2.0 * sizeof(double) + 1.0);
+	/* height and source_rate (doubles) and the packed types; the fast
+	 * sweep's ring rows and buffers are below 2 % of that */
+	return (double)ss_grid_storage_cells(g) * (2.0 * sizeof(double) + 0.25);
 }
 
 int ss_stepper_init(struct ss_stepper *st, const struct ss_grid *g,
@@ -47,9 +47,9 @@ int ss_stepper_init(struct ss_stepper *st, const struct ss_grid *g,
 
 	const size_t n = ss_grid_storage_cells(g);
 	st->height = ss_alloc(n, sizeof(double), "heights");
-	st->cell_type = ss_alloc(n, sizeof(uint8_t), "cell types");
+	st->cell_types = ss_alloc(ss_cell_types_bytes(n), 1, "cell types");
 	st->row_scratch = ss_alloc((size_t)g->ny, sizeof(double), "row sums");
-	if (!st->height || !st->cell_type || !st->row_scratch) {
+	if (!st->height || !st->cell_types || !st->row_scratch) {
 		ss_stepper_release(st);
 		return SS_ERR_FAIL;
 	}
@@ -68,7 +68,8 @@ void ss_stepper_release(struct ss_stepper *st)
 	ss_free(st->row_scratch);
 	ss_free(st->flux_y);
 	ss_free(st->flux_x);
-	ss_free(st->cell_type);
+	ss_free(st->cell_type_bytes);
+	ss_free(st->cell_types);
 	ss_free(st->height);
 	memset(st, 0, sizeof *st);
 }
@@ -88,7 +89,8 @@ int ss_stepper_add_source(struct ss_stepper *st, const uint8_t *mask,
 	for (int j = 0; j < g->ny; j++)
 		for (int i = 0; i < g->nx; i++)
 			count += mask[(size_t)j * g->nx + i] &&
-			         st->cell_type[ss_grid_index(g, i, j)] == SS_CELL_FLOW;
+			         ss_cell_type_get(st->cell_types, ss_grid_index(g, i, j)) ==
+			         SS_CELL_FLOW;
 	struct ss_source *s = &st->sources[st->source_count];
 	s->cells = ss_alloc(count ? count : 1, sizeof *s->cells, "source cells");
 	if (!s->cells)
@@ -97,7 +99,8 @@ int ss_stepper_add_source(struct ss_stepper *st, const uint8_t *mask,
 	for (int j = 0; j < g->ny; j++) {
 		for (int i = 0; i < g->nx; i++) {
 			const ptrdiff_t k = ss_grid_index(g, i, j);
-			if (mask[(size_t)j * g->nx + i] && st->cell_type[k] == SS_CELL_FLOW)
+			if (mask[(size_t)j * g->nx + i] &&
+			    ss_cell_type_get(st->cell_types, k) == SS_CELL_FLOW)
 				s->cells[n++] = k;
 		}
 	}
@@ -112,7 +115,7 @@ int ss_stepper_add_source(struct ss_stepper *st, const uint8_t *mask,
 static int open_faces_build(struct ss_stepper *st)
 {
 	const struct ss_grid *g = &st->grid;
-	const uint8_t *t = st->cell_type;
+	const uint8_t *t = st->cell_types;
 	const ptrdiff_t stride = g->stride;
 	/* two passes: count, then fill (axis, neighbour offset, sign) */
 	for (int pass = 0; pass < 2; pass++) {
@@ -120,7 +123,7 @@ static int open_faces_build(struct ss_stepper *st)
 		for (int j = 0; j < g->ny; j++) {
 			for (int i = 0; i < g->nx; i++) {
 				const ptrdiff_t k = ss_grid_index(g, i, j);
-				if (t[k] != SS_CELL_FLOW)
+				if (ss_cell_type_get(t, k) != SS_CELL_FLOW)
 					continue;
 				/* west, east, south, north faces of flow cell k */
 				const struct ss_open_face f[4] = {
@@ -129,7 +132,7 @@ static int open_faces_build(struct ss_stepper *st)
 				};
 				const ptrdiff_t nb[4] = {k - 1, k + 1, k - stride, k + stride};
 				for (int m = 0; m < 4; m++) {
-					if (t[nb[m]] != SS_CELL_OPEN)
+					if (ss_cell_type_get(t, nb[m]) != SS_CELL_OPEN)
 						continue;
 					if (pass == 1)
 						st->open_faces[n] = f[m];
@@ -151,13 +154,14 @@ static int open_faces_build(struct ss_stepper *st)
 int ss_stepper_prepare(struct ss_stepper *st)
 {
 	const struct ss_grid *g = &st->grid;
-	ss_boundary_fill_types(g, &st->boundary, st->cell_type);
+	ss_boundary_fill_types(g, &st->boundary, st->cell_types);
 	for (int j = 0; j < g->ny; j++) {
 		for (int i = 0; i < g->nx; i++) {
 			const ptrdiff_t k = ss_grid_index(g, i, j);
-			if (st->cell_type[k] == SS_CELL_OPEN)
+			const enum ss_cell_type type = ss_cell_type_get(st->cell_types, k);
+			if (type == SS_CELL_OPEN)
 				st->height[k] = st->boundary.open_level;
-			else if (st->cell_type[k] == SS_CELL_WALL)
+			else if (type == SS_CELL_WALL)
 				st->height[k] = 0.0;
 			else if (st->height[k] == 0.0)
 				st->height[k] = 0.0;   /* no -0: h + 0 then keeps every bit */
@@ -179,10 +183,15 @@ int ss_stepper_prepare(struct ss_stepper *st)
 	if (err)
 		return err;
 	if (st->kernel == SS_KERNEL_REFERENCE) {
+		/* the reference sweep reads one type byte per cell */
 		const size_t n = ss_grid_storage_cells(g);
 		st->flux_x = ss_alloc(n, sizeof(double), "x-face fluxes");
 		st->flux_y = ss_alloc(n, sizeof(double), "y-face fluxes");
-		return st->flux_x && st->flux_y ? SS_OK : SS_ERR_FAIL;
+		st->cell_type_bytes = ss_alloc(n, 1, "cell types");
+		if (!st->flux_x || !st->flux_y || !st->cell_type_bytes)
+			return SS_ERR_FAIL;
+		ss_cell_types_unpack(st->cell_types, 0, n, st->cell_type_bytes);
+		return SS_OK;
 	}
 	st->open_flux = ss_alloc(st->open_face_count ? st->open_face_count : 1,
 	                         sizeof(double), "open-face fluxes");
@@ -192,10 +201,10 @@ int ss_stepper_prepare(struct ss_stepper *st)
 	                         ss_parallel_max_threads(),
 	                         st->boundary.side[SS_WEST] == SS_SIDE_PERIODIC,
 	                         st->boundary.side[SS_SOUTH] == SS_SIDE_PERIODIC,
-	                         st->cell_type, st->open_faces, st->open_face_count);
+	                         st->cell_types, st->open_faces, st->open_face_count);
 	if (err)
 		return err;
-	ss_sweep_fast_wake_all(&st->fast, g, st->height, st->cell_type);
+	ss_sweep_fast_wake_all(&st->fast, g, st->height, st->cell_types);
 	return SS_OK;
 }
 
@@ -203,7 +212,7 @@ void ss_stepper_heights_changed(struct ss_stepper *st)
 {
 	ss_boundary_fill_heights(&st->grid, &st->boundary, st->height);
 	if (st->kernel == SS_KERNEL_FAST)
-		ss_sweep_fast_wake_all(&st->fast, &st->grid, st->height, st->cell_type);
+		ss_sweep_fast_wake_all(&st->fast, &st->grid, st->height, st->cell_types);
 }
 
 double ss_stepper_next_source_event(const struct ss_stepper *st, double t)
@@ -310,9 +319,9 @@ enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,
 		ss_boundary_fill_heights(g, &st->boundary, st->height);
 		double t0 = now_seconds();
 		const double s_max = st->kernel == SS_KERNEL_FAST
-			? ss_sweep_fast_begin(&st->fast, g, st->height, st->cell_type)
+			? ss_sweep_fast_begin(&st->fast, g, st->height, st->cell_types)
 			: ss_sweep_fluxes(g, &st->tiling, &st->face_rule, st->height,
-			                  st->cell_type, st->flux_x, st->flux_y);
+			                  st->cell_type_bytes, st->flux_x, st->flux_y);
 		st->seconds_measure += now_seconds() - t0;
 		if (!isfinite(s_max)) {
 			st->rate_max = NAN;
@@ -345,12 +354,12 @@ enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,
 			st->tile_sweeps += ss_sweep_fast_awake(&st->fast);
 			st->rate_max = ss_sweep_fast_step(&st->fast, g, &st->face_rule, dt,
 			                                  st->sources_on ? st->source_rate : NULL,
-			                                  st->cell_type, st->height, st->open_flux);
+			                                  st->cell_types, st->height, st->open_flux);
 		} else {
 			st->tile_sweeps += tiles;
 			st->rate_max = ss_sweep_update(g, &st->tiling, dt, st->flux_x, st->flux_y,
 			                               st->sources_on ? st->source_rate : NULL,
-			                               st->cell_type, st->height);
+			                               st->cell_type_bytes, st->height);
 		}
 		st->seconds_sweep += now_seconds() - t0;
 		st->tile_slots += tiles;
@@ -385,7 +394,7 @@ void ss_stepper_diagnostics(struct ss_stepper *st, struct ss_diagnostics *d)
 		double row = 0.0, top = -INFINITY;
 		for (int i = 0; i < g->nx; i++) {
 			const ptrdiff_t k = ss_grid_index(g, i, j);
-			if (st->cell_type[k] != SS_CELL_FLOW)
+			if (ss_cell_type_get(st->cell_types, k) != SS_CELL_FLOW)
 				continue;
 			const double h = st->height[k];
 			row += h;
@@ -400,7 +409,7 @@ void ss_stepper_diagnostics(struct ss_stepper *st, struct ss_diagnostics *d)
 		volume += row_volume[j];
 
 	ss_boundary_fill_heights(g, &st->boundary, st->height);
-	const double s_max = ss_sweep_max_slope(g, st->height, st->cell_type);
+	const double s_max = ss_sweep_max_slope(g, st->height, st->cell_types);
 	d->volume = volume * g->dx * g->dy;
 	d->inflow = st->inflow;
 	d->outflow = st->outflow;

@@ -17,6 +17,12 @@
 #include "sandslide/error.h"
 #include "sandslide/parallel.h"
 
+/* Packed cell types (grid.h): t is the packed array, k a storage index. */
+static inline uint8_t type_at(const uint8_t *t, ptrdiff_t k)
+{
+	return (uint8_t)ss_cell_type_get(t, k);
+}
+
 /* A face carries flux when neither side is a wall and one side flows. */
 static inline int face_carries(uint8_t a, uint8_t b)
 {
@@ -65,12 +71,14 @@ static inline uint64_t face_slope2_bits(const double *h, const uint8_t *t,
                                         double inv_spacing, double inv_2along)
 {
 	const ptrdiff_t b = a + normal;
-	const double cda = ((t[a + along] == SS_CELL_WALL ? h[a] : h[a + along]) -
-	                    (t[a - along] == SS_CELL_WALL ? h[a] : h[a - along])) * inv_2along;
-	const double cdb = ((t[b + along] == SS_CELL_WALL ? h[b] : h[b + along]) -
-	                    (t[b - along] == SS_CELL_WALL ? h[b] : h[b - along])) * inv_2along;
+	const double cda = ((type_at(t, a + along) == SS_CELL_WALL ? h[a] : h[a + along]) -
+	                    (type_at(t, a - along) == SS_CELL_WALL ? h[a] : h[a - along])) *
+	                   inv_2along;
+	const double cdb = ((type_at(t, b + along) == SS_CELL_WALL ? h[b] : h[b + along]) -
+	                    (type_at(t, b - along) == SS_CELL_WALL ? h[b] : h[b - along])) *
+	                   inv_2along;
 	const double gn = (h[b] - h[a]) * inv_spacing, gt = 0.5 * (cda + cdb);
-	return face_carries(t[a], t[b]) ? bits_of(gn * gn + gt * gt) : 0;
+	return face_carries(type_at(t, a), type_at(t, b)) ? bits_of(gn * gn + gt * gt) : 0;
 }
 
 /* The larger of a and b as a select (fmax() is a library call). */
@@ -91,9 +99,8 @@ static double slope2_x_faces(const struct ss_grid *g, const double *h,
 	const double *hm = h + ss_grid_index(g, 0, j - 1);
 	const double *h0 = h + ss_grid_index(g, 0, j);
 	const double *hp = h + ss_grid_index(g, 0, j + 1);
-	const uint8_t *tm = t + ss_grid_index(g, 0, j - 1);
-	const uint8_t *t0 = t + ss_grid_index(g, 0, j);
-	const uint8_t *tp = t + ss_grid_index(g, 0, j + 1);
+	const ptrdiff_t km = ss_grid_index(g, 0, j - 1), k0 = ss_grid_index(g, 0, j);
+	const ptrdiff_t kp = ss_grid_index(g, 0, j + 1);
 	uint64_t m = 0;
 	if (plain) {
 		for (int i = ia; i <= ib; i++) {
@@ -105,12 +112,16 @@ static double slope2_x_faces(const struct ss_grid *g, const double *h,
 		}
 	} else {
 		for (int i = ia; i <= ib; i++) {
-			const double cda = ((tp[i - 1] == SS_CELL_WALL ? h0[i - 1] : hp[i - 1]) -
-			                    (tm[i - 1] == SS_CELL_WALL ? h0[i - 1] : hm[i - 1])) * inv_2dy;
-			const double cdb = ((tp[i] == SS_CELL_WALL ? h0[i] : hp[i]) -
-			                    (tm[i] == SS_CELL_WALL ? h0[i] : hm[i])) * inv_2dy;
+			const int wall_pa = type_at(t, kp + i - 1) == SS_CELL_WALL;
+			const int wall_ma = type_at(t, km + i - 1) == SS_CELL_WALL;
+			const int wall_pb = type_at(t, kp + i) == SS_CELL_WALL;
+			const int wall_mb = type_at(t, km + i) == SS_CELL_WALL;
+			const double cda = ((wall_pa ? h0[i - 1] : hp[i - 1]) -
+			                    (wall_ma ? h0[i - 1] : hm[i - 1])) * inv_2dy;
+			const double cdb = ((wall_pb ? h0[i] : hp[i]) - (wall_mb ? h0[i] : hm[i])) * inv_2dy;
 			const double gn = (h0[i] - h0[i - 1]) * inv_dx, gt = 0.5 * (cda + cdb);
-			const uint64_t q = face_carries(t0[i - 1], t0[i]) ? bits_of(gn * gn + gt * gt) : 0;
+			const uint64_t q = face_carries(type_at(t, k0 + i - 1), type_at(t, k0 + i))
+			                   ? bits_of(gn * gn + gt * gt) : 0;
 			m = q > m ? q : m;
 		}
 	}
@@ -127,8 +138,7 @@ static double slope2_y_faces(const struct ss_grid *g, const double *h,
 	const double inv_dy = 1.0 / g->dy, inv_2dx = 0.5 / g->dx;
 	const double *ha = h + ss_grid_index(g, 0, j - 1);
 	const double *hb = h + ss_grid_index(g, 0, j);
-	const uint8_t *ta = t + ss_grid_index(g, 0, j - 1);
-	const uint8_t *tb = t + ss_grid_index(g, 0, j);
+	const ptrdiff_t ka = ss_grid_index(g, 0, j - 1), kb = ss_grid_index(g, 0, j);
 	uint64_t m = 0;
 	if (plain) {
 		for (int i = ia; i <= ib; i++) {
@@ -140,12 +150,17 @@ static double slope2_y_faces(const struct ss_grid *g, const double *h,
 		}
 	} else {
 		for (int i = ia; i <= ib; i++) {
-			const double cda = ((ta[i + 1] == SS_CELL_WALL ? ha[i] : ha[i + 1]) -
-			                    (ta[i - 1] == SS_CELL_WALL ? ha[i] : ha[i - 1])) * inv_2dx;
-			const double cdb = ((tb[i + 1] == SS_CELL_WALL ? hb[i] : hb[i + 1]) -
-			                    (tb[i - 1] == SS_CELL_WALL ? hb[i] : hb[i - 1])) * inv_2dx;
+			const int wall_ap = type_at(t, ka + i + 1) == SS_CELL_WALL;
+			const int wall_am = type_at(t, ka + i - 1) == SS_CELL_WALL;
+			const int wall_bp = type_at(t, kb + i + 1) == SS_CELL_WALL;
+			const int wall_bm = type_at(t, kb + i - 1) == SS_CELL_WALL;
+			const double cda = ((wall_ap ? ha[i] : ha[i + 1]) -
+			                    (wall_am ? ha[i] : ha[i - 1])) * inv_2dx;
+			const double cdb = ((wall_bp ? hb[i] : hb[i + 1]) -
+			                    (wall_bm ? hb[i] : hb[i - 1])) * inv_2dx;
 			const double gn = (hb[i] - ha[i]) * inv_dy, gt = 0.5 * (cda + cdb);
-			const uint64_t q = face_carries(ta[i], tb[i]) ? bits_of(gn * gn + gt * gt) : 0;
+			const uint64_t q = face_carries(type_at(t, ka + i), type_at(t, kb + i))
+			                   ? bits_of(gn * gn + gt * gt) : 0;
 			m = q > m ? q : m;
 		}
 	}
@@ -275,10 +290,10 @@ static double slope2_all(const struct ss_grid *g, const double *h,
 }
 
 double ss_sweep_max_slope(const struct ss_grid *g, const double *restrict height,
-                          const uint8_t *restrict cell_type)
+                          const uint8_t *restrict cell_types)
 {
 	int bad = 0;
-	const double m = slope2_all(g, height, cell_type, &bad);
+	const double m = slope2_all(g, height, cell_types, &bad);
 	return bad ? NAN : sqrt(m);
 }
 
@@ -292,7 +307,7 @@ static size_t row_doubles(const struct ss_tiling *t)
 int ss_sweep_fast_init(struct ss_sweep_fast *f, const struct ss_grid *g,
                        const struct ss_tiling *tiling, int threads,
                        int periodic_x, int periodic_y,
-                       const uint8_t *cell_type,
+                       const uint8_t *cell_types,
                        const struct ss_open_face *open_faces,
                        size_t open_face_count)
 {
@@ -333,7 +348,7 @@ int ss_sweep_fast_init(struct ss_sweep_fast *f, const struct ss_grid *g,
 			int plain = 1;
 			for (int j = s.j0 - 1; j <= s.j1 && plain; j++)
 				for (int i = s.i0 - 1; i <= s.i1; i++)
-					plain &= cell_type[ss_grid_index(g, i, j)] == SS_CELL_FLOW;
+					plain &= type_at(cell_types, ss_grid_index(g, i, j)) == SS_CELL_FLOW;
 			f->plain[ty * t->tiles_x + tx] = (uint8_t)plain;
 		}
 	}
@@ -409,11 +424,11 @@ void ss_sweep_fast_release(struct ss_sweep_fast *f)
 }
 
 void ss_sweep_fast_wake_all(struct ss_sweep_fast *f, const struct ss_grid *g,
-                            const double *height, const uint8_t *cell_type)
+                            const double *height, const uint8_t *cell_types)
 {
 	int bad = 0;
 	memset(f->sweep, 1, (size_t)f->tiles);
-	f->s2_interior = slope2_all(g, height, cell_type, &bad);
+	f->s2_interior = slope2_all(g, height, cell_types, &bad);
 	f->nonfinite = bad;
 }
 
@@ -461,7 +476,7 @@ static int list_rows(struct ss_sweep_fast *f)
 }
 
 double ss_sweep_fast_begin(struct ss_sweep_fast *f, const struct ss_grid *g,
-                           const double *height, const uint8_t *cell_type)
+                           const double *height, const uint8_t *cell_types)
 {
 	const struct ss_tiling *t = &f->tiling;
 	const int rows = list_rows(f);
@@ -486,16 +501,16 @@ double ss_sweep_fast_begin(struct ss_sweep_fast *f, const struct ss_grid *g,
 			memcpy(f->ring_north + ty * stride + s.i0,
 			       height + ss_grid_index(g, s.i0 - 1, s.j1), n * sizeof(double));
 			/* the faces whose stencil reaches into the ring */
-			double q = slope2_x_faces(g, height, cell_type, plain, s.j0, s.i0, s.i1, &bad);
-			q = max2(q, slope2_x_faces(g, height, cell_type, plain, s.j1 - 1, s.i0, s.i1, &bad));
-			q = max2(q, slope2_y_faces(g, height, cell_type, plain, s.j0, s.i0, s.i1 - 1, &bad));
-			q = max2(q, slope2_y_faces(g, height, cell_type, plain, s.j1, s.i0, s.i1 - 1, &bad));
+			double q = slope2_x_faces(g, height, cell_types, plain, s.j0, s.i0, s.i1, &bad);
+			q = max2(q, slope2_x_faces(g, height, cell_types, plain, s.j1 - 1, s.i0, s.i1, &bad));
+			q = max2(q, slope2_y_faces(g, height, cell_types, plain, s.j0, s.i0, s.i1 - 1, &bad));
+			q = max2(q, slope2_y_faces(g, height, cell_types, plain, s.j1, s.i0, s.i1 - 1, &bad));
 			/* the west and east columns: x-faces i0 and i1 of rows j0 + 1 ..
 			 * j1 - 2, y-faces of cells i0 and i1 - 1 for j0 + 1 .. j1 - 1 */
 			if (s.j1 - s.j0 >= 2) {
-				q = max2(q, slope2_column(g, height, cell_type, s.i0, s.i0, s.j0 + 1,
+				q = max2(q, slope2_column(g, height, cell_types, s.i0, s.i0, s.j0 + 1,
 				                          s.j1 - 1, &bad));
-				q = max2(q, slope2_column(g, height, cell_type, s.i1, s.i1 - 1, s.j0 + 1,
+				q = max2(q, slope2_column(g, height, cell_types, s.i1, s.i1 - 1, s.j0 + 1,
 				                          s.j1 - 1, &bad));
 			}
 			m = q > m ? q : m;
@@ -540,14 +555,14 @@ static struct row_buffers buffers_of(const struct ss_sweep_fast *f, int thread)
 	return b;
 }
 
-/* Types of the cells at positions 0 .. W + 1 of grid row t (pointer at
- * cell (0, j)). */
-static inline void widen_types(int W, int i0, const uint8_t *restrict t,
-                               wide_type *restrict wide)
+/* Types of the cells at positions 0 .. W + 1 of row j, from the packed
+ * types t. */
+static inline void widen_types(const struct ss_grid *g, int W, int i0, int j,
+                               const uint8_t *restrict t, wide_type *restrict wide)
 {
-	const uint8_t *tt = t + i0 - 1;
+	const ptrdiff_t k = ss_grid_index(g, i0 - 1, j);
 	for (int x = 0; x <= W + 1; x++)
-		wide[x] = tt[x];
+		wide[x] = type_at(t, k + x);
 }
 
 /* Central differences along x of buffer row b (types tt by position),
@@ -654,8 +669,8 @@ static void sweep_tile(struct ss_sweep_fast *f, const struct ss_grid *g,
 	memcpy(prev, f->ring_south + ty * stride + i0, (size_t)(W + 2) * sizeof(double));
 	load_row(cur, h + ss_grid_index(g, 0, j0), i0, W, w->west_old[0]);
 	if (!plain) {
-		widen_types(W, i0, type + ss_grid_index(g, 0, j0 - 1), type_prev);
-		widen_types(W, i0, type + ss_grid_index(g, 0, j0), type_cur);
+		widen_types(g, W, i0, j0 - 1, type, type_prev);
+		widen_types(g, W, i0, j0, type, type_cur);
 	}
 	central_x(plain, W, inv_2dx, prev, type_prev, cdx_prev);
 	central_x(plain, W, inv_2dx, cur, type_cur, cdx_cur);
@@ -676,7 +691,7 @@ static void sweep_tile(struct ss_sweep_fast *f, const struct ss_grid *g,
 		else
 			memcpy(next, f->ring_north + ty * stride + i0, (size_t)(W + 2) * sizeof(double));
 		if (!plain)
-			widen_types(W, i0, type + ss_grid_index(g, 0, j + 1), type_next);
+			widen_types(g, W, i0, j + 1, type, type_next);
 
 		/* x-faces of row j, positions 0 .. W */
 		if (plain) {
@@ -845,7 +860,7 @@ static void plan_next(struct ss_sweep_fast *f)
 double ss_sweep_fast_step(struct ss_sweep_fast *f, const struct ss_grid *g,
                           const struct ss_face_rule *rule, double dt,
                           const double *restrict source_rate,
-                          const uint8_t *restrict cell_type,
+                          const uint8_t *restrict cell_types,
                           double *restrict height, double *restrict open_flux)
 {
 	const struct ss_tiling *t = &f->tiling;
@@ -868,7 +883,7 @@ double ss_sweep_fast_step(struct ss_sweep_fast *f, const struct ss_grid *g,
 					continue;
 				}
 				struct tile_result res;
-				sweep_tile(f, g, rule, dt, source_rate, cell_type, height, open_flux,
+				sweep_tile(f, g, rule, dt, source_rate, cell_types, height, open_flux,
 				           tx, ty, west_swept, &w, &res);
 				rate_max = max2(rate_max, res.rate_max);
 				s2_max = max2(s2_max, res.s2_max);

@@ -83,9 +83,14 @@ static double *hp(struct ss_stepper *st, int i, int j)
 	return &st->height[ss_grid_index(&st->grid, i, j)];
 }
 
-static uint8_t *tp(struct ss_stepper *st, int i, int j)
+static void set_type(struct ss_stepper *st, int i, int j, enum ss_cell_type type)
 {
-	return &st->cell_type[ss_grid_index(&st->grid, i, j)];
+	ss_cell_type_set(st->cell_types, ss_grid_index(&st->grid, i, j), type);
+}
+
+static enum ss_cell_type type_of(const struct ss_stepper *st, int i, int j)
+{
+	return ss_cell_type_get(st->cell_types, ss_grid_index(&st->grid, i, j));
 }
 
 static int prepare(struct ss_stepper *st)
@@ -144,7 +149,7 @@ static void conservation_case(enum ss_closure_kind kind)
 			*hp(&st, i, j) = 0.05 * i * dx + 0.3 * rng_uniform(&r);
 			int wall = i >= 15 && i < 22 && j >= 8 && j < 14;  /* block */
 			int open = i >= 30 && i < 34 && j >= 20 && j < 24; /* a pit */
-			*tp(&st, i, j) = wall ? SS_CELL_WALL : open ? SS_CELL_OPEN : SS_CELL_FLOW;
+			set_type(&st, i, j, wall ? SS_CELL_WALL : open ? SS_CELL_OPEN : SS_CELL_FLOW);
 		}
 	}
 	uint8_t *m1 = calloc((size_t)nx * ny, 1), *m2 = calloc((size_t)nx * ny, 1);
@@ -210,10 +215,16 @@ static void test_conservation(void)
 static double max_face_slope(struct ss_stepper *st, int i_limit)
 {
 	const struct ss_grid *g = &st->grid;
-	ss_boundary_fill_types(g, &st->boundary, st->cell_type);
+	ss_boundary_fill_types(g, &st->boundary, st->cell_types);
 	ss_boundary_fill_heights(g, &st->boundary, st->height);
 	const double *h = st->height;
-	const uint8_t *t = st->cell_type;
+	/* one byte per cell, unpacked here by the simplest loop */
+	const size_t cells = ss_grid_storage_cells(g);
+	uint8_t *t = malloc(cells);
+	if (!t)
+		return NAN;
+	for (size_t k = 0; k < cells; k++)
+		t[k] = (uint8_t)ss_cell_type_get(st->cell_types, (ptrdiff_t)k);
 	double smax = 0.0;
 	for (int axis = 0; axis < 2; axis++) {
 		const ptrdiff_t n = axis == 0 ? 1 : g->stride;   /* across */
@@ -243,6 +254,7 @@ static double max_face_slope(struct ss_stepper *st, int i_limit)
 			}
 		}
 	}
+	free(t);
 	return smax;
 }
 
@@ -265,14 +277,14 @@ static void test_subcritical_unchanged(void)
 			int wall = (i >= 20 && i < 26 && j >= 10 && j < 15) ||      /* block */
 			           (j == 25 && i >= 5 && i < 30);                 /* thin wall */
 			int open = i >= 36 && i < 40 && j >= 24 && j < 28;        /* pit */
-			*tp(&st, i, j) = wall ? SS_CELL_WALL : open ? SS_CELL_OPEN : SS_CELL_FLOW;
+			set_type(&st, i, j, wall ? SS_CELL_WALL : open ? SS_CELL_OPEN : SS_CELL_FLOW);
 		}
 	}
 	/* heights relative to the open level: every face slope is linear in
 	 * the perturbation, so one scale factor sets the steepest to 0.8 tc */
 	for (int j = 0; j < ny; j++)
 		for (int i = 0; i < nx; i++)
-			*hp(&st, i, j) = *tp(&st, i, j) == SS_CELL_OPEN ? level : p[j * nx + i];
+			*hp(&st, i, j) = type_of(&st, i, j) == SS_CELL_OPEN ? level : p[j * nx + i];
 	for (int j = 0; j < ny; j++)
 		for (int i = 0; i < nx; i++)
 			*hp(&st, i, j) -= level;
@@ -283,7 +295,7 @@ static void test_subcritical_unchanged(void)
 	const double tc = st.closure.tan_cr, scale = 0.8 * tc / s_unit;
 	for (int j = 0; j < ny; j++)
 		for (int i = 0; i < nx; i++)
-			if (*tp(&st, i, j) != SS_CELL_WALL)
+			if (type_of(&st, i, j) != SS_CELL_WALL)
 				*hp(&st, i, j) = level + scale * *hp(&st, i, j);
 	free(p);
 	if (prepare(&st))
@@ -336,7 +348,7 @@ static void test_subcritical_unchanged(void)
 			const int wall = i == cut || (i >= 20 && i < 26 && j >= 10 && j < 15) ||
 			                 (j == 25 && i >= 5 && i < 30);
 			const int open = i >= 36 && i < 40 && j >= 24 && j < 28;
-			*tp(&st, i, j) = wall ? SS_CELL_WALL : open ? SS_CELL_OPEN : SS_CELL_FLOW;
+			set_type(&st, i, j, wall ? SS_CELL_WALL : open ? SS_CELL_OPEN : SS_CELL_FLOW);
 			*hp(&st, i, j) = i < cut ? before[j * nx + i] : level + 0.3 * rng_uniform(&r);
 		}
 	}
@@ -625,7 +637,7 @@ static void oblique_room(int rx, int ry, int door_east, int door_at, int door_w,
 			const int along = door_east ? j : i, across = door_east ? nx - 1 - i : j;
 			const int in_door = across < w && along >= d0 && along < d1;
 			const int by_door = in_room && across == w && along >= d0 && along < d1;
-			*tp(&st, i, j) = in_room ? SS_CELL_FLOW : in_door ? SS_CELL_OPEN : SS_CELL_WALL;
+			set_type(&st, i, j, in_room ? SS_CELL_FLOW : in_door ? SS_CELL_OPEN : SS_CELL_WALL);
 			flow[(size_t)j * nx + i] = (uint8_t)in_room;
 			seed_dist[(size_t)j * nx + i] = by_door ? 0.5 * (door_east ? dx : dy) : INFINITY;
 		}
@@ -787,7 +799,7 @@ static struct det_result determinism_run(int threads, int tile_nx, int tile_ny)
 			const int wall = (i - 115) * (i - 115) + (j - 48) * (j - 48) < 256 ||
 			                 (i == 38 && j > 18 && j < 113);
 			const int open = i >= 153 && i < 169 && j >= 96 && j < 113;
-			*tp(&st, i, j) = wall ? SS_CELL_WALL : open ? SS_CELL_OPEN : SS_CELL_FLOW;
+			set_type(&st, i, j, wall ? SS_CELL_WALL : open ? SS_CELL_OPEN : SS_CELL_FLOW);
 			mask[j * nx + i] = i >= 57 && i < 85 && j >= 80 && j < 107;
 		}
 	}

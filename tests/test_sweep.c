@@ -141,7 +141,7 @@ static int build(struct ss_stepper *st, const struct scenario *sc, enum ss_kerne
 		for (int i = 0; i < sc->nx; i++) {
 			const ptrdiff_t k = ss_grid_index(&st->grid, i, j);
 			st->height[k] = sc->h0[(size_t)j * sc->nx + i];
-			st->cell_type[k] = sc->type[(size_t)j * sc->nx + i];
+			ss_cell_type_set(st->cell_types, k, sc->type[(size_t)j * sc->nx + i]);
 		}
 	}
 	for (int s = 0; s < sc->sources; s++) {
@@ -557,7 +557,7 @@ static void test_subcritical(void)
 	if (build(&st, &sc, SS_KERNEL_FAST, 16, 8, 2))
 		goto out;
 	ss_boundary_fill_heights(&st.grid, &st.boundary, st.height);
-	const double s_unit = ss_sweep_max_slope(&st.grid, st.height, st.cell_type);
+	const double s_unit = ss_sweep_max_slope(&st.grid, st.height, st.cell_types);
 	ss_stepper_release(&st);
 	const double tc = tan(REPOSE * M_PI / 180.0);
 	for (size_t k = 0; k < (size_t)nx * ny; k++)
@@ -570,7 +570,7 @@ static void test_subcritical(void)
 	double *before = malloc(storage * sizeof *before);
 	ss_boundary_fill_heights(g, &st.boundary, st.height);
 	memcpy(before, st.height, storage * sizeof *before);
-	const double s0 = ss_sweep_max_slope(g, st.height, st.cell_type);
+	const double s0 = ss_sweep_max_slope(g, st.height, st.cell_types);
 	CHECK(s0 < tc && s0 > 0.9 * tc, "subcritical: test set-up: steepest face %g, "
 	      "tan a_cr %g", s0, tc);
 
@@ -580,11 +580,11 @@ static void test_subcritical(void)
 	CHECK(awake0 == tiles, "subcritical: %g of %g tiles awake after prepare", awake0, tiles);
 	for (int step = 0; step < 3; step++) {
 		ss_boundary_fill_heights(g, &st.boundary, st.height);
-		const double s = ss_sweep_fast_begin(&st.fast, g, st.height, st.cell_type);
+		const double s = ss_sweep_fast_begin(&st.fast, g, st.height, st.cell_types);
 		CHECK(s <= tc, "subcritical: step %d: the fast sweep measures slope %g > tan "
 		      "a_cr %g", step, s, tc);
 		const double rate = ss_sweep_fast_step(&st.fast, g, &st.face_rule, 1e3, NULL,
-		                                       st.cell_type, st.height, st.open_flux);
+		                                       st.cell_types, st.height, st.open_flux);
 		CHECK(rate == 0.0, "subcritical: step %d: max |dh/dt| %g", step, rate);
 		CHECK(memcmp(before, st.height, storage * sizeof *before) == 0,
 		      "subcritical: step %d with dt = 1000 s changed the heights", step);
@@ -664,7 +664,7 @@ static void test_max_slope(void)
 			for (int j = 0; j < ny; j++) {
 				for (int i = 0; i < nx; i++) {
 					const ptrdiff_t k = ss_grid_index(g, i, j);
-					const uint8_t t = ref.cell_type[k];
+					const uint8_t t = ref.cell_type_bytes[k];
 					const double h = t == SS_CELL_FLOW ? amp * (rng_uniform(&r) - 0.5)
 					               : t == SS_CELL_OPEN ? sc.sides.open_level : 0.0;
 					ref.height[k] = fast.height[k] = h;
@@ -672,11 +672,11 @@ static void test_max_slope(void)
 			}
 			ss_boundary_fill_heights(g, &ref.boundary, ref.height);
 			ss_boundary_fill_heights(g, &fast.boundary, fast.height);
-			const double m = ss_sweep_max_slope(g, ref.height, ref.cell_type);
+			const double m = ss_sweep_max_slope(g, ref.height, ref.cell_types);
 			const double f = ss_sweep_fluxes(g, &ref.tiling, &ref.face_rule, ref.height,
-			                                 ref.cell_type, ref.flux_x, ref.flux_y);
-			ss_sweep_fast_wake_all(&fast.fast, g, fast.height, fast.cell_type);
-			const double b = ss_sweep_fast_begin(&fast.fast, g, fast.height, fast.cell_type);
+			                                 ref.cell_type_bytes, ref.flux_x, ref.flux_y);
+			ss_sweep_fast_wake_all(&fast.fast, g, fast.height, fast.cell_types);
+			const double b = ss_sweep_fast_begin(&fast.fast, g, fast.height, fast.cell_types);
 			cases++;
 			if (!same_bits(m, f)) {
 				mismatches++;
@@ -693,9 +693,9 @@ static void test_max_slope(void)
 		}
 		/* a NaN height: documented NaN */
 		const ptrdiff_t k = ss_grid_index(g, nx / 2, ny / 2);
-		if (ref.cell_type[k] == SS_CELL_FLOW) {
+		if (ref.cell_type_bytes[k] == SS_CELL_FLOW) {
 			ref.height[k] = NAN;
-			const double m = ss_sweep_max_slope(g, ref.height, ref.cell_type);
+			const double m = ss_sweep_max_slope(g, ref.height, ref.cell_types);
 			CHECK(isnan(m), "ss_sweep_max_slope with a NaN height gave %g, not NaN", m);
 		}
 		ss_stepper_release(&ref);
@@ -1005,6 +1005,38 @@ static void test_face_lanes(void)
 	       total, differ);
 }
 
+/* Packed cell types (grid.h): every set is read back, no set disturbs
+ * another cell, and unpacking from any start matches cell-by-cell reads. */
+static void test_packed_types(void)
+{
+	enum { CELLS = 1037 };
+	struct rng r = {seed ^ 0x7e57u};
+	uint8_t packed[(CELLS + 3) / 4], expect[CELLS], out[CELLS];
+	CHECK(ss_cell_types_bytes(CELLS) == sizeof packed,
+	      "ss_cell_types_bytes(%d) = %zu, expected %zu", CELLS,
+	      ss_cell_types_bytes(CELLS), sizeof packed);
+	memset(packed, 0, sizeof packed);
+	memset(expect, SS_CELL_FLOW, sizeof expect);
+	int wrong = 0;
+	for (int n = 0; n < 20000; n++) {
+		const int k = rng_int(&r, CELLS);
+		const enum ss_cell_type t = (enum ss_cell_type)rng_int(&r, 3);
+		ss_cell_type_set(packed, k, t);
+		expect[k] = (uint8_t)t;
+		if (n % 97 == 0)
+			for (int m = 0; m < CELLS; m++)
+				wrong += ss_cell_type_get(packed, m) != expect[m];
+	}
+	CHECK(wrong == 0, "packed types: %d reads differ from the values set", wrong);
+	int unpack_wrong = 0;
+	for (int k0 = 0; k0 < 9; k0++) {
+		ss_cell_types_unpack(packed, k0, (size_t)(CELLS - k0), out);
+		unpack_wrong += memcmp(out, expect + k0, (size_t)(CELLS - k0)) != 0;
+	}
+	CHECK(unpack_wrong == 0, "ss_cell_types_unpack differs from the values set for "
+	      "%d of 9 start cells", unpack_wrong);
+}
+
 int main(void)
 {
 	const char *env = getenv("SANDSLIDE_TEST_SEED");
@@ -1014,6 +1046,7 @@ int main(void)
 	ss_parallel_set_threads(2);
 	printf("test_sweep: seed %llu, rsqrt %s\n", (unsigned long long)seed,
 	       ss_face_rsqrt_method());
+	RUN(test_packed_types);
 	{
 		const double t_ = check_now();
 		RUN(test_face_rsqrt);

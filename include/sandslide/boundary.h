@@ -36,11 +36,11 @@ int ss_side_kind_parse(const char *name, enum ss_side_kind *kind);
 /* SS_ERR_INPUT unless opposite sides are both periodic or both not. */
 int ss_boundary_check(const struct ss_boundary *b);
 
-/* Ghost cell types.  The x sides are filled for rows 0..ny-1, then the y
+/* Ghost cell types (packed, grid.h).  The x sides are filled for rows 0..ny-1, then the y
  * sides for the whole width, so a corner takes the y side's rule (periodic
  * in both directions copies the diagonal corner). */
 void ss_boundary_fill_types(const struct ss_grid *g, const struct ss_boundary *b,
-                            uint8_t *cell_type);
+                            uint8_t *cell_types);
 
 /* Ghost heights, in the same order. */
 void ss_boundary_fill_heights(const struct ss_grid *g, const struct ss_boundary *b,

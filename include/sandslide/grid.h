@@ -50,6 +50,32 @@ static inline ptrdiff_t ss_grid_index(const struct ss_grid *g, int i, int j)
 	return (ptrdiff_t)(j + SS_GRID_GHOST) * g->stride + (i + SS_GRID_GHOST);
 }
 
+/*
+ * Cell types are stored packed, four cells to a byte (2 bits each, in
+ * storage order: cell k in bits 2 (k mod 4) of byte k / 4), so that a cell
+ * costs 8 B of height plus a quarter byte of type (the memory budget of
+ * SPEC section 7).  Writers are single-threaded (set-up); two threads must
+ * never set cells of the same byte.
+ */
+static inline size_t ss_cell_types_bytes(size_t cells)
+{
+	return (cells + 3) / 4;
+}
+
+static inline enum ss_cell_type ss_cell_type_get(const uint8_t *types, ptrdiff_t k)
+{
+	return (enum ss_cell_type)(types[k >> 2] >> (2 * (k & 3)) & 3);
+}
+
+static inline void ss_cell_type_set(uint8_t *types, ptrdiff_t k, enum ss_cell_type type)
+{
+	const unsigned shift = 2 * (unsigned)(k & 3);
+	types[k >> 2] = (uint8_t)((types[k >> 2] & ~(3u << shift)) | ((unsigned)type << shift));
+}
+
+/* One byte per cell for cells k0 .. k0 + n - 1 of packed types, into out. */
+void ss_cell_types_unpack(const uint8_t *types, ptrdiff_t k0, size_t n, uint8_t *out);
+
 /* Cell-centre coordinates, m. */
 static inline double ss_grid_x(const struct ss_grid *g, int i)
 {

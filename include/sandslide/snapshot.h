@@ -36,12 +36,12 @@ struct ss_snapshot_meta {
 	int deflate;             /* 0 (none) .. 9 */
 };
 
-/* Create the output and write the static variables; cell_type has the
- * grid's halo layout.  The file is written as "path.partial" and renamed to
+/* Create the output and write the static variables; cell_types are packed
+ * in the grid's halo layout (grid.h).  The file is written as "path.partial" and renamed to
  * path when the first snapshot is complete (an existing file of that name is
  * replaced only then).  SS_ERR_FAIL with a message on any HDF5 error. */
 int ss_snapshot_create(struct ss_snapshot **out, const char *path,
-                       const struct ss_grid *g, const uint8_t *cell_type,
+                       const struct ss_grid *g, const uint8_t *cell_types,
                        const struct ss_snapshot_meta *meta);
 
 /* Append one snapshot (height with the grid's halo layout), flush the file

@@ -55,7 +55,10 @@ struct ss_stepper {
 	double cfl;                   /* in (0, 1] */
 
 	double *height;               /* m, cells with halo (ss_grid_index) */
-	uint8_t *cell_type;           /* enum ss_cell_type, with halo */
+	uint8_t *cell_types;          /* enum ss_cell_type with halo, packed
+	                               * (ss_cell_type_get, grid.h) */
+	uint8_t *cell_type_bytes;     /* the same, one byte per cell
+	                               * (reference kernel only) */
 	double *flux_x, *flux_y;      /* m^2/s per face (reference kernel only) */
 	double *open_flux;            /* m^2/s per open face (fast kernel only) */
 	double *source_rate;          /* m/s, with halo; NULL without sources */

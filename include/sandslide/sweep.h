@@ -88,10 +88,12 @@ double ss_sweep_update(const struct ss_grid *g, const struct ss_tiling *t,
 /*
  * The largest slope s over the faces that can carry flux (as pass 1 returns
  * it), without computing fluxes; NaN if a height is NaN.  For diagnostics
- * and to start the fast sweep's running measure.
+ * and to start the fast sweep's running measure.  The fast sweep's
+ * functions, from here on, read the packed cell types of grid.h; the
+ * reference passes above read one byte per cell.
  */
 double ss_sweep_max_slope(const struct ss_grid *g, const double *restrict height,
-                          const uint8_t *restrict cell_type);
+                          const uint8_t *restrict cell_types);
 
 /*
  * The fast sweep (sweep_fast.c): one in-place pass per step over the tiles
@@ -101,8 +103,8 @@ double ss_sweep_max_slope(const struct ss_grid *g, const double *restrict height
  * by row, from three old rows held in a small buffer; the old values of the
  * neighbouring tile rows' edge rows are saved before the pass (ring_south,
  * ring_north), the old east column of a tile is carried to the next one.
- * So the heights are the only grid-sized array: 8 B per cell plus the type
- * byte plus 2 rows per tile row.
+ * So the heights are the only grid-sized array: 8 B per cell plus a
+ * quarter byte of packed type plus 2 rows per tile row.
  *
  * The time step needs the largest face slope of the current state before
  * the pass.  It is measured without another pass over the grid: a tile
@@ -159,12 +161,13 @@ struct ss_open_face_slot {
 	int which;               /* 0 x-face, 1 y-face south, 2 y-face north */
 };
 
-/* Allocate for grid g covered by `tiling`, `threads` OpenMP threads; cell types must be final (halo included).  The fast
- * sweep writes the flux of open_faces[m] to open_flux[m].  Every tile starts awake. */
+/* Allocate for grid g covered by `tiling`, `threads` OpenMP threads; the
+ * cell types must be final (halo included).  The fast sweep writes the flux
+ * of open_faces[m] to open_flux[m].  Every tile starts awake. */
 int ss_sweep_fast_init(struct ss_sweep_fast *f, const struct ss_grid *g,
                        const struct ss_tiling *tiling, int threads,
                        int periodic_x, int periodic_y,
-                       const uint8_t *cell_type,
+                       const uint8_t *cell_types,
                        const struct ss_open_face *open_faces,
                        size_t open_face_count);
 void ss_sweep_fast_release(struct ss_sweep_fast *f);
@@ -172,7 +175,7 @@ void ss_sweep_fast_release(struct ss_sweep_fast *f);
 /* Wake every tile and measure the state from scratch (after heights were
  * changed from outside). */
 void ss_sweep_fast_wake_all(struct ss_sweep_fast *f, const struct ss_grid *g,
-                            const double *height, const uint8_t *cell_type);
+                            const double *height, const uint8_t *cell_types);
 
 /* Mark the tiles holding a cell with a non-zero source rate (NULL: none). */
 void ss_sweep_fast_mark_sources(struct ss_sweep_fast *f, const struct ss_grid *g,
@@ -183,7 +186,7 @@ void ss_sweep_fast_mark_sources(struct ss_sweep_fast *f, const struct ss_grid *g
  * slope of the current state that can matter for the time step (exact when
  * it is above the critical slope); sets f->nonfinite on NaN. */
 double ss_sweep_fast_begin(struct ss_sweep_fast *f, const struct ss_grid *g,
-                           const double *height, const uint8_t *cell_type);
+                           const double *height, const uint8_t *cell_types);
 
 /* The step: advance the tiles to sweep by dt, in place.  Returns max |dh/dt|
  * over the flow cells (INFINITY on NaN); open_flux gets the fluxes of the
@@ -191,7 +194,7 @@ double ss_sweep_fast_begin(struct ss_sweep_fast *f, const struct ss_grid *g,
 double ss_sweep_fast_step(struct ss_sweep_fast *f, const struct ss_grid *g,
                           const struct ss_face_rule *rule, double dt,
                           const double *restrict source_rate,
-                          const uint8_t *restrict cell_type,
+                          const uint8_t *restrict cell_types,
                           double *restrict height, double *restrict open_flux);
 
 /* Tiles in the grid and tiles the coming step sweeps. */
