@@ -122,7 +122,7 @@ static void bench_step(struct ss_stepper *st, double lambda_idle)
 	st->tile_sweeps += ss_sweep_fast_awake(&st->fast);
 	st->tile_slots += st->fast.tiles;
 	ss_sweep_fast_step(&st->fast, g, &st->face_rule, st->cfl / (2.0 * lambda * inv_d2),
-	                   NULL, st->cell_types, st->height, st->open_flux);
+	                   NULL, NULL, st->cell_types, st->height, st->open_flux);
 }
 
 struct case_result {

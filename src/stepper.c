@@ -64,6 +64,7 @@ void ss_stepper_release(struct ss_stepper *st)
 	ss_free(st->open_faces);
 	ss_free(st->open_flux);
 	ss_sweep_fast_release(&st->fast);
+	ss_free(st->bedrock);
 	ss_free(st->source_rate);
 	ss_free(st->row_scratch);
 	ss_free(st->flux_y);
@@ -110,6 +111,51 @@ int ss_stepper_add_source(struct ss_stepper *st, const uint8_t *mask,
 	s->stop = stop;
 	st->source_count++;
 	return SS_OK;
+}
+
+int ss_stepper_set_bedrock(struct ss_stepper *st, const double *bedrock)
+{
+	const struct ss_grid *g = &st->grid;
+	if (!st->bedrock) {
+		st->bedrock = ss_alloc(ss_grid_storage_cells(g), sizeof(double), "bedrock");
+		if (!st->bedrock)
+			return SS_ERR_FAIL;
+	}
+	for (size_t k = 0; k < ss_grid_storage_cells(g); k++)
+		st->bedrock[k] = -INFINITY;
+	for (int j = 0; j < g->ny; j++) {
+		for (int i = 0; i < g->nx; i++) {
+			const double b = bedrock[(size_t)j * g->nx + i];
+			const ptrdiff_t k = ss_grid_index(g, i, j);
+			if (!isfinite(b))
+				return ss_error_input("bedrock of cell (%d, %d) at x = %g m, y = %g m "
+				                      "is %g: it must be finite", i, j,
+				                      ss_grid_x(g, i), ss_grid_y(g, j), b);
+			if (ss_cell_type_get(st->cell_types, k) == SS_CELL_FLOW)
+				st->bedrock[k] = b;
+		}
+	}
+	return SS_OK;
+}
+
+/* Bedrock ghosts: a periodic side copies the cell it wraps to; elsewhere no
+ * sand lies outside the grid (-infinity: no limit). */
+static void fill_bedrock_halo(struct ss_stepper *st)
+{
+	const struct ss_grid *g = &st->grid;
+	const struct ss_boundary *b = &st->boundary;
+	double *r = st->bedrock;
+	const int nx = g->nx, ny = g->ny;
+	const int px = b->side[SS_WEST] == SS_SIDE_PERIODIC;
+	const int py = b->side[SS_SOUTH] == SS_SIDE_PERIODIC;
+	for (int j = 0; j < ny; j++) {
+		r[ss_grid_index(g, -1, j)] = px ? r[ss_grid_index(g, nx - 1, j)] : -INFINITY;
+		r[ss_grid_index(g, nx, j)] = px ? r[ss_grid_index(g, 0, j)] : -INFINITY;
+	}
+	for (int i = -1; i <= nx; i++) {
+		r[ss_grid_index(g, i, -1)] = py ? r[ss_grid_index(g, i, ny - 1)] : -INFINITY;
+		r[ss_grid_index(g, i, ny)] = py ? r[ss_grid_index(g, i, 0)] : -INFINITY;
+	}
 }
 
 static int open_faces_build(struct ss_stepper *st)
@@ -170,9 +216,17 @@ int ss_stepper_prepare(struct ss_stepper *st)
 				                      "y = %g m is %g: heights must be finite",
 				                      i, j, ss_grid_x(g, i), ss_grid_y(g, j),
 				                      st->height[k]);
+			if (st->bedrock && type == SS_CELL_FLOW && st->bedrock[k] > st->height[k])
+				return ss_error_input("bedrock of cell (%d, %d) at x = %g m, y = %g m "
+				                      "is %.17g m, above the surface %.17g m: the "
+				                      "surface must be at or above the bedrock",
+				                      i, j, ss_grid_x(g, i), ss_grid_y(g, j),
+				                      st->bedrock[k], st->height[k]);
 		}
 	}
 	ss_boundary_fill_heights(g, &st->boundary, st->height);
+	if (st->bedrock)
+		fill_bedrock_halo(st);
 	if (st->source_count > 0) {
 		st->source_rate = ss_alloc(ss_grid_storage_cells(g), sizeof(double),
 		                           "source rates");
@@ -354,9 +408,13 @@ enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,
 			st->tile_sweeps += ss_sweep_fast_awake(&st->fast);
 			st->rate_max = ss_sweep_fast_step(&st->fast, g, &st->face_rule, dt,
 			                                  st->sources_on ? st->source_rate : NULL,
-			                                  st->cell_types, st->height, st->open_flux);
+			                                  st->bedrock, st->cell_types, st->height,
+			                                  st->open_flux);
 		} else {
 			st->tile_sweeps += tiles;
+			if (st->bedrock)
+				ss_sweep_limit(g, &st->tiling, dt, st->height, st->bedrock,
+				               st->flux_x, st->flux_y);
 			st->rate_max = ss_sweep_update(g, &st->tiling, dt, st->flux_x, st->flux_y,
 			                               st->sources_on ? st->source_rate : NULL,
 			                               st->cell_type_bytes, st->height);

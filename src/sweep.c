@@ -115,6 +115,37 @@ double ss_sweep_fluxes(const struct ss_grid *g, const struct ss_tiling *t,
 	return sqrt(s2_max);
 }
 
+void ss_sweep_limit(const struct ss_grid *g, const struct ss_tiling *t, double dt,
+                    const double *restrict height, const double *restrict bedrock,
+                    double *restrict flux_x, double *restrict flux_y)
+{
+	const int tiles = t->tiles_x * t->tiles_y;
+	const ptrdiff_t stride = g->stride;
+	const double limit_x = 0.25 * g->dx / dt, limit_y = 0.25 * g->dy / dt;
+
+	#pragma omp parallel for schedule(static)
+	for (int tile = 0; tile < tiles; tile++) {
+		const struct ss_tile_span sp = ss_tiling_span(t, g, tile % t->tiles_x,
+		                                              tile / t->tiles_x);
+		const int x_end = sp.i1 == g->nx ? sp.i1 + 1 : sp.i1;
+		const int y_end = sp.j1 == g->ny ? sp.j1 + 1 : sp.j1;
+		for (int j = sp.j0; j < sp.j1; j++) {
+			for (int i = sp.i0; i < x_end; i++) {
+				const ptrdiff_t k = ss_grid_index(g, i, j);
+				flux_x[k] = ss_face_limit(flux_x[k], height[k - 1] - bedrock[k - 1],
+				                          height[k] - bedrock[k], limit_x);
+			}
+		}
+		for (int j = sp.j0; j < y_end; j++) {
+			for (int i = sp.i0; i < sp.i1; i++) {
+				const ptrdiff_t k = ss_grid_index(g, i, j);
+				flux_y[k] = ss_face_limit(flux_y[k], height[k - stride] - bedrock[k - stride],
+				                          height[k] - bedrock[k], limit_y);
+			}
+		}
+	}
+}
+
 double ss_sweep_update(const struct ss_grid *g, const struct ss_tiling *t,
                        double dt, const double *restrict flux_x,
                        const double *restrict flux_y,

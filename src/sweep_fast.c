@@ -623,6 +623,16 @@ static inline int y_faces(const struct ss_face_rule *rule, int plain, int W,
 	                plain ? NULL : tb + 1, fy + 1);
 }
 
+/* Bedrock limits (ss_face_limit) on the faces between buffer rows a and b
+ * (positions 1 .. W); bed_a, bed_b: bedrock of those rows by position. */
+static inline void limit_y_faces(int W, double limit, const double *restrict a,
+                                 const double *restrict b, const double *restrict bed_a,
+                                 const double *restrict bed_b, double *restrict fy)
+{
+	for (int x = 1; x <= W; x++)
+		fy[x] = ss_face_limit(fy[x], a[x] - bed_a[x], b[x] - bed_b[x], limit);
+}
+
 struct tile_result {
 	double rate_max, s2_max;
 	int bad;
@@ -640,7 +650,8 @@ static inline void load_row(double *restrict buf, const double *restrict h_row,
 
 static void sweep_tile(struct ss_sweep_fast *f, const struct ss_grid *g,
                        const struct ss_face_rule *rule, double dt,
-                       const double *restrict src, const uint8_t *restrict type,
+                       const double *restrict src, const double *restrict bed,
+                       const uint8_t *restrict type,
                        double *restrict h, double *restrict open_flux,
                        int tx, int ty, int west_swept, struct row_buffers *w,
                        struct tile_result *res)
@@ -652,6 +663,7 @@ static void sweep_tile(struct ss_sweep_fast *f, const struct ss_grid *g,
 	const ptrdiff_t stride = g->stride;
 	const double inv_dx = 1.0 / g->dx, inv_dy = 1.0 / g->dy;
 	const double inv_2dx = 0.5 / g->dx, inv_2dy = 0.5 / g->dy;
+	const double limit_x = 0.25 * g->dx / dt, limit_y = 0.25 * g->dy / dt;
 	double *prev = w->row[0], *cur = w->row[1], *next = w->row[2];
 	double *cdx_prev = w->cdx[0], *cdx_cur = w->cdx[1], *cdx_next = w->cdx[2];
 	double *fy_south = w->fy[0], *fy_north = w->fy[1];
@@ -676,6 +688,9 @@ static void sweep_tile(struct ss_sweep_fast *f, const struct ss_grid *g,
 	central_x(plain, W, inv_2dx, cur, type_cur, cdx_cur);
 	moving |= y_faces(rule, plain, W, inv_dy, prev, cur, cdx_prev, cdx_cur,
 	                  type_prev, type_cur, w, fy_south);
+	if (bed)
+		limit_y_faces(W, limit_y, prev, cur, bed + ss_grid_index(g, i0 - 1, j0 - 1),
+		              bed + ss_grid_index(g, i0 - 1, j0), fy_south);
 
 	for (int j = j0; j < j1; j++) {
 		double *h_row = h + ss_grid_index(g, 0, j);
@@ -710,11 +725,18 @@ static void sweep_tile(struct ss_sweep_fast *f, const struct ss_grid *g,
 		}
 		moving |= face_row(rule, W + 1, w->gn, w->gt, plain ? NULL : type_cur,
 		                   plain ? NULL : type_cur + 1, w->fx);
+		const double *bed_cur = bed ? bed + ss_grid_index(g, i0 - 1, j) : NULL;
+		if (bed)
+			for (int x = 0; x <= W; x++)
+				w->fx[x] = ss_face_limit(w->fx[x], cur[x] - bed_cur[x],
+				                         cur[x + 1] - bed_cur[x + 1], limit_x);
 
 		/* y-faces (j | j + 1) */
 		central_x(plain, W, inv_2dx, next, type_next, cdx_next);
 		moving |= y_faces(rule, plain, W, inv_dy, cur, next, cdx_cur, cdx_next,
 		                  type_cur, type_next, w, fy_north);
+		if (bed)
+			limit_y_faces(W, limit_y, cur, next, bed_cur, bed_cur + stride, fy_north);
 
 		/* forward Euler, as ss_sweep_update */
 		const double *fx = w->fx;
@@ -860,6 +882,7 @@ static void plan_next(struct ss_sweep_fast *f)
 double ss_sweep_fast_step(struct ss_sweep_fast *f, const struct ss_grid *g,
                           const struct ss_face_rule *rule, double dt,
                           const double *restrict source_rate,
+                          const double *restrict bedrock,
                           const uint8_t *restrict cell_types,
                           double *restrict height, double *restrict open_flux)
 {
@@ -883,8 +906,8 @@ double ss_sweep_fast_step(struct ss_sweep_fast *f, const struct ss_grid *g,
 					continue;
 				}
 				struct tile_result res;
-				sweep_tile(f, g, rule, dt, source_rate, cell_types, height, open_flux,
-				           tx, ty, west_swept, &w, &res);
+				sweep_tile(f, g, rule, dt, source_rate, bedrock, cell_types, height,
+				           open_flux, tx, ty, west_swept, &w, &res);
 				rate_max = max2(rate_max, res.rate_max);
 				s2_max = max2(s2_max, res.s2_max);
 				bad |= res.bad;

@@ -29,6 +29,7 @@
 #include "sandslide/boundary.h"
 #include "sandslide/closure.h"
 #include "sandslide/diagnostics.h"
+#include "sandslide/error.h"
 #include "sandslide/grid.h"
 #include "sandslide/parallel.h"
 #include "sandslide/stepper.h"
@@ -945,6 +946,143 @@ static double timed(void (*fn)(void))
 		fflush(stdout);                                               \
 	} while (0)
 
+/* ---- bedrock ------------------------------------------------------------ */
+
+/* Smallest sand thickness h - b over the flow cells, checked after every
+ * substep through the progress hook. */
+struct thickness_watch {
+	double min_thickness;
+};
+
+static void watch_thickness(void *context, const struct ss_stepper *st)
+{
+	struct thickness_watch *w = context;
+	const struct ss_grid *g = &st->grid;
+	for (int j = 0; j < g->ny; j++) {
+		for (int i = 0; i < g->nx; i++) {
+			const ptrdiff_t k = ss_grid_index(g, i, j);
+			if (ss_cell_type_get(st->cell_types, k) == SS_CELL_FLOW)
+				w->min_thickness = fmin(w->min_thickness, st->height[k] - st->bedrock[k]);
+		}
+	}
+}
+
+/* A 5 mm layer on a bedrock inclined at 45 degrees (steeper than the 35
+ * degree repose angle), open at the low east end: all of it slides off,
+ * leaving the bedrock bare; no cell ever goes below its bedrock, and the
+ * volume that left is the volume that was there. */
+static void test_bedrock_slide_off(void)
+{
+	const int nx = 60, ny = 12;
+	const double dx = 0.01, slope = 1.0, layer = 0.005;
+	const double open_level = -slope * (nx + 0.5) * dx;  /* the plane, one cell out */
+	struct ss_stepper st;
+	if (setup(&st, nx, ny, dx, SS_CLOSURE_COULOMB, 1.0, 0.05,
+	          sides(SS_SIDE_WALL, SS_SIDE_OPEN, SS_SIDE_WALL, SS_SIDE_WALL, open_level),
+	          16, 8))
+		return;
+	double *bedrock = malloc((size_t)nx * ny * sizeof *bedrock);
+	for (int j = 0; j < ny; j++) {
+		for (int i = 0; i < nx; i++) {
+			bedrock[(size_t)j * nx + i] = -slope * (i + 0.5) * dx;
+			*hp(&st, i, j) = bedrock[(size_t)j * nx + i] + layer;
+		}
+	}
+	int err = ss_stepper_set_bedrock(&st, bedrock);
+	CHECK(err == 0, "bedrock slide-off: bedrock refused");
+	if (err || prepare(&st))
+		goto out;
+	const double v0 = diag(&st).volume;
+	struct thickness_watch w = {INFINITY};
+	const struct ss_advance_options o = {.steady_tol = 1e-9, .progress = watch_thickness,
+	                                     .context = &w};
+	const enum ss_advance_end end = ss_stepper_advance(&st, 50.0, &o);
+	struct ss_diagnostics d = diag(&st);
+	double left = 0.0;
+	for (int j = 0; j < ny; j++)
+		for (int i = 0; i < nx; i++)
+			left = fmax(left, *hp(&st, i, j) - bedrock[(size_t)j * nx + i]);
+	CHECK(end == SS_ADVANCE_STEADY, "bedrock slide-off: no steady state by t = %g s "
+	      "(ended %d, max |dh/dt| %g m/s)", st.time, (int)end, st.rate_max);
+	CHECK(w.min_thickness >= -1e-15, "bedrock slide-off: a cell went %.3g m below its "
+	      "bedrock", -w.min_thickness);
+	CHECK(left < 1e-9, "bedrock slide-off: %.3g m of sand left on the 45 degree "
+	      "bedrock (of %g m)", left, layer);
+	CHECK_REL(d.outflow + (d.volume - (v0 - layer * nx * ny * dx * dx)),
+	          layer * nx * ny * dx * dx, 1e-10,
+	          "bedrock slide-off: the outflow is not the sand that was there");
+	printf("  slide-off: %lld steps to t = %.3g s, thickest remaining %.3g m, thinnest "
+	       "ever %.3g m, outflow %.6g of %.6g m^3\n", st.steps, st.time, left,
+	       w.min_thickness, d.outflow, layer * nx * ny * dx * dx);
+out:
+	free(bedrock);
+	ss_stepper_release(&st);
+}
+
+/* A 50 degree cone of sand on a flat bedrock at 0 with bare bedrock round
+ * it: the pile relaxes to the repose angle, spreading over the bare cells,
+ * with its volume conserved and no cell below the bedrock. */
+static void test_bedrock_flat_pile(void)
+{
+	const int n = 48;
+	const double dx = 0.05, R = 14 * dx, c = 0.5 * n * dx;
+	struct ss_stepper st;
+	if (setup(&st, n, n, dx, SS_CLOSURE_COULOMB, 1.0, 0.01,
+	          sides(SS_SIDE_WALL, SS_SIDE_WALL, SS_SIDE_WALL, SS_SIDE_WALL, 0.0), 0, 0))
+		return;
+	const double t50 = tan(50.0 * DEG), tc = st.closure.tan_cr;
+	double *bedrock = calloc((size_t)n * n, sizeof *bedrock);
+	for (int j = 0; j < n; j++)
+		for (int i = 0; i < n; i++)
+			*hp(&st, i, j) = t50 * fmax(R - hypot(ss_grid_x(&st.grid, i) - c,
+			                                      ss_grid_y(&st.grid, j) - c), 0.0);
+	int err = ss_stepper_set_bedrock(&st, bedrock);
+	CHECK(err == 0, "bedrock pile: bedrock refused");
+	if (err || prepare(&st))
+		goto out;
+	const double v0 = diag(&st).volume;
+	struct thickness_watch w = {INFINITY};
+	const struct ss_advance_options o = {.steady_tol = 1e-10, .progress = watch_thickness,
+	                                     .context = &w};
+	const enum ss_advance_end end = ss_stepper_advance(&st, 1e5, &o);
+	struct ss_diagnostics d = diag(&st);
+	const double s_max = max_face_slope(&st, n + 1);
+	CHECK(end == SS_ADVANCE_STEADY, "bedrock pile: no steady state by t = %g s", st.time);
+	CHECK(s_max <= tc + 1e-6, "bedrock pile: steepest face %.9g above tan a_cr %.9g at "
+	      "steady state", s_max, tc);
+	CHECK(s_max >= tc - 0.02, "bedrock pile: steepest face %.6g: the pile is not at the "
+	      "repose angle (%.6g)", s_max, tc);
+	CHECK_REL(d.volume, v0, 1e-12, "bedrock pile: volume not conserved");
+	CHECK(w.min_thickness >= -1e-15, "bedrock pile: a cell went %.3g m below the "
+	      "bedrock", -w.min_thickness);
+	printf("  flat bedrock pile: steady at t = %.3g s, steepest face %.4f deg, thinnest "
+	       "%.3g m\n", st.time, atan(s_max) / DEG, w.min_thickness);
+out:
+	free(bedrock);
+	ss_stepper_release(&st);
+}
+
+/* A bedrock above the surface or not finite is refused (the messages,
+ * which name the cell, go to stderr). */
+static void test_bedrock_refused(void)
+{
+	struct ss_stepper st;
+	if (setup(&st, 8, 6, 0.1, SS_CLOSURE_COULOMB, 1.0, 0.01,
+	          sides(SS_SIDE_WALL, SS_SIDE_WALL, SS_SIDE_WALL, SS_SIDE_WALL, 0.0), 0, 0))
+		return;
+	double bedrock[48] = {0};
+	bedrock[2 * 8 + 5] = 0.25;   /* cell (5, 2), above the zero surface */
+	int err = ss_stepper_set_bedrock(&st, bedrock);
+	CHECK(err == 0, "bedrock refused before the surface is known");
+	err = ss_stepper_prepare(&st);
+	CHECK(err == SS_ERR_INPUT, "a bedrock above the surface gave %d, not SS_ERR_INPUT",
+	      err);
+	bedrock[2 * 8 + 5] = NAN;
+	err = ss_stepper_set_bedrock(&st, bedrock);
+	CHECK(err == SS_ERR_INPUT, "a NaN bedrock gave %d, not SS_ERR_INPUT", err);
+	ss_stepper_release(&st);
+}
+
 int main(void)
 {
 	const char *s = getenv("SANDSLIDE_TEST_SEED");
@@ -961,6 +1099,9 @@ int main(void)
 	RUN_TIMED(test_symmetry);
 	RUN_TIMED(test_determinism);
 	RUN_TIMED(test_periodic);
+	RUN_TIMED(test_bedrock_slide_off);
+	RUN_TIMED(test_bedrock_flat_pile);
+	RUN_TIMED(test_bedrock_refused);
 	printf("total %.2f s\n", check_now() - t0);
 	return check_report();
 }

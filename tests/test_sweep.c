@@ -82,6 +82,7 @@ struct scenario {
 	struct ss_boundary sides;
 	double *h0;          /* nx * ny, row-major from the south */
 	uint8_t *type;       /* nx * ny */
+	double *bedrock;     /* nx * ny, or NULL */
 	int sources;
 	uint8_t *mask[2];
 	double rate[2], start[2], stop[2];
@@ -102,6 +103,7 @@ static void scenario_free(struct scenario *sc)
 {
 	free(sc->h0);
 	free(sc->type);
+	free(sc->bedrock);
 	for (int k = 0; k < 2; k++)
 		free(sc->mask[k]);
 }
@@ -143,6 +145,11 @@ static int build(struct ss_stepper *st, const struct scenario *sc, enum ss_kerne
 			st->height[k] = sc->h0[(size_t)j * sc->nx + i];
 			ss_cell_type_set(st->cell_types, k, sc->type[(size_t)j * sc->nx + i]);
 		}
+	}
+	if (sc->bedrock && (err = ss_stepper_set_bedrock(st, sc->bedrock))) {
+		CHECK(0, "%s: bedrock refused", sc->name);
+		ss_stepper_release(st);
+		return err;
 	}
 	for (int s = 0; s < sc->sources; s++) {
 		err = ss_stepper_add_source(st, sc->mask[s], sc->rate[s], sc->start[s], sc->stop[s]);
@@ -423,6 +430,64 @@ static void test_identity_periodic_pile(void)
 	scenario_free(&sc);
 }
 
+/* Bedrock: the random scenarios with a bedrock under each flow cell at a
+ * random depth, a third of the cells bare (bedrock = surface), so that the
+ * face limits of face.h bind.  Both kernels must still agree bit for bit. */
+static void test_identity_bedrock(void)
+{
+	const double T = 0.12;
+	const enum ss_side_kind W = SS_SIDE_WALL, O = SS_SIDE_OPEN, P = SS_SIDE_PERIODIC;
+	const struct ss_boundary side_sets[3] = {
+		sides4(O, W, W, O, 0.002), sides4(P, P, O, O, -0.001), sides4(P, P, P, P, 0.0),
+	};
+	const long long before = identity_steps;
+	for (int c = 0; c < N_CLOSURES; c += 2) {
+		struct rng r = {seed * 53u + (uint64_t)c};
+		struct scenario sc;
+		char name[160];
+		random_scenario(&sc, &r, closures[c], side_sets[c / 2 % 3], 0, T);
+		sc.bedrock = malloc((size_t)sc.nx * sc.ny * sizeof *sc.bedrock);
+		const double thick = 0.5 * tan(REPOSE * M_PI / 180.0) * sc.dx;
+		for (size_t k = 0; k < (size_t)sc.nx * sc.ny; k++)
+			sc.bedrock[k] = sc.h0[k] - (rng_int(&r, 3) == 0 ? 0.0 : thick * rng_uniform(&r));
+		snprintf(name, sizeof name, "%s, bedrock, sides %d", closures[c].name, c / 2 % 3);
+		sc.name = name;
+		static const int some[3] = {0, 1, 3};
+		identity_case(&sc, T, some, 3);
+		/* the limits must bind (else this tests nothing) and keep every
+		 * flow cell on or above its bedrock */
+		struct ss_stepper with, without;
+		if (build(&with, &sc, SS_KERNEL_FAST, 16, 8, 2) == 0) {
+			advance_to(&with, T, name);
+			double *bedrock = sc.bedrock;
+			sc.bedrock = NULL;
+			if (build(&without, &sc, SS_KERNEL_FAST, 16, 8, 2) == 0) {
+				advance_to(&without, T, name);
+				double worst = 0.0;
+				long differ = 0;
+				for (int j = 0; j < sc.ny; j++) {
+					for (int i = 0; i < sc.nx; i++) {
+						const ptrdiff_t k = ss_grid_index(&with.grid, i, j);
+						if (ss_cell_type_get(with.cell_types, k) != SS_CELL_FLOW)
+							continue;
+						worst = fmin(worst, with.height[k] - with.bedrock[k]);
+						differ += with.height[k] != without.height[k];
+					}
+				}
+				CHECK(worst >= -1e-15, "%s: a cell ends %.3g m below its bedrock", name,
+				      -worst);
+				CHECK(differ > 0, "%s: test set-up: the bedrock changed no height", name);
+				ss_stepper_release(&without);
+			}
+			sc.bedrock = bedrock;
+			ss_stepper_release(&with);
+		}
+		scenario_free(&sc);
+	}
+	printf("  bit identity with bedrock: 3 closures, %lld reference steps\n",
+	       identity_steps - before);
+}
+
 /* ---- 2. active tiles: a pile slides, spreads and stops -------------------- */
 
 static void test_active_tiles(void)
@@ -583,7 +648,7 @@ static void test_subcritical(void)
 		const double s = ss_sweep_fast_begin(&st.fast, g, st.height, st.cell_types);
 		CHECK(s <= tc, "subcritical: step %d: the fast sweep measures slope %g > tan "
 		      "a_cr %g", step, s, tc);
-		const double rate = ss_sweep_fast_step(&st.fast, g, &st.face_rule, 1e3, NULL,
+		const double rate = ss_sweep_fast_step(&st.fast, g, &st.face_rule, 1e3, NULL, NULL,
 		                                       st.cell_types, st.height, st.open_flux);
 		CHECK(rate == 0.0, "subcritical: step %d: max |dh/dt| %g", step, rate);
 		CHECK(memcmp(before, st.height, storage * sizeof *before) == 0,
@@ -1085,6 +1150,11 @@ int main(void)
 	{
 		const double t_ = check_now();
 		RUN(test_identity_periodic_pile);
+		printf("    (%.2f s)\n", check_now() - t_);
+	}
+	{
+		const double t_ = check_now();
+		RUN(test_identity_bedrock);
 		printf("    (%.2f s)\n", check_now() - t_);
 	}
 	{

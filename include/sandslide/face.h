@@ -58,6 +58,24 @@ int ss_face_fluxes(const struct ss_face_rule *r, int n,
                     const double *restrict g_n, const double *restrict g_t,
                     double *restrict flux);
 
+/*
+ * Non-erodible bedrock: a face takes from the cell it leaves at most a
+ * quarter of that cell's sand per step, so that a cell losing sand through
+ * all four faces keeps thickness h - b >= 0 (to round-off), while each face
+ * still has one flux and the volume balance stays exact.  For an x-face
+ * F dt dy <= (h - b) dx dy / 4, i.e. F <= (h - b) limit with
+ * limit = dx / (4 dt) (dy for a y-face).  thick_a, thick_b: thickness of
+ * the west/south and east/north cell (+infinity where there is no bedrock:
+ * walls, open cells, ghosts); positive F flows from a to b.  A NaN flux or
+ * thickness stays NaN.
+ */
+static inline double ss_face_limit(double flux, double thick_a, double thick_b, double limit)
+{
+	const double out_a = thick_a * limit, out_b = -(thick_b * limit);
+	flux = flux > out_a ? out_a : flux;
+	return flux < out_b ? out_b : flux;
+}
+
 /* y[k] = 1/sqrt(x[k]) for x[k] > 0, k < n, as the face flux computes it. */
 void ss_face_rsqrt(int n, const double *restrict x, double *restrict y);
 

@@ -62,6 +62,9 @@ struct ss_stepper {
 	double *flux_x, *flux_y;      /* m^2/s per face (reference kernel only) */
 	double *open_flux;            /* m^2/s per open face (fast kernel only) */
 	double *source_rate;          /* m/s, with halo; NULL without sources */
+	double *bedrock;              /* m, with halo; NULL without bedrock
+	                               * (-infinity where no sand lies: walls,
+	                               * open cells, open and wall ghosts) */
 	double *row_scratch;          /* ny per-row partial sums */
 
 	struct ss_source *sources;
@@ -104,10 +107,16 @@ double ss_stepper_memory_bytes(const struct ss_grid *g);
 int ss_stepper_add_source(struct ss_stepper *st, const uint8_t *mask,
                           double rate, double start, double stop);
 
+/* A non-erodible bedrock (nx * ny values, m, row-major, south row first):
+ * only the sand above it moves, each face limited by the thickness of the
+ * cell it leaves (face.h).  Call after the cell types are final and before
+ * ss_stepper_prepare, which refuses a bedrock above the surface. */
+int ss_stepper_set_bedrock(struct ss_stepper *st, const double *bedrock);
+
 /* Call once heights and interior cell types are set: fills the halo types,
  * holds open cells at the open level, lists the outflow faces, sets up the
  * kernel chosen in st->kernel.  Returns SS_ERR_INPUT naming the first
- * non-finite height. */
+ * non-finite height or the first cell whose bedrock is above the surface. */
 int ss_stepper_prepare(struct ss_stepper *st);
 
 /* How ss_stepper_advance ended.  Steady needs max |dh/dt| < steady_tol and

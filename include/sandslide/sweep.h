@@ -74,6 +74,15 @@ double ss_sweep_fluxes(const struct ss_grid *g, const struct ss_tiling *t,
                        double *restrict flux_x, double *restrict flux_y);
 
 /*
+ * Between the passes, with a non-erodible bedrock (m, with halo; -infinity
+ * where there is none): each flux limited by the thickness of the cell it
+ * leaves (ss_face_limit, face.h) for a step of dt seconds.
+ */
+void ss_sweep_limit(const struct ss_grid *g, const struct ss_tiling *t, double dt,
+                    const double *restrict height, const double *restrict bedrock,
+                    double *restrict flux_x, double *restrict flux_y);
+
+/*
  * Pass 2.  Advances flow cells by dt seconds with the fluxes of pass 1 and
  * the source rate (m/s per cell, NULL for none).  Returns max |dh/dt| over
  * flow cells, m/s.
@@ -188,12 +197,14 @@ void ss_sweep_fast_mark_sources(struct ss_sweep_fast *f, const struct ss_grid *g
 double ss_sweep_fast_begin(struct ss_sweep_fast *f, const struct ss_grid *g,
                            const double *height, const uint8_t *cell_types);
 
-/* The step: advance the tiles to sweep by dt, in place.  Returns max |dh/dt|
- * over the flow cells (INFINITY on NaN); open_flux gets the fluxes of the
- * faces to open cells.  Then plans which tiles the next step sweeps. */
+/* The step: advance the tiles to sweep by dt, in place, with the fluxes
+ * limited by the bedrock as ss_sweep_limit does (bedrock NULL: none).
+ * Returns max |dh/dt| over the flow cells (INFINITY on NaN); open_flux gets
+ * the fluxes of the faces to open cells.  Then plans which tiles the next step sweeps. */
 double ss_sweep_fast_step(struct ss_sweep_fast *f, const struct ss_grid *g,
                           const struct ss_face_rule *rule, double dt,
                           const double *restrict source_rate,
+                          const double *restrict bedrock,
                           const uint8_t *restrict cell_types,
                           double *restrict height, double *restrict open_flux);
 
