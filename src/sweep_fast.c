@@ -208,13 +208,33 @@ static double slope2_plain_pair(const struct ss_grid *g, const double *h, int j,
  * slope2_x_faces and slope2_y_faces).
  */
 static double slope2_column(const struct ss_grid *g, const double *h,
-                            const uint8_t *t, int i_x, int i_y, int ja, int jb,
-                            int *bad)
+                            const uint8_t *t, int plain, int i_x, int i_y, int ja,
+                            int jb, int *bad)
 {
 	const ptrdiff_t s = g->stride;
 	const double inv_dx = 1.0 / g->dx, inv_dy = 1.0 / g->dy;
 	const double inv_2dx = 0.5 / g->dx, inv_2dy = 0.5 / g->dy;
 	uint64_t m = 0;
+	if (plain) {
+		/* no walls near: face_slope2_bits without the types */
+		for (int j = ja; j <= jb; j++) {
+			const double *c = h + ss_grid_index(g, i_y, j), *b = c - s;
+			const double gn = (c[0] - b[0]) * inv_dy;
+			const double gt = 0.5 * ((b[1] - b[-1]) * inv_2dx + (c[1] - c[-1]) * inv_2dx);
+			uint64_t q = bits_of(gn * gn + gt * gt);
+			m = q > m ? q : m;
+			if (j < jb) {
+				const double *e = h + ss_grid_index(g, i_x, j), *w = e - 1;
+				const double gnx = (e[0] - w[0]) * inv_dx;
+				const double gtx = 0.5 * ((w[s] - w[-s]) * inv_2dy + (e[s] - e[-s]) * inv_2dy);
+				q = bits_of(gnx * gnx + gtx * gtx);
+				m = q > m ? q : m;
+			}
+		}
+		const double max = double_of(m);
+		*bad |= max != max;
+		return max;
+	}
 	for (int j = ja; j <= jb; j++) {
 		uint64_t q = face_slope2_bits(h, t, ss_grid_index(g, i_y, j) - s, s, 1,
 		                              inv_dy, inv_2dx);
@@ -508,10 +528,10 @@ double ss_sweep_fast_begin(struct ss_sweep_fast *f, const struct ss_grid *g,
 			/* the west and east columns: x-faces i0 and i1 of rows j0 + 1 ..
 			 * j1 - 2, y-faces of cells i0 and i1 - 1 for j0 + 1 .. j1 - 1 */
 			if (s.j1 - s.j0 >= 2) {
-				q = max2(q, slope2_column(g, height, cell_types, s.i0, s.i0, s.j0 + 1,
+				q = max2(q, slope2_column(g, height, cell_types, plain, s.i0, s.i0, s.j0 + 1,
 				                          s.j1 - 1, &bad));
-				q = max2(q, slope2_column(g, height, cell_types, s.i1, s.i1 - 1, s.j0 + 1,
-				                          s.j1 - 1, &bad));
+				q = max2(q, slope2_column(g, height, cell_types, plain, s.i1, s.i1 - 1,
+				                          s.j0 + 1, s.j1 - 1, &bad));
 			}
 			m = q > m ? q : m;
 		}
