@@ -1,238 +1,99 @@
 /*
- * dem.c - raster readers (see dem.h).
+ * dem.c - raster input and output (see dem.h): the format from the path,
+ * read options, the HDF5 reader, and the atomic write every writer goes
+ * through.  The formats themselves are in dem_asc.c, dem_png.c and
+ * dem_gdal.c.
  */
 #include "sandslide/dem.h"
 
-#include <ctype.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
+#include "dem_internal.h"
 #include "sandslide/error.h"
 #include "sandslide/snapshot.h"
+
+/* ------------------------------------------------------------------ */
+/* rasters and options                                                  */
+
+static void raster_clear(struct ss_raster *r)
+{
+	memset(r, 0, sizeof *r);
+	r->cellsize = r->cellsize_y = NAN;
+	r->x0 = r->y0 = NAN;
+	r->nodata_value = NAN;
+	r->png_zmin = r->png_zmax = NAN;
+}
+
+int ss_raster_init(struct ss_raster *r, int nx, int ny)
+{
+	raster_clear(r);
+	if (nx < 1 || ny < 1)
+		SS_BUG("ss_raster_init: %d x %d cells", nx, ny);
+	r->nx = nx;
+	r->ny = ny;
+	r->values = ss_alloc((size_t)nx * (size_t)ny, sizeof(double), "raster heights");
+	return r->values ? SS_OK : SS_ERR_FAIL;
+}
 
 void ss_raster_release(struct ss_raster *r)
 {
 	ss_free(r->values);
 	ss_free(r->nodata);
-	memset(r, 0, sizeof *r);
+	ss_free(r->source);
+	ss_free(r->crs_wkt);
+	raster_clear(r);
 }
 
-/* A cursor over text that knows its line. */
-struct scan {
-	const char *s;
-	int line;
-};
-
-/* Next white-space separated token into buf; 0 at the end of the text. */
-static int next_token(struct scan *sc, char *buf, size_t size)
+void ss_dem_read_options_init(struct ss_dem_read_options *o)
 {
-	while (*sc->s && isspace((unsigned char)*sc->s)) {
-		if (*sc->s == '\n')
-			sc->line++;
-		sc->s++;
+	o->format = SS_DEM_AUTO;
+	o->zscale = o->zoffset = o->cellsize = NAN;
+}
+
+char *ss_dem_strdup(const char *s)
+{
+	const size_t n = strlen(s) + 1;
+	char *d = ss_alloc(n, 1, "a string");
+	if (d)
+		memcpy(d, s, n);
+	return d;
+}
+
+double ss_dem_dy(const struct ss_raster *r)
+{
+	return isnan(r->cellsize_y) ? r->cellsize : r->cellsize_y;
+}
+
+/* ------------------------------------------------------------------ */
+/* formats                                                              */
+
+const char *ss_dem_format_name(enum ss_dem_format format)
+{
+	switch (format) {
+	case SS_DEM_ASC:  return "ESRI ASCII grid";
+	case SS_DEM_H5:   return "sandslide HDF5";
+	case SS_DEM_PNG:  return "16-bit greyscale PNG";
+	case SS_DEM_GDAL: return "GeoTIFF (GDAL)";
+	case SS_DEM_AUTO: break;
 	}
-	if (!*sc->s)
-		return 0;
-	size_t n = 0;
-	while (*sc->s && !isspace((unsigned char)*sc->s)) {
-		if (n + 1 < size)
-			buf[n++] = *sc->s;
-		sc->s++;
-	}
-	buf[n] = '\0';
+	return "raster";
+}
+
+int ss_dem_gdal_available(void)
+{
+#ifdef SS_HAVE_GDAL
 	return 1;
-}
-
-static int to_double(const char *t, double *v)
-{
-	char *end;
-	errno = 0;
-	*v = strtod(t, &end);
-	return end != t && *end == '\0' && errno != ERANGE ? 0 : -1;
-}
-
-static char *read_text(const char *path, const char *context, int *err)
-{
-	FILE *f = fopen(path, "rb");
-	if (!f) {
-		*err = ss_error_input_at(context, "cannot open '%s': %s", path, strerror(errno));
-		return NULL;
-	}
-	char *text = NULL;
-	size_t size = 0, cap = 0;
-	for (;;) {
-		if (cap - size < 65536) {
-			cap = cap ? 2 * cap : 1 << 20;
-			char *grown = realloc(text, cap);
-			if (!grown) {
-				free(text);
-				fclose(f);
-				*err = ss_error_fail("out of memory reading '%s'", path);
-				return NULL;
-			}
-			text = grown;
-		}
-		size_t got = fread(text + size, 1, cap - size - 1, f);
-		size += got;
-		if (got == 0)
-			break;
-	}
-	int bad = ferror(f);
-	fclose(f);
-	if (bad) {
-		free(text);
-		*err = ss_error_input_at(context, "cannot read '%s'", path);
-		return NULL;
-	}
-	text[size] = '\0';
-	return text;
-}
-
-static int read_asc(const char *path, const char *context, struct ss_raster *r)
-{
-	int err = SS_OK;
-	char *text = read_text(path, context, &err);
-	if (!text)
-		return err;
-	struct scan sc = {text, 1};
-	char tok[128];
-	double ncols = NAN, nrows = NAN, cell = NAN, x = NAN, y = NAN, nodata = NAN;
-	int x_center = 0, y_center = 0, have_nodata = 0;
-
-	/* header: "key value" pairs until the first number */
-	const char *mark = sc.s;
-	int mark_line = sc.line;
-	while (next_token(&sc, tok, sizeof tok)) {
-		double v;
-		if (!isalpha((unsigned char)tok[0]) || !strcasecmp(tok, "nan") ||
-		    !strcasecmp(tok, "inf") || !strcasecmp(tok, "infinity")) {
-			sc.s = mark;   /* the first value: rewind */
-			sc.line = mark_line;
-			break;
-		}
-		char key[128];
-		snprintf(key, sizeof key, "%s", tok);
-		int key_line = sc.line;
-		if (!next_token(&sc, tok, sizeof tok) || to_double(tok, &v)) {
-			err = ss_error_input_at(context, "%s:%d: header key '%s' has no numeric value", path,
-			                     key_line, key);
-			goto out;
-		}
-		if (!strcasecmp(key, "ncols"))
-			ncols = v;
-		else if (!strcasecmp(key, "nrows"))
-			nrows = v;
-		else if (!strcasecmp(key, "cellsize"))
-			cell = v;
-		else if (!strcasecmp(key, "xllcorner") || !strcasecmp(key, "xllcenter"))
-			x = v, x_center = !strcasecmp(key, "xllcenter");
-		else if (!strcasecmp(key, "yllcorner") || !strcasecmp(key, "yllcenter"))
-			y = v, y_center = !strcasecmp(key, "yllcenter");
-		else if (!strcasecmp(key, "nodata_value"))
-			nodata = v, have_nodata = 1;
-		else {
-			err = ss_error_input_at(context, "%s:%d: unknown header key '%s': expected ncols, nrows, "
-			                     "xllcorner, yllcorner, cellsize, NODATA_value", path,
-			                     key_line, key);
-			goto out;
-		}
-		mark = sc.s;
-		mark_line = sc.line;
-	}
-	if (!(ncols >= 1 && ncols <= 1 << 30 && ncols == floor(ncols)) ||
-	    !(nrows >= 1 && nrows <= 1 << 30 && nrows == floor(nrows))) {
-		err = ss_error_input_at(context, "%s: ESRI ASCII header needs ncols and nrows, integers >= 1",
-		                     path);
-		goto out;
-	}
-	if (!(cell > 0.0)) {
-		err = ss_error_input_at(context, "%s: ESRI ASCII header needs cellsize > 0", path);
-		goto out;
-	}
-	r->nx = (int)ncols;
-	r->ny = (int)nrows;
-	r->cellsize = cell;
-	r->x0 = x_center ? x - 0.5 * cell : x;
-	r->y0 = y_center ? y - 0.5 * cell : y;
-	const size_t n = (size_t)r->nx * (size_t)r->ny;
-	r->values = ss_alloc(n, sizeof(double), "raster heights");
-	if (!r->values) {
-		err = SS_ERR_FAIL;
-		goto out;
-	}
-	for (int row = 0; row < r->ny; row++) {   /* north row first in the file */
-		const int j = r->ny - 1 - row;
-		for (int i = 0; i < r->nx; i++) {
-			double v;
-			if (!next_token(&sc, tok, sizeof tok)) {
-				err = ss_error_input_at(context, "%s: ends after %d of %d x %d values", path,
-				                     row * r->nx + i, r->nx, r->ny);
-				goto out;
-			}
-			if (to_double(tok, &v)) {
-				err = ss_error_input_at(context, "%s:%d: '%s' (row %d, column %d) is not a number",
-				                     path, sc.line, tok, row + 1, i + 1);
-				goto out;
-			}
-			if (have_nodata && v == nodata) {
-				if (!r->nodata && !(r->nodata = ss_alloc(n, 1, "nodata flags"))) {
-					err = SS_ERR_FAIL;
-					goto out;
-				}
-				r->nodata[(size_t)j * r->nx + i] = 1;
-				v = 0.0;
-			} else if (!isfinite(v)) {
-				err = ss_error_input_at(context, "%s:%d: height '%s' (row %d, column %d) is not "
-				                     "finite: heights must be finite numbers (mark "
-				                     "missing cells with NODATA_value)", path, sc.line,
-				                     tok, row + 1, i + 1);
-				goto out;
-			}
-			r->values[(size_t)j * r->nx + i] = v;
-		}
-	}
-	if (next_token(&sc, tok, sizeof tok))
-		err = ss_error_input_at(context, "%s:%d: more values than ncols x nrows = %d x %d", path,
-		                     sc.line, r->nx, r->ny);
-out:
-	free(text);
-	return err;
-}
-
-static int read_h5(const char *spec, const char *context, struct ss_raster *r)
-{
-	/* "file.h5" or "file.h5:/dataset" */
-	char path[4096];
-	const char *dataset = NULL;
-	const char *colon = strstr(spec, ".h5:");
-	if (colon) {
-		size_t n = (size_t)(colon - spec) + 3;
-		snprintf(path, sizeof path, "%.*s", (int)n, spec);
-		dataset = colon + 4;
-	} else {
-		snprintf(path, sizeof path, "%s", spec);
-	}
-	FILE *f = fopen(path, "rb");
-	if (!f)
-		return ss_error_input_at(context, "cannot open '%s': %s", path, strerror(errno));
-	fclose(f);
-	int err = ss_snapshot_read_field(path, dataset, -1, &r->nx, &r->ny, &r->values);
-	if (err)
-		return err;
-	r->cellsize = r->x0 = r->y0 = NAN;
-	const size_t n = (size_t)r->nx * (size_t)r->ny;
-	for (size_t k = 0; k < n; k++) {
-		if (!isfinite(r->values[k]))
-			return ss_error_input_at(context, "%s: height %g at column %zu, row %zu (from the south) "
-			                      "is not finite: heights must be finite numbers", spec,
-			                      r->values[k], k % (size_t)r->nx + 1,
-			                      k / (size_t)r->nx + 1);
-	}
-	return SS_OK;
+#else
+	return 0;
+#endif
 }
 
 static int has_suffix(const char *s, const char *suffix)
@@ -241,13 +102,315 @@ static int has_suffix(const char *s, const char *suffix)
 	return a >= b && strcasecmp(s + a - b, suffix) == 0;
 }
 
-int ss_dem_read(const char *spec, const char *context, struct ss_raster *r)
+/* The HDF5 file name inside "FILE.h5:/dataset", or NULL if spec is not one;
+ * *dataset points into spec. */
+static const char *h5_dataset(const char *spec)
 {
-	memset(r, 0, sizeof *r);
-	if (has_suffix(spec, ".asc"))
-		return read_asc(spec, context, r);
-	if (has_suffix(spec, ".h5") || strstr(spec, ".h5:"))
-		return read_h5(spec, context, r);
-	return ss_error_input_at(context, "'%s': unknown raster format: expected an ESRI ASCII grid "
-	                      "(.asc) or a sandslide HDF5 file (.h5 or .h5:/dataset)", spec);
+	const char *p = spec, *hit = NULL;
+	while ((p = strchr(p, ':'))) {   /* the last ".h5:" wins */
+		if (p - spec >= 3 && strncasecmp(p - 3, ".h5", 3) == 0)
+			hit = p;
+		p++;
+	}
+	return hit ? hit + 1 : NULL;
+}
+
+/* The format from the extension, SS_DEM_AUTO when it is none we know. */
+static enum ss_dem_format format_of(const char *path)
+{
+	if (has_suffix(path, ".asc"))
+		return SS_DEM_ASC;
+	if (has_suffix(path, ".png"))
+		return SS_DEM_PNG;
+	if (has_suffix(path, ".tif") || has_suffix(path, ".tiff"))
+		return SS_DEM_GDAL;
+	if (has_suffix(path, ".h5") || h5_dataset(path))
+		return SS_DEM_H5;
+	return SS_DEM_AUTO;
+}
+
+int ss_dem_format_from_path(const char *path, const char *context, enum ss_dem_format *format)
+{
+	*format = format_of(path);
+	if (*format != SS_DEM_AUTO)
+		return SS_OK;
+	return ss_error_input_at(context, "'%s': unknown raster format: expected " SS_DEM_ACCEPTED_READ,
+	                         path);
+}
+
+static int gdal_unavailable(const char *path, const char *context)
+{
+	return ss_error_input_at(context, "'%s': GeoTIFF and other GDAL rasters are unavailable in this "
+	                         "build (built without GDAL: install libgdal-dev and rebuild); "
+	                         "this build reads an ESRI ASCII grid (.asc), a sandslide HDF5 file "
+	                         "(.h5 or .h5:/dataset) or a 16-bit greyscale PNG (.png)", path);
+}
+
+/* ------------------------------------------------------------------ */
+/* reading                                                              */
+
+/* sandslide HDF5: "file.h5" (last snapshot of /height, with the run's cell
+ * size and corner) or "file.h5:/dataset" (no geometry). */
+static int read_h5(const char *spec, const char *context, struct ss_raster *r)
+{
+	const char *dataset = h5_dataset(spec);
+	char *path = ss_dem_strdup(spec);
+	if (!path)
+		return SS_ERR_FAIL;
+	if (dataset)
+		path[dataset - 1 - spec] = '\0';
+	r->source = path;
+
+	FILE *f = fopen(path, "rb");
+	if (!f)
+		return ss_error_input_at(context, "cannot open '%s': %s", path, strerror(errno));
+	fclose(f);
+	int err = ss_snapshot_read_field(path, dataset, -1, &r->nx, &r->ny, &r->values);
+	if (err)
+		return err;
+	const size_t n = (size_t)r->nx * (size_t)r->ny;
+	for (size_t k = 0; k < n; k++) {
+		if (!isfinite(r->values[k]))
+			return ss_error_input_at(context, "%s: height %g at column %zu, row %zu (from the south) "
+			                         "is not finite: heights must be finite numbers", spec,
+			                         r->values[k], k % (size_t)r->nx + 1,
+			                         k / (size_t)r->nx + 1);
+	}
+	if (dataset)
+		return SS_OK;
+	/* a run's output: its cell size and corner come with it */
+	struct ss_snapshot_summary sum;
+	err = ss_snapshot_read_summary(path, &sum);
+	if (!err) {
+		r->cellsize = sum.dx;
+		r->cellsize_y = sum.dy;
+		r->x0 = sum.origin_x;
+		r->y0 = sum.origin_y;
+	}
+	ss_snapshot_summary_release(&sum);
+	return err;
+}
+
+static int check_options(const struct ss_dem_read_options *o, enum ss_dem_format format,
+                         const char *spec, const char *context)
+{
+	if (!isnan(o->zscale) && !(isfinite(o->zscale) && o->zscale != 0.0))
+		return ss_error_input_at(context, "'%s': zscale = %g: expected a finite number of metres "
+		                         "per grey level, not 0", spec, o->zscale);
+	if (!isnan(o->zoffset) && !isfinite(o->zoffset))
+		return ss_error_input_at(context, "'%s': zoffset = %g: expected a finite height, m", spec,
+		                         o->zoffset);
+	if (!isnan(o->zoffset) && isnan(o->zscale))
+		return ss_error_input_at(context, "'%s': zoffset is given without zscale: give both, or "
+		                         "neither to use the range stored in the PNG", spec);
+	if ((!isnan(o->zscale) || !isnan(o->zoffset)) && format != SS_DEM_PNG)
+		return ss_error_input_at(context, "'%s': zscale and zoffset apply to 16-bit PNG "
+		                         "heightmaps only, not to a %s", spec, ss_dem_format_name(format));
+	if (!isnan(o->cellsize) && !(isfinite(o->cellsize) && o->cellsize > 0.0))
+		return ss_error_input_at(context, "'%s': cell size %g: expected a number > 0, m", spec,
+		                         o->cellsize);
+	return SS_OK;
+}
+
+/* The cell size option: fills in an unknown cell size, replaces a PNG's
+ * stored one, and must agree with one any other file states. */
+static int apply_cellsize(const struct ss_dem_read_options *o, const char *spec,
+                          const char *context, struct ss_raster *r)
+{
+	const double c = o->cellsize;
+	if (isnan(c))
+		return SS_OK;
+	if (r->format != SS_DEM_PNG && !isnan(r->cellsize)) {
+		const double dy = ss_dem_dy(r);
+		if (fabs(r->cellsize - c) > 1e-9 * c || fabs(dy - c) > 1e-9 * c)
+			return ss_error_input_at(context, "'%s' has cell size %.17g x %.17g m: the given "
+			                         "cell size %.17g m disagrees (leave it out to use the "
+			                         "file's)", spec, r->cellsize, dy, c);
+		return SS_OK;
+	}
+	r->cellsize = r->cellsize_y = c;
+	return SS_OK;
+}
+
+int ss_dem_read(const char *spec, const char *context, const struct ss_dem_read_options *opt,
+                struct ss_raster *r)
+{
+	struct ss_dem_read_options defaults;
+	raster_clear(r);
+	if (!opt) {
+		ss_dem_read_options_init(&defaults);
+		opt = &defaults;
+	}
+	enum ss_dem_format format = opt->format != SS_DEM_AUTO ? opt->format : format_of(spec);
+	if (format == SS_DEM_AUTO) {
+		/* any other raster GDAL recognises; else name what is accepted */
+		if (ss_dem_gdal_available() && ss_dem_gdal_identify(spec))
+			format = SS_DEM_GDAL;
+		else
+			return ss_dem_format_from_path(spec, context, &format);
+	}
+	int err = check_options(opt, format, spec, context);
+	if (err)
+		return err;
+	r->format = format;
+	if (format != SS_DEM_H5 && !(r->source = ss_dem_strdup(spec)))
+		return SS_ERR_FAIL;
+
+	switch (format) {
+	case SS_DEM_ASC:
+		err = ss_dem_read_asc(spec, context, opt, r);
+		break;
+	case SS_DEM_H5:
+		err = read_h5(spec, context, r);
+		break;
+	case SS_DEM_PNG:
+		err = ss_dem_read_png(spec, context, opt, r);
+		break;
+	case SS_DEM_GDAL:
+		err = ss_dem_gdal_available() ? ss_dem_read_gdal(spec, context, opt, r)
+		                              : gdal_unavailable(spec, context);
+		break;
+	case SS_DEM_AUTO:
+		SS_BUG("format not resolved");
+	}
+	if (!err)
+		err = apply_cellsize(opt, spec, context, r);
+	return err;
+}
+
+/* ------------------------------------------------------------------ */
+/* writing                                                              */
+
+int ss_dem_check_finite(const struct ss_raster *r, const char *path)
+{
+	const size_t n = (size_t)r->nx * (size_t)r->ny;
+	for (size_t k = 0; k < n; k++) {
+		if (!isfinite(r->values[k]) && !(r->nodata && r->nodata[k]))
+			return ss_error_fail("cannot write '%s': height %g at column %zu, row %zu (from "
+			                     "the south) is not finite", path, r->values[k],
+			                     k % (size_t)r->nx + 1, k / (size_t)r->nx + 1);
+	}
+	return SS_OK;
+}
+
+static int value_is_used(const struct ss_raster *r, double v)
+{
+	const size_t n = (size_t)r->nx * (size_t)r->ny;
+	for (size_t k = 0; k < n; k++) {
+		if ((!r->nodata || !r->nodata[k]) &&
+		    (r->values[k] == v || (isnan(v) && isnan(r->values[k]))))
+			return 1;
+	}
+	return 0;
+}
+
+int ss_dem_pick_nodata(const struct ss_raster *r, const char *path, int allow_nan, int *has,
+                       double *value)
+{
+	static const double fallback[] = {-9999.0, -99999.0, -1e30};
+	*has = r->has_nodata_value || r->nodata;
+	*value = NAN;
+	if (!*has)
+		return SS_OK;
+	if (r->has_nodata_value && (allow_nan || !isnan(r->nodata_value)) &&
+	    !value_is_used(r, r->nodata_value)) {
+		*value = r->nodata_value;
+		return SS_OK;
+	}
+	for (size_t a = 0; a < sizeof fallback / sizeof *fallback; a++) {
+		if (!value_is_used(r, fallback[a])) {
+			*value = fallback[a];
+			return SS_OK;
+		}
+	}
+	return ss_error_fail("cannot write '%s': every candidate nodata value (-9999, -99999, "
+	                     "-1e30) is a height of a cell with data", path);
+}
+
+/* Refuse to replace the file r was read from: the input is never modified. */
+static int check_not_source(const char *path, const struct ss_raster *r)
+{
+	struct stat a, b;
+	if (r->source && stat(path, &a) == 0 && stat(r->source, &b) == 0 &&
+	    a.st_dev == b.st_dev && a.st_ino == b.st_ino)
+		return ss_error_input("cannot write '%s': it is the file the raster was read from, "
+		                      "which is never overwritten: choose another output name", path);
+	return SS_OK;
+}
+
+/* Create an empty, new file beside path ("DIR/.BASE.tmp-PID-N") with the
+ * permissions a plain creation would give; its name into tmp. */
+static int create_temp(const char *path, char *tmp, size_t size, int *fd)
+{
+	const char *slash = strrchr(path, '/');
+	const int dir_len = slash ? (int)(slash - path) + 1 : 0;
+	const char *base = slash ? slash + 1 : path;
+	if (!*base)
+		return ss_error_input("cannot write '%s': expected a file name, not a folder", path);
+	for (int attempt = 0; attempt < 100; attempt++) {
+		int n = snprintf(tmp, size, "%.*s.%s.tmp-%ld-%d", dir_len, path, base,
+		                 (long)getpid(), attempt);
+		if (n < 0 || (size_t)n >= size)
+			return ss_error_input("cannot write '%s': the path is too long", path);
+		*fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+		if (*fd >= 0)
+			return SS_OK;
+		if (errno != EEXIST)
+			return ss_error_input("cannot write '%s': cannot create a file in '%.*s': %s",
+			                      path, dir_len > 1 ? dir_len - 1 : 1, dir_len ? path : ".",
+			                      strerror(errno));
+	}
+	return ss_error_input("cannot write '%s': cannot find a free temporary name beside it", path);
+}
+
+int ss_dem_write(const char *path, enum ss_dem_format format, const struct ss_raster *r)
+{
+	if (format == SS_DEM_AUTO) {
+		int err = ss_dem_format_from_path(path, NULL, &format);
+		if (err)
+			return err;
+	}
+	if (format == SS_DEM_H5)
+		return ss_error_input("cannot write '%s' as a raster: sandslide HDF5 files are written "
+		                      "by the snapshot module; rasters are written as .asc, .png or "
+		                      ".tif", path);
+	if (format == SS_DEM_GDAL && !ss_dem_gdal_available())
+		return gdal_unavailable(path, NULL);
+	if (!r->values || r->nx < 1 || r->ny < 1)
+		SS_BUG("ss_dem_write: empty raster");
+	int err = check_not_source(path, r);
+	if (!err)
+		err = ss_dem_check_finite(r, path);
+	if (err)
+		return err;
+
+	char tmp[4096];
+	int fd = -1;
+	err = create_temp(path, tmp, sizeof tmp, &fd);
+	if (err)
+		return err;
+	if (format == SS_DEM_GDAL) {
+		close(fd);   /* the name is ours; GDAL rewrites the file */
+		err = ss_dem_write_gdal(tmp, path, r);
+	} else {
+		FILE *f = fdopen(fd, "wb");
+		if (!f) {
+			close(fd);
+			err = ss_error_fail("cannot write '%s': %s", path, strerror(errno));
+		} else {
+			err = format == SS_DEM_ASC ? ss_dem_write_asc(f, path, r)
+			                           : ss_dem_write_png(f, path, r);
+			/* complete on disk before it takes the name */
+			if (!err && (fflush(f) || fsync(fileno(f))))
+				err = ss_error_fail("cannot write '%s': %s", path, strerror(errno));
+			if (fclose(f) && !err)
+				err = ss_error_fail("cannot write '%s': %s", path, strerror(errno));
+		}
+	}
+	if (!err && rename(tmp, path))
+		err = ss_error_input("cannot write '%s': cannot rename the finished temporary file "
+		                     "'%s' to it: %s", path, tmp, strerror(errno));
+	if (err)
+		unlink(tmp);
+	return err;
 }

@@ -17,7 +17,7 @@ static int initial_heights(const struct ss_case *c, struct ss_stepper *st)
 	const struct ss_grid *g = &st->grid;
 	if (c->initial == SS_INITIAL_FILE) {
 		struct ss_raster r;
-		int err = ss_dem_read(c->initial_file, c->initial_where, &r);
+		int err = ss_dem_read(c->initial_file, c->initial_where, NULL, &r);
 		if (!err && (r.nx != g->nx || r.ny != g->ny))
 			err = ss_error_input("%s: initial file '%s' is %d x %d cells: expected the "
 			                     "grid's %d x %d (nx x ny)", c->initial_where,

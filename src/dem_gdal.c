@@ -1,0 +1,258 @@
+/*
+ * dem_gdal.c - GeoTIFF and other GDAL rasters (see dem.h), only when built
+ * with GDAL (the Makefile defines SS_HAVE_GDAL when pkg-config finds it).
+ * Without it dem.c refuses these formats before calling in here.
+ *
+ * Band 1 is read as float64 (after the band's scale and offset, if any);
+ * north-up geotransforms only: a rotated or south-up raster would need
+ * resampling onto the grid, which is the user's choice to make (gdalwarp).
+ * Writing is always GeoTIFF, float64, deflate-compressed, with the
+ * geotransform, CRS and nodata value.  GDAL's own messages are silenced
+ * and folded into ours, so each error is still printed once.
+ */
+#include "dem_internal.h"
+
+#include "sandslide/error.h"
+
+#ifdef SS_HAVE_GDAL
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cpl_error.h>
+#include <cpl_string.h>
+#include <gdal.h>
+
+static void gdal_start(void)
+{
+	static int registered;
+	if (!registered) {
+		GDALAllRegister();
+		registered = 1;
+	}
+	CPLPushErrorHandler(CPLQuietErrorHandler);
+	CPLErrorReset();
+}
+
+/* GDAL's last message, or a stand-in when it gave none. */
+static const char *gdal_message(void)
+{
+	const char *m = CPLGetLastErrorMsg();
+	return m && *m ? m : "no reason given";
+}
+
+int ss_dem_gdal_identify(const char *path)
+{
+	gdal_start();
+	const int found = GDALIdentifyDriver(path, NULL) != NULL;
+	CPLPopErrorHandler();
+	return found;
+}
+
+/* Swap rows so that row 0 is the south row. */
+static void flip_rows(double *v, int nx, int ny)
+{
+	for (int a = 0, b = ny - 1; a < b; a++, b--) {
+		double *p = v + (size_t)a * nx, *q = v + (size_t)b * nx;
+		for (int i = 0; i < nx; i++) {
+			const double t = p[i];
+			p[i] = q[i];
+			q[i] = t;
+		}
+	}
+}
+
+static int read_dataset(GDALDatasetH ds, const char *path, const char *context,
+                        struct ss_raster *r)
+{
+	const int bands = GDALGetRasterCount(ds);
+	if (bands != 1)
+		return ss_error_input_at(context, "'%s' has %d bands: expected one band of heights", path,
+		                         bands);
+	const int nx = GDALGetRasterXSize(ds), ny = GDALGetRasterYSize(ds);
+	if (nx < 1 || ny < 1 || nx > 1 << 30 || ny > 1 << 30)
+		return ss_error_input_at(context, "'%s' is %d x %d cells: expected 1 to 2^30 a side",
+		                         path, nx, ny);
+	double gt[6];
+	if (GDALGetGeoTransform(ds, gt) == CE_None) {
+		if (gt[2] != 0.0 || gt[4] != 0.0)
+			return ss_error_input_at(context, "'%s' has a rotated geotransform (terms %g, %g): "
+			                         "expected a north-up raster; resample it first, e.g. "
+			                         "gdalwarp", path, gt[2], gt[4]);
+		if (!(gt[1] > 0.0 && gt[5] < 0.0 && isfinite(gt[0]) && isfinite(gt[3])))
+			return ss_error_input_at(context, "'%s' has pixel size %g x %g: expected a north-up "
+			                         "raster (width > 0, height < 0 in the geotransform)", path,
+			                         gt[1], gt[5]);
+		memcpy(r->geotransform, gt, sizeof gt);
+		r->has_geotransform = 1;
+		r->cellsize = gt[1];
+		r->cellsize_y = -gt[5];
+		r->x0 = gt[0];
+		r->y0 = gt[3] + ny * gt[5];
+	}
+	const char *wkt = GDALGetProjectionRef(ds);
+	if (wkt && *wkt && !(r->crs_wkt = ss_dem_strdup(wkt)))
+		return SS_ERR_FAIL;
+
+	GDALRasterBandH band = GDALGetRasterBand(ds, 1);
+	int has_nodata = 0, has_scale = 0, has_offset = 0;
+	const double nodata = GDALGetRasterNoDataValue(band, &has_nodata);
+	double scale = GDALGetRasterScale(band, &has_scale);
+	double offset = GDALGetRasterOffset(band, &has_offset);
+	scale = has_scale ? scale : 1.0;
+	offset = has_offset ? offset : 0.0;
+	r->has_nodata_value = has_nodata;
+	r->nodata_value = has_nodata ? nodata : NAN;
+
+	r->nx = nx;
+	r->ny = ny;
+	const size_t n = (size_t)nx * (size_t)ny;
+	r->values = ss_alloc(n, sizeof(double), "raster heights");
+	if (!r->values)
+		return SS_ERR_FAIL;
+	if (GDALRasterIO(band, GF_Read, 0, 0, nx, ny, r->values, nx, ny, GDT_Float64, 0, 0) !=
+	    CE_None)
+		return ss_error_input_at(context, "cannot read the heights of '%s': %s", path,
+		                         gdal_message());
+	for (size_t k = 0; k < n; k++) {   /* still north row first */
+		const double v = r->values[k];
+		if (has_nodata && (v == nodata || (isnan(v) && isnan(nodata)))) {
+			if (!r->nodata && !(r->nodata = ss_alloc(n, 1, "nodata flags")))
+				return SS_ERR_FAIL;
+			r->nodata[k] = 1;
+			r->values[k] = 0.0;
+			continue;
+		}
+		const double h = offset + scale * v;
+		if (!isfinite(h))
+			return ss_error_input_at(context, "%s: height %g at row %zu, column %zu (from the "
+			                         "north-west) is not finite: heights must be finite numbers "
+			                         "(mark missing cells with the band's nodata value)", path,
+			                         h, k / (size_t)nx + 1, k % (size_t)nx + 1);
+		r->values[k] = h;
+	}
+	flip_rows(r->values, nx, ny);
+	if (r->nodata) {
+		for (int a = 0, b = ny - 1; a < b; a++, b--) {
+			uint8_t *p = r->nodata + (size_t)a * nx, *q = r->nodata + (size_t)b * nx;
+			for (int i = 0; i < nx; i++) {
+				const uint8_t t = p[i];
+				p[i] = q[i];
+				q[i] = t;
+			}
+		}
+	}
+	return SS_OK;
+}
+
+int ss_dem_read_gdal(const char *path, const char *context, const struct ss_dem_read_options *opt,
+                     struct ss_raster *r)
+{
+	(void)opt;   /* the cell size option is checked by dem.c */
+	gdal_start();
+	int err;
+	GDALDatasetH ds = GDALOpenEx(path, GDAL_OF_RASTER | GDAL_OF_READONLY, NULL, NULL, NULL);
+	if (!ds) {
+		err = ss_error_input_at(context, "cannot read '%s' as a GDAL raster: %s; expected "
+		                        SS_DEM_ACCEPTED_READ, path, gdal_message());
+	} else {
+		err = read_dataset(ds, path, context, r);
+		GDALClose(ds);
+	}
+	CPLPopErrorHandler();
+	return err;
+}
+
+static int write_dataset(GDALDatasetH ds, const char *path, const struct ss_raster *r)
+{
+	const int nx = r->nx, ny = r->ny;
+	double gt[6] = {0};
+	if (r->has_geotransform) {
+		memcpy(gt, r->geotransform, sizeof gt);
+	} else if (r->cellsize > 0.0) {
+		const double dy = ss_dem_dy(r);
+		const double x0 = isnan(r->x0) ? 0.0 : r->x0, y0 = isnan(r->y0) ? 0.0 : r->y0;
+		const double g[6] = {x0, r->cellsize, 0.0, y0 + ny * dy, 0.0, -dy};
+		memcpy(gt, g, sizeof gt);
+	}
+	if ((r->has_geotransform || r->cellsize > 0.0) && GDALSetGeoTransform(ds, gt) != CE_None)
+		return ss_error_fail("cannot write '%s': geotransform: %s", path, gdal_message());
+	if (r->crs_wkt && GDALSetProjection(ds, r->crs_wkt) != CE_None)
+		return ss_error_input("cannot write '%s': the CRS is not one GDAL accepts: %s", path,
+		                      gdal_message());
+
+	GDALRasterBandH band = GDALGetRasterBand(ds, 1);
+	int has_nodata;
+	double nodata;
+	int err = ss_dem_pick_nodata(r, path, 1, &has_nodata, &nodata);
+	if (err)
+		return err;
+	if (has_nodata && GDALSetRasterNoDataValue(band, nodata) != CE_None)
+		return ss_error_fail("cannot write '%s': nodata value: %s", path, gdal_message());
+	double *row = ss_alloc((size_t)nx, sizeof(double), "a raster row");
+	if (!row)
+		return SS_ERR_FAIL;
+	for (int line = 0; line < ny && !err; line++) {   /* north row first */
+		const size_t j = (size_t)(ny - 1 - line);
+		for (int i = 0; i < nx; i++)
+			row[i] = r->nodata && r->nodata[j * nx + i] ? nodata : r->values[j * nx + i];
+		if (GDALRasterIO(band, GF_Write, 0, line, nx, 1, row, nx, 1, GDT_Float64, 0, 0) != CE_None)
+			err = ss_error_fail("cannot write '%s': %s", path, gdal_message());
+	}
+	ss_free(row);
+	return err;
+}
+
+int ss_dem_write_gdal(const char *tmp, const char *path, const struct ss_raster *r)
+{
+	gdal_start();
+	int err = SS_OK;
+	GDALDriverH drv = GDALGetDriverByName("GTiff");
+	if (!drv) {
+		err = ss_error_input("cannot write '%s': this GDAL has no GTiff driver", path);
+		goto out;
+	}
+	/* lossless: deflate with the floating-point predictor */
+	char **options = NULL;
+	options = CSLSetNameValue(options, "COMPRESS", "DEFLATE");
+	options = CSLSetNameValue(options, "PREDICTOR", "3");
+	options = CSLSetNameValue(options, "BIGTIFF", "IF_SAFER");
+	GDALDatasetH ds = GDALCreate(drv, tmp, r->nx, r->ny, 1, GDT_Float64, options);
+	CSLDestroy(options);
+	if (!ds) {
+		err = ss_error_input("cannot write '%s': %s", path, gdal_message());
+		goto out;
+	}
+	err = write_dataset(ds, path, r);
+	CPLErrorReset();
+	GDALClose(ds);   /* flushes: a failure here is a failed write */
+	if (!err && CPLGetLastErrorType() >= CE_Failure)
+		err = ss_error_fail("cannot write '%s': %s", path, gdal_message());
+out:
+	CPLPopErrorHandler();
+	return err;
+}
+
+#else /* !SS_HAVE_GDAL: dem.c never calls these */
+
+int ss_dem_gdal_identify(const char *path)
+{
+	(void)path;
+	return 0;
+}
+
+int ss_dem_read_gdal(const char *path, const char *context, const struct ss_dem_read_options *opt,
+                     struct ss_raster *r)
+{
+	(void)path, (void)context, (void)opt, (void)r;
+	SS_BUG("GDAL reader called in a build without GDAL");
+}
+
+int ss_dem_write_gdal(const char *tmp, const char *path, const struct ss_raster *r)
+{
+	(void)tmp, (void)path, (void)r;
+	SS_BUG("GDAL writer called in a build without GDAL");
+}
+
+#endif

@@ -1,0 +1,50 @@
+/*
+ * dem_internal.h - what the raster format files (dem_*.c) share with dem.c.
+ * Not installed; dem.h is the public interface.
+ */
+#ifndef SANDSLIDE_DEM_INTERNAL_H
+#define SANDSLIDE_DEM_INTERNAL_H
+
+#include <stddef.h>
+#include <stdio.h>
+
+#include "sandslide/dem.h"
+
+/* What the extension-less error messages list as accepted. */
+#define SS_DEM_ACCEPTED_READ                                                    \
+	"an ESRI ASCII grid (.asc), a sandslide HDF5 file (.h5 or .h5:/dataset), " \
+	"a 16-bit greyscale PNG (.png) or a GeoTIFF (.tif, .tiff)"
+
+/* Readers: r is zeroed with unknown geometry on entry; r->source is set. */
+int ss_dem_read_asc(const char *path, const char *context,
+                    const struct ss_dem_read_options *opt, struct ss_raster *r);
+int ss_dem_read_png(const char *path, const char *context,
+                    const struct ss_dem_read_options *opt, struct ss_raster *r);
+int ss_dem_read_gdal(const char *path, const char *context,
+                     const struct ss_dem_read_options *opt, struct ss_raster *r);
+/* 1 if GDAL has a driver that recognises path (quietly), else 0. */
+int ss_dem_gdal_identify(const char *path);
+
+/* Writers: write to tmp (already created, empty), which dem.c renames to
+ * path when they return SS_OK.  Messages name path, not tmp. */
+int ss_dem_write_asc(FILE *f, const char *path, const struct ss_raster *r);
+int ss_dem_write_png(FILE *f, const char *path, const struct ss_raster *r);
+int ss_dem_write_gdal(const char *tmp, const char *path, const struct ss_raster *r);
+
+/* The value to write for nodata cells: r's nodata value when no valid cell
+ * holds it (and it is not NaN, unless allow_nan), else the first of -9999,
+ * -99999, -1e30 that none holds.  *has is 0 when r has neither flags nor a
+ * nodata value (write none). */
+int ss_dem_pick_nodata(const struct ss_raster *r, const char *path, int allow_nan, int *has,
+                       double *value);
+
+/* SS_ERR_FAIL naming the first cell with data whose value is not finite. */
+int ss_dem_check_finite(const struct ss_raster *r, const char *path);
+
+/* Cell sizes to write: cellsize and cellsize_y (cellsize_y NAN: cellsize). */
+double ss_dem_dy(const struct ss_raster *r);
+
+/* A copy of s with ss_alloc (NULL and a message when out of memory). */
+char *ss_dem_strdup(const char *s);
+
+#endif

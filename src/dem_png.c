@@ -1,0 +1,397 @@
+/*
+ * dem_png.c - 16-bit greyscale PNG heightmaps (see dem.h).
+ *
+ * The format is the renderer's gray16 style (render/shade.c, render/png.c),
+ * so a picture `sandslide render --style gray16` made is a DEM, and a DEM
+ * written here is a gray16 picture:
+ *
+ *   grey 0        no data (a wall, a missing cell); marked transparent by a
+ *                 tRNS chunk
+ *   grey v >= 1   height zmin + (v - 1) (zmax - zmin) / 65534, with zmin
+ *                 and zmax from the tEXt chunks zmin_m and zmax_m ("%.17g"),
+ *                 so grey 1 is zmin and grey 65535 is zmax exactly
+ *
+ * plus the optional chunks dx_m, dy_m (when not dx_m), x0_m, y0_m (cell
+ * size and lower-left corner, m), which this writer adds and the renderer
+ * leaves out when its pixels are not cells.  A PNG without zmin_m and
+ * zmax_m is read as height = zoffset + zscale * grey with zscale and
+ * zoffset from the read options, and then only a tRNS grey marks no data.
+ * Rows are north first in the file.
+ *
+ * libpng's full API (the simplified one neither reads nor writes text
+ * chunks); each setjmp sits in a small function whose changing state lives
+ * behind a pointer, so nothing local is indeterminate after a longjmp.
+ */
+#include "dem_internal.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <png.h>
+
+#include "sandslide/error.h"
+
+#define KEY_ZMIN "zmin_m"
+#define KEY_ZMAX "zmax_m"
+#define KEY_DX   "dx_m"
+#define KEY_DY   "dy_m"
+#define KEY_X0   "x0_m"
+#define KEY_Y0   "y0_m"
+#define NO_GREY  (-1)
+
+/* The error pointer is a char[ERROR_SIZE] for libpng's message. */
+#define ERROR_SIZE 256
+
+/* What a libpng call sequence leaves behind, reachable after a longjmp. */
+struct png_job {
+	char message[ERROR_SIZE]; /* libpng's error */
+	uint8_t *pixels;         /* big-endian 16-bit samples, north row first */
+	png_bytep *rows;         /* row pointers into pixels */
+	png_uint_32 width, height;
+	int bit_depth, color_type;
+};
+
+static void on_error(png_structp png, png_const_charp msg)
+{
+	snprintf(png_get_error_ptr(png), ERROR_SIZE, "%s", msg);
+	png_longjmp(png, 1);
+}
+
+static void on_warning(png_structp png, png_const_charp msg)
+{
+	(void)png;   /* benign (e.g. an unusual ICC profile): heights are unaffected */
+	(void)msg;
+}
+
+/* ------------------------------------------------------------------ */
+/* reading                                                              */
+
+enum { DECODE_OK, DECODE_PNG_ERROR, DECODE_NOT_GRAY16, DECODE_NO_MEMORY };
+
+static int decode(png_structp png, png_infop info, png_infop end, FILE *f, struct png_job *job)
+{
+	if (setjmp(png_jmpbuf(png)))
+		return DECODE_PNG_ERROR;
+	png_init_io(png, f);
+	png_set_sig_bytes(png, 8);
+	png_read_info(png, info);
+	job->width = png_get_image_width(png, info);
+	job->height = png_get_image_height(png, info);
+	job->bit_depth = png_get_bit_depth(png, info);
+	job->color_type = png_get_color_type(png, info);
+	if (job->bit_depth != 16 || job->color_type != PNG_COLOR_TYPE_GRAY)
+		return DECODE_NOT_GRAY16;
+	png_set_interlace_handling(png);
+	png_read_update_info(png, info);
+	const size_t row_bytes = 2 * (size_t)job->width;
+	job->pixels = ss_alloc((size_t)job->height, row_bytes, "PNG pixels");
+	job->rows = ss_alloc((size_t)job->height, sizeof *job->rows, "PNG rows");
+	if (!job->pixels || !job->rows)
+		return DECODE_NO_MEMORY;
+	for (png_uint_32 y = 0; y < job->height; y++)
+		job->rows[y] = job->pixels + y * row_bytes;
+	png_read_image(png, job->rows);
+	png_read_end(png, end);   /* text chunks may also follow the image */
+	return DECODE_OK;
+}
+
+static const char *color_name(int color_type)
+{
+	switch (color_type) {
+	case PNG_COLOR_TYPE_GRAY:       return "greyscale";
+	case PNG_COLOR_TYPE_GRAY_ALPHA: return "greyscale+alpha";
+	case PNG_COLOR_TYPE_PALETTE:    return "palette";
+	case PNG_COLOR_TYPE_RGB:        return "RGB";
+	case PNG_COLOR_TYPE_RGB_ALPHA:  return "RGBA";
+	}
+	return "unknown colour type";
+}
+
+/* The text chunks we know, NAN when absent. */
+struct png_meta {
+	double zmin, zmax, dx, dy, x0, y0;
+};
+
+static int read_meta(png_structp png, png_infop info, const char *path, const char *context,
+                     struct png_meta *m)
+{
+	static const struct {
+		const char *key;
+		size_t offset;
+	} keys[] = {
+		{KEY_ZMIN, offsetof(struct png_meta, zmin)},
+		{KEY_ZMAX, offsetof(struct png_meta, zmax)},
+		{KEY_DX, offsetof(struct png_meta, dx)},
+		{KEY_DY, offsetof(struct png_meta, dy)},
+		{KEY_X0, offsetof(struct png_meta, x0)},
+		{KEY_Y0, offsetof(struct png_meta, y0)},
+	};
+	png_textp text;
+	const int count = png_get_text(png, info, &text, NULL);
+	for (int a = 0; a < count; a++) {
+		for (size_t k = 0; k < sizeof keys / sizeof *keys; k++) {
+			if (strcmp(text[a].key, keys[k].key))
+				continue;
+			char *end;
+			const double v = strtod(text[a].text, &end);
+			if (end == text[a].text || *end != '\0' || !isfinite(v))
+				return ss_error_input_at(context, "%s: text chunk %s = '%s' is not a finite "
+				                         "number", path, text[a].key, text[a].text);
+			*(double *)((char *)m + keys[k].offset) = v;
+		}
+	}
+	return SS_OK;
+}
+
+int ss_dem_read_png(const char *path, const char *context, const struct ss_dem_read_options *opt,
+                    struct ss_raster *r)
+{
+	FILE *f = fopen(path, "rb");
+	if (!f)
+		return ss_error_input_at(context, "cannot open '%s': %s", path, strerror(errno));
+	png_byte sig[8];
+	if (fread(sig, 1, 8, f) != 8 || png_sig_cmp(sig, 0, 8)) {
+		fclose(f);
+		return ss_error_input_at(context, "'%s' is not a PNG file: expected a 16-bit greyscale "
+		                         "PNG heightmap", path);
+	}
+	struct png_job job;
+	memset(&job, 0, sizeof job);
+	int err = SS_OK;
+	png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, job.message, on_error,
+	                                         on_warning);
+	png_infop info = png ? png_create_info_struct(png) : NULL;
+	png_infop end = png ? png_create_info_struct(png) : NULL;
+	if (!png || !info || !end) {
+		err = ss_error_fail("cannot read '%s': out of memory in libpng", path);
+		goto out;
+	}
+	switch (decode(png, info, end, f, &job)) {
+	case DECODE_OK:
+		break;
+	case DECODE_PNG_ERROR:
+		err = ss_error_input_at(context, "cannot decode PNG '%s': %s", path, job.message);
+		goto out;
+	case DECODE_NOT_GRAY16:
+		err = ss_error_input_at(context, "'%s' is a %d-bit %s PNG: expected a 16-bit greyscale "
+		                        "heightmap (colour type grey, bit depth 16, no alpha)", path,
+		                        job.bit_depth, color_name(job.color_type));
+		goto out;
+	case DECODE_NO_MEMORY:
+		err = SS_ERR_FAIL;
+		goto out;
+	}
+	if (job.width > 1u << 30 || job.height > 1u << 30) {
+		err = ss_error_input_at(context, "'%s' is %u x %u pixels: at most 2^30 a side", path,
+		                        (unsigned)job.width, (unsigned)job.height);
+		goto out;
+	}
+
+	struct png_meta m = {NAN, NAN, NAN, NAN, NAN, NAN};
+	if ((err = read_meta(png, info, path, context, &m)) ||
+	    (err = read_meta(png, end, path, context, &m)))
+		goto out;
+	if ((!isnan(m.dx) && !(m.dx > 0.0)) || (!isnan(m.dy) && !(m.dy > 0.0))) {
+		err = ss_error_input_at(context, "%s: text chunk " KEY_DX " or " KEY_DY " is not > 0",
+		                        path);
+		goto out;
+	}
+	/* how grey becomes height, and which greys are no data */
+	const int given = !isnan(opt->zscale);
+	if (!given && (isnan(m.zmin) || isnan(m.zmax))) {
+		err = ss_error_input_at(context, "%s: 16-bit PNG without a height range (no text "
+		                        "chunks " KEY_ZMIN " and " KEY_ZMAX "): give the vertical scale "
+		                        "zscale (m per grey level) and zoffset (m at grey 0)", path);
+		goto out;
+	}
+	const double zscale = given ? opt->zscale : (m.zmax - m.zmin) / 65534.0;
+	const double zoffset = given ? (isnan(opt->zoffset) ? 0.0 : opt->zoffset) : 0.0;
+	png_color_16p trns = NULL;
+	const int trns_grey = png_get_tRNS(png, info, NULL, NULL, &trns) && trns ? trns->gray
+	                                                                         : NO_GREY;
+	const int zero_nodata = !given;   /* the gray16 rule: grey 0 is no data */
+
+	r->nx = (int)job.width;
+	r->ny = (int)job.height;
+	if (!given) {
+		r->png_zmin = m.zmin;
+		r->png_zmax = m.zmax;
+	}
+	r->cellsize = m.dx;
+	r->cellsize_y = isnan(m.dy) ? m.dx : m.dy;
+	r->x0 = m.x0;
+	r->y0 = m.y0;
+	const size_t n = (size_t)r->nx * (size_t)r->ny;
+	r->values = ss_alloc(n, sizeof(double), "raster heights");
+	if (!r->values) {
+		err = SS_ERR_FAIL;
+		goto out;
+	}
+	for (int row = 0; row < r->ny; row++) {   /* north row first in the file */
+		const size_t j = (size_t)(r->ny - 1 - row);
+		const uint8_t *p = job.rows[row];
+		for (int i = 0; i < r->nx; i++) {
+			const int grey = p[2 * i] << 8 | p[2 * i + 1];
+			if (grey == trns_grey || (grey == 0 && zero_nodata)) {
+				if (!r->nodata && !(r->nodata = ss_alloc(n, 1, "nodata flags"))) {
+					err = SS_ERR_FAIL;
+					goto out;
+				}
+				r->nodata[j * r->nx + i] = 1;
+				continue;
+			}
+			/* both ends of the stored range come back exactly */
+			const double h = given ? zoffset + zscale * grey
+			               : grey == 65535 ? m.zmax : m.zmin + (grey - 1) * zscale;
+			if (!isfinite(h)) {
+				err = ss_error_input_at(context, "%s: grey %d at row %d, column %d (from the "
+				                        "north-west) gives height %g: the range is too large",
+				                        path, grey, row + 1, i + 1, h);
+				goto out;
+			}
+			r->values[j * r->nx + i] = h;
+		}
+	}
+out:
+	png_destroy_read_struct(png ? &png : NULL, info ? &info : NULL, end ? &end : NULL);
+	ss_free(job.rows);
+	ss_free(job.pixels);
+	fclose(f);
+	return err;
+}
+
+/* ------------------------------------------------------------------ */
+/* writing                                                              */
+
+/* zmin, zmax: r's range if every value with data lies within it (to half
+ * a grey level), else the data's own, so min and max come back exactly. */
+static void choose_range(const struct ss_raster *r, double *zmin, double *zmax)
+{
+	const size_t n = (size_t)r->nx * (size_t)r->ny;
+	double lo = INFINITY, hi = -INFINITY;
+	for (size_t k = 0; k < n; k++) {
+		if (!r->nodata || !r->nodata[k]) {
+			lo = fmin(lo, r->values[k]);
+			hi = fmax(hi, r->values[k]);
+		}
+	}
+	if (isinf(lo)) {   /* no cell has data */
+		*zmin = 0.0;
+		*zmax = 1.0;
+		return;
+	}
+	const double a = r->png_zmin, b = r->png_zmax;
+	if (isfinite(a) && isfinite(b) && a < b) {
+		const double half = 0.5 * (b - a) / 65534.0;
+		if (lo >= a - half && hi <= b + half) {
+			*zmin = a;
+			*zmax = b;
+			return;
+		}
+	}
+	*zmin = lo;
+	*zmax = hi;
+}
+
+struct png_out {
+	char message[ERROR_SIZE];
+	const struct ss_raster *r;
+	double zmin, zmax;
+	png_textp text;
+	int text_count;
+	uint8_t *row;   /* one row of big-endian samples */
+};
+
+static int encode(png_structp png, png_infop info, FILE *f, struct png_out *o)
+{
+	if (setjmp(png_jmpbuf(png)))
+		return -1;
+	const struct ss_raster *r = o->r;
+	png_init_io(png, f);
+	png_set_IHDR(png, info, (png_uint_32)r->nx, (png_uint_32)r->ny, 16, PNG_COLOR_TYPE_GRAY,
+	             PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+	png_set_text(png, info, o->text, o->text_count);
+	png_color_16 transparent = {0};   /* grey 0: no data */
+	png_set_tRNS(png, info, NULL, 0, &transparent);
+	png_write_info(png, info);
+	/* the renderer's rounding: v = 1 + round((h - zmin) / (zmax - zmin) * 65534) */
+	const double to_steps = o->zmax > o->zmin ? 65534.0 / (o->zmax - o->zmin) : 0.0;
+	for (int j = r->ny - 1; j >= 0; j--) {   /* north row first */
+		const double *h = r->values + (size_t)j * r->nx;
+		const uint8_t *flag = r->nodata ? r->nodata + (size_t)j * r->nx : NULL;
+		for (int i = 0; i < r->nx; i++) {
+			long grey = 0;
+			if (!flag || !flag[i]) {
+				const double s = (h[i] - o->zmin) * to_steps;
+				grey = 1 + (s <= 0.0 ? 0 : s >= 65534.0 ? 65534 : (long)(s + 0.5));
+			}
+			o->row[2 * i] = (uint8_t)(grey >> 8);
+			o->row[2 * i + 1] = (uint8_t)(grey & 0xff);
+		}
+		png_write_row(png, o->row);
+	}
+	png_write_end(png, info);
+	return 0;
+}
+
+int ss_dem_write_png(FILE *f, const char *path, const struct ss_raster *r)
+{
+	struct png_out o;
+	memset(&o, 0, sizeof o);
+	o.r = r;
+	choose_range(r, &o.zmin, &o.zmax);
+
+	/* the renderer's gray16 chunks, then the geometry; numbers as "%.17g"
+	 * so they read back exactly */
+	enum { MAX_TEXT = 10 };
+	char num[MAX_TEXT][40];
+	const char *keys[MAX_TEXT], *values[MAX_TEXT];
+	int n = 0;
+	const double dy = ss_dem_dy(r);
+#define TEXT(k, v) (keys[n] = (k), values[n] = (v), n++)
+#define NUMBER(k, x) (snprintf(num[n], sizeof num[n], "%.17g", (x)), TEXT(k, num[n]))
+	TEXT("Software", "sandslide " SS_VERSION);
+	TEXT("style", "gray16");
+	NUMBER(KEY_ZMIN, o.zmin);
+	NUMBER(KEY_ZMAX, o.zmax);
+	TEXT("height_m", "zmin_m + (value - 1) * (zmax_m - zmin_m) / 65534 for value >= 1; "
+	                 "value 0: wall or no data (transparent)");
+	if (r->cellsize > 0.0)
+		NUMBER(KEY_DX, r->cellsize);
+	if (r->cellsize > 0.0 && dy > 0.0 && dy != r->cellsize)
+		NUMBER(KEY_DY, dy);
+	if (isfinite(r->x0) && isfinite(r->y0)) {
+		NUMBER(KEY_X0, r->x0);
+		NUMBER(KEY_Y0, r->y0);
+	}
+#undef NUMBER
+#undef TEXT
+	png_text text[MAX_TEXT];
+	memset(text, 0, sizeof text);
+	for (int a = 0; a < n; a++) {
+		text[a].compression = PNG_TEXT_COMPRESSION_NONE;
+		text[a].key = (png_charp)keys[a];
+		text[a].text = (png_charp)values[a];
+		text[a].text_length = strlen(values[a]);
+	}
+	o.text = text;
+	o.text_count = n;
+
+	o.row = ss_alloc((size_t)r->nx, 2, "a PNG row");
+	if (!o.row)
+		return SS_ERR_FAIL;
+	int err = SS_OK;
+	png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, o.message, on_error,
+	                                          on_warning);
+	png_infop info = png ? png_create_info_struct(png) : NULL;
+	if (!png || !info)
+		err = ss_error_fail("cannot write '%s': out of memory in libpng", path);
+	else if (encode(png, info, f, &o))
+		err = ss_error_fail("cannot write '%s': %s", path, o.message);
+	png_destroy_write_struct(png ? &png : NULL, info ? &info : NULL);
+	ss_free(o.row);
+	return err;
+}
