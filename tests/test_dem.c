@@ -1,0 +1,736 @@
+/*
+ * test_dem.c - raster input and output (dem.h): round trips keep what each
+ * format can hold, malformed files are refused with messages that name the
+ * place, and writes are atomic and never touch the input.
+ *
+ * Everything happens in a mkdtemp folder that is removed at the end.  The
+ * GeoTIFF tests print a note and pass when the build has no GDAL.
+ */
+#include "check.h"
+
+#include <dirent.h>
+#include <fcntl.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <png.h>
+
+#include "sandslide/dem.h"
+#include "sandslide/error.h"
+
+static char dir[64];
+
+/* dir/name into a static buffer (two in turn, enough for one call) */
+static const char *at(const char *name)
+{
+	static char buf[2][512];
+	static int k;
+	k ^= 1;
+	snprintf(buf[k], sizeof buf[k], "%s/%s", dir, name);
+	return buf[k];
+}
+
+static void write_file(const char *path, const char *text)
+{
+	FILE *f = fopen(path, "wb");
+	if (!f || fputs(text, f) == EOF || fclose(f)) {
+		perror(path);
+		exit(2);
+	}
+}
+
+/* Whole file into a malloc'd buffer; *size its length. */
+static char *slurp(const char *path, size_t *size)
+{
+	FILE *f = fopen(path, "rb");
+	if (!f)
+		return NULL;
+	fseek(f, 0, SEEK_END);
+	long n = ftell(f);
+	fseek(f, 0, SEEK_SET);
+	char *b = malloc((size_t)n + 1);
+	if (b && fread(b, 1, (size_t)n, f) != (size_t)n) {
+		free(b);
+		b = NULL;
+	}
+	if (b)
+		b[n] = '\0';
+	fclose(f);
+	*size = (size_t)n;
+	return b;
+}
+
+/* Files in dir whose name starts with '.': leftover temporaries. */
+static int hidden_files(void)
+{
+	DIR *d = opendir(dir);
+	int n = 0;
+	for (struct dirent *e; d && (e = readdir(d));)
+		n += e->d_name[0] == '.' && strcmp(e->d_name, ".") && strcmp(e->d_name, "..");
+	if (d)
+		closedir(d);
+	return n;
+}
+
+static void remove_dir(void)
+{
+	DIR *d = opendir(dir);
+	for (struct dirent *e; d && (e = readdir(d));) {
+		if (strcmp(e->d_name, ".") && strcmp(e->d_name, ".."))
+			unlink(at(e->d_name));
+	}
+	if (d)
+		closedir(d);
+	rmdir(dir);
+}
+
+/* stderr into a file while a call is expected to fail, so the messages
+ * can be checked (and do not clutter the test output). */
+static int saved_stderr = -1;
+
+static void capture_begin(void)
+{
+	fflush(stderr);
+	saved_stderr = dup(2);
+	int fd = open(at("stderr.txt"), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+	dup2(fd, 2);
+	close(fd);
+}
+
+static char captured[4096];
+
+static const char *capture_end(void)
+{
+	fflush(stderr);
+	dup2(saved_stderr, 2);
+	close(saved_stderr);
+	size_t n;
+	char *b = slurp(at("stderr.txt"), &n);
+	snprintf(captured, sizeof captured, "%s", b ? b : "");
+	free(b);
+	unlink(at("stderr.txt"));
+	return captured;
+}
+
+/* A raster of random heights with a few nodata cells. */
+static void random_raster(struct ss_raster *r, int nx, int ny, struct rng *g, int with_nodata)
+{
+	if (ss_raster_init(r, nx, ny))
+		exit(2);
+	r->cellsize = r->cellsize_y = 0.25;
+	r->x0 = -3.125;
+	r->y0 = 1e5 + 0.1;
+	for (int k = 0; k < nx * ny; k++)
+		r->values[k] = 10.0 * rng_uniform(g) - 2.0;
+	if (with_nodata) {
+		r->nodata = calloc((size_t)nx * ny, 1);
+		for (int a = 0; a < nx * ny / 10 + 1; a++) {
+			const int k = rng_int(g, nx * ny);
+			r->nodata[k] = 1;
+			r->values[k] = 0.0;
+		}
+	}
+}
+
+static int same_flags(const struct ss_raster *a, const struct ss_raster *b)
+{
+	const size_t n = (size_t)a->nx * a->ny;
+	for (size_t k = 0; k < n; k++) {
+		if ((a->nodata && a->nodata[k]) != (b->nodata && b->nodata[k]))
+			return 0;
+	}
+	return 1;
+}
+
+static int same_values(const struct ss_raster *a, const struct ss_raster *b)
+{
+	return a->nx == b->nx && a->ny == b->ny &&
+	       memcmp(a->values, b->values, sizeof(double) * a->nx * a->ny) == 0;
+}
+
+/* ------------------------------------------------------------------ */
+
+static void format_from_path(void)
+{
+	static const struct {
+		const char *path;
+		enum ss_dem_format f;
+	} ok[] = {
+		{"a.asc", SS_DEM_ASC}, {"dir.x/B.ASC", SS_DEM_ASC}, {"a.png", SS_DEM_PNG},
+		{"a.tif", SS_DEM_GDAL}, {"a.TIFF", SS_DEM_GDAL}, {"out/run.h5", SS_DEM_H5},
+		{"run.h5:/height", SS_DEM_H5},
+	};
+	for (size_t a = 0; a < sizeof ok / sizeof *ok; a++) {
+		enum ss_dem_format f = SS_DEM_AUTO;
+		CHECK(ss_dem_format_from_path(ok[a].path, NULL, &f) == SS_OK && f == ok[a].f,
+		      "%s: format %d, expected %d", ok[a].path, (int)f, (int)ok[a].f);
+	}
+	enum ss_dem_format f;
+	capture_begin();
+	int err = ss_dem_format_from_path("heights.jpg", "case.ini:3", &f);
+	const char *msg = capture_end();
+	CHECK(err == SS_ERR_INPUT, "unknown extension gives %d", err);
+	CHECK(strstr(msg, "case.ini:3") && strstr(msg, "heights.jpg") && strstr(msg, ".asc") &&
+	      strstr(msg, ".png") && strstr(msg, ".tif") && strstr(msg, ".h5"),
+	      "the message names the place, the file and every accepted extension: %s", msg);
+}
+
+static void asc_round_trip_is_bit_exact(void)
+{
+	struct rng g = {20240605};
+	const int nx = 13, ny = 7;
+	/* a file as another program writes it: odd corner, NODATA cells */
+	FILE *f = fopen(at("in.asc"), "w");
+	fprintf(f, "NCOLS %d\nnrows %d\nxllcorner 612345.67\nyllcorner -4200.125\n"
+	           "cellsize 0.3\nNODATA_value -9999\n", nx, ny);
+	double expect[13 * 7];
+	uint8_t hole[13 * 7] = {0};
+	for (int row = 0; row < ny; row++) {
+		for (int i = 0; i < nx; i++) {
+			const int k = (ny - 1 - row) * nx + i;   /* south row first */
+			expect[k] = (rng_uniform(&g) - 0.5) * pow(10.0, rng_int(&g, 9) - 4);
+			hole[k] = rng_int(&g, 8) == 0;
+			if (hole[k])
+				fprintf(f, " -9999");
+			else
+				fprintf(f, " %.17g", expect[k]);
+		}
+		fputc('\n', f);
+	}
+	fclose(f);
+
+	struct ss_raster a, b;
+	int err = ss_dem_read(at("in.asc"), NULL, NULL, &a);
+	CHECK(err == SS_OK, "read in.asc: %d", err);
+	CHECK(a.nx == nx && a.ny == ny, "size %d x %d", a.nx, a.ny);
+	CHECK(a.format == SS_DEM_ASC && a.cellsize == 0.3 && a.cellsize_y == 0.3 &&
+	      a.x0 == 612345.67 && a.y0 == -4200.125, "geometry %g %g %g", a.cellsize, a.x0, a.y0);
+	CHECK(a.has_nodata_value && a.nodata_value == -9999.0 && a.nodata, "nodata value kept");
+	int values_ok = 1, flags_ok = 1;
+	for (int k = 0; k < nx * ny; k++) {
+		flags_ok &= a.nodata[k] == hole[k];
+		values_ok &= hole[k] ? a.values[k] == 0.0 : a.values[k] == expect[k];
+	}
+	CHECK(flags_ok, "nodata flags where the file has -9999, south row first");
+	CHECK(values_ok, "every value read exactly (0 at nodata cells)");
+
+	err = ss_dem_write(at("out.asc"), SS_DEM_AUTO, &a);
+	CHECK(err == SS_OK, "write out.asc: %d", err);
+	err = ss_dem_read(at("out.asc"), NULL, NULL, &b);
+	CHECK(err == SS_OK, "read out.asc: %d", err);
+	CHECK(same_values(&a, &b), "values bit-identical after write and read");
+	CHECK(same_flags(&a, &b), "nodata flags identical");
+	CHECK(b.cellsize == a.cellsize && b.x0 == a.x0 && b.y0 == a.y0 &&
+	      b.nodata_value == -9999.0, "corner, cell size and NODATA_value kept");
+	CHECK(hidden_files() == 0, "no temporary file left");
+	size_t n;
+	char *text = slurp(at("out.asc"), &n);
+	CHECK(text && strstr(text, "xllcorner 612345.67\n") && strstr(text, "NODATA_value -9999\n"),
+	      "header written as corner and NODATA_value");
+	free(text);
+	ss_raster_release(&a);
+	ss_raster_release(&b);
+}
+
+static void asc_keeps_centre_and_rectangular_cells(void)
+{
+	write_file(at("c.asc"), "ncols 3\nnrows 2\nxllcenter 10\nyllcenter 20\ndx 2\ndy 4\n"
+	                        "1 2 3\n4 5 6\n");
+	struct ss_raster a, b;
+	int err = ss_dem_read(at("c.asc"), NULL, NULL, &a);
+	CHECK(err == SS_OK, "read c.asc: %d", err);
+	CHECK(a.x0 == 9.0 && a.y0 == 18.0 && a.asc_center, "centre %g %g gives the corner", a.x0, a.y0);
+	CHECK(a.cellsize == 2.0 && a.cellsize_y == 4.0, "dx, dy %g %g", a.cellsize, a.cellsize_y);
+	CHECK(a.values[0] == 4.0 && a.values[5] == 3.0, "south row first: %g %g", a.values[0],
+	      a.values[5]);
+	CHECK(!a.nodata && !a.has_nodata_value, "no nodata without NODATA_value");
+	err = ss_dem_write(at("c2.asc"), SS_DEM_ASC, &a);
+	size_t n;
+	char *text = slurp(at("c2.asc"), &n);
+	CHECK(err == SS_OK && text && strstr(text, "xllcenter 10\nyllcenter 20\ndx 2\ndy 4\n") &&
+	      !strstr(text, "NODATA"), "written back with xllcenter, dx, dy and no NODATA: %s",
+	      text ? text : "(none)");
+	free(text);
+	CHECK(ss_dem_read(at("c2.asc"), NULL, NULL, &b) == SS_OK && same_values(&a, &b),
+	      "values kept");
+	ss_raster_release(&a);
+	ss_raster_release(&b);
+}
+
+/* Each malformed file is SS_ERR_INPUT and the message has every word. */
+static void asc_malformed_is_refused(void)
+{
+	static const struct {
+		const char *text;
+		const char *words[3];
+	} bad[] = {
+		{"nrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2\n3 4\n", {"ncols", "nrows"}},
+		{"ncols 2\nnrows 2\nyllcorner 0\ncellsize 1\n1 2\n3 4\n", {"xllcorner", "corner"}},
+		{"ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\n1 2\n3 4\n", {"cellsize"}},
+		{"ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize -1\n1 2\n3 4\n", {"> 0"}},
+		{"ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2\n3\n", {"ends after 3 of"}},
+		{"ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2\nnan 4\n",
+		 {"bad.asc:7", "row 2, column 1", "finite"}},
+		{"ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 inf\n3 4\n",
+		 {"bad.asc:6", "row 1, column 2", "finite"}},
+		{"ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2\n3 four\n",
+		 {"bad.asc:7", "'four'", "not a number"}},
+		{"ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2\n3 4\n5\n",
+		 {"bad.asc:8", "more values"}},
+		{"ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\ncolour 3\n1 2\n3 4\n",
+		 {"bad.asc:6", "'colour'", "NODATA_value"}},
+		{"ncols 2\nnrows 2\nncols 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2\n3 4\n",
+		 {"bad.asc:3", "repeats line 1"}},
+		{"ncols 2\nnrows 2\nxllcorner 0\nyllcenter 0\ncellsize 1\n1 2\n3 4\n", {"centre"}},
+	};
+	for (size_t a = 0; a < sizeof bad / sizeof *bad; a++) {
+		write_file(at("bad.asc"), bad[a].text);
+		struct ss_raster r;
+		capture_begin();
+		int err = ss_dem_read(at("bad.asc"), "case.ini:9", NULL, &r);
+		const char *msg = capture_end();
+		ss_raster_release(&r);
+		CHECK(err == SS_ERR_INPUT, "case %zu: status %d", a, err);
+		CHECK(strstr(msg, "case.ini:9") != NULL, "case %zu names where the file was given: %s",
+		      a, msg);
+		for (int w = 0; w < 3 && bad[a].words[w]; w++)
+			CHECK(strstr(msg, bad[a].words[w]) != NULL, "case %zu: '%s' in: %s", a,
+			      bad[a].words[w], msg);
+		CHECK(strchr(msg, '\n') == msg + strlen(msg) - 1, "case %zu: one message: %s", a, msg);
+	}
+}
+
+static void cellsize_option_must_agree(void)
+{
+	write_file(at("g.asc"), "ncols 1\nnrows 1\nxllcorner 0\nyllcorner 0\ncellsize 0.5\n7\n");
+	struct ss_dem_read_options o;
+	ss_dem_read_options_init(&o);
+	struct ss_raster r;
+	o.cellsize = 0.5;
+	CHECK(ss_dem_read(at("g.asc"), NULL, &o, &r) == SS_OK, "agreeing cell size accepted");
+	ss_raster_release(&r);
+	o.cellsize = 0.25;
+	capture_begin();
+	int err = ss_dem_read(at("g.asc"), NULL, &o, &r);
+	const char *msg = capture_end();
+	ss_raster_release(&r);
+	CHECK(err == SS_ERR_INPUT && strstr(msg, "0.25") && strstr(msg, "0.5"),
+	      "a disagreeing cell size is refused naming both: %s", msg);
+	ss_dem_read_options_init(&o);
+	o.zscale = 0.1;
+	capture_begin();
+	err = ss_dem_read(at("g.asc"), NULL, &o, &r);
+	msg = capture_end();
+	ss_raster_release(&r);
+	CHECK(err == SS_ERR_INPUT && strstr(msg, "PNG"), "zscale on an .asc is refused: %s", msg);
+}
+
+/* The largest |a - b| over cells with data. */
+static double max_diff(const struct ss_raster *a, const struct ss_raster *b)
+{
+	double d = 0.0;
+	for (int k = 0; k < a->nx * a->ny; k++) {
+		if (!a->nodata || !a->nodata[k])
+			d = fmax(d, fabs(a->values[k] - b->values[k]));
+	}
+	return d;
+}
+
+static void png16_round_trip(void)
+{
+	struct rng g = {7};
+	struct ss_raster a, b, c;
+	random_raster(&a, 37, 23, &g, 1);
+	double lo = INFINITY, hi = -INFINITY;
+	int klo = 0, khi = 0;
+	for (int k = 0; k < a.nx * a.ny; k++) {
+		if (a.nodata[k])
+			continue;
+		if (a.values[k] < lo)
+			lo = a.values[k], klo = k;
+		if (a.values[k] > hi)
+			hi = a.values[k], khi = k;
+	}
+	int err = ss_dem_write(at("h.png"), SS_DEM_AUTO, &a);
+	CHECK(err == SS_OK, "write h.png: %d", err);
+	err = ss_dem_read(at("h.png"), NULL, NULL, &b);
+	CHECK(err == SS_OK, "read h.png: %d", err);
+	CHECK(b.nx == a.nx && b.ny == a.ny && b.format == SS_DEM_PNG, "size %d x %d", b.nx, b.ny);
+	CHECK(b.png_zmin == lo && b.png_zmax == hi, "range from the text chunks exact: %.17g %.17g",
+	      b.png_zmin, b.png_zmax);
+	CHECK(b.values[klo] == lo && b.values[khi] == hi, "lowest and highest cells exact");
+	const double step = (hi - lo) / 65534.0;
+	CHECK_NEAR(max_diff(&a, &b), 0.0, 0.5 * step * (1 + 1e-9), "within half a grey level");
+	CHECK(same_flags(&a, &b), "nodata cells are grey 0 and come back flagged");
+	CHECK(b.cellsize == a.cellsize && b.x0 == a.x0 && b.y0 == a.y0,
+	      "cell size and corner from dx_m, x0_m, y0_m");
+	/* a heightmap read and written again keeps every bit */
+	CHECK(ss_dem_write(at("h2.png"), SS_DEM_PNG, &b) == SS_OK, "write h2.png");
+	CHECK(ss_dem_read(at("h2.png"), NULL, NULL, &c) == SS_OK && same_values(&b, &c) &&
+	      same_flags(&b, &c), "second round trip bit-identical");
+	CHECK(hidden_files() == 0, "no temporary file left");
+
+	/* north row first in the file: the top row of the picture is row ny-1 */
+	png_image im;
+	memset(&im, 0, sizeof im);
+	im.version = PNG_IMAGE_VERSION;
+	uint16_t *px = NULL;
+	if (png_image_begin_read_from_file(&im, at("h.png"))) {
+		im.format = PNG_FORMAT_LINEAR_Y;
+		px = malloc(PNG_IMAGE_SIZE(im));
+		png_image_finish_read(&im, NULL, px, 0, NULL);
+	}
+	CHECK(px && (px[0] == 0) == (a.nodata[(size_t)(a.ny - 1) * a.nx] != 0),
+	      "top-left pixel is the north-west cell");
+	free(px);
+	ss_raster_release(&a);
+	ss_raster_release(&b);
+	ss_raster_release(&c);
+}
+
+/* Write a 16-bit grey PNG with libpng: greys north row first, optional
+ * text chunks "key=value" and optional tRNS grey. */
+static void write_gray16(const char *path, int w, int h, const uint16_t *grey,
+                         const char *const *texts, int ntext, int trns)
+{
+	FILE *f = fopen(path, "wb");
+	png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, NULL, NULL, NULL);
+	png_infop info = png_create_info_struct(png);
+	if (setjmp(png_jmpbuf(png))) {
+		fprintf(stderr, "libpng failed writing %s\n", path);
+		exit(2);
+	}
+	png_init_io(png, f);
+	png_set_IHDR(png, info, w, h, 16, PNG_COLOR_TYPE_GRAY, PNG_INTERLACE_NONE,
+	             PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+	png_text t[8];
+	char kv[8][64];
+	memset(t, 0, sizeof t);
+	for (int a = 0; a < ntext; a++) {
+		snprintf(kv[a], sizeof kv[a], "%s", texts[a]);
+		char *eq = strchr(kv[a], '=');
+		*eq = '\0';
+		t[a].compression = PNG_TEXT_COMPRESSION_NONE;
+		t[a].key = kv[a];
+		t[a].text = eq + 1;
+	}
+	if (ntext)
+		png_set_text(png, info, t, ntext);
+	if (trns >= 0) {
+		png_color_16 c = {0};
+		c.gray = (png_uint_16)trns;
+		png_set_tRNS(png, info, NULL, 0, &c);
+	}
+	png_write_info(png, info);
+	uint8_t *row = malloc(2 * (size_t)w);
+	for (int y = 0; y < h; y++) {
+		for (int x = 0; x < w; x++) {
+			row[2 * x] = grey[y * w + x] >> 8;
+			row[2 * x + 1] = grey[y * w + x] & 0xff;
+		}
+		png_write_row(png, row);
+	}
+	png_write_end(png, NULL);
+	png_destroy_write_struct(&png, &info);
+	free(row);
+	fclose(f);
+}
+
+/* A gray16 picture as the renderer writes it. */
+static void png_from_renderer_convention(void)
+{
+	const uint16_t grey[6] = {0, 1, 2, 65535, 32768, 65534};   /* north row first */
+	const char *const texts[] = {"style=gray16", "zmin_m=-1.5", "zmax_m=2.5"};
+	write_gray16(at("r.png"), 3, 2, grey, texts, 3, 0);
+	struct ss_raster r;
+	int err = ss_dem_read(at("r.png"), NULL, NULL, &r);
+	CHECK(err == SS_OK, "read r.png: %d", err);
+	const double step = 4.0 / 65534.0;
+	/* south row first: (65535, 32768, 65534) then (0, 1, 2) */
+	CHECK(r.nodata && r.nodata[3] && !r.nodata[4] && !r.nodata[0], "grey 0 is no data");
+	CHECK(r.values[4] == -1.5 && r.values[0] == 2.5, "grey 1 is zmin, 65535 is zmax: %g %g",
+	      r.values[4], r.values[0]);
+	CHECK_NEAR(r.values[5], -1.5 + step, 1e-15, "grey 2");
+	CHECK_NEAR(r.values[1], -1.5 + 32767 * step, 1e-15, "grey 32768");
+	CHECK(isnan(r.cellsize), "no dx_m: cell size unknown");
+	ss_raster_release(&r);
+}
+
+static void png_with_explicit_scale(void)
+{
+	const uint16_t grey[4] = {0, 10, 1000, 65535};
+	write_gray16(at("plain.png"), 2, 2, grey, NULL, 0, -1);
+	struct ss_raster r;
+	capture_begin();
+	int err = ss_dem_read(at("plain.png"), "relax", NULL, &r);
+	const char *msg = capture_end();
+	ss_raster_release(&r);
+	CHECK(err == SS_ERR_INPUT && strstr(msg, "plain.png") && strstr(msg, "zscale") &&
+	      strstr(msg, "zmin_m"), "no range and no zscale is refused: %s", msg);
+
+	struct ss_dem_read_options o;
+	ss_dem_read_options_init(&o);
+	o.zscale = 0.01;
+	o.zoffset = 5.0;
+	o.cellsize = 2.0;
+	err = ss_dem_read(at("plain.png"), NULL, &o, &r);
+	CHECK(err == SS_OK, "read with zscale: %d", err);
+	CHECK(!r.nodata, "grey 0 is a height without tRNS or a gray16 range");
+	CHECK(r.values[2] == 5.0 && r.values[0] == 5.0 + 0.01 * 1000 &&
+	      r.values[1] == 5.0 + 0.01 * 65535, "height = zoffset + zscale grey: %g %g %g",
+	      r.values[2], r.values[0], r.values[1]);
+	CHECK(r.cellsize == 2.0 && r.cellsize_y == 2.0, "cell size from the options");
+	ss_raster_release(&r);
+
+	write_gray16(at("trns.png"), 2, 2, grey, NULL, 0, 10);
+	err = ss_dem_read(at("trns.png"), NULL, &o, &r);
+	CHECK(err == SS_OK && r.nodata && r.nodata[3] && !r.nodata[2],
+	      "the tRNS grey marks no data");
+	ss_raster_release(&r);
+
+	ss_dem_read_options_init(&o);
+	o.zoffset = 1.0;
+	capture_begin();
+	err = ss_dem_read(at("plain.png"), NULL, &o, &r);
+	msg = capture_end();
+	ss_raster_release(&r);
+	CHECK(err == SS_ERR_INPUT && strstr(msg, "zoffset"), "zoffset alone is refused: %s", msg);
+}
+
+static void png_not_gray16_is_refused(void)
+{
+	/* an 8-bit grey picture, as a mask would be */
+	uint8_t px[12] = {0, 50, 100, 150, 200, 250, 0, 50, 100, 150, 200, 250};
+	png_image im;
+	memset(&im, 0, sizeof im);
+	im.version = PNG_IMAGE_VERSION;
+	im.width = 4;
+	im.height = 3;
+	im.format = PNG_FORMAT_GRAY;
+	CHECK(png_image_write_to_file(&im, at("eight.png"), 0, px, 0, NULL), "write eight.png");
+	struct ss_raster r;
+	capture_begin();
+	int err = ss_dem_read(at("eight.png"), NULL, NULL, &r);
+	const char *msg = capture_end();
+	ss_raster_release(&r);
+	CHECK(err == SS_ERR_INPUT && strstr(msg, "eight.png") && strstr(msg, "8-bit") &&
+	      strstr(msg, "16-bit greyscale"), "8-bit PNG refused: %s", msg);
+
+	memset(&im, 0, sizeof im);
+	im.version = PNG_IMAGE_VERSION;
+	im.width = 2;
+	im.height = 2;
+	im.format = PNG_FORMAT_RGB;
+	CHECK(png_image_write_to_file(&im, at("rgb.png"), 0, px, 0, NULL), "write rgb.png");
+	capture_begin();
+	err = ss_dem_read(at("rgb.png"), NULL, NULL, &r);
+	msg = capture_end();
+	ss_raster_release(&r);
+	CHECK(err == SS_ERR_INPUT && strstr(msg, "RGB"), "RGB PNG refused: %s", msg);
+
+	write_file(at("fake.png"), "GIF89a not a png at all");
+	capture_begin();
+	err = ss_dem_read(at("fake.png"), NULL, NULL, &r);
+	msg = capture_end();
+	ss_raster_release(&r);
+	CHECK(err == SS_ERR_INPUT && strstr(msg, "not a PNG"), "non-PNG refused: %s", msg);
+}
+
+static void writes_are_atomic_and_spare_the_input(void)
+{
+	struct rng g = {99};
+	struct ss_raster a, b;
+	random_raster(&a, 5, 4, &g, 0);
+	CHECK(ss_dem_write(at("src.asc"), SS_DEM_AUTO, &a) == SS_OK, "write src.asc");
+	ss_raster_release(&a);
+	CHECK(ss_dem_read(at("src.asc"), NULL, NULL, &b) == SS_OK, "read src.asc");
+	size_t n0, n1;
+	char *before = slurp(at("src.asc"), &n0);
+
+	/* writing over the file it came from (even by another name) */
+	capture_begin();
+	int err = ss_dem_write(at("src.asc"), SS_DEM_AUTO, &b);
+	const char *msg = capture_end();
+	CHECK(err == SS_ERR_INPUT && strstr(msg, "read from"), "overwriting the input refused: %s",
+	      msg);
+	CHECK(symlink("src.asc", at("alias.asc")) == 0, "symlink");
+	capture_begin();
+	err = ss_dem_write(at("alias.asc"), SS_DEM_AUTO, &b);
+	capture_end();
+	CHECK(err == SS_ERR_INPUT, "overwriting the input through a link refused");
+	unlink(at("alias.asc"));
+
+	/* a failed write leaves an existing output whole */
+	write_file(at("old.asc"), "keep me\n");
+	b.values[3] = NAN;
+	capture_begin();
+	err = ss_dem_write(at("old.asc"), SS_DEM_AUTO, &b);
+	msg = capture_end();
+	CHECK(err == SS_ERR_FAIL && strstr(msg, "column 4, row 1"), "a NaN height is not written: %s",
+	      msg);
+	char *old = slurp(at("old.asc"), &n1);
+	CHECK(old && !strcmp(old, "keep me\n"), "the earlier file is untouched");
+	free(old);
+	b.values[3] = 1.0;
+
+	/* unwritable places and formats */
+	capture_begin();
+	err = ss_dem_write(at("no/such/dir/x.asc"), SS_DEM_AUTO, &b);
+	msg = capture_end();
+	CHECK(err == SS_ERR_INPUT && strstr(msg, "x.asc") && strstr(msg, "No such file"),
+	      "missing folder: %s", msg);
+	capture_begin();
+	err = ss_dem_write(at("x.h5"), SS_DEM_AUTO, &b);
+	msg = capture_end();
+	CHECK(err == SS_ERR_INPUT && strstr(msg, "HDF5"), "HDF5 is not written here: %s", msg);
+	b.cellsize = b.cellsize_y = NAN;
+	capture_begin();
+	err = ss_dem_write(at("nocell.asc"), SS_DEM_AUTO, &b);
+	msg = capture_end();
+	CHECK(err == SS_ERR_INPUT && strstr(msg, "cell size"), "asc needs a cell size: %s", msg);
+	CHECK(access(at("nocell.asc"), F_OK) != 0, "and nothing was written");
+
+	char *after = slurp(at("src.asc"), &n1);
+	CHECK(before && after && n0 == n1 && !memcmp(before, after, n0), "the input is unchanged");
+	CHECK(hidden_files() == 0, "no temporary file left after failures");
+	free(before);
+	free(after);
+	ss_raster_release(&b);
+}
+
+static void nodata_value_avoids_real_heights(void)
+{
+	struct ss_raster a, b;
+	ss_raster_init(&a, 3, 1);
+	a.cellsize = a.cellsize_y = 1.0;
+	a.x0 = a.y0 = 0.0;
+	a.values[0] = -9999.0;   /* a real height equal to the usual marker */
+	a.nodata = calloc(3, 1);
+	a.nodata[2] = 1;
+	CHECK(ss_dem_write(at("nd.asc"), SS_DEM_AUTO, &a) == SS_OK, "write nd.asc");
+	CHECK(ss_dem_read(at("nd.asc"), NULL, NULL, &b) == SS_OK, "read nd.asc");
+	CHECK(b.nodata_value == -99999.0 && b.values[0] == -9999.0 && same_flags(&a, &b),
+	      "another marker is chosen, %g, and the height survives", b.nodata_value);
+	ss_raster_release(&a);
+	ss_raster_release(&b);
+}
+
+static const char utm33n[] =
+	"PROJCS[\"WGS 84 / UTM zone 33N\",GEOGCS[\"WGS 84\",DATUM[\"WGS_1984\","
+	"SPHEROID[\"WGS 84\",6378137,298.257223563]],PRIMEM[\"Greenwich\",0],"
+	"UNIT[\"degree\",0.0174532925199433]],PROJECTION[\"Transverse_Mercator\"],"
+	"PARAMETER[\"latitude_of_origin\",0],PARAMETER[\"central_meridian\",15],"
+	"PARAMETER[\"scale_factor\",0.9996],PARAMETER[\"false_easting\",500000],"
+	"PARAMETER[\"false_northing\",0],UNIT[\"metre\",1],AUTHORITY[\"EPSG\",\"32633\"]]";
+
+static void geotiff_round_trip(void)
+{
+	struct rng g = {31337};
+	struct ss_raster a, b, c;
+	random_raster(&a, 17, 11, &g, 1);
+	if (!ss_dem_gdal_available()) {
+		capture_begin();
+		int err = ss_dem_write(at("g.tif"), SS_DEM_AUTO, &a);
+		const char *msg = capture_end();
+		CHECK(err == SS_ERR_INPUT && strstr(msg, "unavailable in this build"),
+		      "without GDAL a .tif is refused clearly: %s", msg);
+		write_file(at("g.tif"), "II*");
+		capture_begin();
+		err = ss_dem_read(at("g.tif"), NULL, NULL, &b);
+		msg = capture_end();
+		ss_raster_release(&b);
+		CHECK(err == SS_ERR_INPUT && strstr(msg, "unavailable in this build") &&
+		      strstr(msg, ".asc"), "reading too: %s", msg);
+		printf("note: built without GDAL, GeoTIFF round trip skipped\n");
+		ss_raster_release(&a);
+		return;
+	}
+	a.cellsize = 30.0;
+	a.cellsize_y = 20.0;   /* rectangular pixels */
+	a.x0 = 500000.0;
+	a.y0 = 4649776.22482;
+	a.crs_wkt = strdup(utm33n);
+	a.has_nodata_value = 1;
+	a.nodata_value = -32768.0;
+	int err = ss_dem_write(at("g.tif"), SS_DEM_AUTO, &a);
+	CHECK(err == SS_OK, "write g.tif: %d", err);
+	err = ss_dem_read(at("g.tif"), NULL, NULL, &b);
+	CHECK(err == SS_OK, "read g.tif: %d", err);
+	CHECK(b.format == SS_DEM_GDAL && same_values(&a, &b) && same_flags(&a, &b),
+	      "values bit-identical, nodata flags kept");
+	CHECK(b.has_geotransform && b.geotransform[0] == 500000.0 && b.geotransform[1] == 30.0 &&
+	      b.geotransform[2] == 0.0 && b.geotransform[3] == a.y0 + 11 * 20.0 &&
+	      b.geotransform[4] == 0.0 && b.geotransform[5] == -20.0,
+	      "geotransform %.17g %g %g %.17g %g %g", b.geotransform[0], b.geotransform[1],
+	      b.geotransform[2], b.geotransform[3], b.geotransform[4], b.geotransform[5]);
+	CHECK(b.cellsize == 30.0 && b.cellsize_y == 20.0 && b.x0 == 500000.0 &&
+	      fabs(b.y0 - a.y0) <= 1e-9, "cell size and corner");
+	CHECK(b.has_nodata_value && b.nodata_value == -32768.0, "nodata value %g", b.nodata_value);
+	CHECK(b.crs_wkt && strstr(b.crs_wkt, "UTM zone 33N") && strstr(b.crs_wkt, "32633"),
+	      "CRS kept: %s", b.crs_wkt ? b.crs_wkt : "(none)");
+
+	/* again from what was read: geotransform and CRS exactly as read */
+	err = ss_dem_write(at("g2.tif"), SS_DEM_GDAL, &b);
+	CHECK(err == SS_OK && ss_dem_read(at("g2.tif"), NULL, NULL, &c) == SS_OK, "g2.tif");
+	CHECK(same_values(&b, &c) && same_flags(&b, &c) &&
+	      !memcmp(b.geotransform, c.geotransform, sizeof b.geotransform) &&
+	      c.crs_wkt && !strcmp(b.crs_wkt, c.crs_wkt), "second round trip identical");
+	ss_raster_release(&c);
+
+	/* a GeoTIFF to .asc keeps the corner and nodata */
+	b.cellsize_y = b.cellsize = 30.0;
+	b.has_geotransform = 0;
+	err = ss_dem_write(at("g.asc"), SS_DEM_AUTO, &b);
+	CHECK(err == SS_OK && ss_dem_read(at("g.asc"), NULL, NULL, &c) == SS_OK &&
+	      same_values(&b, &c) && same_flags(&b, &c) && c.nodata_value == -32768.0 &&
+	      c.x0 == 500000.0, "GeoTIFF to .asc");
+	ss_raster_release(&c);
+
+	/* a rotated geotransform is refused */
+	const double rotated[6] = {0, 1, 0.5, 0, 0.5, -1};
+	memcpy(b.geotransform, rotated, sizeof rotated);
+	b.has_geotransform = 1;
+	CHECK(ss_dem_write(at("rot.tif"), SS_DEM_AUTO, &b) == SS_OK, "write rot.tif");
+	capture_begin();
+	err = ss_dem_read(at("rot.tif"), NULL, NULL, &c);
+	const char *msg = capture_end();
+	ss_raster_release(&c);
+	CHECK(err == SS_ERR_INPUT && strstr(msg, "rotated") && strstr(msg, "north-up"),
+	      "rotated refused: %s", msg);
+
+	/* something that is no raster */
+	write_file(at("junk.tif"), "II*\0 this is not a TIFF");
+	capture_begin();
+	err = ss_dem_read(at("junk.tif"), "case.ini:4", NULL, &c);
+	msg = capture_end();
+	ss_raster_release(&c);
+	CHECK(err == SS_ERR_INPUT && strstr(msg, "case.ini:4") && strstr(msg, "junk.tif") &&
+	      strstr(msg, ".asc"), "a broken TIFF: %s", msg);
+	CHECK(hidden_files() == 0, "no temporary file left");
+	ss_raster_release(&a);
+	ss_raster_release(&b);
+}
+
+int main(void)
+{
+	snprintf(dir, sizeof dir, "/tmp/test_dem.XXXXXX");
+	if (!mkdtemp(dir)) {
+		perror("mkdtemp");
+		return 2;
+	}
+	RUN(format_from_path);
+	RUN(asc_round_trip_is_bit_exact);
+	RUN(asc_keeps_centre_and_rectangular_cells);
+	RUN(asc_malformed_is_refused);
+	RUN(cellsize_option_must_agree);
+	RUN(png16_round_trip);
+	RUN(png_from_renderer_convention);
+	RUN(png_with_explicit_scale);
+	RUN(png_not_gray16_is_refused);
+	RUN(writes_are_atomic_and_spare_the_input);
+	RUN(nodata_value_avoids_real_heights);
+	RUN(geotiff_round_trip);
+	remove_dir();
+	return check_report();
+}
