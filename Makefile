@@ -27,7 +27,7 @@ DEB_libpng := libpng-dev
 DEB_inih   := libinih-dev
 PC_MODULES := hdf5 libpng inih
 DEB_BUILD  := pkg-config $(foreach m,$(PC_MODULES),$(DEB_$(m)))
-DEB_TEST   := python3-h5py python3-numpy python3-pytest netcdf-bin
+DEB_TEST   := python3-h5py python3-numpy python3-pytest netcdf-bin ffmpeg
 
 # Goals that need no library: do not probe pkg-config for them.
 NO_PROBE_GOALS := deps clean help
@@ -84,7 +84,9 @@ else
 endif
 
 LIB_SRC  := $(filter-out src/main.c,$(wildcard src/*.c))
-LIB_OBJ  := $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o)
+# The renderer (render/, SPEC section 6) is part of the library.
+RENDER_SRC := $(wildcard render/*.c)
+LIB_OBJ  := $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o) $(RENDER_SRC:render/%.c=$(BUILD)/obj/render/%.o)
 MAIN_OBJ := $(BUILD)/obj/main.o
 TEST_SRC := $(wildcard tests/test_*.c)
 TEST_BIN := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
@@ -100,6 +102,11 @@ $(BUILD)/.flags: FORCE
 FORCE:
 
 $(BUILD)/obj/%.o: src/%.c $(BUILD)/.flags
+	@mkdir -p $(@D)
+	@$(if $(Q),echo '  CC      $<')
+	$(Q)$(CC) $(ALL_CFLAGS) -c $< -o $@
+
+$(BUILD)/obj/render/%.o: render/%.c $(BUILD)/.flags
 	@mkdir -p $(@D)
 	@$(if $(Q),echo '  CC      $<')
 	$(Q)$(CC) $(ALL_CFLAGS) -c $< -o $@

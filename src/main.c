@@ -14,6 +14,7 @@
 #include "sandslide/bench.h"
 #include "sandslide/error.h"
 #include "sandslide/parallel.h"
+#include "sandslide/render.h"
 #include "sandslide/run.h"
 #include "sandslide/snapshot.h"
 
@@ -26,6 +27,7 @@ static const char usage_main[] =
 	"commands:\n"
 	"  run CASE.ini     run a case, writing HDF5 snapshots\n"
 	"  info FILE.h5     summarise an output file\n"
+	"  render FILE.h5   draw snapshots as PNG frames (and a video)\n"
 	"  bench            measure the sweep's throughput on synthetic surfaces\n"
 	"\n"
 	"  sandslide --version    print the version\n"
@@ -46,6 +48,9 @@ static const char usage_run[] =
 	"                        against (same bits, several times slower)\n"
 	"  --deflate N           HDF5 deflate level of /height, 0 (off, default) to 9\n"
 	"  -q, --quiet           no progress line and no summary\n"
+	"  --frames DIR          also draw each snapshot as it is written, to\n"
+	"                        DIR/frame_00000.png, ... (shaded; the look options\n"
+	"                        of `sandslide render --help` apply, e.g. --label)\n"
 	"\n"
 	"Writes OUT.h5 (SPEC section 5) and the XDMF sidecar OUT.xmf, flushed after\n"
 	"every snapshot.  Exit status: 0 done, 1 failure while running, 2 bad input.\n";
@@ -55,6 +60,49 @@ static const char usage_info[] =
 	"\n"
 	"Prints the grid, model, cell counts and the diagnostics of every snapshot\n"
 	"(first and last ten when there are more than twenty).\n";
+
+static const char usage_render[] =
+	"usage: sandslide render FILE.h5 [-o DIR] [--frames A:B:STEP | --time T] [options]\n"
+	"       sandslide render --bench [N]\n"
+	"\n"
+	"Draws the snapshots of a sandslide output file as PNG pictures,\n"
+	"DIR/frame_00000.png, frame_00001.png, ... in time order (SPEC section 6).\n"
+	"\n"
+	"  -o, --output DIR      folder of the frames (default frames/, created if\n"
+	"                        missing)\n"
+	"  --frames A:B:STEP     snapshots A, A+STEP, ... before B, as a Python slice\n"
+	"                        (negative counts from the end; parts may be left out)\n"
+	"  --time T              only the snapshot nearest T seconds\n"
+	"  --video FILE.mp4      assemble the frames with ffmpeg (H.264, yuv420p) if it\n"
+	"                        is on PATH; without it the frames are kept\n"
+	"  --fps N               frames per second of the video (default 24)\n"
+	"  --threads N           OpenMP threads (default: all processors)\n"
+	"  -q, --quiet           no summary\n"
+	"  --bench [N]           time the shaded style on an N x N grid (default 4096)\n"
+	"\n"
+	"The look of the frames (also for `sandslide run --frames`):\n"
+	"  --style NAME          shaded (default): colour map x hillshade, 8-bit RGB;\n"
+	"                        gray16: 16-bit grey heights, zmin..zmax in the PNG text;\n"
+	"                        oblique: perspective view, walls as raised blocks\n"
+	"  --cmap NAME           dune (default; perceptually uniform), terrain, gray\n"
+	"  --zmin Z, --zmax Z    height scale, m (default: the lowest and highest sand\n"
+	"                        of the whole file, so all frames share it)\n"
+	"  --azimuth DEG         light from this compass bearing (default 315: north-west)\n"
+	"  --altitude DEG        light above the horizon (default 45)\n"
+	"  --zscale S            vertical exaggeration of shading and view (default 1)\n"
+	"  --contour DZ          contour lines every DZ m (shaded)\n"
+	"  --label               draw the simulated time on each frame\n"
+	"  --colorbar            add a colour bar with the height scale\n"
+	"  --max-size PX         at most PX pixels a side (cells are area-averaged)\n"
+	"  --scale K             K pixels per cell (default 1 for gray16, otherwise\n"
+	"                        enough for a side of 512 px)\n"
+	"  --view-azimuth DEG    oblique: the camera's bearing from the centre (200)\n"
+	"  --view-elevation DEG  oblique: the camera above the horizon (35)\n"
+	"  --compression N       zlib level of the PNGs, 0 to 9 (default 6)\n"
+	"\n"
+	"Each PNG holds the time, the height scale and the snapshot in text chunks;\n"
+	"a frame is written under a temporary name and renamed when complete.\n"
+	"Exit status: 0 done, 1 failure while rendering, 2 bad input.\n";
 
 static const char usage_bench[] =
 	"usage: sandslide bench [--nx N] [--ny N] [--closure NAME|all] [--threads 1,2]\n"
@@ -93,6 +141,78 @@ static int parse_int(const char *s, int lo, int hi, int *out)
 		return -1;
 	*out = (int)v;
 	return 0;
+}
+
+static int parse_double(const char *s, double *out)
+{
+	char *end;
+	errno = 0;
+	double v = s ? strtod(s, &end) : NAN;
+	if (!s || end == s || *end || errno || !isfinite(v))
+		return -1;
+	*out = v;
+	return 0;
+}
+
+/*
+ * One option of the look of frames (`render`, and `run --frames`) at
+ * argv[*k]: 1 if it was one (*k then points at its last word), 0 if not,
+ * 2 after a usage error.  Ranges are checked by ss_render_options_check.
+ */
+static int parse_look_option(int argc, char **argv, int *k, struct ss_render_options *o,
+                             const char *usage)
+{
+	const char *a = argv[*k], *next = *k + 1 < argc ? argv[*k + 1] : NULL;
+	struct {
+		const char *name;
+		double *value;
+	} const numbers[] = {
+		{"--zmin", &o->zmin}, {"--zmax", &o->zmax}, {"--azimuth", &o->azimuth_deg},
+		{"--altitude", &o->altitude_deg}, {"--zscale", &o->zscale},
+		{"--contour", &o->contour}, {"--view-azimuth", &o->view_azimuth_deg},
+		{"--view-elevation", &o->view_elevation_deg},
+	};
+	for (size_t n = 0; n < sizeof numbers / sizeof numbers[0]; n++) {
+		if (strcmp(a, numbers[n].name))
+			continue;
+		if (parse_double(next, numbers[n].value))
+			return usage_error(usage, "%s needs a finite number", a);
+		++*k;
+		return 1;
+	}
+	if (!strcmp(a, "--label")) {
+		o->label = 1;
+	} else if (!strcmp(a, "--colorbar")) {
+		o->colorbar = 1;
+	} else if (!strcmp(a, "--style")) {
+		if (!next || ss_render_style_parse(next, &o->style))
+			return usage_error(usage, "--style '%s': expected " SS_RENDER_STYLE_NAMES,
+			                   next ? next : "");
+		++*k;
+	} else if (!strcmp(a, "--cmap")) {
+		if (!next || ss_render_cmap_parse(next, &o->cmap))
+			return usage_error(usage, "--cmap '%s': expected " SS_RENDER_CMAP_NAMES,
+			                   next ? next : "");
+		++*k;
+	} else if (!strcmp(a, "--max-size")) {
+		if (!next || parse_int(next, 8, 65536, &o->max_size))
+			return usage_error(usage, "--max-size '%s': expected 8 to 65536 px",
+			                   next ? next : "");
+		++*k;
+	} else if (!strcmp(a, "--scale")) {
+		if (!next || parse_int(next, 1, 100, &o->scale))
+			return usage_error(usage, "--scale '%s': expected 1 to 100 px per cell",
+			                   next ? next : "");
+		++*k;
+	} else if (!strcmp(a, "--compression")) {
+		if (!next || parse_int(next, 0, 9, &o->compression))
+			return usage_error(usage, "--compression '%s': expected 0 to 9",
+			                   next ? next : "");
+		++*k;
+	} else {
+		return 0;
+	}
+	return 1;
 }
 
 /* The command line as one string, for the history attribute. */
@@ -224,6 +344,82 @@ static int cmd_bench(int argc, char **argv)
 	return ss_status_exit_code(ss_bench_run(&o));
 }
 
+static int cmd_render(int argc, char **argv)
+{
+	struct ss_render_series_options o = {0};
+	ss_render_options_default(&o.look);
+	o.output_dir = "frames";
+	o.time = NAN;
+	o.fps = 24;
+	int threads = 0, bench = 0, bench_n = 4096;
+
+	for (int k = 2; k < argc; k++) {
+		const char *a = argv[k], *next = k + 1 < argc ? argv[k + 1] : NULL;
+		const int look = parse_look_option(argc, argv, &k, &o.look, usage_render);
+		if (look == 2)
+			return 2;
+		if (look)
+			continue;
+		if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+			fputs(usage_render, stdout);
+			return 0;
+		} else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
+			if (!next || !*next)
+				return usage_error(usage_render, "%s needs a folder", a);
+			o.output_dir = argv[++k];
+		} else if (!strcmp(a, "--frames")) {
+			if (!next)
+				return usage_error(usage_render, "%s needs A:B:STEP", a);
+			o.frames = argv[++k];
+		} else if (!strcmp(a, "--time")) {
+			if (parse_double(next, &o.time))
+				return usage_error(usage_render, "--time '%s': expected a time in s",
+				                   next ? next : "");
+			k++;
+		} else if (!strcmp(a, "--video")) {
+			if (!next || !*next)
+				return usage_error(usage_render, "%s needs a file name", a);
+			o.video = argv[++k];
+		} else if (!strcmp(a, "--fps")) {
+			if (!next || parse_int(next, 1, 240, &o.fps))
+				return usage_error(usage_render, "--fps '%s': expected 1 to 240",
+				                   next ? next : "");
+			k++;
+		} else if (!strcmp(a, "--threads")) {
+			if (!next || parse_int(next, 1, 4096, &threads))
+				return usage_error(usage_render, "--threads '%s': expected an integer "
+				                   "from 1 to 4096", next ? next : "");
+			k++;
+		} else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
+			o.quiet = 1;
+		} else if (!strcmp(a, "--bench")) {
+			bench = 1;
+			if (next && parse_int(next, 16, 32768, &bench_n) == 0)
+				k++;
+		} else if (a[0] == '-' && a[1]) {
+			return usage_error(usage_render, "unknown option '%s'", a);
+		} else if (o.input) {
+			return usage_error(usage_render, "one file only (got a second: '%s')", a);
+		} else {
+			o.input = a;
+		}
+	}
+	ss_parallel_set_threads(threads > 0 ? threads : ss_parallel_processors());
+	if (bench)
+		return ss_status_exit_code(ss_render_bench(bench_n, 5));
+	if (!o.input)
+		return usage_error(usage_render, "%s", "render needs a sandslide output file");
+	return ss_status_exit_code(ss_render_series(&o));
+}
+
+/* `run --frames`: render each snapshot the run reports. */
+static int render_run_snapshot(void *context, const struct ss_run_snapshot *s)
+{
+	const struct ss_render_frames_bounds b = {s->source_rise, s->open_level,
+	                                          s->any_open_side};
+	return ss_render_frames_add(context, s->path, s->index, &b);
+}
+
 static int cmd_run(int argc, char **argv)
 {
 	struct ss_run_options o = {0};
@@ -231,11 +427,28 @@ static int cmd_run(int argc, char **argv)
 	if (!overrides)
 		return ss_status_exit_code(ss_error_fail("out of memory"));
 	int status = 2;
+	const char *frames_dir = NULL, *look_option = NULL;
+	struct ss_render_options look;
+	ss_render_options_default(&look);
+	struct ss_render_frames *frames = NULL;
 
 	for (int k = 2; k < argc; k++) {
 		const char *a = argv[k];
 		const char *next = k + 1 < argc ? argv[k + 1] : NULL;
-		if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+		const int is_look = parse_look_option(argc, argv, &k, &look, usage_run);
+		if (is_look == 2)
+			goto out;
+		if (is_look) {
+			look_option = a;
+			continue;
+		}
+		if (!strcmp(a, "--frames")) {
+			if (!next || !*next) {
+				status = usage_error(usage_run, "%s needs a folder", a);
+				goto out;
+			}
+			frames_dir = argv[++k];
+		} else if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
 			fputs(usage_run, stdout);
 			status = 0;
 			goto out;
@@ -292,12 +505,26 @@ static int cmd_run(int argc, char **argv)
 		status = usage_error(usage_run, "%s", "run needs a case file");
 		goto out;
 	}
+	if (look_option && !frames_dir) {
+		status = usage_error(usage_run, "%s sets the look of frames: it needs --frames DIR",
+		                     look_option);
+		goto out;
+	}
+	if (frames_dir) {
+		if ((status = ss_status_exit_code(ss_render_frames_create(&frames, frames_dir, &look))))
+			goto out;
+		o.on_snapshot = render_run_snapshot;
+		o.snapshot_context = frames;
+	}
 	o.overrides = overrides;
 	char *history = join_args(argc, argv);
 	o.history = history;
 	status = ss_status_exit_code(ss_run_case(&o));
 	free(history);
+	if (frames && !o.quiet)
+		printf("wrote %lld frames to %s/\n", ss_render_frames_count(frames), frames_dir);
 out:
+	ss_render_frames_destroy(frames);
 	free(overrides);
 	return status;
 }
@@ -392,6 +619,8 @@ int main(int argc, char **argv)
 		return cmd_info(argc, argv);
 	if (!strcmp(cmd, "bench"))
 		return cmd_bench(argc, argv);
-	return usage_error(usage_main, "unknown command '%s': expected run, info or bench",
-	                   cmd);
+	if (!strcmp(cmd, "render"))
+		return cmd_render(argc, argv);
+	return usage_error(usage_main, "unknown command '%s': expected run, info, render or "
+	                   "bench", cmd);
 }

@@ -121,6 +121,38 @@ static int write_snapshot(struct ss_snapshot *snap, struct ss_stepper *st, doubl
 	return err;
 }
 
+/* The most the sources can add to one cell by time `stop`: each source's
+ * rate times its time on, summed, as sources may overlap (m). */
+static double source_rise(const struct ss_case *c, double stop)
+{
+	double rise = 0.0;
+	for (int k = 0; k < c->region_count; k++) {
+		const struct ss_region *r = &c->regions[k];
+		const double on = fmin(r->stop, stop) - r->start;
+		if (r->role == SS_REGION_SOURCE && on > 0.0)
+			rise += r->rate * on;
+	}
+	return rise;
+}
+
+/* Tell o->on_snapshot (if any) that the last snapshot is in the file. */
+static int report_snapshot(const struct ss_run_options *o, const char *output,
+                           const struct ss_snapshot *snap, const struct ss_stepper *st,
+                           const struct ss_case *c)
+{
+	if (!o->on_snapshot)
+		return SS_OK;
+	const struct ss_boundary *b = &c->boundary;
+	const struct ss_run_snapshot s = {
+		.path = output, .index = ss_snapshot_count(snap) - 1, .time = st->time,
+		.source_rise = source_rise(c, c->steady ? c->max_time : c->end),
+		.open_level = b->open_level,
+		.any_open_side = b->side[SS_WEST] == SS_SIDE_OPEN || b->side[SS_EAST] == SS_SIDE_OPEN ||
+		                 b->side[SS_SOUTH] == SS_SIDE_OPEN || b->side[SS_NORTH] == SS_SIDE_OPEN,
+	};
+	return o->on_snapshot(o->snapshot_context, &s);
+}
+
 int ss_run_case(const struct ss_run_options *o)
 {
 	const double started = now_seconds();
@@ -157,7 +189,8 @@ int ss_run_case(const struct ss_run_options *o)
 	};
 	if ((err = ss_snapshot_create(&snap, output, &st.grid, st.cell_types, &meta)))
 		goto out_stepper;
-	if ((err = write_snapshot(snap, &st, started, &seconds_output)))
+	if ((err = write_snapshot(snap, &st, started, &seconds_output)) ||
+	    (err = report_snapshot(o, output, snap, &st, &c)))
 		goto out_snapshot;
 
 	struct progress prog = {
@@ -192,7 +225,8 @@ int ss_run_case(const struct ss_run_options *o)
 			                    ss_snapshot_count(snap), output);
 			goto out_snapshot;
 		}
-		if ((err = write_snapshot(snap, &st, started, &seconds_output)))
+		if ((err = write_snapshot(snap, &st, started, &seconds_output)) ||
+		    (err = report_snapshot(o, output, snap, &st, &c)))
 			goto out_snapshot;
 		if (end == SS_ADVANCE_STEADY)
 			break;

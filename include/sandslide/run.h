@@ -9,6 +9,19 @@
 #ifndef SANDSLIDE_RUN_H
 #define SANDSLIDE_RUN_H
 
+/* What a run reports after each snapshot is written and flushed. */
+struct ss_run_snapshot {
+	const char *path;            /* the output file */
+	long long index;             /* snapshot number, 0 at t = 0 */
+	double time;                 /* s */
+	double source_rise;          /* m: the most the sources can add to one
+	                              * cell over the whole run (each source's
+	                              * rate times its time on, summed);
+	                              * INFINITY if a source never stops */
+	double open_level;           /* m, held on open cells and sides */
+	int any_open_side;           /* a side of the grid is open */
+};
+
 struct ss_run_options {
 	const char *case_path;
 	const char *output;          /* NULL: out/<case name>.h5 */
@@ -20,6 +33,10 @@ struct ss_run_options {
 	int deflate;                 /* HDF5 deflate level 0..9 */
 	int quiet;                   /* no progress, no summary */
 	const char *history;         /* the command line, for the file */
+	/* Called after every snapshot (NULL: none), e.g. to render it; a
+	 * non-zero return (a status, message printed) stops the run. */
+	int (*on_snapshot)(void *context, const struct ss_run_snapshot *s);
+	void *snapshot_context;
 };
 
 /* Returns SS_OK, SS_ERR_INPUT or SS_ERR_FAIL (message already printed). */

@@ -1,0 +1,213 @@
+/*
+ * render.h - pictures of snapshots (SPEC section 6): PNG heightmaps, frame
+ * sequences and videos.  The code is in render/; `sandslide render` and
+ * `sandslide run --frames` reach it.  The numerical kernel knows nothing of
+ * it: the renderer reads the HDF5 output (SPEC section 5) itself.
+ *
+ * A frame is made in three steps, each its own function:
+ *
+ *   1. resample   the cells (nx x ny, dx x dy) onto the picture's pixels:
+ *                 area averaging when the picture is smaller than the grid
+ *                 (--max-size), bilinear between cell centres when it is
+ *                 larger (small grids are drawn at K pixels per cell); wall
+ *                 cells never enter an average.
+ *   2. colour     shaded:  colour map of height x hillshade (Horn's method),
+ *                          walls dark, open cells light, optional contours;
+ *                 gray16:  16-bit grey, linear between zmin and zmax;
+ *                 oblique: a perspective view, z-buffered triangles, walls
+ *                          as raised blocks.
+ *                 Then the optional time label and colour bar.
+ *   3. encode     libpng, to a temporary name renamed into place, with the
+ *                 time, the height scale and the snapshot in text chunks.
+ *
+ * Rows are split between OpenMP threads within a frame, or frames between
+ * threads in a series of small frames; the bits are the same either way.
+ */
+#ifndef SANDSLIDE_RENDER_H
+#define SANDSLIDE_RENDER_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+enum ss_render_style {
+	SS_RENDER_SHADED,   /* colour map x hillshade, 8-bit RGB */
+	SS_RENDER_GRAY16,   /* 16-bit grey heights, for data */
+	SS_RENDER_OBLIQUE,  /* perspective view, 8-bit RGB */
+};
+
+enum ss_render_cmap {
+	SS_RENDER_CMAP_DUNE,     /* perceptually uniform (CIELAB lightness linear),
+	                          * violet - teal - green - yellow, like viridis */
+	SS_RENDER_CMAP_TERRAIN,  /* blue - green - sand - brown - white */
+	SS_RENDER_CMAP_GRAY,     /* black to white */
+};
+
+/* Colours of the shaded style for cells that are not sand, and for
+ * heights that are not numbers (R, G, B). */
+#define SS_RENDER_WALL_RGB   0x2b, 0x2b, 0x30   /* dark slate */
+#define SS_RENDER_OPEN_RGB   0xc4, 0xdc, 0xf0   /* pale sky blue */
+#define SS_RENDER_NODATA_RGB 0xff, 0x00, 0xff   /* magenta */
+
+/* How frames look.  ss_render_options_default() sets every field. */
+struct ss_render_options {
+	enum ss_render_style style;
+	enum ss_render_cmap cmap;
+	double zmin, zmax;          /* m, the height scale; NAN: from the data */
+	double azimuth_deg;         /* light comes from, clockwise from north (315) */
+	double altitude_deg;        /* light above the horizon, (0, 90] (45) */
+	double zscale;              /* vertical exaggeration of shading and view (1) */
+	double contour;             /* m between contour lines; 0: none */
+	int label;                  /* draw "t = ... s" on the picture */
+	int colorbar;               /* add a colour bar with the scale on the right */
+	int max_size;               /* longest side at most this many px; 0: no cap */
+	int scale;                  /* px per cell; 0: 1 for gray16, otherwise the
+	                             * smallest giving a side of at least 512 px */
+	double view_azimuth_deg;    /* oblique: camera's compass bearing from the
+	                             * centre of the grid (200: south-south-west) */
+	double view_elevation_deg;  /* oblique: camera above the horizon, (0, 90) (35) */
+	int compression;            /* zlib level of the PNG, 0..9 (6) */
+};
+
+void ss_render_options_default(struct ss_render_options *o);
+
+/* SS_ERR_INPUT (with a message naming the option) for values out of range,
+ * zmin >= zmax when both are given, or label/colorbar with gray16. */
+int ss_render_options_check(const struct ss_render_options *o);
+
+/* Names of styles and colour maps, and parsing them (0, or -1 if unknown). */
+const char *ss_render_style_name(enum ss_render_style s);
+int ss_render_style_parse(const char *name, enum ss_render_style *s);
+const char *ss_render_cmap_name(enum ss_render_cmap c);
+int ss_render_cmap_parse(const char *name, enum ss_render_cmap *c);
+#define SS_RENDER_STYLE_NAMES "shaded, gray16, oblique"
+#define SS_RENDER_CMAP_NAMES "dune, terrain, gray"
+
+/* The 256-entry RGB table of a colour map, index 0 at zmin. */
+void ss_render_cmap_table(enum ss_render_cmap c, uint8_t table[256][3]);
+
+/* One snapshot in memory. */
+struct ss_render_field {
+	int nx, ny;                 /* cells */
+	double dx, dy;              /* cell size, m */
+	ptrdiff_t stride;           /* elements between rows, >= nx */
+	const double *height;       /* m: cell (i, j) at height[j * stride + i],
+	                             * i west to east, j = 0 the south row */
+	const uint8_t *cell_type;   /* enum ss_cell_type (grid.h), same layout;
+	                             * NULL: every cell is a flow cell */
+	double time;                /* s */
+};
+
+/* A picture: rows from the top (north), samples interleaved. */
+struct ss_render_image {
+	int width, height;          /* px */
+	int channels;               /* 3 (RGB) or 1 (grey) */
+	int bit_depth;              /* 8, or 16 (samples are native uint16_t) */
+	size_t row_bytes;
+	unsigned char *pixels;      /* height * row_bytes, owned */
+	/* written as PNG text chunks */
+	double time;                /* s */
+	double zmin, zmax;          /* m, the scale the picture was made with */
+	long long snapshot;         /* index in its file, -1 if none */
+	enum ss_render_style style;
+	char source[4096];          /* file the snapshot came from, "" if none */
+};
+
+/* Allocate a zeroed picture; SS_ERR_FAIL if out of memory. */
+int ss_render_image_init(struct ss_render_image *img, int width, int height,
+                         int channels, int bit_depth);
+void ss_render_image_release(struct ss_render_image *img);
+
+/* Picture size for a grid of nx x ny cells of dx x dy under o (scale,
+ * max_size, style): the cells' pixels, before any colour bar. */
+void ss_render_picture_size(int nx, int ny, double dx, double dy,
+                            const struct ss_render_options *o, int *width, int *height);
+
+/*
+ * Render one field into img (initialised here; release it).  NAN zmin or
+ * zmax are taken from this field's flow and open cells.  Rows are split
+ * between the OpenMP threads.  SS_ERR_INPUT for bad options or a field
+ * with no cells, SS_ERR_FAIL when out of memory.
+ */
+int ss_render_field(const struct ss_render_field *f, const struct ss_render_options *o,
+                    struct ss_render_image *img);
+
+/* Write img as a PNG: to "path.partial", renamed to path when complete,
+ * so a picture that exists is whole.  compression is the zlib level. */
+int ss_render_write_png(const struct ss_render_image *img, const char *path,
+                        int compression);
+
+/* `sandslide render`: a series of frames from a sandslide HDF5 file. */
+struct ss_render_series_options {
+	const char *input;          /* the .h5 file */
+	const char *output_dir;     /* frames go here (created if missing) */
+	const char *frames;         /* "A:B:STEP" (B exclusive, as a Python slice;
+	                             * negative counts from the end), "A", or NULL: all */
+	double time;                /* s: the snapshot nearest this; NAN: unused */
+	const char *video;          /* FILE.mp4 to assemble with ffmpeg, or NULL */
+	int fps;                    /* frames per second of the video (24) */
+	int quiet;                  /* no summary */
+	struct ss_render_options look;
+};
+
+/*
+ * Render the chosen snapshots of o->input to output_dir/frame_00000.png,
+ * frame_00001.png, ... in time order, then the video if asked for (without
+ * ffmpeg on PATH: a note, the frames are kept, success).  Everything is
+ * checked before the first frame is written.  Returns SS_OK, SS_ERR_INPUT
+ * (not a sandslide file, no snapshots, a range outside the series, an
+ * unwritable folder, zmin >= zmax) or SS_ERR_FAIL.
+ */
+int ss_render_series(const struct ss_render_series_options *o);
+
+/* Name of frame k in dir: "dir/frame_%05lld.png". */
+void ss_render_frame_path(const char *dir, long long k, char *out, size_t size);
+
+/*
+ * Frames of a run as it writes them (`sandslide run --frames DIR`): each
+ * snapshot is read back from the output file just flushed and rendered to
+ * DIR/frame_<k>.png.  The height scale, unless look gives it, is fixed at
+ * snapshot 0 so that all frames share it: from the lowest to the highest
+ * height the run can reach by the maximum principle, i.e. the range of the
+ * initial surface (and of open_level when something is open) with
+ * `source_rise` (the most the sources can add to a cell over the run, m)
+ * added at the top.
+ */
+struct ss_render_frames;
+
+/* Check that dir is or can be made a writable folder (SS_ERR_INPUT) and
+ * the look (ss_render_options_check); nothing is created yet. */
+int ss_render_frames_create(struct ss_render_frames **out, const char *dir,
+                            const struct ss_render_options *look);
+
+struct ss_render_frames_bounds {
+	double source_rise;         /* m, INFINITY: no bound (each frame its own scale) */
+	double open_level;          /* m */
+	int any_open_side;          /* an open side holds heights at open_level */
+};
+
+/* Render snapshot `index` of the file at path as the next frame. */
+int ss_render_frames_add(struct ss_render_frames *fr, const char *path, long long index,
+                         const struct ss_render_frames_bounds *bounds);
+
+/* Frames written so far. */
+long long ss_render_frames_count(const struct ss_render_frames *fr);
+
+/* ss_render_frames_destroy(NULL) is a no-op. */
+void ss_render_frames_destroy(struct ss_render_frames *fr);
+
+/*
+ * Assemble dir/frame_00000.png .. frame_<count-1>.png into a video with
+ * ffmpeg (H.264, yuv420p, fps frames per second), written to a temporary
+ * name and renamed.  Returns SS_OK, SS_ERR_FAIL when ffmpeg fails, or 1
+ * (after saying so on stderr) when ffmpeg is not on PATH.
+ */
+int ss_render_video(const char *dir, long long count, int fps, const char *video);
+
+/*
+ * Throughput of the shaded style on an n x n synthetic grid (walls, open
+ * cells, slopes), one frame rendered `repeats` times, and of the PNG
+ * encoding; prints the median, min and max in Mpixel/s.
+ */
+int ss_render_bench(int n, int repeats);
+
+#endif

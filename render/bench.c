@@ -1,0 +1,119 @@
+/*
+ * bench.c - `sandslide render --bench N`: throughput of the shaded style.
+ *
+ * A synthetic N x N snapshot in memory (a cone with ripples, wall blocks,
+ * an open strip) is resampled 1:1 and coloured `repeats` times on the
+ * current threads; the median, min and max time give Mpixel/s.  The PNG
+ * encoding of the same picture is timed separately (once per zlib level
+ * shown), since it is serial and its cost depends on the level.  Nothing
+ * here is a test: timings vary with the machine and its load.
+ */
+#include "internal.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "sandslide/error.h"
+#include "sandslide/grid.h"
+#include "sandslide/parallel.h"
+
+static double now_seconds(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+	const double x = *(const double *)a, y = *(const double *)b;
+	return x < y ? -1 : x > y;
+}
+
+static void synthetic(int n, double *h, uint8_t *type)
+{
+	#pragma omp parallel for schedule(static)
+	for (int j = 0; j < n; j++)
+		for (int i = 0; i < n; i++) {
+			const double x = (i + 0.5) / n - 0.5, y = (j + 0.5) / n - 0.5;
+			const double r = sqrt(x * x + y * y);
+			const size_t k = (size_t)j * n + i;
+			h[k] = fmax(0.0, 0.35 - 0.7 * r) + 0.01 * sin(40.0 * x) * cos(30.0 * y);
+			type[k] = SS_CELL_FLOW;
+			if (fabs(x - 0.25) < 0.04 && fabs(y) < 0.2)
+				type[k] = SS_CELL_WALL;
+			if (i < n / 64)
+				type[k] = SS_CELL_OPEN;
+		}
+}
+
+int ss_render_bench(int n, int repeats)
+{
+	if (n < 16 || n > 32768 || repeats < 1 || repeats > 100)
+		return ss_error_input("--bench %d: expected a grid of 16 to 32768 cells a side "
+		                      "(and 1 to 100 repeats)", n);
+	const size_t cells = (size_t)n * n;
+	double *h = ss_alloc(cells, sizeof *h, "bench heights");
+	uint8_t *type = ss_alloc(cells, 1, "bench cell types");
+	double *times = calloc((size_t)repeats, sizeof *times);
+	if (!h || !type || !times) {
+		ss_free(h);
+		ss_free(type);
+		free(times);
+		return times ? SS_ERR_FAIL : ss_error_fail("out of memory");
+	}
+	synthetic(n, h, type);
+	struct ss_render_options o;
+	ss_render_options_default(&o);
+	const struct ss_render_field f = {n, n, 1e-3, 1e-3, n, h, type, 0.0};
+
+	/* one untimed frame: first-touch of the pages, the picture to encode */
+	struct ss_render_image img;
+	int err = ss_render_field(&f, &o, &img);
+	for (int r = 0; r < repeats && !err; r++) {
+		struct ss_render_image again;
+		const double t0 = now_seconds();
+		err = ss_render_field(&f, &o, &again);
+		times[r] = now_seconds() - t0;
+		if (!err)
+			ss_render_image_release(&again);
+	}
+	if (!err) {
+		qsort(times, (size_t)repeats, sizeof *times, cmp_double);
+		const double mpx = (double)cells * 1e-6;
+		printf("shaded %d x %d (%.1f Mpixel), %d threads, %d repeats: median %.3f s = %.1f "
+		       "Mpixel/s (min %.3f s, max %.3f s)\n", n, n, mpx, ss_parallel_max_threads(),
+		       repeats, times[repeats / 2], mpx / times[repeats / 2], times[0],
+		       times[repeats - 1]);
+		char path[4200];
+		const char *dir = getenv("TMPDIR");
+		snprintf(path, sizeof path, "%s/sandslide-bench-%ld.png", dir && *dir ? dir : "/tmp",
+		         (long)getpid());
+		const int levels[] = {1, 6};
+		for (int l = 0; l < 2 && !err; l++) {
+			const double t0 = now_seconds();
+			err = ss_render_write_png(&img, path, levels[l]);
+			const double s = now_seconds() - t0;
+			FILE *fp = err ? NULL : fopen(path, "rb");
+			long bytes = 0;
+			if (fp) {
+				fseek(fp, 0, SEEK_END);
+				bytes = ftell(fp);
+				fclose(fp);
+			}
+			remove(path);
+			if (!err)
+				printf("png encoding, zlib level %d (serial): %.3f s = %.1f Mpixel/s, "
+				       "%.1f MB\n", levels[l], s, mpx / s, bytes * 1e-6);
+		}
+		ss_render_image_release(&img);
+	}
+	free(times);
+	ss_free(type);
+	ss_free(h);
+	return err;
+}

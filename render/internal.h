@@ -1,0 +1,207 @@
+/*
+ * internal.h - what the files of render/ share and nothing else sees (the
+ * public interface is include/sandslide/render.h).  No HDF5 or libpng type
+ * appears here: series.c alone includes <hdf5.h>, png.c alone <png.h>.
+ */
+#ifndef SANDSLIDE_RENDER_INTERNAL_H
+#define SANDSLIDE_RENDER_INTERNAL_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "sandslide/render.h"
+
+#define SS_RENDER_BACKGROUND 0xff               /* white: oblique sky, colour bar */
+
+/* ---- resample.c: cells -> pixels ------------------------------------- */
+
+/* Weights of one axis: output pixel k (counted from the south or west)
+ * takes source cells first[k] .. first[k] + count[k] - 1 with weights
+ * w[k * span + m]. */
+struct ss_render_axis {
+	int n_out, span;
+	int *first, *count;
+	double *w;
+};
+
+/* The cells-to-pixels map of a picture.  Heights use `ix`/`iy` (area
+ * averaging when shrinking, bilinear between cell centres when growing);
+ * cell types always use the area weights `bx`/`by` so walls stay cell-sharp. */
+struct ss_render_resampler {
+	int nx, ny;                 /* cells */
+	int width, height;          /* px */
+	double px_dx, px_dy;        /* m per pixel */
+	struct ss_render_axis bx, by, ix, iy;
+};
+
+int ss_render_resampler_init(struct ss_render_resampler *r, int nx, int ny, double dx,
+                             double dy, int width, int height);
+void ss_render_resampler_release(struct ss_render_resampler *r);
+
+/* Pixel types (width * height, north row first) from the cell types
+ * (nx * ny with row stride `stride`, south row first; NULL: all flow): the
+ * type covering most of the pixel, ties going to walls, then open cells. */
+void ss_render_resample_types(const struct ss_render_resampler *r, const uint8_t *cell_type,
+                              ptrdiff_t stride, uint8_t *pixel_type, int parallel);
+
+/*
+ * Add cell rows j0 .. j0 + rows - 1 (south-first numbering; h points at
+ * row j0, cell_type at row 0 of the whole field) to the accumulators of
+ * the weighted height sum and the weight sum (width * height each, north
+ * row first).  Walls carry no weight.  Rows may come in blocks in any
+ * order; the same order gives the same bits.
+ */
+void ss_render_resample_rows(const struct ss_render_resampler *r, const double *h,
+                             ptrdiff_t stride, const uint8_t *cell_type,
+                             ptrdiff_t type_stride, int j0, int rows, double *acc_hw,
+                             double *acc_w, int parallel);
+
+/* acc_hw / acc_w into acc_hw: the pixel heights (NAN without weight). */
+void ss_render_resample_finish(const struct ss_render_resampler *r, double *acc_hw,
+                               const double *acc_w, int parallel);
+
+/* ---- the resampled field a style colours ----------------------------- */
+
+struct ss_render_raster {
+	int width, height;          /* px */
+	double px_dx, px_dy;        /* m per pixel */
+	const double *h;            /* m, width * height, north row first; NAN: none */
+	const uint8_t *type;        /* enum ss_cell_type per pixel */
+	int step_x, step_y;         /* px between the points of the gradient
+	                             * stencil: one cell (at least one px) */
+};
+
+/* Height gradient (dh/dx east, dh/dy north) at pixel (x, y) by Horn's
+ * 3 x 3 weighted differences over points step_x, step_y pixels apart; a
+ * wall, NaN or outside neighbour takes the centre's height (the mirror
+ * rule of the model, SPEC section 2).  On a grid enlarged K times the
+ * points are a cell apart: differences of the bilinear surface across one
+ * cell are the bilinear interpolation of the cells' own differences, so
+ * the shading varies smoothly instead of in flat squares per cell. */
+void ss_render_gradient(const struct ss_render_raster *r, int x, int y, double *gx,
+                        double *gy);
+
+/* Brightness in [ambient, 1] of a surface of gradient (gx, gy) lit from
+ * azimuth/altitude (degrees), heights exaggerated by zscale. */
+struct ss_render_light {
+	double lx, ly, lz;          /* unit vector towards the light */
+	double zscale;
+};
+void ss_render_light_init(struct ss_render_light *l, double azimuth_deg,
+                          double altitude_deg, double zscale);
+double ss_render_hillshade(const struct ss_render_light *l, double gx, double gy);
+
+/* Colour-map index 0..255 of height h on [zmin, zmax], clamped. */
+static inline int ss_render_cmap_index(double h, double zmin, double zmax)
+{
+	const double t = (h - zmin) / (zmax - zmin) * 255.0;
+	return t <= 0.0 ? 0 : t >= 255.0 ? 255 : (int)(t + 0.5);
+}
+
+/* ---- the styles: raster -> the first raster->width columns of img ---- */
+
+void ss_render_shaded(const struct ss_render_raster *r, const struct ss_render_options *o,
+                      double zmin, double zmax, struct ss_render_image *img, int parallel);
+void ss_render_gray16(const struct ss_render_raster *r, double zmin, double zmax,
+                      struct ss_render_image *img, int parallel);
+
+/* oblique.c: picture size for a raster (the camera framing depends only on
+ * the grid and the height scale, so every frame of a series matches). */
+void ss_render_oblique_size(const struct ss_render_raster *r,
+                            const struct ss_render_options *o, double zmin, double zmax,
+                            int *width, int *height);
+int ss_render_oblique(const struct ss_render_raster *r, const struct ss_render_options *o,
+                      double zmin, double zmax, struct ss_render_image *img, int parallel);
+
+/* ---- overlay.c: label and colour bar --------------------------------- */
+
+/* Integer magnification of the 5 x 7 font for a picture of w x h px. */
+int ss_render_font_scale(int w, int h);
+int ss_render_text_width(const char *text, int scale);
+/* Draw text with its top-left corner at (x, y) in colour rgb (8-bit RGB
+ * pictures), clipped to the picture. */
+void ss_render_draw_text(struct ss_render_image *img, int x, int y, int scale,
+                         const char *text, const uint8_t rgb[3]);
+/* "t = 12.5 s" on a dark box at the top left. */
+void ss_render_draw_label(struct ss_render_image *img, int pic_w, int pic_h, double time);
+/* Width of the colour-bar strip added right of a pic_w x pic_h picture. */
+int ss_render_colorbar_width(int pic_w, int pic_h, double zmin, double zmax);
+/* Draw the colour bar in columns x0 .. img->width - 1. */
+void ss_render_draw_colorbar(struct ss_render_image *img, int x0, int pic_h,
+                             enum ss_render_cmap cmap, double zmin, double zmax);
+
+/* ---- series.c: the HDF5 file (the only includer of <hdf5.h>) --------- */
+
+struct ss_render_h5;                /* the open file: opaque */
+
+struct ss_render_source {
+	char path[4096];
+	int nx, ny;                 /* cells */
+	long long count;            /* snapshots */
+	double dx, dy;              /* m */
+	double *time;               /* count entries, s */
+	uint8_t *cell_type;         /* nx * ny, south row first */
+	struct ss_render_h5 *h5;
+};
+
+/* Open and check a sandslide output file (SS_ERR_INPUT with a message if
+ * it is not one) and read its times and cell types. */
+int ss_render_source_open(struct ss_render_source *s, const char *path);
+void ss_render_source_close(struct ss_render_source *s);
+
+/* Rows j0 .. j0 + rows - 1 of snapshot t into buf (rows * nx, south row
+ * first).  Safe to call from several threads (one read at a time). */
+int ss_render_source_read_rows(struct ss_render_source *s, long long t, int j0, int rows,
+                               double *buf);
+
+/* Rows per read: whole HDF5 chunks, about 8 MB. */
+int ss_render_source_block_rows(const struct ss_render_source *s);
+
+/* Lowest and highest finite height on flow and open cells of snapshots
+ * first .. last (inclusive); +INFINITY/-INFINITY when there are none. */
+int ss_render_source_range(struct ss_render_source *s, long long first, long long last,
+                           double *zmin, double *zmax);
+
+/* ---- frame.c: one frame from a source -------------------------------- */
+
+/* Fill in a missing zmin or zmax (NAN) from the data's range [lo, hi]
+ * (empty: 0..1, flat: widened by 0.5 m each way); SS_ERR_INPUT naming
+ * `what` if the scale is then empty. */
+int ss_render_scale_resolve(double *zmin, double *zmax, double lo, double hi,
+                            const char *what);
+
+/* Everything that is the same for all frames of a series. */
+struct ss_render_plan {
+	struct ss_render_options look;
+	double zmin, zmax;          /* m, resolved */
+	struct ss_render_resampler rs;
+	uint8_t *pixel_type;        /* rs.width * rs.height */
+	int image_w, image_h;       /* the picture with its colour bar */
+	int pic_w, pic_h;           /* the picture without it */
+};
+
+/* Set up a plan for a grid of nx x ny cells (cell_type with stride, NULL:
+ * all flow) once zmin and zmax are known. */
+int ss_render_plan_init(struct ss_render_plan *p, const struct ss_render_options *look,
+                        int nx, int ny, double dx, double dy, const uint8_t *cell_type,
+                        ptrdiff_t type_stride, double zmin, double zmax, int parallel);
+void ss_render_plan_release(struct ss_render_plan *p);
+
+/* Colour the resampled heights (width * height) into img (initialised
+ * here), with label and colour bar. */
+int ss_render_plan_draw(const struct ss_render_plan *p, const double *pixel_h, double time,
+                        struct ss_render_image *img, int parallel);
+
+/* Render snapshot t of s to path (parallel: split rows between threads). */
+int ss_render_plan_snapshot(const struct ss_render_plan *p, struct ss_render_source *s,
+                            long long t, const char *path, int parallel);
+
+/* series_render.c: dir must be a writable folder, or a missing one whose
+ * parent is (created when `create`); SS_ERR_INPUT says which it is not. */
+int ss_render_check_dir(const char *dir, int create);
+
+/* Nice round numbers: z formatted with the fewest digits that tell apart
+ * values `step` apart ("0.35", "12"). */
+void ss_render_format_height(double z, double step, char *out, size_t size);
+
+#endif

@@ -1,0 +1,415 @@
+/*
+ * oblique.c - a perspective view of the sand surface from an elevated
+ * camera, like the 3-D panels of [Paper] Figs. 5-6, drawn in software as
+ * z-buffered triangles.
+ *
+ * Scene (x east, y north, z up, metres; z = zscale (h - zmin)):
+ *   - the sand surface: a triangle mesh through the pixel centres of the
+ *     resampled raster, two triangles per square, each vertex coloured by
+ *     the colour map and lit like the shaded style (Horn gradient);
+ *     vertices on walls take the mean height of their sand neighbours, so
+ *     the surface runs under the wall blocks without a step;
+ *   - walls: a block per wall pixel, its top 10 % of the height range
+ *     above zmax, sides only where the neighbour is not a wall;
+ *   - a skirt down to a base 8 % of the range below zmin along the edges
+ *     of the grid, so the sand reads as a solid slab.
+ * Camera: at compass bearing view_azimuth and elevation view_elevation
+ * from the centre of the scene's box, far enough that the box's bounding
+ * sphere fills a 30 degree field of view; the picture frames the projected
+ * box.  The framing depends only on the grid and the height scale, so
+ * every frame of a series has the same camera.
+ *
+ * Rasterising: pixel centres inside a triangle (edge functions) take the
+ * depth 1/Z interpolated linearly on screen (exact for perspective) and
+ * the vertex colours (Gouraud).  A pixel keeps the nearest triangle; on a
+ * tie the one drawn first.  The picture is split into bands of rows
+ * shared between threads; each band draws every triangle in the same
+ * order, so the bits do not depend on the number of threads.
+ */
+#include "internal.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "sandslide/error.h"
+#include "sandslide/grid.h"
+#include "sandslide/parallel.h"
+
+#define WALL_RISE 0.10          /* wall tops above zmax, fraction of the range */
+#define BASE_DEPTH 0.08         /* slab base below zmin, fraction of the range */
+#define FIELD_OF_VIEW_DEG 30.0
+#define MARGIN 0.03             /* of the picture width, on every side */
+#define AMBIENT 0.4
+
+static const uint8_t wall_rgb[3] = {0x8c, 0x8c, 0x96};   /* lit faces of the blocks */
+static const uint8_t skirt_rgb[3] = {0x9a, 0x86, 0x64};  /* the slab's sides */
+
+struct camera {
+	double ex, ey, ez;          /* eye, m */
+	double r[3], u[3], f[3];    /* right, up, forward (unit) */
+	double sx0, sy1;            /* projected left and top of the box */
+	double scale;               /* px per unit of projected coordinate */
+	double margin;              /* px */
+	int width, height;          /* px */
+	double z_floor, z_wall;     /* m, scene heights of the base and wall tops */
+};
+
+static void project(const struct camera *c, double x, double y, double z, double *sx,
+                    double *sy, double *iz)
+{
+	const double vx = x - c->ex, vy = y - c->ey, vz = z - c->ez;
+	const double X = vx * c->r[0] + vy * c->r[1] + vz * c->r[2];
+	const double Y = vx * c->u[0] + vy * c->u[1] + vz * c->u[2];
+	const double Z = vx * c->f[0] + vy * c->f[1] + vz * c->f[2];
+	*iz = 1.0 / Z;
+	*sx = X / Z;
+	*sy = Y / Z;
+}
+
+/* The camera for a raster and height scale; width is the picture's. */
+static void camera_init(struct camera *c, const struct ss_render_raster *ra,
+                        const struct ss_render_options *o, double zmin, double zmax)
+{
+	const double lx = ra->width * ra->px_dx, ly = ra->height * ra->px_dy;
+	const double range = o->zscale * (zmax - zmin);
+	c->z_floor = -BASE_DEPTH * range;
+	c->z_wall = (1.0 + WALL_RISE) * range;
+	const double cx = 0.5 * lx, cy = 0.5 * ly, cz = 0.5 * (c->z_floor + c->z_wall);
+	const double dz = c->z_wall - c->z_floor;
+	const double radius = 0.5 * sqrt(lx * lx + ly * ly + dz * dz);
+	const double dist = radius / sin(0.5 * FIELD_OF_VIEW_DEG * M_PI / 180.0);
+	const double az = o->view_azimuth_deg * M_PI / 180.0;
+	const double el = o->view_elevation_deg * M_PI / 180.0;
+	const double d[3] = {sin(az) * cos(el), cos(az) * cos(el), sin(el)};
+	c->ex = cx + dist * d[0];
+	c->ey = cy + dist * d[1];
+	c->ez = cz + dist * d[2];
+	c->f[0] = -d[0], c->f[1] = -d[1], c->f[2] = -d[2];
+	/* right is horizontal whatever the elevation: no singularity overhead */
+	c->r[0] = -cos(az), c->r[1] = sin(az), c->r[2] = 0.0;
+	c->u[0] = c->r[1] * c->f[2] - c->r[2] * c->f[1];
+	c->u[1] = c->r[2] * c->f[0] - c->r[0] * c->f[2];
+	c->u[2] = c->r[0] * c->f[1] - c->r[1] * c->f[0];
+
+	double sx0 = INFINITY, sx1 = -INFINITY, sy0 = INFINITY, sy1 = -INFINITY;
+	for (int k = 0; k < 8; k++) {
+		double sx, sy, iz;
+		project(c, k & 1 ? lx : 0.0, k & 2 ? ly : 0.0, k & 4 ? c->z_wall : c->z_floor, &sx,
+		        &sy, &iz);
+		sx0 = fmin(sx0, sx), sx1 = fmax(sx1, sx);
+		sy0 = fmin(sy0, sy), sy1 = fmax(sy1, sy);
+	}
+	c->width = ra->width > 64 ? ra->width : 64;
+	c->margin = MARGIN * c->width;
+	c->scale = (c->width - 2.0 * c->margin) / (sx1 - sx0);
+	c->sx0 = sx0;
+	c->sy1 = sy1;
+	int h = (int)ceil((sy1 - sy0) * c->scale + 2.0 * c->margin);
+	c->height = h < 16 ? 16 : h > 4 * c->width ? 4 * c->width : h;
+}
+
+void ss_render_oblique_size(const struct ss_render_raster *r,
+                            const struct ss_render_options *o, double zmin, double zmax,
+                            int *width, int *height)
+{
+	struct camera c;
+	camera_init(&c, r, o, zmin, zmax);
+	*width = c.width;
+	*height = c.height;
+}
+
+/* A projected vertex: picture coordinates, 1/depth and colour. */
+struct vtx {
+	float x, y, iz;
+	uint8_t c[3];
+};
+
+static struct vtx make_vtx(const struct camera *c, double x, double y, double z,
+                           const uint8_t rgb[3], double brightness)
+{
+	struct vtx v;
+	double sx, sy, iz;
+	project(c, x, y, z, &sx, &sy, &iz);
+	v.x = (float)(c->margin + (sx - c->sx0) * c->scale);
+	v.y = (float)(c->margin + (c->sy1 - sy) * c->scale);
+	v.iz = (float)iz;
+	for (int k = 0; k < 3; k++)
+		v.c[k] = (uint8_t)(rgb[k] * brightness + 0.5);
+	return v;
+}
+
+/* Brightness of a flat face of unit normal n. */
+static double face_light(const struct ss_render_light *l, double nx, double ny, double nz)
+{
+	const double d = nx * l->lx + ny * l->ly + nz * l->lz;
+	return AMBIENT + (1.0 - AMBIENT) * (d > 0.0 ? d : 0.0);
+}
+
+/* What one band of rows draws into. */
+struct target {
+	struct ss_render_image *img;
+	float *depth;               /* 1/Z per pixel; 0: nothing yet */
+	int width;                  /* columns of the view (the picture may be
+	                             * wider: a colour bar) */
+	int y0, y1;                 /* rows of the band */
+};
+
+static inline double edge(const struct vtx *a, const struct vtx *b, double px, double py)
+{
+	return ((double)b->x - a->x) * (py - a->y) - ((double)b->y - a->y) * (px - a->x);
+}
+
+static void draw_triangle(struct target *t, const struct vtx *a, const struct vtx *b,
+                          const struct vtx *c)
+{
+	const double area = edge(a, b, c->x, c->y);
+	if (fabs(area) < 1e-12)
+		return;
+	const double ymin = fmin(a->y, fmin(b->y, c->y)), ymax = fmax(a->y, fmax(b->y, c->y));
+	int ya = (int)ceil(ymin - 0.5), yb = (int)floor(ymax - 0.5);
+	if (ya < t->y0)
+		ya = t->y0;
+	if (yb > t->y1 - 1)
+		yb = t->y1 - 1;
+	if (ya > yb)
+		return;
+	const double xmin = fmin(a->x, fmin(b->x, c->x)), xmax = fmax(a->x, fmax(b->x, c->x));
+	int xa = (int)ceil(xmin - 0.5), xb = (int)floor(xmax - 0.5);
+	if (xa < 0)
+		xa = 0;
+	if (xb > t->width - 1)
+		xb = t->width - 1;
+	const double inv = 1.0 / area, eps = -1e-9;
+	for (int y = ya; y <= yb; y++) {
+		const double py = y + 0.5;
+		for (int x = xa; x <= xb; x++) {
+			const double px = x + 0.5;
+			const double wa = edge(b, c, px, py) * inv, wb = edge(c, a, px, py) * inv;
+			const double wc = 1.0 - wa - wb;
+			if (wa < eps || wb < eps || wc < eps)
+				continue;
+			const float iz = (float)(wa * a->iz + wb * b->iz + wc * c->iz);
+			const size_t k = (size_t)y * t->img->width + x;
+			if (iz <= t->depth[k])
+				continue;
+			t->depth[k] = iz;
+			uint8_t *p = t->img->pixels + (size_t)y * t->img->row_bytes + 3 * (size_t)x;
+			for (int ch = 0; ch < 3; ch++)
+				p[ch] = (uint8_t)(wa * a->c[ch] + wb * b->c[ch] + wc * c->c[ch] + 0.5);
+		}
+	}
+}
+
+static void draw_quad(struct target *t, const struct vtx *a, const struct vtx *b,
+                      const struct vtx *c, const struct vtx *d)
+{
+	draw_triangle(t, a, b, c);
+	draw_triangle(t, a, c, d);
+}
+
+/* Is the quad's bounding box clear of the band? */
+static int outside_band(const struct target *t, float y_lo, float y_hi)
+{
+	return y_hi < t->y0 - 1 || y_lo > t->y1 + 1;
+}
+
+/* Height of the surface mesh at raster pixel k: walls and NaN take the mean
+ * of their sand neighbours (or the base if they have none). */
+static double mesh_height(const struct ss_render_raster *r, int x, int y, double base)
+{
+	const size_t k = (size_t)y * r->width + x;
+	if (r->type[k] != SS_CELL_WALL && !isnan(r->h[k]))
+		return r->h[k];
+	double sum = 0.0;
+	int n = 0;
+	for (int v = -1; v <= 1; v++)
+		for (int u = -1; u <= 1; u++) {
+			const int xn = x + u, yn = y + v;
+			if (xn < 0 || yn < 0 || xn >= r->width || yn >= r->height)
+				continue;
+			const size_t m = (size_t)yn * r->width + xn;
+			if (r->type[m] != SS_CELL_WALL && !isnan(r->h[m])) {
+				sum += r->h[m];
+				n++;
+			}
+		}
+	return n ? sum / n : base;
+}
+
+/* The surface's vertices, one per raster pixel. */
+static void surface_vertices(const struct ss_render_raster *r, const struct camera *c,
+                             const struct ss_render_options *o, double zmin, double zmax,
+                             struct vtx *v, int parallel)
+{
+	(void)parallel;   /* used by the pragmas only */
+	uint8_t lut[256][3];
+	ss_render_cmap_table(o->cmap, lut);
+	struct ss_render_light light;
+	ss_render_light_init(&light, o->azimuth_deg, o->altitude_deg, o->zscale);
+	static const uint8_t open[3] = {SS_RENDER_OPEN_RGB}, nodata[3] = {SS_RENDER_NODATA_RGB};
+	const int W = r->width, H = r->height;
+	const double base = zmin - BASE_DEPTH * (zmax - zmin);
+
+	#pragma omp parallel for schedule(static) if(parallel)
+	for (int y = 0; y < H; y++)
+		for (int x = 0; x < W; x++) {
+			const size_t k = (size_t)y * W + x;
+			const double h = mesh_height(r, x, y, base);
+			const double wx = (x + 0.5) * r->px_dx, wy = (H - y - 0.5) * r->px_dy;
+			double b = 1.0;
+			const uint8_t *rgb = wall_rgb;
+			if (r->type[k] != SS_CELL_WALL) {
+				double gx, gy;
+				ss_render_gradient(r, x, y, &gx, &gy);
+				b = isnan(r->h[k]) ? 1.0 : ss_render_hillshade(&light, gx, gy);
+				rgb = isnan(r->h[k]) ? nodata : r->type[k] == SS_CELL_OPEN
+				      ? open : lut[ss_render_cmap_index(h, zmin, zmax)];
+			}
+			v[k] = make_vtx(c, wx, wy, o->zscale * (h - zmin), rgb, b);
+		}
+}
+
+/* The sides of the slab along the grid's edges, between neighbouring
+ * edge vertices. */
+static void draw_skirt(struct target *t, const struct ss_render_raster *r,
+                       const struct camera *c, const struct ss_render_light *light,
+                       const struct vtx *v)
+{
+	const int W = r->width, H = r->height;
+	/* edges: south (y = H-1, normal -y), north (y = 0, +y), west, east */
+	for (int side = 0; side < 4; side++) {
+		const int along_x = side < 2, n = along_x ? W : H;
+		const double nx = side == 2 ? -1.0 : side == 3 ? 1.0 : 0.0;
+		const double ny = side == 0 ? -1.0 : side == 1 ? 1.0 : 0.0;
+		const double b = face_light(light, nx, ny, 0.0);
+		for (int s = 0; s + 1 < n; s++) {
+			const int x0 = along_x ? s : side == 2 ? 0 : W - 1;
+			const int y0 = along_x ? (side == 0 ? H - 1 : 0) : s;
+			const int x1 = along_x ? s + 1 : x0, y1 = along_x ? y0 : s + 1;
+			const size_t k0 = (size_t)y0 * W + x0, k1 = (size_t)y1 * W + x1;
+			if (r->type[k0] == SS_CELL_WALL && r->type[k1] == SS_CELL_WALL)
+				continue;
+			const struct vtx *a = &v[k0], *d = &v[k1];
+			const struct vtx b0 = make_vtx(c, (x0 + 0.5) * r->px_dx, (H - y0 - 0.5) * r->px_dy,
+			                               c->z_floor, skirt_rgb, b);
+			const struct vtx b1 = make_vtx(c, (x1 + 0.5) * r->px_dx, (H - y1 - 0.5) * r->px_dy,
+			                               c->z_floor, skirt_rgb, b);
+			struct vtx ta = *a, td = *d;   /* the top edge in the skirt's colour */
+			for (int ch = 0; ch < 3; ch++)
+				ta.c[ch] = td.c[ch] = (uint8_t)(skirt_rgb[ch] * b + 0.5);
+			if (outside_band(t, fminf(fminf(ta.y, td.y), fminf(b0.y, b1.y)),
+			                 fmaxf(fmaxf(ta.y, td.y), fmaxf(b0.y, b1.y))))
+				continue;
+			draw_quad(t, &ta, &td, &b1, &b0);
+		}
+	}
+}
+
+/* A block on wall pixel (x, y): its top, and sides facing non-walls. */
+static void draw_wall(struct target *t, const struct ss_render_raster *r,
+                      const struct camera *c, const struct ss_render_light *light, int x,
+                      int y)
+{
+	const int W = r->width, H = r->height;
+	const double x0 = x * r->px_dx, x1 = (x + 1) * r->px_dx;
+	const double y1 = (H - y) * r->px_dy, y0 = (H - y - 1) * r->px_dy;   /* north, south */
+	const double zt = c->z_wall, zb = c->z_floor;
+	/* quick reject on the top face's projection, widened by the sides */
+	struct vtx top[4];
+	const double bt = face_light(light, 0, 0, 1);
+	top[0] = make_vtx(c, x0, y0, zt, wall_rgb, bt);
+	top[1] = make_vtx(c, x1, y0, zt, wall_rgb, bt);
+	top[2] = make_vtx(c, x1, y1, zt, wall_rgb, bt);
+	top[3] = make_vtx(c, x0, y1, zt, wall_rgb, bt);
+	struct vtx bot[4];
+	bot[0] = make_vtx(c, x0, y0, zb, wall_rgb, 1.0);
+	bot[1] = make_vtx(c, x1, y0, zb, wall_rgb, 1.0);
+	bot[2] = make_vtx(c, x1, y1, zb, wall_rgb, 1.0);
+	bot[3] = make_vtx(c, x0, y1, zb, wall_rgb, 1.0);
+	float lo = top[0].y, hi = top[0].y;
+	for (int k = 0; k < 4; k++) {
+		lo = fminf(lo, fminf(top[k].y, bot[k].y));
+		hi = fmaxf(hi, fmaxf(top[k].y, bot[k].y));
+	}
+	if (outside_band(t, lo, hi))
+		return;
+	draw_quad(t, &top[0], &top[1], &top[2], &top[3]);
+	/* sides: south (0-1), east (1-2), north (2-3), west (3-0) */
+	static const int nb[4][2] = {{0, 1}, {1, 0}, {0, -1}, {-1, 0}};
+	static const double normal[4][2] = {{0, -1}, {1, 0}, {0, 1}, {-1, 0}};
+	for (int s = 0; s < 4; s++) {
+		const int xn = x + nb[s][0], yn = y + nb[s][1];
+		if (xn >= 0 && yn >= 0 && xn < W && yn < H &&
+		    r->type[(size_t)yn * W + xn] == SS_CELL_WALL)
+			continue;
+		const double b = face_light(light, normal[s][0], normal[s][1], 0.0);
+		struct vtx a = top[s], d = top[(s + 1) & 3], p = bot[(s + 1) & 3], q = bot[s];
+		for (int ch = 0; ch < 3; ch++) {
+			const uint8_t v = (uint8_t)(wall_rgb[ch] * b + 0.5);
+			a.c[ch] = d.c[ch] = p.c[ch] = q.c[ch] = v;
+		}
+		draw_quad(t, &a, &d, &p, &q);
+	}
+}
+
+static void draw_band(struct target *t, const struct ss_render_raster *r,
+                      const struct camera *c, const struct ss_render_light *light,
+                      const struct vtx *v)
+{
+	const int W = r->width, H = r->height;
+	for (int y = 0; y + 1 < H; y++)
+		for (int x = 0; x + 1 < W; x++) {
+			const struct vtx *a = &v[(size_t)y * W + x], *b = a + 1;
+			const struct vtx *d = a + W, *e = d + 1;
+			const float lo = fminf(fminf(a->y, b->y), fminf(d->y, e->y));
+			const float hi = fmaxf(fmaxf(a->y, b->y), fmaxf(d->y, e->y));
+			if (outside_band(t, lo, hi))
+				continue;
+			draw_quad(t, a, b, e, d);
+		}
+	draw_skirt(t, r, c, light, v);
+	for (int y = 0; y < H; y++)
+		for (int x = 0; x < W; x++)
+			if (r->type[(size_t)y * W + x] == SS_CELL_WALL)
+				draw_wall(t, r, c, light, x, y);
+}
+
+int ss_render_oblique(const struct ss_render_raster *r, const struct ss_render_options *o,
+                      double zmin, double zmax, struct ss_render_image *img, int parallel)
+{
+	struct camera c;
+	camera_init(&c, r, o, zmin, zmax);
+	if (img->width < c.width || img->height != c.height)
+		SS_BUG("oblique picture %d x %d, camera %d x %d", img->width, img->height, c.width,
+		       c.height);
+	const size_t n = (size_t)r->width * r->height;
+	struct vtx *v = ss_alloc(n, sizeof *v, "oblique vertices");
+	float *depth = ss_alloc((size_t)img->width * img->height, sizeof *depth, "depth buffer");
+	if (!v || !depth) {
+		ss_free(v);
+		ss_free(depth);
+		return SS_ERR_FAIL;
+	}
+	for (int y = 0; y < img->height; y++)   /* the sky */
+		memset(img->pixels + (size_t)y * img->row_bytes, SS_RENDER_BACKGROUND,
+		       3 * (size_t)c.width);
+	surface_vertices(r, &c, o, zmin, zmax, v, parallel);
+	struct ss_render_light light;
+	ss_render_light_init(&light, o->azimuth_deg, o->altitude_deg, o->zscale);
+
+	/* bands of rows: several per thread so uneven bands balance out */
+	const int threads = parallel ? ss_parallel_max_threads() : 1;
+	const int bands = threads > 1 ? 4 * threads : 1;
+	const int rows = (img->height + bands - 1) / bands;
+	#pragma omp parallel for schedule(dynamic, 1) if(parallel)
+	for (int band = 0; band < bands; band++) {
+		struct target t = {img, depth, c.width, band * rows, (band + 1) * rows};
+		if (t.y1 > img->height)
+			t.y1 = img->height;
+		if (t.y0 < t.y1)
+			draw_band(&t, r, &c, &light, v);
+	}
+	ss_free(depth);
+	ss_free(v);
+	return SS_OK;
+}

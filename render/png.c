@@ -1,0 +1,206 @@
+/*
+ * png.c - pictures in memory and their PNG encoding (step 3 of a frame).
+ *
+ * libpng's simplified API cannot write text chunks, and the frames must
+ * carry their time and height scale, so this uses the classic write API:
+ * errors come back through a longjmp to the one setjmp below.  16-bit
+ * samples are kept native in memory and swapped to the PNG's big-endian
+ * order by libpng on little-endian machines.
+ *
+ * A frame is written as "NAME.partial" and renamed to NAME once it is
+ * complete and closed, so a picture with the final name is always whole,
+ * even if the program is killed while writing.
+ */
+#include "internal.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <png.h>
+
+#include "sandslide/error.h"
+
+int ss_render_image_init(struct ss_render_image *img, int width, int height,
+                         int channels, int bit_depth)
+{
+	memset(img, 0, sizeof *img);
+	img->time = NAN;
+	img->zmin = img->zmax = NAN;
+	img->snapshot = -1;
+	if (width < 1 || height < 1 || (channels != 1 && channels != 3) ||
+	    (bit_depth != 8 && bit_depth != 16))
+		SS_BUG("image %d x %d, %d channels, %d bits", width, height, channels, bit_depth);
+	img->width = width;
+	img->height = height;
+	img->channels = channels;
+	img->bit_depth = bit_depth;
+	img->row_bytes = (size_t)width * (size_t)channels * (size_t)(bit_depth / 8);
+	img->pixels = ss_alloc((size_t)height, img->row_bytes, "picture");
+	return img->pixels ? SS_OK : SS_ERR_FAIL;
+}
+
+void ss_render_image_release(struct ss_render_image *img)
+{
+	ss_free(img->pixels);
+	img->pixels = NULL;
+}
+
+/* libpng reports errors here; the message is kept for ours. */
+struct png_failure {
+	char message[256];
+};
+
+static void on_png_error(png_structp png, png_const_charp message)
+{
+	struct png_failure *f = png_get_error_ptr(png);
+	snprintf(f->message, sizeof f->message, "%s", message);
+	png_longjmp(png, 1);
+}
+
+static void on_png_warning(png_structp png, png_const_charp message)
+{
+	(void)png;
+	(void)message;   /* nothing we write can warrant one */
+}
+
+static int host_is_little_endian(void)
+{
+	const uint16_t one = 1;
+	return *(const uint8_t *)&one == 1;
+}
+
+/* The text chunks: enough to know what a frame shows and, for gray16, to
+ * turn its samples back into heights. */
+struct png_texts {
+	png_text t[8];
+	int n;
+	char software[64], time[40], zmin[40], zmax[40], snapshot[32];
+};
+
+static void add_text(struct png_texts *x, const char *key, const char *value)
+{
+	png_text *t = &x->t[x->n++];
+	memset(t, 0, sizeof *t);
+	t->compression = PNG_TEXT_COMPRESSION_NONE;
+	t->key = (png_charp)key;
+	t->text = (png_charp)value;
+	t->text_length = strlen(value);
+}
+
+static void fill_texts(struct png_texts *x, const struct ss_render_image *img)
+{
+	x->n = 0;
+	snprintf(x->software, sizeof x->software, "sandslide %s", SS_VERSION);
+	add_text(x, "Software", x->software);
+	if (img->source[0])
+		add_text(x, "Source", img->source);
+	add_text(x, "style", ss_render_style_name(img->style));
+	if (!isnan(img->time)) {
+		snprintf(x->time, sizeof x->time, "%.17g", img->time);
+		add_text(x, "time_s", x->time);
+	}
+	if (!isnan(img->zmin) && !isnan(img->zmax)) {
+		snprintf(x->zmin, sizeof x->zmin, "%.17g", img->zmin);
+		snprintf(x->zmax, sizeof x->zmax, "%.17g", img->zmax);
+		add_text(x, "zmin_m", x->zmin);
+		add_text(x, "zmax_m", x->zmax);
+	}
+	if (img->snapshot >= 0) {
+		snprintf(x->snapshot, sizeof x->snapshot, "%lld", img->snapshot);
+		add_text(x, "snapshot", x->snapshot);
+	}
+	if (img->style == SS_RENDER_GRAY16)
+		add_text(x, "height_m", "zmin_m + (value - 1) * (zmax_m - zmin_m) / 65534 for "
+		                        "value >= 1; value 0: wall or no data (transparent)");
+}
+
+/* Encode img into the open file f; returns 0, or -1 with failure->message. */
+static int encode(FILE *f, const struct ss_render_image *img, int compression,
+                  struct png_failure *failure)
+{
+	png_bytep *rows = malloc((size_t)img->height * sizeof *rows);
+	if (!rows) {
+		snprintf(failure->message, sizeof failure->message, "out of memory");
+		return -1;
+	}
+	for (int y = 0; y < img->height; y++)
+		rows[y] = img->pixels + (size_t)y * img->row_bytes;
+	struct png_texts texts;
+	fill_texts(&texts, img);
+
+	png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, failure, on_png_error,
+	                                          on_png_warning);
+	png_infop info = png ? png_create_info_struct(png) : NULL;
+	if (!png || !info) {
+		png_destroy_write_struct(&png, &info);
+		free(rows);
+		snprintf(failure->message, sizeof failure->message, "out of memory");
+		return -1;
+	}
+	if (setjmp(png_jmpbuf(png))) {
+		png_destroy_write_struct(&png, &info);
+		free(rows);
+		return -1;
+	}
+	png_init_io(png, f);
+	png_set_IHDR(png, info, (png_uint_32)img->width, (png_uint_32)img->height,
+	             img->bit_depth, img->channels == 3 ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_GRAY,
+	             PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+	png_set_compression_level(png, compression);
+	png_set_text(png, info, texts.t, texts.n);
+	if (img->style == SS_RENDER_GRAY16 && img->channels == 1) {
+		png_color_16 transparent = {0};   /* grey 0: walls, no data */
+		png_set_tRNS(png, info, NULL, 0, &transparent);
+	}
+	png_write_info(png, info);
+	if (img->bit_depth == 16 && host_is_little_endian())
+		png_set_swap(png);
+	png_write_image(png, rows);
+	png_write_end(png, NULL);
+	png_destroy_write_struct(&png, &info);
+	free(rows);
+	return 0;
+}
+
+int ss_render_write_png(const struct ss_render_image *img, const char *path, int compression)
+{
+	const size_t n = strlen(path) + sizeof ".partial";
+	char *tmp = malloc(n);
+	if (!tmp)
+		return ss_error_fail("out of memory");
+	snprintf(tmp, n, "%s.partial", path);
+
+	FILE *f = fopen(tmp, "wb");
+	if (!f) {
+		int err = ss_error_fail("cannot write '%s': %s", tmp, strerror(errno));
+		free(tmp);
+		return err;
+	}
+	struct png_failure failure = {""};
+	int bad = encode(f, img, compression, &failure);
+	int e = 0;
+	if (fflush(f) != 0 || ferror(f)) {
+		e = errno;
+		bad = 1;
+	}
+	if (fclose(f) != 0 && !e) {
+		e = errno;
+		bad = 1;
+	}
+	if (!bad && rename(tmp, path) != 0) {
+		e = errno;
+		bad = 1;
+	}
+	int err = SS_OK;
+	if (bad) {
+		remove(tmp);
+		err = ss_error_fail("cannot write '%s': %s", path,
+		                    failure.message[0] ? failure.message
+		                                       : e ? strerror(e) : "write error");
+	}
+	free(tmp);
+	return err;
+}

@@ -1,0 +1,343 @@
+"""`sandslide render` and `sandslide run --frames` through the command line
+(SPEC section 6): frames written in time order with their times, frame
+selection, bad input (exit 2, nothing written), the video with and without
+ffmpeg, and determinism.  Pixel-level properties are in tests/test_render.c.
+"""
+import os
+import shutil
+import struct
+import subprocess
+import zlib
+
+import h5py
+import numpy as np
+import pytest
+
+from conftest import BASE, edit, h5open, run, run_ok
+
+# BASE with five snapshots and a source, so the surface changes in time.
+CASE = edit(BASE, "output_every = 0.5", "output_every = 0.25") + (
+    "\n[source pour]\nrect = 0.2 0.4 0.6 1.2\nrate = 0.05\n")
+
+
+def read_png(path, pixels=False):
+    """Size, bit depth, colour type and text chunks of a PNG; with pixels,
+    also the samples as a numpy array (rows, columns[, channels]), decoded
+    here with zlib (no image library needed)."""
+    data = open(path, "rb").read()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n", f"{path} is not a PNG"
+    pos, idat, info = 8, [], {"text": {}}
+    while pos < len(data):
+        n, kind = struct.unpack(">I4s", data[pos:pos + 8])
+        body = data[pos + 8:pos + 8 + n]
+        pos += 12 + n
+        if kind == b"IHDR":
+            w, h, depth, ctype = struct.unpack(">IIBB", body[:10])
+            info.update(width=w, height=h, depth=depth, ctype=ctype)
+        elif kind == b"tEXt":
+            key, _, value = body.partition(b"\0")
+            info["text"][key.decode("latin-1")] = value.decode("latin-1")
+        elif kind == b"IDAT":
+            idat.append(body)
+    if not pixels:
+        return info
+    channels = {0: 1, 2: 3}[info["ctype"]]
+    bpp = channels * info["depth"] // 8
+    stride = info["width"] * bpp
+    raw = zlib.decompress(b"".join(idat))
+    out, prev = bytearray(), bytearray(stride)
+    for y in range(info["height"]):
+        f, line = raw[y * (stride + 1)], bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
+        for x in range(stride):
+            a = line[x - bpp] if x >= bpp else 0
+            b = prev[x]
+            c = prev[x - bpp] if x >= bpp else 0
+            if f == 1:
+                line[x] = (line[x] + a) & 255
+            elif f == 2:
+                line[x] = (line[x] + b) & 255
+            elif f == 3:
+                line[x] = (line[x] + (a + b) // 2) & 255
+            elif f == 4:
+                p = a + b - c
+                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+                line[x] = (line[x] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
+        out += line
+        prev = line
+    dtype = ">u2" if info["depth"] == 16 else "u1"
+    arr = np.frombuffer(bytes(out), dtype=dtype).reshape(info["height"], info["width"], channels)
+    info["pixels"] = arr[:, :, 0] if channels == 1 else arr
+    return info
+
+
+@pytest.fixture(scope="module")
+def series(tmp_path_factory):
+    """A short run: 5 snapshots of a 20 x 16 grid with a source."""
+    d = tmp_path_factory.mktemp("series")
+    (d / "case.ini").write_text(CASE)
+    run_ok(["run", "case.ini", "-o", "out.h5", "-q"], cwd=d)
+    with h5open(d / "out.h5") as f:
+        times = f["time"][:]
+    assert len(times) == 5
+    return d, times
+
+
+def frames_in(folder):
+    return sorted(n for n in os.listdir(folder))
+
+
+# ---- frames --------------------------------------------------------------
+
+def test_every_frame_in_time_order(series, tmp_path):
+    d, times = series
+    r = run_ok(["render", d / "out.h5", "-o", tmp_path / "frames"])
+    assert "wrote 5 frames" in r.stdout
+    names = frames_in(tmp_path / "frames")
+    assert names == [f"frame_{k:05d}.png" for k in range(5)], names
+    sizes = set()
+    for k, name in enumerate(names):
+        info = read_png(tmp_path / "frames" / name)
+        assert float(info["text"]["time_s"]) == times[k], f"{name}: time"
+        assert info["text"]["snapshot"] == str(k)
+        assert info["depth"] == 8 and info["ctype"] == 2, "shaded is 8-bit RGB"
+        sizes.add((info["width"], info["height"]))
+        zs = (info["text"]["zmin_m"], info["text"]["zmax_m"])
+        if k == 0:
+            scale = zs
+        assert zs == scale, "one height scale for the whole series"
+    assert sizes == {(520, 416)}, "20 x 16 cells at 26 px per cell"
+    with h5open(d / "out.h5") as f:
+        h = f["height"][:]
+        walls = f["cell_type"][:] == 1
+    assert float(scale[0]) == h[:, ~walls].min() and float(scale[1]) == h[:, ~walls].max(), \
+        "the default scale is the whole file's range"
+
+
+def test_frames_slice_and_time(series, tmp_path):
+    d, times = series
+    run_ok(["render", d / "out.h5", "-o", tmp_path / "a", "--frames", "1:4:2", "-q"])
+    names = frames_in(tmp_path / "a")
+    assert names == ["frame_00000.png", "frame_00001.png"]
+    assert [read_png(tmp_path / "a" / n)["text"]["snapshot"] for n in names] == ["1", "3"]
+    run_ok(["render", d / "out.h5", "-o", tmp_path / "b", "--frames", "-2:", "-q"])
+    assert [read_png(tmp_path / "b" / n)["text"]["snapshot"]
+            for n in frames_in(tmp_path / "b")] == ["3", "4"]
+    t = 0.5 * (times[2] + times[3]) - 0.01      # nearer snapshot 2
+    run_ok(["render", d / "out.h5", "-o", tmp_path / "c", "--time", t, "-q"])
+    assert frames_in(tmp_path / "c") == ["frame_00000.png"]
+    assert read_png(tmp_path / "c" / "frame_00000.png")["text"]["snapshot"] == "2"
+
+
+def test_gray16_heights_and_range(series, tmp_path):
+    d, times = series
+    run_ok(["render", d / "out.h5", "-o", tmp_path, "--style", "gray16", "--frames", "4",
+            "--zmin", "0", "--zmax", "0.5", "-q"])
+    info = read_png(tmp_path / "frame_00000.png", pixels=True)
+    assert info["depth"] == 16 and info["ctype"] == 0
+    assert (info["width"], info["height"]) == (20, 16), "gray16: one pixel per cell"
+    assert float(info["text"]["zmin_m"]) == 0.0 and float(info["text"]["zmax_m"]) == 0.5
+    with h5open(d / "out.h5") as f:
+        h = f["height"][4]
+        walls = f["cell_type"][:] == 1
+    v = info["pixels"][::-1].astype(float)       # north row first -> south first
+    back = (v - 1) * 0.5 / 65534
+    step = 0.5 / 65534
+    assert np.all(v[walls] == 0)
+    assert np.max(np.abs(back[~walls] - h[~walls])) <= 0.5 * step + 1e-12
+
+
+def test_styles_label_colorbar_and_size(series, tmp_path):
+    d, _ = series
+    run_ok(["render", d / "out.h5", "-o", tmp_path / "o", "--style", "oblique",
+            "--frames", "4", "--label", "-q"])
+    info = read_png(tmp_path / "o" / "frame_00000.png")
+    assert info["width"] == 520 and info["text"]["style"] == "oblique"
+    run_ok(["render", d / "out.h5", "-o", tmp_path / "c", "--frames", "4", "--colorbar",
+            "--contour", "0.05", "--cmap", "terrain", "-q"])
+    info = read_png(tmp_path / "c" / "frame_00000.png")
+    assert info["height"] == 416 and info["width"] > 520, "the colour bar widens the picture"
+    run_ok(["render", d / "out.h5", "-o", tmp_path / "m", "--frames", "4", "--max-size", "10",
+            "-q"])
+    info = read_png(tmp_path / "m" / "frame_00000.png")
+    assert (info["width"], info["height"]) == (10, 8), "--max-size 10 on 20 x 16 cells"
+
+
+def test_same_bytes_on_one_and_two_threads(series, tmp_path):
+    """Frames split between threads, or rows of one frame: the same files."""
+    d, _ = series
+    for threads in ("1", "2"):
+        run_ok(["render", d / "out.h5", "-o", tmp_path / threads, "--threads", threads,
+                "--style", "oblique", "-q"])
+        run_ok(["render", d / "out.h5", "-o", tmp_path / ("one" + threads), "--frames", "3",
+                "--threads", threads, "-q"])
+    for name in frames_in(tmp_path / "1"):
+        assert (tmp_path / "1" / name).read_bytes() == (tmp_path / "2" / name).read_bytes(), name
+    assert ((tmp_path / "one1" / "frame_00000.png").read_bytes() ==
+            (tmp_path / "one2" / "frame_00000.png").read_bytes())
+
+
+# ---- bad input: exit 2, a clear message, nothing written ------------------
+
+def make_empty_series(path):
+    """A file laid out like sandslide output but with no snapshot."""
+    with h5py.File(path, "w") as f:
+        f.attrs["source"] = np.bytes_("sandslide 0.1.0")
+        f.attrs["dx"] = 0.1
+        f.attrs["dy"] = 0.1
+        f.create_dataset("height", shape=(0, 4, 5), maxshape=(None, 4, 5), dtype="f8",
+                         chunks=(1, 4, 5))
+        f.create_dataset("time", shape=(0,), maxshape=(None,), dtype="f8", chunks=(16,))
+        f.create_dataset("cell_type", data=np.zeros((4, 5), dtype="u1"))
+
+
+@pytest.mark.parametrize("what", ["text", "hdf5", "empty", "missing"])
+def test_bad_files(tmp_path, what):
+    path = tmp_path / "in.h5"
+    if what == "text":
+        path.write_text("not hdf5\n")
+        expect = "is not an HDF5 file"
+    elif what == "hdf5":
+        with h5py.File(path, "w") as f:
+            f["height"] = np.zeros((2, 3, 3))
+        expect = "is not a sandslide output file"
+    elif what == "empty":
+        make_empty_series(path)
+        expect = "holds no snapshots"
+    else:
+        expect = "cannot open"
+    r = run(["render", path, "-o", tmp_path / "frames"])
+    assert r.returncode == 2, r.stderr
+    assert expect in r.stderr and str(path) in r.stderr, r.stderr
+    assert not (tmp_path / "frames").exists(), "nothing written"
+
+
+@pytest.mark.parametrize("args, expect", [
+    (["--frames", "5:9"], "outside the series"),
+    (["--frames", "7"], "outside the series"),
+    (["--frames", "3:1"], "selects no snapshot"),
+    (["--frames", "a:b"], "expected A:B:STEP"),
+    (["--time", "99"], "outside the series"),
+    (["--zmin", "0.5", "--zmax", "0.1"], "not below --zmax"),
+    (["--zmin", "0.3", "--zmax", "0.3"], "not below --zmax"),
+    (["--zmin", "5"], "give --zmax too"),
+    (["--style", "gray16", "--label"], "do not apply to --style gray16"),
+    (["--style", "ruled"], "expected shaded, gray16, oblique"),
+    (["--altitude", "0"], "(0, 90]"),
+    (["--fps", "0", "--video", "v.mp4"], "--fps"),
+])
+def test_bad_choices(series, tmp_path, args, expect):
+    d, _ = series
+    r = run(["render", d / "out.h5", "-o", tmp_path / "frames"] + args, cwd=tmp_path)
+    assert r.returncode == 2, r.stderr
+    assert expect in r.stderr, r.stderr
+    assert not (tmp_path / "frames").exists(), "nothing written"
+
+
+def test_bad_output_folders(series, tmp_path):
+    d, _ = series
+    r = run(["render", d / "out.h5", "-o", tmp_path / "no" / "such"])
+    assert r.returncode == 2 and "does not exist" in r.stderr, r.stderr
+    (tmp_path / "file").write_text("x")
+    r = run(["render", d / "out.h5", "-o", tmp_path / "file"])
+    assert r.returncode == 2 and "not a folder" in r.stderr, r.stderr
+    r = run(["render", d / "out.h5", "-o", tmp_path / "f", "--video", tmp_path / "no" / "v.mp4"])
+    assert r.returncode == 2 and "does not exist" in r.stderr, r.stderr
+    assert not (tmp_path / "f").exists()
+    if os.geteuid() != 0:       # root writes anywhere
+        locked = tmp_path / "locked"
+        locked.mkdir(mode=0o555)
+        r = run(["render", d / "out.h5", "-o", locked])
+        assert r.returncode == 2 and "not writable" in r.stderr, r.stderr
+        assert os.listdir(locked) == []
+
+
+def test_no_partial_frames_left(series, tmp_path):
+    d, _ = series
+    run_ok(["render", d / "out.h5", "-o", tmp_path, "-q"])
+    assert not [n for n in os.listdir(tmp_path) if "partial" in n]
+
+
+# ---- video ---------------------------------------------------------------
+
+def test_video_without_ffmpeg_keeps_frames(series, tmp_path):
+    d, _ = series
+    empty = tmp_path / "bin"
+    empty.mkdir()
+    r = run(["render", d / "out.h5", "-o", tmp_path / "frames", "--video", tmp_path / "v.mp4"],
+            env={**os.environ, "PATH": str(empty)})
+    assert r.returncode == 0, r.stderr
+    assert "ffmpeg is not on PATH" in r.stderr
+    assert len(frames_in(tmp_path / "frames")) == 5, "the frames are kept"
+    assert not (tmp_path / "v.mp4").exists()
+
+
+@pytest.mark.skipif(not (shutil.which("ffmpeg") and shutil.which("ffprobe")),
+                    reason="ffmpeg/ffprobe not installed")
+def test_video_frame_count(series, tmp_path):
+    d, _ = series
+    # a frame left over from a longer earlier series must not get in
+    (tmp_path / "frames").mkdir()
+    (tmp_path / "frames" / "frame_00005.png").write_bytes(b"not a picture")
+    r = run_ok(["render", d / "out.h5", "-o", tmp_path / "frames", "--video",
+                tmp_path / "v.mp4", "--fps", "10", "--max-size", "101"], timeout=300)
+    assert "left from an earlier render" in r.stdout
+    assert (tmp_path / "v.mp4").stat().st_size > 0
+    assert not (tmp_path / "v.partial.mp4").exists()
+    probe = subprocess.run(
+        ["ffprobe", "-v", "error", "-count_frames", "-select_streams", "v:0",
+         "-show_entries", "stream=nb_read_frames,codec_name,pix_fmt", "-of",
+         "default=noprint_wrappers=1", str(tmp_path / "v.mp4")],
+        capture_output=True, text=True, timeout=60)
+    fields = dict(line.split("=", 1) for line in probe.stdout.split())
+    assert fields == {"codec_name": "h264", "pix_fmt": "yuv420p", "nb_read_frames": "5"}, \
+        probe.stdout + probe.stderr
+
+
+# ---- run --frames ---------------------------------------------------------
+
+def test_run_frames_as_written(tmp_path):
+    (tmp_path / "case.ini").write_text(CASE)
+    r = run_ok(["run", "case.ini", "-o", "out.h5", "--frames", "frames", "--label"],
+               cwd=tmp_path)
+    assert "wrote 5 frames to frames/" in r.stdout
+    with h5open(tmp_path / "out.h5") as f:
+        times = f["time"][:]
+        hmax = f["height"][:].max()
+        hmin = f["height"][:].min()
+    names = frames_in(tmp_path / "frames")
+    assert names == [f"frame_{k:05d}.png" for k in range(5)]
+    infos = [read_png(tmp_path / "frames" / n) for n in names]
+    assert [float(i["text"]["time_s"]) for i in infos] == list(times)
+    scales = {(i["text"]["zmin_m"], i["text"]["zmax_m"]) for i in infos}
+    assert len(scales) == 1, "one scale for all the frames of the run"
+    zmin, zmax = map(float, scales.pop())
+    # flat 0.2 m with an open side at 0 m; the source adds at most 0.05 m/s x 1 s
+    assert zmin == 0.0 and zmax == pytest.approx(0.25)
+    # (up to the round-off of summing the source's increments)
+    assert zmin <= hmin and hmax <= zmax * (1 + 1e-12), "the bound holds every height"
+
+
+def test_run_frames_bad_folder_touches_nothing(tmp_path):
+    (tmp_path / "case.ini").write_text(CASE)
+    r = run(["run", "case.ini", "-o", "out.h5", "--frames", "no/such"], cwd=tmp_path)
+    assert r.returncode == 2 and "does not exist" in r.stderr, r.stderr
+    assert not (tmp_path / "out.h5").exists()
+    r = run(["run", "case.ini", "-o", "out.h5", "--label"], cwd=tmp_path)
+    assert r.returncode == 2 and "needs --frames" in r.stderr, r.stderr
+    r = run(["run", "case.ini", "-o", "out.h5", "--frames", "f", "--zmin", "1", "--zmax", "0"],
+            cwd=tmp_path)
+    assert r.returncode == 2 and "not below --zmax" in r.stderr, r.stderr
+    assert not (tmp_path / "out.h5").exists() and not (tmp_path / "f").exists()
+
+
+def test_help_and_usage(tmp_path):
+    r = run_ok(["render", "--help"])
+    for option in ("--frames", "--time", "--style", "--video", "--max-size", "--contour",
+                   "--colorbar", "--label", "--view-azimuth", "--zmin"):
+        assert option in r.stdout, option
+    assert "render" in run_ok(["--help"]).stdout
+    assert "--frames DIR" in run_ok(["run", "--help"]).stdout
+    r = run(["render"])
+    assert r.returncode == 2 and "needs a sandslide output file" in r.stderr
+    r = run(["render", "x.h5", "--bogus"])
+    assert r.returncode == 2 and "unknown option" in r.stderr
