@@ -25,7 +25,7 @@ void ss_render_options_default(struct ss_render_options *o)
 	o->altitude_deg = 45.0;
 	o->zscale = 1.0;
 	o->view_azimuth_deg = 200.0;
-	o->view_elevation_deg = 35.0;
+	o->view_elevation_deg = 45.0;
 	o->compression = 6;
 }
 
@@ -120,7 +120,7 @@ int ss_render_plan_init(struct ss_render_plan *p, const struct ss_render_options
 	p->pic_w = w;
 	p->pic_h = h;
 	if (look->style == SS_RENDER_OBLIQUE) {
-		const struct ss_render_raster r = {w, h, p->rs.px_dx, p->rs.px_dy, NULL, NULL, 1, 1};
+		const struct ss_render_raster r = {w, h, p->rs.px_dx, p->rs.px_dy, NULL, w, NULL, 1, 1};
 		ss_render_oblique_size(&r, look, zmin, zmax, &p->pic_w, &p->pic_h);
 	}
 	p->image_w = p->pic_w;
@@ -130,8 +130,9 @@ int ss_render_plan_init(struct ss_render_plan *p, const struct ss_render_options
 	return SS_OK;
 }
 
-int ss_render_plan_draw(const struct ss_render_plan *p, const double *pixel_h, double time,
-                        struct ss_render_image *img, int parallel)
+int ss_render_plan_draw(const struct ss_render_plan *p, const double *pixel_h,
+                        ptrdiff_t stride, double time, struct ss_render_image *img,
+                        int parallel)
 {
 	const struct ss_render_options *o = &p->look;
 	const int gray = o->style == SS_RENDER_GRAY16;
@@ -141,8 +142,12 @@ int ss_render_plan_draw(const struct ss_render_plan *p, const double *pixel_h, d
 	img->zmin = p->zmin;
 	img->zmax = p->zmax;
 	img->style = o->style;
+	if (o->style != SS_RENDER_OBLIQUE) {
+		img->px_dx = p->rs.px_dx;
+		img->px_dy = p->rs.px_dy;
+	}
 	const struct ss_render_raster r = {
-		p->rs.width, p->rs.height, p->rs.px_dx, p->rs.px_dy, pixel_h, p->pixel_type,
+		p->rs.width, p->rs.height, p->rs.px_dx, p->rs.px_dy, pixel_h, stride, p->pixel_type,
 		p->rs.width > p->rs.nx ? (int)lround((double)p->rs.width / p->rs.nx) : 1,
 		p->rs.height > p->rs.ny ? (int)lround((double)p->rs.height / p->rs.ny) : 1,
 	};
@@ -182,35 +187,72 @@ static int alloc_accumulators(const struct ss_render_plan *p, double **hw, doubl
 	return SS_OK;
 }
 
+/* The pixel heights of snapshot t: one pixel per cell reads the snapshot
+ * as it is (rows flipped by a negative stride, no copy); otherwise the
+ * cells stream through the resampler a block of rows at a time. */
+static int snapshot_heights(const struct ss_render_plan *p, struct ss_render_source *s,
+                            long long t, double **buf, double **acc_w, const double **h,
+                            ptrdiff_t *stride, int parallel)
+{
+	*acc_w = NULL;
+	const int block = ss_render_source_block_rows(s);
+	if (ss_render_resampler_is_identity(&p->rs)) {
+		*buf = ss_alloc((size_t)s->nx * (size_t)s->ny, sizeof **buf, "snapshot heights");
+		if (!*buf)
+			return SS_ERR_FAIL;
+		for (int j0 = 0; j0 < s->ny; j0 += block) {
+			const int rows = s->ny - j0 < block ? s->ny - j0 : block;
+			int err = ss_render_source_read_rows(s, t, j0, rows, *buf + (size_t)j0 * s->nx);
+			if (err)
+				return err;
+		}
+		*h = *buf + (size_t)(s->ny - 1) * s->nx;
+		*stride = -(ptrdiff_t)s->nx;
+		return SS_OK;
+	}
+	double *rows_buf = ss_alloc((size_t)block * (size_t)s->nx, sizeof *rows_buf, "height rows");
+	if (!rows_buf || alloc_accumulators(p, buf, acc_w)) {
+		ss_free(rows_buf);
+		return SS_ERR_FAIL;
+	}
+	int err = SS_OK;
+	for (int j0 = 0; j0 < s->ny && !err; j0 += block) {
+		const int rows = s->ny - j0 < block ? s->ny - j0 : block;
+		if (!(err = ss_render_source_read_rows(s, t, j0, rows, rows_buf)))
+			ss_render_resample_rows(&p->rs, rows_buf, s->nx, s->cell_type, s->nx, j0, rows,
+			                        *buf, *acc_w, parallel);
+	}
+	ss_free(rows_buf);
+	if (!err)
+		ss_render_resample_finish(&p->rs, *buf, *acc_w, parallel);
+	*h = *buf;
+	*stride = p->rs.width;
+	return err;
+}
+
 int ss_render_plan_snapshot(const struct ss_render_plan *p, struct ss_render_source *s,
                             long long t, const char *path, int parallel)
 {
-	double *hw, *w;
-	if (alloc_accumulators(p, &hw, &w))
-		return SS_ERR_FAIL;
-	const int block = ss_render_source_block_rows(s);
-	double *buf = ss_alloc((size_t)block * (size_t)s->nx, sizeof *buf, "height rows");
-	int err = buf ? SS_OK : SS_ERR_FAIL;
-	for (int j0 = 0; j0 < s->ny && !err; j0 += block) {
-		const int rows = s->ny - j0 < block ? s->ny - j0 : block;
-		if (!(err = ss_render_source_read_rows(s, t, j0, rows, buf)))
-			ss_render_resample_rows(&p->rs, buf, s->nx, s->cell_type, s->nx, j0, rows, hw, w,
-			                        parallel);
-	}
-	ss_free(buf);
+	double *buf = NULL, *w = NULL;
+	const double *h;
+	ptrdiff_t stride;
+	int err = snapshot_heights(p, s, t, &buf, &w, &h, &stride, parallel);
 	if (!err) {
-		ss_render_resample_finish(&p->rs, hw, w, parallel);
 		struct ss_render_image img;
-		err = ss_render_plan_draw(p, hw, s->time[t], &img, parallel);
+		err = ss_render_plan_draw(p, h, stride, s->time[t], &img, parallel);
 		if (!err) {
 			img.snapshot = t;
 			snprintf(img.source, sizeof img.source, "%s", s->path);
+			if (p->look.style != SS_RENDER_OBLIQUE) {
+				img.x0 = s->origin_x;
+				img.y0 = s->origin_y;
+			}
 			err = ss_render_write_png(&img, path, p->look.compression);
 			ss_render_image_release(&img);
 		}
 	}
 	ss_free(w);
-	ss_free(hw);
+	ss_free(buf);
 	return err;
 }
 
@@ -253,13 +295,18 @@ int ss_render_field(const struct ss_render_field *f, const struct ss_render_opti
 	if ((err = ss_render_plan_init(&p, o, f->nx, f->ny, f->dx, f->dy, f->cell_type, f->stride,
 	                               zmin, zmax, 1)))
 		return err;
+	if (ss_render_resampler_is_identity(&p.rs)) {   /* the cells are the pixels */
+		err = ss_render_plan_draw(&p, f->height + (ptrdiff_t)(f->ny - 1) * f->stride,
+		                          -f->stride, f->time, img, 1);
+		goto out_plan;
+	}
 	double *hw, *w;
 	if ((err = alloc_accumulators(&p, &hw, &w)))
 		goto out_plan;
 	ss_render_resample_rows(&p.rs, f->height, f->stride, f->cell_type, f->stride, 0, f->ny,
 	                        hw, w, 1);
 	ss_render_resample_finish(&p.rs, hw, w, 1);
-	err = ss_render_plan_draw(&p, hw, f->time, img, 1);
+	err = ss_render_plan_draw(&p, hw, p.rs.width, f->time, img, 1);
 	ss_free(w);
 	ss_free(hw);
 out_plan:

@@ -38,6 +38,12 @@ int ss_render_resampler_init(struct ss_render_resampler *r, int nx, int ny, doub
                              double dy, int width, int height);
 void ss_render_resampler_release(struct ss_render_resampler *r);
 
+/* One pixel per cell: the heights need no resampling at all. */
+static inline int ss_render_resampler_is_identity(const struct ss_render_resampler *r)
+{
+	return r->width == r->nx && r->height == r->ny;
+}
+
 /* Pixel types (width * height, north row first) from the cell types
  * (nx * ny with row stride `stride`, south row first; NULL: all flow): the
  * type covering most of the pixel, ties going to walls, then open cells. */
@@ -65,16 +71,24 @@ void ss_render_resample_finish(const struct ss_render_resampler *r, double *acc_
 struct ss_render_raster {
 	int width, height;          /* px */
 	double px_dx, px_dy;        /* m per pixel */
-	const double *h;            /* m, width * height, north row first; NAN: none */
-	const uint8_t *type;        /* enum ss_cell_type per pixel */
+	const double *h;            /* m at pixel (x, y) = h[y * stride + x], y = 0
+	                             * the north row; NAN: none */
+	ptrdiff_t stride;           /* negative when the rows are the cells' own,
+	                             * stored south first */
+	const uint8_t *type;        /* enum ss_cell_type, width * height, north first */
 	int step_x, step_y;         /* px between the points of the gradient
 	                             * stencil: one cell (at least one px) */
 };
 
+static inline double ss_render_raster_h(const struct ss_render_raster *r, int x, int y)
+{
+	return r->h[(ptrdiff_t)y * r->stride + x];
+}
+
 /* Height gradient (dh/dx east, dh/dy north) at pixel (x, y) by Horn's
- * 3 x 3 weighted differences over points step_x, step_y pixels apart; a
- * wall, NaN or outside neighbour takes the centre's height (the mirror
- * rule of the model, SPEC section 2).  On a grid enlarged K times the
+ * 3 x 3 weighted differences over points step_x, step_y pixels apart; next
+ * to a wall, NaN or the edge, the lines that reach one take one-sided
+ * differences instead.  Only for pixels with sand.  On a grid enlarged K times the
  * points are a cell apart: differences of the bilinear surface across one
  * cell are the bilinear interpolation of the cells' own differences, so
  * the shading varies smoothly instead of in flat squares per cell. */
@@ -139,6 +153,7 @@ struct ss_render_source {
 	int nx, ny;                 /* cells */
 	long long count;            /* snapshots */
 	double dx, dy;              /* m */
+	double origin_x, origin_y;  /* lower-left corner, m (NAN if unknown) */
 	double *time;               /* count entries, s */
 	uint8_t *cell_type;         /* nx * ny, south row first */
 	struct ss_render_h5 *h5;
@@ -187,10 +202,11 @@ int ss_render_plan_init(struct ss_render_plan *p, const struct ss_render_options
                         ptrdiff_t type_stride, double zmin, double zmax, int parallel);
 void ss_render_plan_release(struct ss_render_plan *p);
 
-/* Colour the resampled heights (width * height) into img (initialised
- * here), with label and colour bar. */
-int ss_render_plan_draw(const struct ss_render_plan *p, const double *pixel_h, double time,
-                        struct ss_render_image *img, int parallel);
+/* Colour the pixel heights (pixel (x, y) at pixel_h[y * stride + x], y = 0
+ * north) into img (initialised here), with label and colour bar. */
+int ss_render_plan_draw(const struct ss_render_plan *p, const double *pixel_h,
+                        ptrdiff_t stride, double time, struct ss_render_image *img,
+                        int parallel);
 
 /* Render snapshot t of s to path (parallel: split rows between threads). */
 int ss_render_plan_snapshot(const struct ss_render_plan *p, struct ss_render_source *s,

@@ -218,8 +218,8 @@ static int outside_band(const struct target *t, float y_lo, float y_hi)
 static double mesh_height(const struct ss_render_raster *r, int x, int y, double base)
 {
 	const size_t k = (size_t)y * r->width + x;
-	if (r->type[k] != SS_CELL_WALL && !isnan(r->h[k]))
-		return r->h[k];
+	if (r->type[k] != SS_CELL_WALL && !isnan(ss_render_raster_h(r, x, y)))
+		return ss_render_raster_h(r, x, y);
 	double sum = 0.0;
 	int n = 0;
 	for (int v = -1; v <= 1; v++)
@@ -228,8 +228,8 @@ static double mesh_height(const struct ss_render_raster *r, int x, int y, double
 			if (xn < 0 || yn < 0 || xn >= r->width || yn >= r->height)
 				continue;
 			const size_t m = (size_t)yn * r->width + xn;
-			if (r->type[m] != SS_CELL_WALL && !isnan(r->h[m])) {
-				sum += r->h[m];
+			if (r->type[m] != SS_CELL_WALL && !isnan(ss_render_raster_h(r, xn, yn))) {
+				sum += ss_render_raster_h(r, xn, yn);
 				n++;
 			}
 		}
@@ -258,12 +258,13 @@ static void surface_vertices(const struct ss_render_raster *r, const struct came
 			const double wx = (x + 0.5) * r->px_dx, wy = (H - y - 0.5) * r->px_dy;
 			double b = 1.0;
 			const uint8_t *rgb = wall_rgb;
-			if (r->type[k] != SS_CELL_WALL) {
+			if (r->type[k] != SS_CELL_WALL && isnan(ss_render_raster_h(r, x, y))) {
+				rgb = nodata;
+			} else if (r->type[k] != SS_CELL_WALL) {
 				double gx, gy;
 				ss_render_gradient(r, x, y, &gx, &gy);
-				b = isnan(r->h[k]) ? 1.0 : ss_render_hillshade(&light, gx, gy);
-				rgb = isnan(r->h[k]) ? nodata : r->type[k] == SS_CELL_OPEN
-				      ? open : lut[ss_render_cmap_index(h, zmin, zmax)];
+				b = ss_render_hillshade(&light, gx, gy);
+				rgb = r->type[k] == SS_CELL_OPEN ? open : lut[ss_render_cmap_index(h, zmin, zmax)];
 			}
 			v[k] = make_vtx(c, wx, wy, o->zscale * (h - zmin), rgb, b);
 		}

@@ -87,7 +87,7 @@ static const struct glyph *glyph_of(char c)
 int ss_render_font_scale(int w, int h)
 {
 	const int m = w < h ? w : h;
-	const int s = (m + 128) / 256;   /* about 1/40 of the picture per line */
+	const int s = (m + 120) / 240;   /* a line of text about 1/30 of the picture */
 	return s < 1 ? 1 : s;
 }
 

@@ -30,6 +30,7 @@ int ss_render_image_init(struct ss_render_image *img, int width, int height,
 	img->time = NAN;
 	img->zmin = img->zmax = NAN;
 	img->snapshot = -1;
+	img->px_dx = img->px_dy = img->x0 = img->y0 = NAN;
 	if (width < 1 || height < 1 || (channels != 1 && channels != 3) ||
 	    (bit_depth != 8 && bit_depth != 16))
 		SS_BUG("image %d x %d, %d channels, %d bits", width, height, channels, bit_depth);
@@ -38,13 +39,21 @@ int ss_render_image_init(struct ss_render_image *img, int width, int height,
 	img->channels = channels;
 	img->bit_depth = bit_depth;
 	img->row_bytes = (size_t)width * (size_t)channels * (size_t)(bit_depth / 8);
-	img->pixels = ss_alloc((size_t)height, img->row_bytes, "picture");
-	return img->pixels ? SS_OK : SS_ERR_FAIL;
+	/* not zeroed: every style writes every pixel, and the threads that do
+	 * so first-touch the pages in parallel instead of one memset here */
+	if ((size_t)height > SIZE_MAX / img->row_bytes) {
+		ss_error_fail("cannot allocate a picture of %d x %d px: size overflows", width, height);
+		return SS_ERR_FAIL;
+	}
+	img->pixels = malloc((size_t)height * img->row_bytes);
+	if (!img->pixels)
+		return ss_error_fail("cannot allocate a picture of %d x %d px", width, height);
+	return SS_OK;
 }
 
 void ss_render_image_release(struct ss_render_image *img)
 {
-	ss_free(img->pixels);
+	free(img->pixels);
 	img->pixels = NULL;
 }
 
@@ -75,9 +84,10 @@ static int host_is_little_endian(void)
 /* The text chunks: enough to know what a frame shows and, for gray16, to
  * turn its samples back into heights. */
 struct png_texts {
-	png_text t[8];
+	png_text t[12];
 	int n;
 	char software[64], time[40], zmin[40], zmax[40], snapshot[32];
+	char dx[40], dy[40], x0[40], y0[40];
 };
 
 static void add_text(struct png_texts *x, const char *key, const char *value)
@@ -111,6 +121,19 @@ static void fill_texts(struct png_texts *x, const struct ss_render_image *img)
 	if (img->snapshot >= 0) {
 		snprintf(x->snapshot, sizeof x->snapshot, "%lld", img->snapshot);
 		add_text(x, "snapshot", x->snapshot);
+	}
+	/* the map's geometry, so that a gray16 frame is a DEM (dem.h) */
+	if (!isnan(img->px_dx) && !isnan(img->px_dy)) {
+		snprintf(x->dx, sizeof x->dx, "%.17g", img->px_dx);
+		snprintf(x->dy, sizeof x->dy, "%.17g", img->px_dy);
+		add_text(x, "dx_m", x->dx);
+		add_text(x, "dy_m", x->dy);
+	}
+	if (!isnan(img->x0) && !isnan(img->y0)) {
+		snprintf(x->x0, sizeof x->x0, "%.17g", img->x0);
+		snprintf(x->y0, sizeof x->y0, "%.17g", img->y0);
+		add_text(x, "x0_m", x->x0);
+		add_text(x, "y0_m", x->y0);
 	}
 	if (img->style == SS_RENDER_GRAY16)
 		add_text(x, "height_m", "zmin_m + (value - 1) * (zmax_m - zmin_m) / 65534 for "

@@ -137,6 +137,17 @@ void ss_render_resample_types(const struct ss_render_resampler *r, const uint8_t
 	const int W = r->width, H = r->height;
 	const struct ss_render_axis *bx = &r->bx, *by = &r->by;
 
+	if (ss_render_resampler_is_identity(r)) {   /* the rows flipped, north first */
+		#pragma omp parallel for schedule(static) if(parallel)
+		for (int py = 0; py < H; py++)
+			for (int px = 0; px < W; px++) {
+				const int t = cell_type ? cell_type[(ptrdiff_t)(H - 1 - py) * stride + px]
+				                        : SS_CELL_FLOW;
+				pixel_type[(size_t)py * W + px] = (uint8_t)(t <= SS_CELL_OPEN ? t : SS_CELL_WALL);
+			}
+		return;
+	}
+
 	#pragma omp parallel for schedule(static) if(parallel)
 	for (int py = 0; py < H; py++) {
 		const int q = H - 1 - py;   /* pixel rows from the south, like cells */

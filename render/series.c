@@ -102,6 +102,27 @@ static int dataset_dims(hid_t file, const char *name, hsize_t dims[3])
 	return rank;
 }
 
+/* The first value of a 1-D coordinate variable, NAN if unreadable. */
+static double first_value(hid_t file, const char *name)
+{
+	double v = NAN;
+	hsize_t dims[3] = {0, 0, 0}, zero = 0, one = 1;
+	if (dataset_dims(file, name, dims) != 1 || dims[0] < 1)
+		return NAN;
+	hid_t d = H5Dopen2(file, name, H5P_DEFAULT);
+	hid_t fs = d >= 0 ? H5Dget_space(d) : -1;
+	hid_t ms = H5Screate_simple(1, &one, NULL);
+	if (fs < 0 || H5Sselect_hyperslab(fs, H5S_SELECT_SET, &zero, NULL, &one, NULL) < 0 ||
+	    H5Dread(d, H5T_NATIVE_DOUBLE, ms, fs, H5P_DEFAULT, &v) < 0)
+		v = NAN;
+	H5Sclose(ms);
+	if (fs >= 0)
+		H5Sclose(fs);
+	if (d >= 0)
+		H5Dclose(d);
+	return v;
+}
+
 static int read_all(hid_t file, const char *name, hid_t mem_type, void *out)
 {
 	hid_t d = H5Dopen2(file, name, H5P_DEFAULT);
@@ -140,6 +161,9 @@ static int check_layout(struct ss_render_source *s, hid_t file)
 	s->count = (long long)hd[0];
 	s->ny = (int)hd[1];
 	s->nx = (int)hd[2];
+	/* the corner from the first cell centres (x, y are optional here) */
+	s->origin_x = first_value(file, "x") - 0.5 * s->dx;
+	s->origin_y = first_value(file, "y") - 0.5 * s->dy;
 	return SS_OK;
 }
 

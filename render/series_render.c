@@ -288,9 +288,11 @@ int ss_render_series(const struct ss_render_series_options *o)
 	const double seconds = now_seconds() - t0;
 
 	if (!o->quiet) {
-		printf("wrote %lld frame%s of %d x %d px to %s/ (t = %g .. %g s, %s, heights %g .. %g "
-		       "m) in %.2f s: %.1f frames/s, %.1f Mpixel/s on %d threads\n", n,
-		       n == 1 ? "" : "s", plan.image_w, plan.image_h, o->output_dir, s.time[sel[0]],
+		const size_t len = strlen(o->output_dir);
+		printf("wrote %lld frame%s of %d x %d px to %s%s (t = %g .. %g s, %s, heights %g .. "
+		       "%g m) in %.2f s: %.1f frames/s, %.1f Mpixel/s on %d threads\n", n,
+		       n == 1 ? "" : "s", plan.image_w, plan.image_h, o->output_dir,
+		       len && o->output_dir[len - 1] == '/' ? "" : "/", s.time[sel[0]],
 		       s.time[sel[n - 1]], ss_render_style_name(o->look.style), zmin, zmax,
 		       now_seconds() - started, n / fmax(seconds, 1e-9),
 		       (double)n * plan.image_w * plan.image_h / fmax(seconds, 1e-9) * 1e-6,

@@ -2,13 +2,15 @@
  * shade.c - the two map styles (step 2 of a frame, render.h).
  *
  * shaded   colour = colour map of height x brightness.  The brightness is
- *          the hillshade of Horn's method [Horn 1981]: the gradient from
+ *          the hillshade of Horn's method [Horn] (README References): the gradient from
  *          the 3 x 3 neighbourhood with weights 1 2 1,
  *
  *            dh/dx = ((c + 2f + i) - (a + 2d + g)) / (8 dx)     a b c
  *            dh/dy = ((a + 2b + c) - (g + 2h + i)) / (8 dy)     d e f
  *                                                               g h i
- *          (a b c the northern row), gives the normal n ~ (-z dh/dx,
+ *          (a b c the northern row; where a point is a wall or outside,
+ *          its row or column takes a one-sided difference, so slopes next
+ *          to walls are not flattened), gives the normal n ~ (-z dh/dx,
  *          -z dh/dy, 1) with z the vertical exaggeration, and the
  *          brightness is ambient + (1 - ambient) max(n . L, 0) for the unit
  *          vector L towards the light.  40 % ambient keeps faces turned
@@ -37,27 +39,88 @@
 #define AMBIENT 0.4             /* brightness of a face the light misses */
 #define CONTOUR_DARKEN 0.55     /* a contour pixel keeps 45 % of its colour */
 
-/* Height of neighbour (x, y), or `centre` where there is no sand surface. */
-static inline double neighbour(const struct ss_render_raster *r, int x, int y, double centre)
+/* Is there a sand surface at pixel (x, y)? */
+static inline int has_sand(const struct ss_render_raster *r, int x, int y)
 {
 	if (x < 0 || y < 0 || x >= r->width || y >= r->height)
-		return centre;
-	const size_t k = (size_t)y * r->width + x;
-	const double v = r->h[k];
-	return r->type[k] == SS_CELL_WALL || isnan(v) ? centre : v;
+		return 0;
+	return r->type[(size_t)y * r->width + x] != SS_CELL_WALL &&
+	       !isnan(ss_render_raster_h(r, x, y));
+}
+
+static inline double at(const struct ss_render_raster *r, int x, int y)
+{
+	return ss_render_raster_h(r, x, y);
+}
+
+/* Difference quotient per pixel through (x, y) along (ux, uy), from points
+ * n px away: central where both have sand, one-sided where one has, 0
+ * where neither; returns 0 if (x, y) itself has none. */
+static inline int slope_through(const struct ss_render_raster *r, int x, int y, int ux, int uy,
+                                int n, double *slope)
+{
+	if (!has_sand(r, x, y))
+		return 0;
+	const int fwd = has_sand(r, x + n * ux, y + n * uy);
+	const int back = has_sand(r, x - n * ux, y - n * uy);
+	const double c = at(r, x, y);
+	if (fwd && back)
+		*slope = (at(r, x + n * ux, y + n * uy) - at(r, x - n * ux, y - n * uy)) / (2.0 * n);
+	else if (fwd)
+		*slope = (at(r, x + n * ux, y + n * uy) - c) / n;
+	else if (back)
+		*slope = (c - at(r, x - n * ux, y - n * uy)) / n;
+	else
+		*slope = 0.0;
+	return 1;
+}
+
+/* Horn's weighted mean of the difference quotients along three parallel
+ * lines `across` px apart (weights 1 2 1), over the lines with sand. */
+static double horn(const struct ss_render_raster *r, int x, int y, int ux, int uy, int n,
+                   int across)
+{
+	static const double weight[3] = {1.0, 2.0, 1.0};
+	double sum = 0.0, wsum = 0.0, s;
+	for (int k = -1; k <= 1; k++)
+		if (slope_through(r, x + k * across * uy, y + k * across * ux, ux, uy, n, &s)) {
+			sum += weight[k + 1] * s;
+			wsum += weight[k + 1];
+		}
+	return wsum > 0.0 ? sum / wsum : 0.0;
+}
+
+/* Horn's formula itself where all nine points have sand (most pixels);
+ * 0 if one has not. */
+static inline int gradient_inside(const struct ss_render_raster *r, int x, int y, double *gx,
+                                  double *gy)
+{
+	const int u = r->step_x, v = r->step_y;
+	if (x < u || y < v || x >= r->width - u || y >= r->height - v)
+		return 0;
+	const size_t w = (size_t)r->width;
+	const uint8_t *tn = r->type + (size_t)(y - v) * w + x, *tc = r->type + (size_t)y * w + x,
+	              *ts = r->type + (size_t)(y + v) * w + x;
+	if ((tn[-u] | tn[0] | tn[u] | tc[-u] | tc[u] | ts[-u] | ts[0] | ts[u]) & SS_CELL_WALL)
+		return 0;   /* flow 0, wall 1, open 2: any wall sets bit 0 */
+	const double *hn = r->h + (ptrdiff_t)(y - v) * r->stride + x;
+	const double *hc = r->h + (ptrdiff_t)y * r->stride + x;
+	const double *hs = r->h + (ptrdiff_t)(y + v) * r->stride + x;
+	const double a = hn[-u], b = hn[0], c = hn[u], d = hc[-u], f = hc[u], g = hs[-u],
+	             h = hs[0], i = hs[u];
+	*gx = ((c + 2.0 * f + i) - (a + 2.0 * d + g)) / (8.0 * u * r->px_dx);
+	*gy = ((a + 2.0 * b + c) - (g + 2.0 * h + i)) / (8.0 * v * r->px_dy);
+	return !isnan(*gx) && !isnan(*gy);
 }
 
 void ss_render_gradient(const struct ss_render_raster *r, int x, int y, double *gx,
                         double *gy)
 {
-	const int u = r->step_x, v = r->step_y;
-	const double e = r->h[(size_t)y * r->width + x];
-	const double a = neighbour(r, x - u, y - v, e), b = neighbour(r, x, y - v, e),
-	             c = neighbour(r, x + u, y - v, e), d = neighbour(r, x - u, y, e),
-	             f = neighbour(r, x + u, y, e), g = neighbour(r, x - u, y + v, e),
-	             h = neighbour(r, x, y + v, e), i = neighbour(r, x + u, y + v, e);
-	*gx = ((c + 2.0 * f + i) - (a + 2.0 * d + g)) / (8.0 * u * r->px_dx);
-	*gy = ((a + 2.0 * b + c) - (g + 2.0 * h + i)) / (8.0 * v * r->px_dy);
+	if (gradient_inside(r, x, y, gx, gy))
+		return;
+	/* pixel rows run east, pixel columns south: north is -y */
+	*gx = horn(r, x, y, 1, 0, r->step_x, r->step_y) / r->px_dx;
+	*gy = -horn(r, x, y, 0, 1, r->step_y, r->step_x) / r->px_dy;
 }
 
 void ss_render_light_init(struct ss_render_light *l, double azimuth_deg,
@@ -88,8 +151,8 @@ static int on_contour(const struct ss_render_raster *r, int x, int y, double v, 
 		const int xn = x + dxy[n][0], yn = y + dxy[n][1];
 		if (xn < 0 || yn < 0 || xn >= r->width || yn >= r->height)
 			continue;
-		const size_t k = (size_t)yn * r->width + xn;
-		if (r->type[k] == SS_CELL_FLOW && floor(r->h[k] / dz) > level)
+		if (r->type[(size_t)yn * r->width + xn] == SS_CELL_FLOW &&
+		    floor(ss_render_raster_h(r, xn, yn) / dz) > level)
 			return 1;
 	}
 	return 0;
@@ -111,11 +174,12 @@ void ss_render_shaded(const struct ss_render_raster *r, const struct ss_render_o
 	#pragma omp parallel for schedule(static) if(parallel)
 	for (int y = 0; y < H; y++) {
 		uint8_t *row = img->pixels + (size_t)y * img->row_bytes;
+		const uint8_t *types = r->type + (size_t)y * W;
+		const double *hrow = r->h + (ptrdiff_t)y * r->stride;
 		for (int x = 0; x < W; x++) {
-			const size_t k = (size_t)y * W + x;
-			const double v = r->h[k];
-			const uint8_t *c = r->type[k] == SS_CELL_WALL ? wall
-			                 : r->type[k] == SS_CELL_OPEN ? open
+			const double v = hrow[x];
+			const uint8_t *c = types[x] == SS_CELL_WALL ? wall
+			                 : types[x] == SS_CELL_OPEN ? open
 			                 : isnan(v) ? nodata : NULL;
 			uint8_t *p = row + 3 * (size_t)x;
 			if (c) {
@@ -128,8 +192,9 @@ void ss_render_shaded(const struct ss_render_raster *r, const struct ss_render_o
 			if (dz > 0.0 && on_contour(r, x, y, v, dz))
 				b *= 1.0 - CONTOUR_DARKEN;
 			const uint8_t *m = lut[ss_render_cmap_index(v, zmin, zmax)];
-			for (int ch = 0; ch < 3; ch++)
-				p[ch] = (uint8_t)(m[ch] * b + 0.5);
+			p[0] = (uint8_t)(m[0] * b + 0.5);
+			p[1] = (uint8_t)(m[1] * b + 0.5);
+			p[2] = (uint8_t)(m[2] * b + 0.5);
 		}
 	}
 }
@@ -144,10 +209,11 @@ void ss_render_gray16(const struct ss_render_raster *r, double zmin, double zmax
 	#pragma omp parallel for schedule(static) if(parallel)
 	for (int y = 0; y < H; y++) {
 		uint16_t *row = (uint16_t *)(img->pixels + (size_t)y * img->row_bytes);
+		const uint8_t *types = r->type + (size_t)y * W;
+		const double *hrow = r->h + (ptrdiff_t)y * r->stride;
 		for (int x = 0; x < W; x++) {
-			const size_t k = (size_t)y * W + x;
-			const double v = r->h[k];
-			if (r->type[k] == SS_CELL_WALL || isnan(v)) {
+			const double v = hrow[x];
+			if (types[x] == SS_CELL_WALL || isnan(v)) {
 				row[x] = 0;
 				continue;
 			}

@@ -97,7 +97,7 @@ static const char usage_render[] =
 	"  --scale K             K pixels per cell (default 1 for gray16, otherwise\n"
 	"                        enough for a side of 512 px)\n"
 	"  --view-azimuth DEG    oblique: the camera's bearing from the centre (200)\n"
-	"  --view-elevation DEG  oblique: the camera above the horizon (35)\n"
+	"  --view-elevation DEG  oblique: the camera above the horizon (45)\n"
 	"  --compression N       zlib level of the PNGs, 0 to 9 (default 6)\n"
 	"\n"
 	"Each PNG holds the time, the height scale and the snapshot in text chunks;\n"
@@ -522,7 +522,8 @@ static int cmd_run(int argc, char **argv)
 	status = ss_status_exit_code(ss_run_case(&o));
 	free(history);
 	if (frames && !o.quiet)
-		printf("wrote %lld frames to %s/\n", ss_render_frames_count(frames), frames_dir);
+		printf("wrote %lld frames to %s%s\n", ss_render_frames_count(frames), frames_dir,
+		       frames_dir[strlen(frames_dir) - 1] == '/' ? "" : "/");
 out:
 	ss_render_frames_destroy(frames);
 	free(overrides);

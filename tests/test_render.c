@@ -697,6 +697,7 @@ static void test_write_failure_leaves_nothing(void)
 {
 	struct ss_render_image img;
 	CHECK(ss_render_image_init(&img, 8, 8, 3, 8) == SS_OK, "init");
+	memset(img.pixels, 0x80, img.row_bytes * img.height);
 	char path[512];
 	snprintf(path, sizeof path, "%s/missing-folder/frame.png", tmpdir);
 	CHECK(ss_render_write_png(&img, path, 6) != SS_OK, "no folder: an error");

@@ -64,7 +64,7 @@ struct ss_render_options {
 	                             * smallest giving a side of at least 512 px */
 	double view_azimuth_deg;    /* oblique: camera's compass bearing from the
 	                             * centre of the grid (200: south-south-west) */
-	double view_elevation_deg;  /* oblique: camera above the horizon, (0, 90) (35) */
+	double view_elevation_deg;  /* oblique: camera above the horizon, (0, 90) (45) */
 	int compression;            /* zlib level of the PNG, 0..9 (6) */
 };
 
@@ -108,11 +108,14 @@ struct ss_render_image {
 	double time;                /* s */
 	double zmin, zmax;          /* m, the scale the picture was made with */
 	long long snapshot;         /* index in its file, -1 if none */
+	double px_dx, px_dy;        /* m per pixel (map styles; NAN for oblique) */
+	double x0, y0;              /* lower-left corner of the map, m; NAN if unknown */
 	enum ss_render_style style;
 	char source[4096];          /* file the snapshot came from, "" if none */
 };
 
-/* Allocate a zeroed picture; SS_ERR_FAIL if out of memory. */
+/* Allocate a picture (its pixels are not cleared); SS_ERR_FAIL if out of
+ * memory. */
 int ss_render_image_init(struct ss_render_image *img, int width, int height,
                          int channels, int bit_depth);
 void ss_render_image_release(struct ss_render_image *img);

@@ -136,6 +136,8 @@ def test_gray16_heights_and_range(series, tmp_path):
     assert info["depth"] == 16 and info["ctype"] == 0
     assert (info["width"], info["height"]) == (20, 16), "gray16: one pixel per cell"
     assert float(info["text"]["zmin_m"]) == 0.0 and float(info["text"]["zmax_m"]) == 0.5
+    geometry = [float(info["text"][k]) for k in ("dx_m", "dy_m", "x0_m", "y0_m")]
+    assert geometry == [0.1, 0.1, 0.0, 0.0], "pixel size and corner: the picture is a DEM"
     with h5open(d / "out.h5") as f:
         h = f["height"][4]
         walls = f["cell_type"][:] == 1
