@@ -93,6 +93,7 @@ static const struct key_spec keys[] = {
 	KEY("initial", "radius", V_POSITIVE, cone_radius),
 	KEY("initial", "angle", V_ANGLE, cone_angle_deg),
 	KEY("initial", "file", V_PATH, initial_file),
+	KEY("initial", "bedrock", V_PATH, bedrock_file),
 };
 #undef KEY
 enum { KEY_COUNT = sizeof keys / sizeof *keys };
@@ -258,7 +259,9 @@ static int store_value(struct parse *p, const struct key_spec *k, const char *va
 			return ss_error_fail("out of memory reading '%s'", p->path);
 		free(*(char **)field);
 		*(char **)field = s;
-		snprintf(p->c->initial_where, sizeof p->c->initial_where, "%s", p->where);
+		char *where = field == &p->c->bedrock_file ? p->c->bedrock_where
+		                                           : p->c->initial_where;
+		snprintf(where, SS_CASE_WHERE_SIZE, "%s", p->where);
 		return SS_OK;
 	}
 	}
@@ -923,6 +926,7 @@ void ss_case_release(struct ss_case *c)
 	}
 	free(c->regions);
 	free(c->initial_file);
+	free(c->bedrock_file);
 	free(c->text);
 	free(c->path);
 	memset(c, 0, sizeof *c);

@@ -185,7 +185,7 @@ int ss_run_case(const struct ss_run_options *o)
 		.title = c.path, .history = o->history ? o->history : "",
 		.case_text = c.text, .closure = ss_closure_name(c.closure),
 		.repose_angle_deg = c.repose_angle_deg, .nu = c.nu, .gamma = c.gamma,
-		.deflate = o->deflate,
+		.deflate = o->deflate, .bedrock = st.bedrock,
 	};
 	if ((err = ss_snapshot_create(&snap, output, &st.grid, st.cell_types, &meta)))
 		goto out_stepper;

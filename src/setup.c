@@ -63,6 +63,29 @@ static int initial_heights(const struct ss_case *c, struct ss_stepper *st)
 	return SS_OK;
 }
 
+/* [initial] bedrock = FILE: the fixed base, the grid's size, data in every
+ * cell. */
+static int load_bedrock(const struct ss_case *c, struct ss_stepper *st)
+{
+	const struct ss_grid *g = &st->grid;
+	struct ss_raster r;
+	int err = ss_dem_read(c->bedrock_file, c->bedrock_where, NULL, &r);
+	if (!err && (r.nx != g->nx || r.ny != g->ny))
+		err = ss_error_input("%s: bedrock '%s' is %d x %d cells: expected the grid's "
+		                     "%d x %d (nx x ny)", c->bedrock_where, c->bedrock_file,
+		                     r.nx, r.ny, g->nx, g->ny);
+	for (size_t m = 0; !err && r.nodata && m < (size_t)r.nx * r.ny; m++)
+		if (r.nodata[m])
+			err = ss_error_input("%s: bedrock '%s' has no data at cell (%d, %d): the "
+			                     "bedrock needs a value in every cell", c->bedrock_where,
+			                     c->bedrock_file, (int)(m % (size_t)r.nx),
+			                     (int)(m / (size_t)r.nx));
+	if (!err)
+		err = ss_stepper_set_bedrock(st, r.values);
+	ss_raster_release(&r);
+	return err;
+}
+
 int ss_setup_stepper(const struct ss_case *c, int tile_nx, int tile_ny,
                      enum ss_kernel kernel, struct ss_stepper *st)
 {
@@ -123,6 +146,8 @@ int ss_setup_stepper(const struct ss_case *c, int tile_nx, int tile_ny,
 		}
 		if (pass == 0 && !err)
 			err = initial_heights(c, st);
+		if (pass == 0 && !err && c->bedrock_file)
+			err = load_bedrock(c, st);
 	}
 	ss_free(mask);
 	if (!err)

@@ -185,6 +185,46 @@ static int write_cell_types(hid_t dataset, hid_t file_space, const struct ss_gri
 	return bad;
 }
 
+/* bedrock (y, x), m: NaN (the _FillValue) where no sand can lie (walls,
+ * open cells), written a block of rows at a time. */
+static int write_bedrock(hid_t file, hid_t x, hid_t y, const struct ss_grid *g,
+                         const double *bedrock)
+{
+	hsize_t dims[2] = {(hsize_t)g->ny, (hsize_t)g->nx};
+	hid_t space = H5Screate_simple(2, dims, NULL);
+	hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
+	const double fill = NAN;
+	H5Pset_fill_value(dcpl, H5T_NATIVE_DOUBLE, &fill);
+	hid_t d = H5Dcreate2(file, "bedrock", H5T_IEEE_F64LE, space, H5P_DEFAULT, dcpl,
+	                     H5P_DEFAULT);
+	H5Pclose(dcpl);
+	const int rows = g->ny < 64 ? g->ny : 64;
+	double *block = ss_alloc((size_t)rows * (size_t)g->nx, sizeof *block, "bedrock rows");
+	int bad = d < 0 || !block;
+	for (int j0 = 0; j0 < g->ny && !bad; j0 += rows) {
+		const int n = g->ny - j0 < rows ? g->ny - j0 : rows;
+		for (int j = 0; j < n; j++) {
+			const double *row = bedrock + ss_grid_index(g, 0, j0 + j);
+			for (int i = 0; i < g->nx; i++)
+				block[(size_t)j * g->nx + i] = isinf(row[i]) ? NAN : row[i];
+		}
+		hsize_t start[2] = {(hsize_t)j0, 0}, count[2] = {(hsize_t)n, (hsize_t)g->nx};
+		hid_t mem = H5Screate_simple(2, count, NULL);
+		bad = mem < 0 ||
+		      H5Sselect_hyperslab(space, H5S_SELECT_SET, start, NULL, count, NULL) < 0 ||
+		      H5Dwrite(d, H5T_NATIVE_DOUBLE, mem, space, H5P_DEFAULT, block) < 0;
+		if (mem >= 0)
+			H5Sclose(mem);
+	}
+	ss_free(block);
+	bad = bad || attr_units(d, "m", "non-erodible bedrock under the sand") ||
+	      H5DSattach_scale(d, y, 0) < 0 || H5DSattach_scale(d, x, 1) < 0;
+	if (d >= 0)
+		H5Dclose(d);
+	H5Sclose(space);
+	return bad;
+}
+
 static int write_static(struct ss_snapshot *s, const uint8_t *cell_types,
                         const struct ss_snapshot_meta *meta)
 {
@@ -247,6 +287,8 @@ static int write_static(struct ss_snapshot *s, const uint8_t *cell_types,
 	H5Sclose(space);
 	if (ct >= 0)
 		H5Dclose(ct);
+
+	bad = bad || (meta->bedrock && write_bedrock(f, x, y, g, meta->bedrock));
 
 	for (int k = 0; k < DIAG_COUNT && !bad; k++) {
 		s->diag[k] = create_series(f, diag_names[k], diag_units[k], diag_long_names[k]);

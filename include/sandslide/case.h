@@ -80,6 +80,8 @@ struct ss_case {
 	double cone_angle_deg;
 	char *initial_file;     /* resolved against the case file's folder */
 	char initial_where[SS_CASE_WHERE_SIZE];
+	char *bedrock_file;     /* non-erodible base (raster), or NULL */
+	char bedrock_where[SS_CASE_WHERE_SIZE];
 
 	struct ss_region *regions; /* in file order */
 	int region_count;

@@ -7,6 +7,7 @@
  *   /time        float64 (time), s
  *   /x, /y       float64 cell centres, m
  *   /cell_type   uint8 (y, x), flag_values 0 1 2, "flow wall open"
+ *   /bedrock     float64 (y, x), m, only with a bedrock (NaN off flow cells)
  *   /volume /inflow /outflow /max_height /max_slope_deg /steps
  *   /active_fraction /wall_seconds      float64 (time)
  *   root attributes: Conventions, title, history, source, closure,
@@ -34,6 +35,7 @@ struct ss_snapshot_meta {
 	double nu;               /* m^2/s */
 	double gamma;
 	int deflate;             /* 0 (none) .. 9 */
+	const double *bedrock;   /* m, the grid's halo layout, or NULL */
 };
 
 /* Create the output and write the static variables; cell_types are packed
