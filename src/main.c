@@ -14,6 +14,7 @@
 #include "sandslide/bench.h"
 #include "sandslide/error.h"
 #include "sandslide/parallel.h"
+#include "sandslide/relax.h"
 #include "sandslide/render.h"
 #include "sandslide/run.h"
 #include "sandslide/snapshot.h"
@@ -27,6 +28,7 @@ static const char usage_main[] =
 	"commands:\n"
 	"  run CASE.ini     run a case, writing HDF5 snapshots\n"
 	"  info FILE.h5     summarise an output file\n"
+	"  relax DEM        relax a DEM to the repose angle (terrain in, terrain out)\n"
 	"  render FILE.h5   draw snapshots as PNG frames (and a video)\n"
 	"  bench            measure the sweep's throughput on synthetic surfaces\n"
 	"\n"
@@ -54,6 +56,47 @@ static const char usage_run[] =
 	"\n"
 	"Writes OUT.h5 (SPEC section 5) and the XDMF sidecar OUT.xmf, flushed after\n"
 	"every snapshot.  Exit status: 0 done, 1 failure while running, 2 bad input.\n";
+
+static const char usage_relax[] =
+	"usage: sandslide relax DEM [-o OUT] [--angle DEG] [--closure NAME] [--nu V]\n"
+	"                       [--tol X] [--max-time T] [--threads N] [...]\n"
+	"\n"
+	"Relaxes a digital elevation model to the repose angle: every slope steeper\n"
+	"than it slides until the surface is steady, the volume conserved.\n"
+	"\n"
+	"  DEM                   .asc (ESRI ASCII grid), .png (16-bit greyscale),\n"
+	"                        FILE.h5[:/dataset] (sandslide HDF5, last snapshot),\n"
+	"                        .tif and other GDAL rasters (builds with GDAL)\n"
+	"  -o, --output OUT      .asc, .png, .tif: the relaxed raster; .h5: the whole\n"
+	"                        series with diagnostics (default out/<DEM>-relaxed\n"
+	"                        with the input's extension)\n"
+	"  --angle DEG           repose angle (default 35)\n"
+	"  --closure NAME        " SS_CLOSURE_NAMES " (default coulomb)\n"
+	"  --gamma G             herschel-bulkley exponent (default 1)\n"
+	"  --nu V                m^2/s (default 1): sets the time scale only\n"
+	"  --tol X               steady when max |dh/dt| < X m/s (default 1e-9)\n"
+	"  --max-time T          stop at T s even if not steady (default: none)\n"
+	"  --threads N           OpenMP threads (default: all processors)\n"
+	"  --sides wall|open     the four sides of the DEM (default wall)\n"
+	"  --nodata wall|open    cells without data (default open: sand leaves there)\n"
+	"  --open-level M        height held on open cells and sides (default: the\n"
+	"                        lowest height of the DEM)\n"
+	"  --bedrock FILE        non-erodible base, a raster of the DEM's size: only\n"
+	"                        the sand above it moves\n"
+	"  --add-sand SHAPE      pour sand on rect=X0,Y0,X1,Y1 or disk=X,Y,R (m)\n"
+	"  --sand-rate R         at R m/s (needed with --add-sand)\n"
+	"  --sand-duration S     for S seconds from t = 0 (needed with --add-sand)\n"
+	"  --dx M                cell size, for files that do not give one\n"
+	"  --zscale Z            PNG: m per grey level (default: the file's range)\n"
+	"  --zoffset Z0          PNG: height of grey 0, m (default 0)\n"
+	"  --output-every T      .h5 output: a snapshot every T s\n"
+	"  --report FILE.json    write the diagnostics for scripts\n"
+	"  -q, --quiet           no progress line and no summary\n"
+	"\n"
+	"Prints cells and volume moved, steepest face before and after, steps and\n"
+	"wall time.  The input is never modified; the output is written under a\n"
+	"temporary name and renamed when complete.  Exit status: 0 done, 1\n"
+	"failure while running, 2 bad input.\n";
 
 static const char usage_info[] =
 	"usage: sandslide info FILE.h5\n"
@@ -530,6 +573,160 @@ out:
 	return status;
 }
 
+/* A number in [lo, hi]; -1 if malformed. */
+static int parse_real(const char *s, double lo, double hi, double *out)
+{
+	double v;
+	if (parse_double(s, &v) || !(v >= lo && v <= hi))
+		return -1;
+	*out = v;
+	return 0;
+}
+
+/* rect=X0,Y0,X1,Y1 or disk=X,Y,R into a shape; -1 if malformed. */
+static int parse_sand_shape(const char *s, struct ss_shape *shape)
+{
+	const int rect = !strncmp(s, "rect=", 5), disk = !strncmp(s, "disk=", 5);
+	if (!rect && !disk)
+		return -1;
+	const int n = rect ? 4 : 3;
+	const char *p = s + 5;
+	for (int k = 0; k < n; k++) {
+		char *end;
+		errno = 0;
+		shape->v[k] = strtod(p, &end);
+		if (end == p || errno || !isfinite(shape->v[k]) || *end != (k + 1 < n ? ',' : '\0'))
+			return -1;
+		p = end + 1;
+	}
+	if (rect && !(shape->v[0] < shape->v[2] && shape->v[1] < shape->v[3]))
+		return -1;
+	if (disk && !(shape->v[2] > 0.0))
+		return -1;
+	shape->kind = rect ? SS_SHAPE_RECT : SS_SHAPE_DISK;
+	snprintf(shape->where, sizeof shape->where, "--add-sand");
+	return 0;
+}
+
+static int cmd_relax(int argc, char **argv)
+{
+	struct ss_relax_options o;
+	ss_relax_options_init(&o);
+	int have_rate = 0, have_duration = 0;
+	for (int k = 2; k < argc; k++) {
+		const char *a = argv[k], *next = k + 1 < argc ? argv[k + 1] : NULL;
+		if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+			fputs(usage_relax, stdout);
+			return 0;
+		} else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
+			o.quiet = 1;
+			continue;
+		} else if (a[0] != '-' || !a[1]) {
+			if (o.dem)
+				return usage_error(usage_relax, "one DEM only (got a second: '%s')", a);
+			o.dem = a;
+			continue;
+		}
+		if (!next)
+			return usage_error(usage_relax, "%s needs a value", a);
+		k++;
+		if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
+			o.output = next;
+		} else if (!strcmp(a, "--angle")) {
+			if (parse_real(next, 1e-9, 90.0 - 1e-9, &o.angle_deg))
+				return usage_error(usage_relax, "--angle '%s': expected degrees in "
+				                   "(0, 90)", next);
+		} else if (!strcmp(a, "--closure")) {
+			if (ss_closure_parse(next, &o.closure))
+				return usage_error(usage_relax, "--closure '%s': expected "
+				                   SS_CLOSURE_NAMES, next);
+		} else if (!strcmp(a, "--gamma")) {
+			if (parse_real(next, 1e-6, 1e6, &o.gamma))
+				return usage_error(usage_relax, "--gamma '%s': expected a number > 0",
+				                   next);
+		} else if (!strcmp(a, "--nu")) {
+			if (parse_real(next, 1e-300, 1e300, &o.nu))
+				return usage_error(usage_relax, "--nu '%s': expected m^2/s > 0", next);
+		} else if (!strcmp(a, "--tol")) {
+			if (parse_real(next, 1e-300, 1e300, &o.tol))
+				return usage_error(usage_relax, "--tol '%s': expected m/s > 0", next);
+		} else if (!strcmp(a, "--max-time")) {
+			if (parse_real(next, 1e-300, 1e300, &o.max_time))
+				return usage_error(usage_relax, "--max-time '%s': expected s > 0", next);
+		} else if (!strcmp(a, "--output-every")) {
+			if (parse_real(next, 1e-300, 1e300, &o.output_every))
+				return usage_error(usage_relax, "--output-every '%s': expected s > 0",
+				                   next);
+		} else if (!strcmp(a, "--cfl")) {
+			if (parse_real(next, 1e-9, 1.0, &o.cfl))
+				return usage_error(usage_relax, "--cfl '%s': expected (0, 1]", next);
+		} else if (!strcmp(a, "--threads")) {
+			if (parse_int(next, 1, 4096, &o.threads))
+				return usage_error(usage_relax, "--threads '%s': expected an integer "
+				                   "from 1 to 4096", next);
+		} else if (!strcmp(a, "--sides")) {
+			if (strcmp(next, "wall") && strcmp(next, "open"))
+				return usage_error(usage_relax, "--sides '%s': expected wall or open",
+				                   next);
+			o.sides = !strcmp(next, "wall") ? SS_SIDE_WALL : SS_SIDE_OPEN;
+		} else if (!strcmp(a, "--nodata")) {
+			if (strcmp(next, "wall") && strcmp(next, "open"))
+				return usage_error(usage_relax, "--nodata '%s': expected wall or open",
+				                   next);
+			o.nodata_type = !strcmp(next, "wall") ? SS_CELL_WALL : SS_CELL_OPEN;
+		} else if (!strcmp(a, "--open-level")) {
+			if (parse_real(next, -1e300, 1e300, &o.open_level))
+				return usage_error(usage_relax, "--open-level '%s': expected a height "
+				                   "in m", next);
+		} else if (!strcmp(a, "--bedrock")) {
+			o.bedrock = next;
+		} else if (!strcmp(a, "--add-sand")) {
+			if (parse_sand_shape(next, &o.sand_shape))
+				return usage_error(usage_relax, "--add-sand '%s': expected "
+				                   "rect=X0,Y0,X1,Y1 (X0 < X1, Y0 < Y1) or disk=X,Y,R "
+				                   "(R > 0), in m", next);
+			o.add_sand = 1;
+		} else if (!strcmp(a, "--sand-rate")) {
+			if (parse_real(next, 1e-300, 1e300, &o.sand_rate))
+				return usage_error(usage_relax, "--sand-rate '%s': expected m/s > 0",
+				                   next);
+			have_rate = 1;
+		} else if (!strcmp(a, "--sand-duration")) {
+			if (parse_real(next, 1e-300, 1e300, &o.sand_duration))
+				return usage_error(usage_relax, "--sand-duration '%s': expected s > 0",
+				                   next);
+			have_duration = 1;
+		} else if (!strcmp(a, "--dx")) {
+			if (parse_real(next, 1e-300, 1e300, &o.read.cellsize))
+				return usage_error(usage_relax, "--dx '%s': expected m > 0", next);
+		} else if (!strcmp(a, "--zscale")) {
+			if (parse_real(next, 1e-300, 1e300, &o.read.zscale))
+				return usage_error(usage_relax, "--zscale '%s': expected m per grey "
+				                   "level > 0", next);
+		} else if (!strcmp(a, "--zoffset")) {
+			if (parse_real(next, -1e300, 1e300, &o.read.zoffset))
+				return usage_error(usage_relax, "--zoffset '%s': expected m", next);
+		} else if (!strcmp(a, "--report")) {
+			o.report = next;
+		} else {
+			return usage_error(usage_relax, "unknown option '%s'", a);
+		}
+	}
+	if (!o.dem)
+		return usage_error(usage_relax, "%s", "relax needs a DEM");
+	if (o.add_sand != (have_rate && have_duration) || (!o.add_sand && (have_rate || have_duration)))
+		return usage_error(usage_relax, "%s", "--add-sand, --sand-rate and "
+		                   "--sand-duration go together");
+	if (!isnan(o.read.zoffset) && isnan(o.read.zscale))
+		return usage_error(usage_relax, "%s", "--zoffset needs --zscale");
+	char *history = join_args(argc, argv);
+	o.history = history;
+	struct ss_relax_report report;
+	const int status = ss_status_exit_code(ss_relax_run(&o, &report));
+	free(history);
+	return status;
+}
+
 static void print_diag_row(const struct ss_snapshot_summary *s, long long k)
 {
 	const struct ss_diagnostics *d = &s->diag[k];
@@ -622,6 +819,8 @@ int main(int argc, char **argv)
 		return cmd_bench(argc, argv);
 	if (!strcmp(cmd, "render"))
 		return cmd_render(argc, argv);
-	return usage_error(usage_main, "unknown command '%s': expected run, info, render or "
-	                   "bench", cmd);
+	if (!strcmp(cmd, "relax"))
+		return cmd_relax(argc, argv);
+	return usage_error(usage_main, "unknown command '%s': expected run, relax, info, "
+	                   "render or bench", cmd);
 }

@@ -1,0 +1,57 @@
+#!/usr/bin/python3
+"""Write a synthetic terrain with steep cliffs as an ESRI ASCII grid.
+
+    /usr/bin/python3 cases/fractal_dem.py N OUT.asc [--seed S] [--cellsize M]
+
+The terrain is fractal (spectral synthesis: random phases, amplitude
+k^-beta, beta = 1.6, i.e. a surface of fractal dimension about 2.2) scaled to
+a relief of N/8 cells, then cut into terraces 1/24 of the relief high: each
+terrace edge is a vertical cliff, which the repose angle brings down.  With
+N = 4096 this is the terrain of the DEM section of the README.  Needs numpy.
+"""
+import argparse
+import sys
+
+import numpy as np
+
+
+def fractal_terrain(n, seed, cellsize):
+    rng = np.random.default_rng(seed)
+    kx = np.fft.fftfreq(n)[None, :]
+    ky = np.fft.rfftfreq(n)[:, None]
+    k = np.hypot(kx, ky)
+    k[0, 0] = 1.0
+    amplitude = k ** -1.6
+    amplitude[0, 0] = 0.0
+    phase = np.exp(2j * np.pi * rng.random(amplitude.shape))
+    h = np.fft.irfft2((amplitude * phase).T, s=(n, n)).T
+    h -= h.min()
+    h *= (n / 8 * cellsize) / h.max()           # relief: n/8 cells
+    step = (n / 8 * cellsize) / 24
+    return np.floor(h / step) * step             # terraces with vertical cliffs
+
+
+def write_asc(path, h, cellsize):
+    ny, nx = h.shape
+    with open(path, "w") as f:
+        f.write(f"ncols {nx}\nnrows {ny}\nxllcorner 0\nyllcorner 0\n"
+                f"cellsize {cellsize!r}\n")
+        for row in h[::-1]:                       # north row first
+            f.write(" ".join(f"{v:.6g}" for v in row))
+            f.write("\n")
+
+
+def main(argv):
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("n", type=int, help="cells per side")
+    p.add_argument("output", help="ESRI ASCII grid to write (.asc)")
+    p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--cellsize", type=float, default=1.0, help="m (default 1)")
+    a = p.parse_args(argv)
+    if a.n < 8:
+        p.error("n must be at least 8")
+    write_asc(a.output, fractal_terrain(a.n, a.seed, a.cellsize), a.cellsize)
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
