@@ -12,7 +12,7 @@
 void ss_tiling_init(struct ss_tiling *t, const struct ss_grid *g,
                     int tile_nx, int tile_ny)
 {
-	/* default: 256 x 64, smaller on small grids (about 4 x 8 tiles, at
+	/* default: 256 x 128, smaller on small grids (about 4 x 8 tiles, at
 	 * least 32 x 8) so that settled parts of them can be skipped */
 	if (tile_nx < 1) {
 		const int n = (g->nx / 4 + 7) / 8 * 8;

@@ -51,10 +51,10 @@ static inline struct ss_tile_span ss_tiling_span(const struct ss_tiling *t,
 }
 
 #define SS_TILE_NX_DEFAULT 256
-#define SS_TILE_NY_DEFAULT 64
+#define SS_TILE_NY_DEFAULT 128
 
 /* Cover g with tiles of tile_nx x tile_ny cells (the last ones may be
- * smaller); sizes < 1 mean the defaults: 256 x 64, or on a small grid about
+ * smaller); sizes < 1 mean the defaults: 256 x 128, or on a small grid about
  * a quarter of its width (a multiple of 8, at least 32) by an eighth of its
  * height (at least 8). */
 void ss_tiling_init(struct ss_tiling *t, const struct ss_grid *g,
