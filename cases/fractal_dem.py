@@ -5,9 +5,10 @@
 
 The terrain is fractal (spectral synthesis: random phases, amplitude
 k^-beta, beta = 1.6, i.e. a surface of fractal dimension about 2.2) scaled to
-a relief of N/8 cells, then cut into terraces 1/24 of the relief high: each
-terrace edge is a vertical cliff, which the repose angle brings down.  With
-N = 4096 this is the terrain of the DEM section of the README.  Needs numpy.
+a relief of 48 cells (--relief), then cut into 24 terraces 2 cells high:
+each terrace edge is a cliff of 63 degrees or more, which the repose angle
+brings down.  With N = 4096 this is the terrain of the DEM section of the
+README.  Needs numpy.
 """
 import argparse
 import sys
@@ -15,7 +16,7 @@ import sys
 import numpy as np
 
 
-def fractal_terrain(n, seed, cellsize):
+def fractal_terrain(n, seed, cellsize, relief_cells):
     rng = np.random.default_rng(seed)
     kx = np.fft.fftfreq(n)[None, :]
     ky = np.fft.rfftfreq(n)[:, None]
@@ -26,8 +27,8 @@ def fractal_terrain(n, seed, cellsize):
     phase = np.exp(2j * np.pi * rng.random(amplitude.shape))
     h = np.fft.irfft2((amplitude * phase).T, s=(n, n)).T
     h -= h.min()
-    h *= (n / 8 * cellsize) / h.max()           # relief: n/8 cells
-    step = (n / 8 * cellsize) / 24
+    h *= relief_cells * cellsize / h.max()
+    step = relief_cells * cellsize / 24
     return np.floor(h / step) * step             # terraces with vertical cliffs
 
 
@@ -47,10 +48,12 @@ def main(argv):
     p.add_argument("output", help="ESRI ASCII grid to write (.asc)")
     p.add_argument("--seed", type=int, default=1)
     p.add_argument("--cellsize", type=float, default=1.0, help="m (default 1)")
+    p.add_argument("--relief", type=float, default=48.0,
+                   help="highest minus lowest ground, in cells (default 48)")
     a = p.parse_args(argv)
     if a.n < 8:
         p.error("n must be at least 8")
-    write_asc(a.output, fractal_terrain(a.n, a.seed, a.cellsize), a.cellsize)
+    write_asc(a.output, fractal_terrain(a.n, a.seed, a.cellsize, a.relief), a.cellsize)
 
 
 if __name__ == "__main__":

@@ -78,10 +78,14 @@ static int check_output_folder(const char *path, int is_default)
 }
 
 /*
- * The steepest face that can still move sand, as an angle: faces that can
- * carry flux (SPEC section 2), without the faces whose higher cell has no
- * sand above the bedrock (bare rock may be steeper than the repose angle
- * for ever).  Without bedrock this is ss_sweep_max_slope.
+ * The steepest face of the sand, as an angle: faces that can carry flux
+ * (SPEC section 2) whose stencil (both cells and their neighbours along the
+ * face) lies in sand at least 1e-6 min(dx, dy) thick.  Bare rock may be
+ * steeper than the repose angle for ever, and so may the slope measured
+ * next to a rock cliff, whose step enters the tangential difference; a cell
+ * at the top of a cliff drains geometrically (a quarter of its sand per
+ * face and step, face.h), so it never quite reaches 0.  Without bedrock
+ * this is ss_sweep_max_slope.
  */
 static double steepest_sand_face_deg(struct ss_stepper *st)
 {
@@ -90,6 +94,7 @@ static double steepest_sand_face_deg(struct ss_stepper *st)
 	if (!st->bedrock)
 		return atan(ss_sweep_max_slope(g, st->height, st->cell_types)) * (180.0 / M_PI);
 	const double *h = st->height, *b = st->bedrock;
+	const double bare = 1e-6 * fmin(g->dx, g->dy);   /* m */
 	const uint8_t *t = st->cell_types;
 	double s2_max = 0.0;
 	for (int axis = 0; axis < 2; axis++) {
@@ -106,8 +111,13 @@ static double steepest_sand_face_deg(struct ss_stepper *st)
 				if (ta == SS_CELL_WALL || tb == SS_CELL_WALL ||
 				    (ta != SS_CELL_FLOW && tb != SS_CELL_FLOW))
 					continue;
-				const ptrdiff_t high = h[kb] > h[ka] ? kb : ka;
-				if (!(h[high] - b[high] > 0.0))
+				const ptrdiff_t stencil[6] = {ka, kb, ka + along, ka - along,
+				                              kb + along, kb - along};
+				int in_sand = 1;
+				for (int m = 0; m < 6; m++)
+					in_sand &= ss_cell_type_get(t, stencil[m]) != SS_CELL_FLOW ||
+					           h[stencil[m]] - b[stencil[m]] > bare;
+				if (!in_sand)
 					continue;
 				double gt = 0.0;
 				const ptrdiff_t cells[2] = {ka, kb};
