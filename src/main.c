@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "sandslide/bench.h"
+#include "sandslide/dem.h"
 #include "sandslide/error.h"
 #include "sandslide/parallel.h"
 #include "sandslide/relax.h"
@@ -802,13 +803,13 @@ int main(int argc, char **argv)
 		return 0;
 	}
 	if (!strcmp(cmd, "--version") || !strcmp(cmd, "version")) {
-		printf("sandslide %s (OpenMP: %s, %d processors)\n", SS_VERSION,
+		printf("sandslide %s (OpenMP: %s, %d processors; GDAL: %s)\n", SS_VERSION,
 #ifdef _OPENMP
 		       "on",
 #else
 		       "off",
 #endif
-		       ss_parallel_processors());
+		       ss_parallel_processors(), ss_dem_gdal_available() ? "on" : "off");
 		return 0;
 	}
 	if (!strcmp(cmd, "run"))
