@@ -87,6 +87,17 @@ static inline double max2(double a, double b)
 	return b > a ? b : a;
 }
 
+/* Packed types of cells k .. k + n - 1 widened to 64 bits (n <= TYPE_CHUNK
+ * + 2): the border measures below work on chunks of this many cells. */
+enum { TYPE_CHUNK = 256 };
+
+static inline void unpack_wide(const uint8_t *restrict t, ptrdiff_t k, int n,
+                               int64_t *restrict out)
+{
+	for (int x = 0; x < n; x++)
+		out[x] = type_at(t, k + x);
+}
+
 /*
  * Largest s^2 of the x-faces (i - 1 | i), ia <= i <= ib, of row j, read
  * from the grid (the rows j - 1 .. j + 1 must hold one state).
@@ -111,18 +122,27 @@ static double slope2_x_faces(const struct ss_grid *g, const double *h,
 			m = q > m ? q : m;
 		}
 	} else {
-		for (int i = ia; i <= ib; i++) {
-			const int wall_pa = type_at(t, kp + i - 1) == SS_CELL_WALL;
-			const int wall_ma = type_at(t, km + i - 1) == SS_CELL_WALL;
-			const int wall_pb = type_at(t, kp + i) == SS_CELL_WALL;
-			const int wall_mb = type_at(t, km + i) == SS_CELL_WALL;
-			const double cda = ((wall_pa ? h0[i - 1] : hp[i - 1]) -
-			                    (wall_ma ? h0[i - 1] : hm[i - 1])) * inv_2dy;
-			const double cdb = ((wall_pb ? h0[i] : hp[i]) - (wall_mb ? h0[i] : hm[i])) * inv_2dy;
-			const double gn = (h0[i] - h0[i - 1]) * inv_dx, gt = 0.5 * (cda + cdb);
-			const uint64_t q = face_carries(type_at(t, k0 + i - 1), type_at(t, k0 + i))
-			                   ? bits_of(gn * gn + gt * gt) : 0;
-			m = q > m ? q : m;
+		/* a chunk of packed types at a time, widened so the loop
+		 * vectorises (as in the tile rows) */
+		int64_t tm[TYPE_CHUNK + 2], t0[TYPE_CHUNK + 2], tp[TYPE_CHUNK + 2];
+		for (int c0 = ia; c0 <= ib; c0 += TYPE_CHUNK) {
+			const int c1 = ib - c0 < TYPE_CHUNK ? ib : c0 + TYPE_CHUNK - 1;
+			const int n = c1 - c0 + 2;   /* cells c0 - 1 .. c1 */
+			unpack_wide(t, km + c0 - 1, n, tm);
+			unpack_wide(t, k0 + c0 - 1, n, t0);
+			unpack_wide(t, kp + c0 - 1, n, tp);
+			const double *hm_c = hm + c0 - 1, *h0_c = h0 + c0 - 1, *hp_c = hp + c0 - 1;
+			for (int x = 1; x < n; x++) {
+				const double cda = ((tp[x - 1] == SS_CELL_WALL ? h0_c[x - 1] : hp_c[x - 1]) -
+				                    (tm[x - 1] == SS_CELL_WALL ? h0_c[x - 1] : hm_c[x - 1])) *
+				                   inv_2dy;
+				const double cdb = ((tp[x] == SS_CELL_WALL ? h0_c[x] : hp_c[x]) -
+				                    (tm[x] == SS_CELL_WALL ? h0_c[x] : hm_c[x])) * inv_2dy;
+				const double gn = (h0_c[x] - h0_c[x - 1]) * inv_dx, gt = 0.5 * (cda + cdb);
+				const uint64_t q = wide_carries(t0[x - 1], t0[x])
+				                   ? bits_of(gn * gn + gt * gt) : 0;
+				m = q > m ? q : m;
+			}
 		}
 	}
 	const double max = double_of(m);
@@ -149,19 +169,24 @@ static double slope2_y_faces(const struct ss_grid *g, const double *h,
 			m = q > m ? q : m;
 		}
 	} else {
-		for (int i = ia; i <= ib; i++) {
-			const int wall_ap = type_at(t, ka + i + 1) == SS_CELL_WALL;
-			const int wall_am = type_at(t, ka + i - 1) == SS_CELL_WALL;
-			const int wall_bp = type_at(t, kb + i + 1) == SS_CELL_WALL;
-			const int wall_bm = type_at(t, kb + i - 1) == SS_CELL_WALL;
-			const double cda = ((wall_ap ? ha[i] : ha[i + 1]) -
-			                    (wall_am ? ha[i] : ha[i - 1])) * inv_2dx;
-			const double cdb = ((wall_bp ? hb[i] : hb[i + 1]) -
-			                    (wall_bm ? hb[i] : hb[i - 1])) * inv_2dx;
-			const double gn = (hb[i] - ha[i]) * inv_dy, gt = 0.5 * (cda + cdb);
-			const uint64_t q = face_carries(type_at(t, ka + i), type_at(t, kb + i))
-			                   ? bits_of(gn * gn + gt * gt) : 0;
-			m = q > m ? q : m;
+		int64_t ta[TYPE_CHUNK + 2], tb[TYPE_CHUNK + 2];
+		for (int c0 = ia; c0 <= ib; c0 += TYPE_CHUNK) {
+			const int c1 = ib - c0 < TYPE_CHUNK ? ib : c0 + TYPE_CHUNK - 1;
+			const int n = c1 - c0 + 3;   /* cells c0 - 1 .. c1 + 1 */
+			unpack_wide(t, ka + c0 - 1, n, ta);
+			unpack_wide(t, kb + c0 - 1, n, tb);
+			const double *ha_c = ha + c0 - 1, *hb_c = hb + c0 - 1;
+			for (int x = 1; x < n - 1; x++) {
+				const double cda = ((ta[x + 1] == SS_CELL_WALL ? ha_c[x] : ha_c[x + 1]) -
+				                    (ta[x - 1] == SS_CELL_WALL ? ha_c[x] : ha_c[x - 1])) *
+				                   inv_2dx;
+				const double cdb = ((tb[x + 1] == SS_CELL_WALL ? hb_c[x] : hb_c[x + 1]) -
+				                    (tb[x - 1] == SS_CELL_WALL ? hb_c[x] : hb_c[x - 1])) *
+				                   inv_2dx;
+				const double gn = (hb_c[x] - ha_c[x]) * inv_dy, gt = 0.5 * (cda + cdb);
+				const uint64_t q = wide_carries(ta[x], tb[x]) ? bits_of(gn * gn + gt * gt) : 0;
+				m = q > m ? q : m;
+			}
 		}
 	}
 	const double max = double_of(m);
