@@ -6,6 +6,7 @@
 #include <errno.h>
 #include <limits.h>
 #include <math.h>
+#include <signal.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -38,9 +39,15 @@ static const char usage_main[] =
 
 static const char usage_run[] =
 	"usage: sandslide run CASE.ini [-o OUT.h5] [--threads N] [--set SECTION.KEY=VALUE ...]\n"
+	"       sandslide run --restart OUT.h5 [CASE.ini] [--threads N]\n"
 	"\n"
 	"  -o, --output OUT.h5   output file (default out/<case name>.h5; its folder\n"
 	"                        must exist unless it is the default out/)\n"
+	"  --force               replace OUT.h5 if it exists (else refused)\n"
+	"  --restart OUT.h5      continue the run in OUT.h5 from its last snapshot,\n"
+	"                        appending to it, with the case stored in it (a\n"
+	"                        CASE.ini given too must be that case); the\n"
+	"                        snapshots are those of a run never interrupted\n"
 	"  --threads N           OpenMP threads (default: all processors)\n"
 	"  --set S.K=VALUE       override key K of section S of the case, e.g.\n"
 	"                        --set model.closure=casson, --set 'source pour.rate=0.002'\n"
@@ -56,7 +63,9 @@ static const char usage_run[] =
 	"                        of `sandslide render --help` apply, e.g. --label)\n"
 	"\n"
 	"Writes OUT.h5 (SPEC section 5) and the XDMF sidecar OUT.xmf, flushed after\n"
-	"every snapshot.  Exit status: 0 done, 1 failure while running, 2 bad input.\n";
+	"every snapshot.  Ctrl-C (SIGINT) or SIGTERM finish the substep, write a\n"
+	"snapshot and exit 130 or 143 naming the command that continues the run.\n"
+	"Exit status: 0 done, 1 failure while running, 2 bad input.\n";
 
 static const char usage_relax[] =
 	"usage: sandslide relax DEM [-o OUT] [--angle DEG] [--closure NAME] [--nu V]\n"
@@ -92,6 +101,7 @@ static const char usage_relax[] =
 	"  --zoffset Z0          PNG: height of grey 0, m (default 0)\n"
 	"  --output-every T      .h5 output: a snapshot every T s\n"
 	"  --report FILE.json    write the diagnostics for scripts\n"
+	"  --force               replace OUT if it exists (else refused)\n"
 	"  -q, --quiet           no progress line and no summary\n"
 	"\n"
 	"Prints cells and volume moved, steepest face before and after, steps and\n"
@@ -166,6 +176,31 @@ static const char usage_bench[] =
 	"\n"
 	"Also measures the memory bandwidth (read+write of one array) in the same run\n"
 	"and reports the fraction of that roofline each case reaches.\n";
+
+/* The signal that asked a run to stop (SIGINT or SIGTERM), 0 while none
+ * did: the run finishes its substep, writes a snapshot and returns, and the
+ * exit status is 128 + the signal.  A second signal kills at once
+ * (SA_RESETHAND). */
+static volatile sig_atomic_t stop_signal;
+
+static void on_stop_signal(int sig)
+{
+	stop_signal = sig;
+}
+
+static void install_signal_handlers(void)
+{
+	struct sigaction sa;
+	memset(&sa, 0, sizeof sa);
+	sa.sa_handler = on_stop_signal;
+	sa.sa_flags = SA_RESETHAND;
+	sigemptyset(&sa.sa_mask);
+	sigaction(SIGINT, &sa, NULL);
+	sigaction(SIGTERM, &sa, NULL);
+	/* past a file-size limit, write() must fail with EFBIG (and the run
+	 * report it) rather than the process die silently */
+	signal(SIGXFSZ, SIG_IGN);
+}
 
 static int usage_error(const char *usage, const char *fmt, const char *arg)
 {
@@ -535,6 +570,14 @@ static int cmd_run(int argc, char **argv)
 			o.quiet = 1;
 		} else if (!strcmp(a, "--reference-kernel")) {
 			o.reference_kernel = 1;
+		} else if (!strcmp(a, "--force")) {
+			o.force = 1;
+		} else if (!strcmp(a, "--restart")) {
+			if (!next) {
+				status = usage_error(usage_run, "%s needs the output file to continue", a);
+				goto out;
+			}
+			o.restart = argv[++k];
 		} else if (a[0] == '-' && a[1]) {
 			status = usage_error(usage_run, "unknown option '%s'", a);
 			goto out;
@@ -545,8 +588,8 @@ static int cmd_run(int argc, char **argv)
 			o.case_path = a;
 		}
 	}
-	if (!o.case_path) {
-		status = usage_error(usage_run, "%s", "run needs a case file");
+	if (!o.case_path && !o.restart) {
+		status = usage_error(usage_run, "%s", "run needs a case file (or --restart OUT.h5)");
 		goto out;
 	}
 	if (look_option && !frames_dir) {
@@ -563,7 +606,11 @@ static int cmd_run(int argc, char **argv)
 	o.overrides = overrides;
 	char *history = join_args(argc, argv);
 	o.history = history;
+	o.stop_signal = &stop_signal;
+	install_signal_handlers();
 	status = ss_status_exit_code(ss_run_case(&o));
+	if (status == 0 && stop_signal)
+		status = 128 + stop_signal;
 	free(history);
 	if (frames && !o.quiet)
 		printf("wrote %lld frames to %s%s\n", ss_render_frames_count(frames), frames_dir,
@@ -621,6 +668,9 @@ static int cmd_relax(int argc, char **argv)
 			return 0;
 		} else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
 			o.quiet = 1;
+			continue;
+		} else if (!strcmp(a, "--force")) {
+			o.force = 1;
 			continue;
 		} else if (a[0] != '-' || !a[1]) {
 			if (o.dem)
@@ -723,7 +773,11 @@ static int cmd_relax(int argc, char **argv)
 	char *history = join_args(argc, argv);
 	o.history = history;
 	struct ss_relax_report report;
-	const int status = ss_status_exit_code(ss_relax_run(&o, &report));
+	o.stop_signal = &stop_signal;
+	install_signal_handlers();
+	int status = ss_status_exit_code(ss_relax_run(&o, &report));
+	if (status == 0 && stop_signal)
+		status = 128 + stop_signal;
 	free(history);
 	return status;
 }
@@ -795,6 +849,7 @@ static int cmd_info(int argc, char **argv)
 
 int main(int argc, char **argv)
 {
+	ss_snapshot_library_init();
 	if (argc < 2)
 		return usage_error(usage_main, "%s", "no command given");
 	const char *cmd = argv[1];

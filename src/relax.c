@@ -56,8 +56,9 @@ static void default_output(const char *dem, char *out, size_t size)
 	snprintf(out, size, "out/%.*s-relaxed%.*s", stem, base, len - stem, base + stem);
 }
 
-/* The output's folder must exist and be writable (out/ is created). */
-static int check_output_folder(const char *path, int is_default)
+/* The output's folder must exist and be writable (out/ is created); an
+ * existing output is replaced only with force. */
+static int check_output_folder(const char *path, int is_default, int force)
 {
 	char dir[4096];
 	const char *slash = strrchr(path, '/');
@@ -74,6 +75,8 @@ static int check_output_folder(const char *path, int is_default)
 		return ss_error_input("cannot write '%s': folder '%s' is not writable", path, dir);
 	if (stat(path, &sb) == 0 && S_ISDIR(sb.st_mode))
 		return ss_error_input("cannot write '%s': it is a folder", path);
+	if (!force && stat(path, &sb) == 0)
+		return ss_error_input("'%s' exists: give --force to replace it", path);
 	return SS_OK;
 }
 
@@ -273,7 +276,7 @@ static int write_series_snapshot(struct ss_snapshot *snap, struct ss_stepper *st
 	struct ss_diagnostics d;
 	ss_stepper_diagnostics(st, &d);
 	d.wall_seconds = now_seconds() - started;
-	return ss_snapshot_append(snap, st->time, st->height, &d);
+	return ss_snapshot_append(snap, st->time, st->height, &d, NULL);
 }
 
 int ss_relax_run(const struct ss_relax_options *o, struct ss_relax_report *rep)
@@ -303,7 +306,7 @@ int ss_relax_run(const struct ss_relax_options *o, struct ss_relax_report *rep)
 		                     "write .asc, .png or .h5", rep->output);
 		goto out;
 	}
-	if ((err = check_output_folder(rep->output, o->output == NULL)))
+	if ((err = check_output_folder(rep->output, o->output == NULL, o->force)))
 		goto out;
 	if (o->bedrock) {
 		struct ss_dem_read_options bo = o->read;
@@ -354,6 +357,7 @@ int ss_relax_run(const struct ss_relax_options *o, struct ss_relax_report *rep)
 		.steady_tol = o->tol,
 		.progress = show ? progress_print : NULL,
 		.context = &last_print,
+		.stop = o->stop_signal,
 	};
 	enum ss_advance_end end = SS_ADVANCE_REACHED;
 	for (long long k = 1; st.time < o->max_time; k++) {
@@ -367,11 +371,16 @@ int ss_relax_run(const struct ss_relax_options *o, struct ss_relax_report *rep)
 		}
 		if (snap && (err = write_series_snapshot(snap, &st, started)))
 			goto out;
-		if (end == SS_ADVANCE_STEADY || isinf(target))
+		if (end == SS_ADVANCE_STEADY || end == SS_ADVANCE_INTERRUPTED || isinf(target))
 			break;
 	}
 	if (show)
 		fputc('\n', stderr);
+	if (end == SS_ADVANCE_INTERRUPTED) {
+		fflush(stdout);
+		fprintf(stderr, "sandslide: interrupted at t = %g s (step %lld): '%s' holds the "
+		        "surface as it was then, not relaxed\n", st.time, st.steps, rep->output);
+	}
 	rep->steady = end == SS_ADVANCE_STEADY;
 	rep->steps = st.steps;
 	rep->time = st.time;

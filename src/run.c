@@ -63,12 +63,26 @@ static int check_output(const char *path, int is_default)
 	return SS_OK;
 }
 
+/* An existing output is replaced only with --force (checked last, so that
+ * a run with bad input says what is wrong with it first). */
+static int check_not_existing(const char *path, int force)
+{
+	struct stat sb;
+	if (!force && stat(path, &sb) == 0)
+		return ss_error_input("'%s' exists: give --force to replace it, or --restart %s "
+		                      "to continue that run", path, path);
+	return SS_OK;
+}
+
 struct progress {
 	int enabled;
 	double started, last_print;
 	double end;          /* INFINITY when steady */
 	double steady_tol;   /* m/s */
 	double cells;
+	long long nan_step;  /* test hook: > 0 puts a NaN into a cell at this step */
+	double *height;      /* the stepper's, for the hook */
+	ptrdiff_t nan_cell;
 };
 
 static void format_duration(double s, char *buf, size_t size)
@@ -86,6 +100,10 @@ static void format_duration(double s, char *buf, size_t size)
 static void progress_print(void *context, const struct ss_stepper *st)
 {
 	struct progress *p = context;
+	if (st->steps == p->nan_step)
+		p->height[p->nan_cell] = NAN;   /* SANDSLIDE_TEST_NAN_STEP, see below */
+	if (!p->enabled)
+		return;
 	const double now = now_seconds();
 	if (now - p->last_print < 0.5)
 		return;
@@ -116,7 +134,12 @@ static int write_snapshot(struct ss_snapshot *snap, struct ss_stepper *st, doubl
 	if (!isfinite(d.volume) || !isfinite(d.max_height))
 		return ss_error_fail("the height became non-finite by t = %g s (step %lld): "
 		                     "not writing this snapshot", st->time, st->steps);
-	int err = ss_snapshot_append(snap, st->time, st->height, &d);
+	const struct ss_restart_state state = {
+		.steps = st->steps,
+		.inflow_sum = st->inflow_sum, .inflow_carry = st->inflow_carry,
+		.outflow_sum = st->outflow_sum, .outflow_carry = st->outflow_carry,
+	};
+	int err = ss_snapshot_append(snap, st->time, st->height, &d, &state);
 	*seconds_output += now_seconds() - t0;
 	return err;
 }
@@ -153,57 +176,189 @@ static int report_snapshot(const struct ss_run_options *o, const char *output,
 	return o->on_snapshot(o->snapshot_context, &s);
 }
 
+/* The first cell (in row order) whose height is not finite, as a message
+ * fragment "cell (i, j) at x = .. m, y = .. m". */
+static void first_nonfinite_cell(const struct ss_stepper *st, char *out, size_t size)
+{
+	const struct ss_grid *g = &st->grid;
+	snprintf(out, size, "a cell");
+	for (int j = 0; j < g->ny; j++) {
+		for (int i = 0; i < g->nx; i++) {
+			if (!isfinite(st->height[ss_grid_index(g, i, j)])) {
+				snprintf(out, size, "cell (%d, %d) at x = %g m, y = %g m", i, j,
+				         ss_grid_x(g, i), ss_grid_y(g, j));
+				return;
+			}
+		}
+	}
+}
+
+/* The --set values as one string, a line each (stored for restarts). */
+static char *join_overrides(const char *const *v, int n)
+{
+	size_t len = 1;
+	for (int k = 0; k < n; k++)
+		len += strlen(v[k]) + 1;
+	char *s = malloc(len);
+	if (!s)
+		return NULL;
+	s[0] = '\0';
+	for (int k = 0; k < n; k++) {
+		strcat(s, v[k]);
+		strcat(s, "\n");
+	}
+	return s;
+}
+
+/* The case of a run being continued: the text and overrides stored in its
+ * file.  A case file named as well must be that same text. */
+static int restart_case(const struct ss_run_options *o, const struct ss_restart_info *r,
+                        struct ss_case *c)
+{
+	memset(c, 0, sizeof *c);
+	if (o->override_count > 0)
+		return ss_error_input("--restart %s: --set cannot change a run being continued "
+		                      "(it keeps the overrides it was started with)", o->restart);
+	int n = 0;
+	for (const char *p = r->case_overrides; *p; p++)
+		n += *p == '\n';
+	char *copy = strdup(r->case_overrides);
+	const char **v = calloc((size_t)n + 1, sizeof *v);
+	if (!copy || !v) {
+		free(copy);
+		free(v);
+		return ss_error_fail("out of memory");
+	}
+	int m = 0;
+	for (char *line = strtok(copy, "\n"); line && m < n; line = strtok(NULL, "\n"))
+		v[m++] = line;
+	int err = ss_case_parse(c, r->case_path, r->case_text, v, m);
+	free(v);
+	free(copy);
+	if (err || !o->case_path)
+		return err;
+	struct ss_case given;
+	err = ss_case_load(&given, o->case_path, NULL, 0);
+	if (!err && strcmp(given.text, r->case_text) != 0)
+		err = ss_error_input("--restart %s: '%s' is not the case that file was run from "
+		                     "('%s' as it was then); give that case or none",
+		                     o->restart, o->case_path, r->case_path);
+	ss_case_release(&given);
+	return err;
+}
+
+/* Put the stepper where the restart file's last snapshot left it. */
+static int restart_stepper(const struct ss_run_options *o, const struct ss_restart_info *r,
+                           struct ss_stepper *st)
+{
+	const struct ss_grid *g = &st->grid;
+	if (r->nx != g->nx || r->ny != g->ny)
+		return ss_error_input("--restart %s: its snapshots are %d x %d cells, its case "
+		                      "gives %d x %d", o->restart, r->nx, r->ny, g->nx, g->ny);
+	for (int j = 0; j < g->ny; j++)
+		memcpy(st->height + ss_grid_index(g, 0, j), r->height + (size_t)j * g->nx,
+		       (size_t)g->nx * sizeof(double));
+	st->time = r->time;
+	st->steps = r->state.steps;
+	st->inflow_sum = r->state.inflow_sum;
+	st->inflow_carry = r->state.inflow_carry;
+	st->outflow_sum = r->state.outflow_sum;
+	st->outflow_carry = r->state.outflow_carry;
+	st->inflow = st->inflow_sum + st->inflow_carry;
+	st->outflow = st->outflow_sum + st->outflow_carry;
+	ss_stepper_heights_changed(st);
+	return SS_OK;
+}
+
 int ss_run_case(const struct ss_run_options *o)
 {
 	const double started = now_seconds();
 	struct ss_case c;
 	struct ss_stepper st;
 	struct ss_snapshot *snap = NULL;
+	struct ss_restart_info restart;
 	char output[4096];
 	double seconds_output = 0.0;
+	char *overrides_text = NULL;
 
+	memset(&restart, 0, sizeof restart);
+	memset(&st, 0, sizeof st);
 	ss_parallel_set_threads(o->threads > 0 ? o->threads : ss_parallel_processors());
-	int err = ss_case_load(&c, o->case_path, o->overrides, o->override_count);
-	if (err)
-		goto out_case;
-	if (o->output)
-		snprintf(output, sizeof output, "%s", o->output);
-	else
-		default_output(o->case_path, output, sizeof output);
-	if ((err = check_output(output, o->output == NULL)))
-		goto out_case;
+	int err;
+	if (o->restart) {
+		memset(&c, 0, sizeof c);
+		if ((err = ss_snapshot_read_restart(o->restart, &restart)) ||
+		    (err = restart_case(o, &restart, &c)))
+			goto out_case;
+		if (o->output && strcmp(o->output, o->restart) != 0) {
+			err = ss_error_input("--restart %s continues that file: drop -o %s", o->restart,
+			                     o->output);
+			goto out_case;
+		}
+		snprintf(output, sizeof output, "%s", o->restart);
+	} else {
+		if ((err = ss_case_load(&c, o->case_path, o->overrides, o->override_count)))
+			goto out_case;
+		if (o->output)
+			snprintf(output, sizeof output, "%s", o->output);
+		else
+			default_output(o->case_path, output, sizeof output);
+		if ((err = check_output(output, o->output == NULL)))
+			goto out_case;
+	}
 	if ((err = ss_setup_stepper(&c, o->tile_nx, o->tile_ny,
 	                            o->reference_kernel ? SS_KERNEL_REFERENCE : SS_KERNEL_FAST, &st)))
 		goto out_case;
+	if (o->restart && (err = restart_stepper(o, &restart, &st)))
+		goto out_stepper;
+	if (!o->restart && (err = check_not_existing(output, o->force)))
+		goto out_stepper;
 
 	/* the run starts: from here on the output file is written */
-	if (!o->output && mkdir("out", 0777) != 0 && errno != EEXIST) {
-		err = ss_error_fail("cannot create output folder 'out': %s", strerror(errno));
-		goto out_stepper;
+	if (o->restart) {
+		if ((err = ss_snapshot_open_append(&snap, output, &st.grid)))
+			goto out_stepper;
+	} else {
+		if (!o->output && mkdir("out", 0777) != 0 && errno != EEXIST) {
+			err = ss_error_fail("cannot create output folder 'out': %s", strerror(errno));
+			goto out_stepper;
+		}
+		if (!(overrides_text = join_overrides(o->overrides, o->override_count))) {
+			err = ss_error_fail("out of memory");
+			goto out_stepper;
+		}
+		struct ss_snapshot_meta meta = {
+			.title = c.path, .history = o->history ? o->history : "",
+			.case_text = c.text, .closure = ss_closure_name(c.closure),
+			.repose_angle_deg = c.repose_angle_deg, .nu = c.nu, .gamma = c.gamma,
+			.deflate = o->deflate, .bedrock = st.bedrock,
+			.case_overrides = overrides_text,
+		};
+		if ((err = ss_snapshot_create(&snap, output, &st.grid, st.cell_types, &meta)))
+			goto out_stepper;
+		if ((err = write_snapshot(snap, &st, started, &seconds_output)) ||
+		    (err = report_snapshot(o, output, snap, &st, &c)))
+			goto out_snapshot;
 	}
-	struct ss_snapshot_meta meta = {
-		.title = c.path, .history = o->history ? o->history : "",
-		.case_text = c.text, .closure = ss_closure_name(c.closure),
-		.repose_angle_deg = c.repose_angle_deg, .nu = c.nu, .gamma = c.gamma,
-		.deflate = o->deflate, .bedrock = st.bedrock,
-	};
-	if ((err = ss_snapshot_create(&snap, output, &st.grid, st.cell_types, &meta)))
-		goto out_stepper;
-	if ((err = write_snapshot(snap, &st, started, &seconds_output)) ||
-	    (err = report_snapshot(o, output, snap, &st, &c)))
-		goto out_snapshot;
 
+	/* SANDSLIDE_TEST_NAN_STEP=N (a test hook, not an option): a NaN height
+	 * in the middle cell after substep N, to test the guard below */
+	const char *hook = getenv("SANDSLIDE_TEST_NAN_STEP");
 	struct progress prog = {
 		.enabled = !o->quiet && isatty(fileno(stderr)),
 		.started = started, .last_print = started,
 		.end = c.steady ? c.max_time : c.end,
 		.steady_tol = c.steady_tol,
 		.cells = (double)st.grid.nx * st.grid.ny,
+		.nan_step = hook && *hook ? atoll(hook) : -1,
+		.height = st.height,
+		.nan_cell = ss_grid_index(&st.grid, st.grid.nx / 2, st.grid.ny / 2),
 	};
 	struct ss_advance_options adv = {
 		.steady_tol = c.steady ? c.steady_tol : 0.0,
-		.progress = prog.enabled ? progress_print : NULL,
+		.progress = prog.enabled || prog.nan_step > 0 ? progress_print : NULL,
 		.context = &prog,
+		.stop = o->stop_signal,
 	};
 	const double stop = c.steady ? c.max_time : c.end;
 	enum ss_advance_end end = SS_ADVANCE_REACHED;
@@ -213,9 +368,13 @@ int ss_run_case(const struct ss_run_options *o)
 			continue;
 		end = ss_stepper_advance(&st, target, &adv);
 		if (end == SS_ADVANCE_NONFINITE) {
-			err = ss_error_fail("the height became non-finite at t = %g s (step %lld); "
-			                    "%lld snapshots before it are in '%s'", st.time, st.steps,
-			                    ss_snapshot_count(snap), output);
+			char cell[160];
+			first_nonfinite_cell(&st, cell, sizeof cell);
+			err = ss_error_fail("the height of %s became non-finite in step %lld (t = %g "
+			                    "s); the %lld snapshots before it, the last at t = %g s, "
+			                    "are in '%s'", cell, st.steps, st.time,
+			                    ss_snapshot_count(snap), ss_snapshot_last_time(snap),
+			                    output);
 			goto out_snapshot;
 		}
 		if (end == SS_ADVANCE_STALLED) {
@@ -228,13 +387,19 @@ int ss_run_case(const struct ss_run_options *o)
 		if ((err = write_snapshot(snap, &st, started, &seconds_output)) ||
 		    (err = report_snapshot(o, output, snap, &st, &c)))
 			goto out_snapshot;
-		if (end == SS_ADVANCE_STEADY)
+		if (end == SS_ADVANCE_STEADY || end == SS_ADVANCE_INTERRUPTED)
 			break;
 	}
 	if (prog.enabled)
 		fputc('\n', stderr);
+	if (end == SS_ADVANCE_INTERRUPTED) {
+		fflush(stdout);
+		fprintf(stderr, "sandslide: interrupted at t = %g s (step %lld): snapshot %lld is "
+		        "in '%s'; continue with\n    sandslide run --restart %s\n", st.time,
+		        st.steps, ss_snapshot_count(snap) - 1, output, output);
+	}
 
-	if (!o->quiet) {
+	if (!o->quiet && end != SS_ADVANCE_INTERRUPTED) {
 		const double wall = now_seconds() - started;
 		const double updates = (double)st.steps * st.grid.nx * st.grid.ny;
 		printf("wrote %s: %lld snapshots to t = %g s, %lld steps%s\n", output,
@@ -254,6 +419,8 @@ out_snapshot:
 out_stepper:
 	ss_stepper_release(&st);
 out_case:
+	free(overrides_text);
+	ss_restart_info_release(&restart);
 	ss_case_release(&c);
 	return err;
 }

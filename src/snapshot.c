@@ -13,6 +13,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/statvfs.h>
 
 #include <hdf5.h>
 #include <hdf5_hl.h>
@@ -60,6 +63,8 @@ struct ss_snapshot {
 	hid_t height, time, diag[DIAG_COUNT];
 	struct ss_grid grid;
 	long long count;
+	int failed;             /* a write failed (and said so): the close that
+	                           follows will fail too, silently */
 	double *times;          /* for the sidecar */
 	long long times_cap;
 };
@@ -67,6 +72,15 @@ struct ss_snapshot {
 static void quiet_hdf5(void)
 {
 	H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+}
+
+void ss_snapshot_library_init(void)
+{
+	/* HDF5 1.10 crashes in its exit handler on a file whose close failed
+	 * (a full disk, a file-size limit); we close every file ourselves, so
+	 * it need not clean up at exit.  Only effective as the first call. */
+	H5dont_atexit();
+	quiet_hdf5();
 }
 
 /* ---- attributes ------------------------------------------------------ */
@@ -304,7 +318,8 @@ static int write_static(struct ss_snapshot *s, const uint8_t *cell_types,
 	      attr_doubles(f, "repose_angle_deg", &meta->repose_angle_deg, 1) ||
 	      attr_doubles(f, "nu", &meta->nu, 1) || attr_doubles(f, "gamma", &meta->gamma, 1) ||
 	      attr_doubles(f, "dx", &g->dx, 1) || attr_doubles(f, "dy", &g->dy, 1) ||
-	      attr_string(f, "case", meta->case_text);
+	      attr_string(f, "case", meta->case_text) ||
+	      attr_string(f, "case_overrides", meta->case_overrides ? meta->case_overrides : "");
 	if (x >= 0)
 		H5Dclose(x);
 	if (y >= 0)
@@ -338,7 +353,7 @@ int ss_snapshot_destroy(struct ss_snapshot *s)
 	int err = SS_OK;
 	close_handles(s);
 	if (s->file >= 0 && H5Fclose(s->file) < 0)
-		err = ss_error_fail("cannot close '%s'", s->path);
+		err = s->failed ? SS_ERR_FAIL : ss_error_fail("cannot close '%s'", s->path);
 	if (s->count == 0 && s->partial_path)
 		remove(s->partial_path);   /* never complete: leave nothing */
 	free(s->times);
@@ -349,37 +364,16 @@ int ss_snapshot_destroy(struct ss_snapshot *s)
 	return err;
 }
 
-int ss_snapshot_create(struct ss_snapshot **out, const char *path,
-                       const struct ss_grid *g, const uint8_t *cell_types,
-                       const struct ss_snapshot_meta *meta)
+/* File access of a writer: the v1.8 format (readable by every netCDF-4 and
+ * HDF5 >= 1.8 reader), and changed metadata kept in memory until the flush
+ * that ends a snapshot: evicted early, a chunk index could reach the disk
+ * before the superblock that covers it, and a run killed in the middle of
+ * a snapshot would leave an unreadable file.  The file's metadata is a few
+ * kB, so the cache never needs to evict. */
+static hid_t writer_access(void)
 {
-	quiet_hdf5();
-	*out = NULL;
-	struct ss_snapshot *s = calloc(1, sizeof *s);
-	if (!s)
-		return ss_error_fail("out of memory");
-	s->file = s->height = s->time = -1;
-	for (int k = 0; k < DIAG_COUNT; k++)
-		s->diag[k] = -1;
-	s->grid = *g;
-	s->path = strdup(path);
-	s->xmf_path = malloc(strlen(path) + 8);
-	s->partial_path = malloc(strlen(path) + 16);
-	if (!s->path || !s->xmf_path || !s->partial_path) {
-		ss_snapshot_destroy(s);
-		return ss_error_fail("out of memory");
-	}
-	ss_snapshot_sidecar_path(path, s->xmf_path, strlen(path) + 8);
-	snprintf(s->partial_path, strlen(path) + 16, "%s.partial", path);
-
 	hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
-	/* v1.8 format: readable by every netCDF-4 and HDF5 >= 1.8 reader */
 	H5Pset_libver_bounds(fapl, H5F_LIBVER_EARLIEST, H5F_LIBVER_V18);
-	/* keep changed metadata in memory until the flush that ends a snapshot:
-	 * evicted early, a chunk index could reach the disk before the
-	 * superblock that covers it, and a run killed in the middle of a
-	 * snapshot would leave an unreadable file.  The file's metadata is a
-	 * few kB, so the cache never needs to evict. */
 	H5AC_cache_config_t mdc;
 	mdc.version = H5AC__CURR_CACHE_CONFIG_VERSION;
 	if (H5Pget_mdc_config(fapl, &mdc) >= 0) {
@@ -389,6 +383,41 @@ int ss_snapshot_create(struct ss_snapshot **out, const char *path,
 		mdc.decr_mode = H5C_decr__off;
 		H5Pset_mdc_config(fapl, &mdc);
 	}
+	return fapl;
+}
+
+static struct ss_snapshot *snapshot_alloc(const char *path, const struct ss_grid *g)
+{
+	struct ss_snapshot *s = calloc(1, sizeof *s);
+	if (!s)
+		return NULL;
+	s->file = s->height = s->time = -1;
+	for (int k = 0; k < DIAG_COUNT; k++)
+		s->diag[k] = -1;
+	s->grid = *g;
+	s->path = strdup(path);
+	s->xmf_path = malloc(strlen(path) + 8);
+	s->partial_path = malloc(strlen(path) + 16);
+	if (!s->path || !s->xmf_path || !s->partial_path) {
+		ss_snapshot_destroy(s);
+		return NULL;
+	}
+	ss_snapshot_sidecar_path(path, s->xmf_path, strlen(path) + 8);
+	snprintf(s->partial_path, strlen(path) + 16, "%s.partial", path);
+	return s;
+}
+
+int ss_snapshot_create(struct ss_snapshot **out, const char *path,
+                       const struct ss_grid *g, const uint8_t *cell_types,
+                       const struct ss_snapshot_meta *meta)
+{
+	quiet_hdf5();
+	*out = NULL;
+	struct ss_snapshot *s = snapshot_alloc(path, g);
+	if (!s)
+		return ss_error_fail("out of memory");
+
+	hid_t fapl = writer_access();
 	s->file = H5Fcreate(s->partial_path, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
 	H5Pclose(fapl);
 	if (s->file < 0) {
@@ -463,11 +492,72 @@ static int write_sidecar(const struct ss_snapshot *s)
 	return 0;
 }
 
+/* Root attribute restart_state = steps, inflow sum and carry, outflow sum
+ * and carry of the last snapshot: a restart continues the compensated sums
+ * with the very same bits. */
+static int write_restart_state(hid_t file, const struct ss_restart_state *r)
+{
+	const double v[5] = {(double)r->steps, r->inflow_sum, r->inflow_carry,
+	                     r->outflow_sum, r->outflow_carry};
+	if (H5Aexists(file, "restart_state") > 0) {
+		hid_t a = H5Aopen(file, "restart_state", H5P_DEFAULT);
+		const herr_t w = a >= 0 ? H5Awrite(a, H5T_NATIVE_DOUBLE, v) : -1;
+		if (a >= 0)
+			H5Aclose(a);
+		return w < 0;
+	}
+	return attr_doubles(file, "restart_state", v, 5);
+}
+
+/*
+ * Check that the next snapshot fits before HDF5 writes any of it: under the
+ * file-size limit and in the free space of the file system.  A write that
+ * fails half-way through a flush can leave metadata pointing past the end
+ * of the file, unreadable; failing here leaves the file as the last flush
+ * left it, every snapshot in it complete.  The estimate is whole chunks of
+ * /height plus room for the metadata.  (Space taken by another process
+ * between this check and the flush is not covered.)
+ */
+static int check_snapshot_space(struct ss_snapshot *s)
+{
+	const struct ss_grid *g = &s->grid;
+	void *handle = NULL;
+	struct stat sb;
+	struct statvfs fs;
+	struct rlimit limit;
+	if (H5Fget_vfd_handle(s->file, H5P_DEFAULT, &handle) < 0 || !handle)
+		return 0;                               /* not a plain file: go on */
+	const int fd = *(const int *)handle;
+	if (fstat(fd, &sb) != 0)
+		return 0;
+	const double cy = g->ny < 256 ? g->ny : 256, cx = g->nx < 256 ? g->nx : 256;
+	const double chunks = ceil(g->ny / cy) * ceil(g->nx / cx);
+	const double bytes = chunks * cy * cx * sizeof(double) + (256 << 10);
+	if (getrlimit(RLIMIT_FSIZE, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY &&
+	    (double)sb.st_size + bytes > (double)limit.rlim_cur) {
+		errno = EFBIG;
+		return -1;
+	}
+	if (fstatvfs(fd, &fs) == 0 && (double)fs.f_bavail * (double)fs.f_frsize < bytes) {
+		errno = ENOSPC;
+		return -1;
+	}
+	return 0;
+}
+
 int ss_snapshot_append(struct ss_snapshot *s, double time_s, const double *height,
-                       const struct ss_diagnostics *d)
+                       const struct ss_diagnostics *d, const struct ss_restart_state *state)
 {
 	const struct ss_grid *g = &s->grid;
 	const long long k = s->count;
+	errno = 0;
+	if (check_snapshot_space(s)) {
+		const int e = errno;
+		s->failed = 1;
+		return ss_error_fail("cannot write snapshot %lld (t = %g s) to '%s': %s; the %lld "
+		                     "snapshots before it are complete", k, time_s, s->path,
+		                     strerror(e), k);
+	}
 	hsize_t dims[3] = {(hsize_t)k + 1, (hsize_t)g->ny, (hsize_t)g->nx};
 	hsize_t start[3] = {(hsize_t)k, 0, 0};
 	hsize_t count[3] = {1, (hsize_t)g->ny, (hsize_t)g->nx};
@@ -485,6 +575,8 @@ int ss_snapshot_append(struct ss_snapshot *s, double time_s, const double *heigh
 	for (int m = 0; m < DIAG_COUNT; m++)
 		if (append_value(s->diag[m], k, diag_get(d, m)))
 			goto fail;
+	if (state && write_restart_state(s->file, state))
+		goto fail;
 	if (H5Fflush(s->file, H5F_SCOPE_GLOBAL) < 0)
 		goto fail;
 	/* the file takes its name only once it holds a complete snapshot, so
@@ -508,6 +600,7 @@ int ss_snapshot_append(struct ss_snapshot *s, double time_s, const double *heigh
 		                     strerror(errno));
 	return SS_OK;
 fail:
+	s->failed = 1;
 	return ss_error_fail("cannot write snapshot %lld (t = %g s) to '%s'%s%s", k, time_s,
 	                     s->path, errno ? ": " : "", errno ? strerror(errno) : "");
 }
@@ -515,6 +608,11 @@ fail:
 long long ss_snapshot_count(const struct ss_snapshot *s)
 {
 	return s->count;
+}
+
+double ss_snapshot_last_time(const struct ss_snapshot *s)
+{
+	return s->count > 0 ? s->times[s->count - 1] : NAN;
 }
 
 /* ---- reading --------------------------------------------------------- */
@@ -750,4 +848,132 @@ out:
 	H5Dclose(d);
 	H5Fclose(file);
 	return err;
+}
+
+/* ---- restarts -------------------------------------------------------- */
+
+/* A string attribute as a new string (NULL if absent or not a string). */
+static char *read_attr_text(hid_t obj, const char *name)
+{
+	if (H5Aexists(obj, name) <= 0)
+		return NULL;
+	hid_t a = H5Aopen(obj, name, H5P_DEFAULT);
+	hid_t ft = a >= 0 ? H5Aget_type(a) : -1;
+	char *buf = NULL;
+	if (ft >= 0 && H5Tget_class(ft) == H5T_STRING && !H5Tis_variable_str(ft)) {
+		buf = calloc(1, H5Tget_size(ft) + 1);
+		if (buf && H5Aread(a, ft, buf) < 0) {
+			free(buf);
+			buf = NULL;
+		}
+	}
+	if (ft >= 0)
+		H5Tclose(ft);
+	if (a >= 0)
+		H5Aclose(a);
+	return buf;
+}
+
+void ss_restart_info_release(struct ss_restart_info *r)
+{
+	free(r->case_text);
+	free(r->case_path);
+	free(r->case_overrides);
+	ss_free(r->height);
+	memset(r, 0, sizeof *r);
+}
+
+int ss_snapshot_read_restart(const char *path, struct ss_restart_info *r)
+{
+	memset(r, 0, sizeof *r);
+	struct ss_snapshot_summary sum;
+	int err = ss_snapshot_read_summary(path, &sum);
+	if (err)
+		return err;
+	r->count = sum.count;
+	r->nx = sum.nx;
+	r->ny = sum.ny;
+	r->time = sum.count > 0 ? sum.time[sum.count - 1] : NAN;
+	ss_snapshot_summary_release(&sum);
+	if (r->count < 1)
+		return ss_error_input("cannot restart from '%s': it holds no snapshot", path);
+
+	hid_t file = open_file(path);
+	if (file < 0)
+		return SS_ERR_INPUT;
+	r->case_text = read_attr_text(file, "case");
+	r->case_path = read_attr_text(file, "title");
+	r->case_overrides = read_attr_text(file, "case_overrides");
+	double v[5] = {NAN, NAN, NAN, NAN, NAN};
+	hid_t a = H5Aexists(file, "restart_state") > 0
+	          ? H5Aopen(file, "restart_state", H5P_DEFAULT) : -1;
+	hid_t as = a >= 0 ? H5Aget_space(a) : -1;
+	const int five = as >= 0 && H5Sget_simple_extent_npoints(as) == 5;
+	if (!(five && H5Aread(a, H5T_NATIVE_DOUBLE, v) >= 0))
+		v[0] = NAN;
+	if (as >= 0)
+		H5Sclose(as);
+	if (a >= 0)
+		H5Aclose(a);
+	H5Fclose(file);
+	if (!r->case_text || !r->case_path || !r->case_overrides || !*r->case_text)
+		err = ss_error_input("cannot restart from '%s': it does not hold the case it was "
+		                     "run from (written by sandslide run?)", path);
+	else if (!(v[0] >= 0.0) || !isfinite(v[1] + v[2] + v[3] + v[4]))
+		err = ss_error_input("cannot restart from '%s': its restart state is missing or "
+		                     "damaged (written by an older sandslide?)", path);
+	if (!err) {
+		r->state.steps = (long long)v[0];
+		r->state.inflow_sum = v[1];
+		r->state.inflow_carry = v[2];
+		r->state.outflow_sum = v[3];
+		r->state.outflow_carry = v[4];
+		int nx, ny;
+		err = ss_snapshot_read_field(path, "/height", r->count - 1, &nx, &ny, &r->height);
+	}
+	if (err)
+		ss_restart_info_release(r);
+	return err;
+}
+
+int ss_snapshot_open_append(struct ss_snapshot **out, const char *path,
+                            const struct ss_grid *g)
+{
+	quiet_hdf5();
+	*out = NULL;
+	struct ss_snapshot *s = snapshot_alloc(path, g);
+	if (!s)
+		return ss_error_fail("out of memory");
+	hid_t fapl = writer_access();
+	s->file = H5Fopen(path, H5F_ACC_RDWR, fapl);
+	H5Pclose(fapl);
+	int bad = s->file < 0;
+	if (!bad) {
+		s->height = H5Dopen2(s->file, "height", H5P_DEFAULT);
+		s->time = H5Dopen2(s->file, "time", H5P_DEFAULT);
+		bad = s->height < 0 || s->time < 0;
+		for (int k = 0; k < DIAG_COUNT && !bad; k++)
+			bad = (s->diag[k] = H5Dopen2(s->file, diag_names[k], H5P_DEFAULT)) < 0;
+	}
+	hsize_t dims[3] = {0, 0, 0};
+	if (!bad) {
+		hid_t fs = H5Dget_space(s->height);
+		bad = H5Sget_simple_extent_ndims(fs) != 3 ||
+		      H5Sget_simple_extent_dims(fs, dims, NULL) != 3 ||
+		      dims[1] != (hsize_t)g->ny || dims[2] != (hsize_t)g->nx || dims[0] < 1;
+		H5Sclose(fs);
+	}
+	if (!bad) {
+		s->count = (long long)dims[0];
+		s->times_cap = s->count + 64;
+		s->times = calloc((size_t)s->times_cap, sizeof *s->times);
+		bad = !s->times || read_series(s->file, "time", s->count, s->times);
+	}
+	if (bad) {
+		ss_snapshot_destroy(s);
+		return ss_error_input("cannot open '%s' to continue it: not a sandslide output of "
+		                      "this %d x %d grid", path, g->nx, g->ny);
+	}
+	*out = s;
+	return SS_OK;
 }

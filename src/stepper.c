@@ -436,6 +436,8 @@ enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,
 			return SS_ADVANCE_NONFINITE;
 		if (may_be_steady && st->rate_max < o->steady_tol)
 			return SS_ADVANCE_STEADY;
+		if (o->stop && *o->stop)
+			return SS_ADVANCE_INTERRUPTED;
 	}
 	return SS_ADVANCE_REACHED;
 }

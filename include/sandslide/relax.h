@@ -14,6 +14,8 @@
 #ifndef SANDSLIDE_RELAX_H
 #define SANDSLIDE_RELAX_H
 
+#include <signal.h>
+
 #include "sandslide/boundary.h"
 #include "sandslide/closure.h"
 #include "sandslide/dem.h"
@@ -45,6 +47,9 @@ struct ss_relax_options {
 	const char *report;               /* JSON diagnostics file, or NULL */
 	int quiet;                        /* no progress, no summary */
 	const char *history;              /* the command line */
+	int force;                        /* replace an existing output */
+	const volatile sig_atomic_t *stop_signal; /* non-zero: stop after the
+	                                     substep and write what there is */
 };
 
 void ss_relax_options_init(struct ss_relax_options *o);

@@ -9,6 +9,8 @@
 #ifndef SANDSLIDE_RUN_H
 #define SANDSLIDE_RUN_H
 
+#include <signal.h>
+
 /* What a run reports after each snapshot is written and flushed. */
 struct ss_run_snapshot {
 	const char *path;            /* the output file */
@@ -33,6 +35,12 @@ struct ss_run_options {
 	int deflate;                 /* HDF5 deflate level 0..9 */
 	int quiet;                   /* no progress, no summary */
 	const char *history;         /* the command line, for the file */
+	int force;                   /* replace an existing output (else refused) */
+	const char *restart;         /* continue the run in this output from its
+	                              * last snapshot (case_path may be NULL) */
+	const volatile sig_atomic_t *stop_signal; /* when it becomes non-zero, the
+	                              * run finishes its substep, writes a
+	                              * snapshot and returns SS_OK */
 	/* Called after every snapshot (NULL: none), e.g. to render it; a
 	 * non-zero return (a status, message printed) stops the run. */
 	int (*on_snapshot)(void *context, const struct ss_run_snapshot *s);

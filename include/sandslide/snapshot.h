@@ -36,7 +36,20 @@ struct ss_snapshot_meta {
 	double gamma;
 	int deflate;             /* 0 (none) .. 9 */
 	const double *bedrock;   /* m, the grid's halo layout, or NULL */
+	const char *case_overrides; /* the --set values, one per line, or NULL */
 };
+
+/* What a restart needs beyond the heights to continue with the same bits:
+ * the step counter and the compensated sums (stepper.h). */
+struct ss_restart_state {
+	long long steps;
+	double inflow_sum, inflow_carry;    /* m^3 */
+	double outflow_sum, outflow_carry;
+};
+
+/* Call first in a program: HDF5 quiet (errors are reported by the callers)
+ * and no clean-up at exit, which crashes HDF5 1.10 after a failed close. */
+void ss_snapshot_library_init(void);
 
 /* Create the output and write the static variables; cell_types are packed
  * in the grid's halo layout (grid.h).  The file is written as "path.partial" and renamed to
@@ -46,13 +59,39 @@ int ss_snapshot_create(struct ss_snapshot **out, const char *path,
                        const struct ss_grid *g, const uint8_t *cell_types,
                        const struct ss_snapshot_meta *meta);
 
-/* Append one snapshot (height with the grid's halo layout), flush the file
- * and rewrite the XDMF sidecar. */
+/* Append one snapshot (height with the grid's halo layout) and, when state
+ * is not NULL, the restart state (root attribute restart_state), flush the
+ * file and rewrite the XDMF sidecar. */
 int ss_snapshot_append(struct ss_snapshot *s, double time_s, const double *height,
-                       const struct ss_diagnostics *d);
+                       const struct ss_diagnostics *d, const struct ss_restart_state *state);
+
+/* Reopen an output of grid g to append snapshots to it (a restart).
+ * SS_ERR_INPUT if it is not a sandslide output of that grid. */
+int ss_snapshot_open_append(struct ss_snapshot **out, const char *path,
+                            const struct ss_grid *g);
+
+/* The last snapshot of an output and what a restart needs with it. */
+struct ss_restart_info {
+	int nx, ny;
+	long long count;         /* snapshots in the file */
+	double time;             /* of the last one, s */
+	double *height;          /* nx * ny, south row first (ss_free) */
+	struct ss_restart_state state;
+	char *case_text;         /* the case file's text */
+	char *case_path;         /* where it was read from */
+	char *case_overrides;    /* --set values, one per line */
+};
+
+/* SS_ERR_INPUT naming what is missing for a file that cannot be continued
+ * (not a sandslide output, no snapshot, no case text or restart state). */
+int ss_snapshot_read_restart(const char *path, struct ss_restart_info *r);
+void ss_restart_info_release(struct ss_restart_info *r);
 
 /* Snapshots written so far. */
 long long ss_snapshot_count(const struct ss_snapshot *s);
+
+/* Time of the last snapshot written (NaN before the first), s. */
+double ss_snapshot_last_time(const struct ss_snapshot *s);
 
 /* Close the file; returns SS_ERR_FAIL if the final close fails.
  * ss_snapshot_destroy(NULL) is a no-op. */

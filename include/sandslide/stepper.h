@@ -22,6 +22,7 @@
 #ifndef SANDSLIDE_STEPPER_H
 #define SANDSLIDE_STEPPER_H
 
+#include <signal.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -127,6 +128,7 @@ enum ss_advance_end {
 	SS_ADVANCE_NONFINITE,   /* a rate or height became NaN or infinite */
 	SS_ADVANCE_STALLED,     /* dt fell below the resolution of the clock */
 	SS_ADVANCE_STEPS,       /* took max_steps substeps */
+	SS_ADVANCE_INTERRUPTED, /* *stop became non-zero (after a whole substep) */
 };
 
 struct ss_advance_options {
@@ -134,6 +136,8 @@ struct ss_advance_options {
 	long long max_steps;    /* > 0: stop after this many substeps */
 	void (*progress)(void *context, const struct ss_stepper *st);
 	void *context;          /* passed to progress, called after each substep */
+	const volatile sig_atomic_t *stop; /* NULL, or checked after each substep
+	                                    * (set by a signal handler) */
 };
 
 enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,

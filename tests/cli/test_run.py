@@ -164,7 +164,7 @@ def test_not_a_terminal_no_progress(tmp_path):
 def test_quiet(tmp_path):
     write(tmp_path, BASE)
     for flag in ("--quiet", "-q"):
-        r = run_ok(["run", "case.ini", "-o", "o.h5", flag], cwd=tmp_path)
+        r = run_ok(["run", "case.ini", "-o", "o.h5", flag, "--force"], cwd=tmp_path)
         assert r.stdout == "", f"{flag}: stdout must be empty, got {r.stdout!r}"
         assert r.stderr == "", f"{flag}: stderr must be empty, got {r.stderr!r}"
     assert (tmp_path / "o.h5").exists()
@@ -221,10 +221,10 @@ def test_default_output(tmp_path):
         assert f["height"].shape == (3, 16, 20)
 
 
-def test_rerun_replaces_output(tmp_path):
+def test_force_replaces_output(tmp_path):
     write(tmp_path, BASE)
     (tmp_path / "o.h5").write_bytes(b"old contents")
-    run_ok(["run", "case.ini", "-o", "o.h5", "-q"], cwd=tmp_path)
+    run_ok(["run", "case.ini", "-o", "o.h5", "-q", "--force"], cwd=tmp_path)
     with h5open(tmp_path / "o.h5") as f:
         assert f["height"].shape[0] == 3
 
