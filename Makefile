@@ -132,12 +132,62 @@ headers-check: $(BUILD)/.flags
 	  $(CC) $(filter-out -MMD -MP,$(ALL_CFLAGS)) -fsyntax-only $(BUILD)/hdrcheck/t.c || exit 1; \
 	done; echo "  headers compile on their own"
 
+# ---- fuzzing (tests/fuzz/) --------------------------------------------------
+# One harness per input reader: case (ss_case_parse), mask (PNG masks of
+# shapes), asc and png (ss_dem_read).
+#   make fuzz         libFuzzer binaries $(BUILD)/fuzz/fuzz_NAME, built with
+#                     clang (FUZZ_CC), the library compiled again with the same
+#                     sanitizers; tests/fuzz/README.md says how to run them
+#   make fuzz-replay  the same harnesses with $(CC), ASan and UBSan and a plain
+#                     main() (tests/fuzz/replay.c), run over
+#                     tests/fuzz/corpus/NAME/ and tests/fuzz/regressions/NAME/:
+#                     no clang needed; `make test` runs it too
+FUZZ_NAMES   := case mask asc png
+FUZZ_CC      ?= clang
+FUZZ_BUILD   := $(BUILD)/fuzz
+FUZZ_SAN     := -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
+FUZZ_CFLAGS  := -std=c11 -D_XOPEN_SOURCE=700 -O1 -g $(WARN) -Wno-unknown-pragmas -Iinclude \
+                -Itests/fuzz -DSS_VERSION='"$(VERSION)"' $(DEP_CFLAGS) $(FUZZ_SAN) -MMD -MP $(CFLAGS)
+FUZZ_LIB_SRC := $(LIB_SRC) $(RENDER_SRC)
+FUZZ_BIN     := $(FUZZ_NAMES:%=$(FUZZ_BUILD)/fuzz_%)
+FUZZ_REPLAY  := $(FUZZ_NAMES:%=$(FUZZ_BUILD)/replay/fuzz_%)
+FUZZ_REPLAY_RUN = for h in $(FUZZ_NAMES); do \
+	  ./$(FUZZ_BUILD)/replay/fuzz_$$h tests/fuzz/corpus/$$h \
+	    $$(ls -d tests/fuzz/regressions/$$h 2>/dev/null) || exit 1; done
+.PHONY: fuzz fuzz-replay
+fuzz: $(FUZZ_BIN)
+fuzz-replay: $(FUZZ_REPLAY)
+	@$(FUZZ_REPLAY_RUN)
+
+# library objects: libFuzzer build in lf/, replay build in replay/
+$(FUZZ_BUILD)/lf/%.o: %.c $(BUILD)/.flags
+	@mkdir -p $(@D)
+	@$(if $(Q),echo '  CLANG   $<')
+	$(Q)$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer-no-link -c $< -o $@
+$(FUZZ_BUILD)/replay/%.o: %.c $(BUILD)/.flags
+	@mkdir -p $(@D)
+	@$(if $(Q),echo '  CC      $<')
+	$(Q)$(CC) $(FUZZ_CFLAGS) -c $< -o $@
+$(FUZZ_BUILD)/lf/libsandslide.a: $(FUZZ_LIB_SRC:%.c=$(FUZZ_BUILD)/lf/%.o)
+	$(Q)rm -f $@ && ar rcs $@ $^
+$(FUZZ_BUILD)/replay/libsandslide.a: $(FUZZ_LIB_SRC:%.c=$(FUZZ_BUILD)/replay/%.o)
+	$(Q)rm -f $@ && ar rcs $@ $^
+$(FUZZ_BUILD)/fuzz_%: tests/fuzz/fuzz_%.c $(FUZZ_BUILD)/lf/libsandslide.a $(wildcard tests/fuzz/*.h)
+	@$(if $(Q),echo '  LINK    $@')
+	$(Q)$(FUZZ_CC) $(filter-out -MMD -MP,$(FUZZ_CFLAGS)) -fsanitize=fuzzer $(filter %.c %.a,$^) $(LIBS) -o $@
+$(FUZZ_BUILD)/replay/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/replay.c $(FUZZ_BUILD)/replay/libsandslide.a $(wildcard tests/fuzz/*.h)
+	@$(if $(Q),echo '  LINK    $@')
+	$(Q)$(CC) $(filter-out -MMD -MP,$(FUZZ_CFLAGS)) $(filter %.c %.a,$^) $(LIBS) -o $@
+-include $(wildcard $(FUZZ_BUILD)/*/*/*.d)
+
 # The README's test command.  C test programs first (each prints
-# "N passed, M failed"), then the CLI/file tests with pytest.
-test check: all $(TEST_BIN) headers-check
+# "N passed, M failed"), the fuzz corpora replayed, then the CLI/file tests
+# with pytest.
+test check: all $(TEST_BIN) headers-check $(FUZZ_REPLAY)
 	@fail=0; for t in $(TEST_BIN); do \
 	  echo "== $$t"; OMP_NUM_THREADS=$${OMP_NUM_THREADS:-2} ./$$t || fail=1; \
 	done; \
+	echo "== tests/fuzz (corpora and regressions replayed)"; ( $(FUZZ_REPLAY_RUN) ) || fail=1; \
 	echo "== tests/cli (pytest)"; \
 	SANDSLIDE=$(abspath $(BUILD)/sandslide) $(PYTHON) -m pytest -q tests/cli || fail=1; \
 	exit $$fail
