@@ -47,6 +47,22 @@ static int next_token(struct scan *sc, char *buf, size_t size)
 	return 1;
 }
 
+/* White-space separated tokens from s on, counting up to limit. */
+static size_t count_tokens(const char *s, size_t limit)
+{
+	size_t n = 0;
+	while (n < limit) {
+		while (*s && isspace((unsigned char)*s))
+			s++;
+		if (!*s)
+			break;
+		n++;
+		while (*s && !isspace((unsigned char)*s))
+			s++;
+	}
+	return n;
+}
+
 static int to_double(const char *t, double *v)
 {
 	char *end;
@@ -214,7 +230,15 @@ int ss_dem_read_asc(const char *path, const char *context, const struct ss_dem_r
 	r->has_nodata_value = have_nodata;
 	r->nodata_value = have_nodata ? nodata : NAN;
 
+	/* a short file is refused before the heights are allocated: a
+	 * header of a few bytes must not claim gigabytes */
 	const size_t n = (size_t)r->nx * (size_t)r->ny;
+	const size_t given = count_tokens(sc.s, n);
+	if (given < n) {
+		err = ss_error_input_at(context, "%s: ends after %zu of %d x %d values", path, given,
+		                        r->nx, r->ny);
+		goto out;
+	}
 	r->values = ss_alloc(n, sizeof(double), "raster heights");
 	if (!r->values) {
 		err = SS_ERR_FAIL;

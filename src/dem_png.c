@@ -29,6 +29,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include <png.h>
 
@@ -50,6 +51,7 @@ struct png_job {
 	char message[ERROR_SIZE]; /* libpng's error */
 	uint8_t *pixels;         /* big-endian 16-bit samples, north row first */
 	png_bytep *rows;         /* row pointers into pixels */
+	double file_bytes;       /* size of the file */
 	png_uint_32 width, height;
 	int bit_depth, color_type;
 };
@@ -69,7 +71,11 @@ static void on_warning(png_structp png, png_const_charp msg)
 /* ------------------------------------------------------------------ */
 /* reading                                                              */
 
-enum { DECODE_OK, DECODE_PNG_ERROR, DECODE_NOT_GRAY16, DECODE_NO_MEMORY };
+enum { DECODE_OK, DECODE_PNG_ERROR, DECODE_NOT_GRAY16, DECODE_NO_MEMORY, DECODE_TOO_SHORT };
+
+/* Deflate expands its input at most 1032 times (a 258-byte match in 2
+ * bits), so a file of B bytes holds at most 1032 B bytes of image data. */
+#define DEFLATE_MAX_RATIO 1032.0
 
 static int decode(png_structp png, png_infop info, png_infop end, FILE *f, struct png_job *job)
 {
@@ -84,6 +90,10 @@ static int decode(png_structp png, png_infop info, png_infop end, FILE *f, struc
 	job->color_type = png_get_color_type(png, info);
 	if (job->bit_depth != 16 || job->color_type != PNG_COLOR_TYPE_GRAY)
 		return DECODE_NOT_GRAY16;
+	/* a header of a few bytes must not make us allocate gigabytes: the
+	 * rows, each with its filter byte, must fit in what the file can hold */
+	if ((double)job->height * (1.0 + 2.0 * job->width) > DEFLATE_MAX_RATIO * job->file_bytes)
+		return DECODE_TOO_SHORT;
 	png_set_interlace_handling(png);
 	png_read_update_info(png, info);
 	const size_t row_bytes = 2 * (size_t)job->width;
@@ -160,6 +170,8 @@ int ss_dem_read_png(const char *path, const char *context, const struct ss_dem_r
 	}
 	struct png_job job;
 	memset(&job, 0, sizeof job);
+	struct stat st;
+	job.file_bytes = fstat(fileno(f), &st) == 0 ? (double)st.st_size : INFINITY;
 	int err = SS_OK;
 	png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, job.message, on_error,
 	                                         on_warning);
@@ -182,6 +194,12 @@ int ss_dem_read_png(const char *path, const char *context, const struct ss_dem_r
 		goto out;
 	case DECODE_NO_MEMORY:
 		err = SS_ERR_FAIL;
+		goto out;
+	case DECODE_TOO_SHORT:
+		err = ss_error_input_at(context, "cannot decode PNG '%s': %.0f bytes cannot hold "
+		                        "%u x %u 16-bit pixels: the file is truncated or corrupt",
+		                        path, job.file_bytes, (unsigned)job.width,
+		                        (unsigned)job.height);
 		goto out;
 	}
 	if (job.width > 1u << 30 || job.height > 1u << 30) {

@@ -270,6 +270,9 @@ static void asc_malformed_is_refused(void)
 		{"ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\n1 2\n3 4\n", {"cellsize"}},
 		{"ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize -1\n1 2\n3 4\n", {"> 0"}},
 		{"ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2\n3\n", {"ends after 3 of"}},
+		/* refused before allocating 2^63 bytes (fuzz_asc) */
+		{"ncols 1073741824\nnrows 1073741824\nxllcorner 0\nyllcorner 0\ncellsize 1\n1\n",
+		 {"ends after 1 of 1073741824 x 1073741824"}},
 		{"ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2\nnan 4\n",
 		 {"bad.asc:7", "row 2, column 1", "finite"}},
 		{"ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 inf\n3 4\n",
@@ -537,6 +540,51 @@ static void png_not_gray16_is_refused(void)
 	CHECK(err == SS_ERR_INPUT && strstr(msg, "not a PNG"), "non-PNG refused: %s", msg);
 }
 
+/* CRC-32 of PNG chunks (ISO 3309), for the patched headers below. */
+static uint32_t png_crc(const unsigned char *p, size_t n)
+{
+	uint32_t c = 0xffffffffu;
+	for (size_t k = 0; k < n; k++) {
+		c ^= p[k];
+		for (int b = 0; b < 8; b++)
+			c = c & 1 ? 0xedb88320u ^ (c >> 1) : c >> 1;
+	}
+	return c ^ 0xffffffffu;
+}
+
+/* A 4 x 4 heightmap whose header claims 10^6 x 10^6 pixels is refused
+ * before 2 TB are allocated (fuzz_png). */
+static void png_too_short_for_its_size_is_refused(void)
+{
+	const uint16_t grey[16] = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16};
+	const char *const texts[] = {"zmin_m=0", "zmax_m=1"};
+	write_gray16(at("claims.png"), 4, 4, grey, texts, 2, -1);
+	size_t size;
+	unsigned char *b = (unsigned char *)slurp(at("claims.png"), &size);
+	CHECK(b && size > 33 && memcmp(b + 12, "IHDR", 4) == 0, "claims.png starts with IHDR");
+	if (!b || size <= 33) {
+		free(b);
+		return;
+	}
+	const unsigned char million[4] = {0x00, 0x0f, 0x42, 0x40};
+	memcpy(b + 16, million, 4);   /* width */
+	memcpy(b + 20, million, 4);   /* height */
+	const uint32_t crc = png_crc(b + 12, 17);
+	const unsigned char be[4] = {crc >> 24, crc >> 16 & 0xff, crc >> 8 & 0xff, crc & 0xff};
+	memcpy(b + 29, be, 4);
+	FILE *f = fopen(at("claims.png"), "wb");
+	fwrite(b, 1, size, f);
+	fclose(f);
+	free(b);
+	struct ss_raster r;
+	capture_begin();
+	int err = ss_dem_read(at("claims.png"), NULL, NULL, &r);
+	const char *msg = capture_end();
+	ss_raster_release(&r);
+	CHECK(err == SS_ERR_INPUT && strstr(msg, "cannot hold 1000000 x 1000000") &&
+	      strstr(msg, "truncated"), "status %d: %s", err, msg);
+}
+
 static void writes_are_atomic_and_spare_the_input(void)
 {
 	struct rng g = {99};
@@ -728,6 +776,7 @@ int main(void)
 	RUN(png_from_renderer_convention);
 	RUN(png_with_explicit_scale);
 	RUN(png_not_gray16_is_refused);
+	RUN(png_too_short_for_its_size_is_refused);
 	RUN(writes_are_atomic_and_spare_the_input);
 	RUN(nodata_value_avoids_real_heights);
 	RUN(geotiff_round_trip);
