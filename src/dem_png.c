@@ -34,6 +34,7 @@
 #include <png.h>
 
 #include "sandslide/error.h"
+#include "sandslide/png_check.h"
 
 #define KEY_ZMIN "zmin_m"
 #define KEY_ZMAX "zmax_m"
@@ -167,6 +168,14 @@ int ss_dem_read_png(const char *path, const char *context, const struct ss_dem_r
 		fclose(f);
 		return ss_error_input_at(context, "'%s' is not a PNG file: expected a 16-bit greyscale "
 		                         "PNG heightmap", path);
+	}
+	char chunk[5];
+	unsigned long chunk_bytes;
+	if (ss_png_check_chunks(f, chunk, &chunk_bytes)) {
+		fclose(f);
+		return ss_error_input_at(context, "cannot decode PNG '%s': chunk %s claims %lu bytes, "
+		                         "more than the file holds: the file is truncated or corrupt",
+		                         path, chunk, chunk_bytes);
 	}
 	struct png_job job;
 	memset(&job, 0, sizeof job);

@@ -14,6 +14,7 @@
 #include <png.h>
 
 #include "sandslide/error.h"
+#include "sandslide/png_check.h"
 
 /* Even-odd rule: count crossings of the ray from (x, y) towards +x. */
 static int polygon_contains(const double *xy, int n, double x, double y)
@@ -35,7 +36,14 @@ static int read_mask(const struct ss_shape *s, const struct ss_grid *g, uint8_t 
 	if (!f)
 		return ss_error_input("%s: cannot open mask '%s': %s", s->where, s->mask_path,
 		                      strerror(errno));
+	char chunk[5];
+	unsigned long chunk_bytes;
+	const int bad = ss_png_check_chunks(f, chunk, &chunk_bytes);
 	fclose(f);
+	if (bad)
+		return ss_error_input("%s: mask '%s' is not a readable PNG: chunk %s claims %lu bytes, "
+		                      "more than the file holds (truncated or corrupt)", s->where,
+		                      s->mask_path, chunk, chunk_bytes);
 
 	png_image image;
 	memset(&image, 0, sizeof image);

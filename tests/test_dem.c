@@ -585,6 +585,38 @@ static void png_too_short_for_its_size_is_refused(void)
 	      strstr(msg, "truncated"), "status %d: %s", err, msg);
 }
 
+/* A text chunk that claims 1.7 GB, in a file of 120 bytes, is refused
+ * before libpng allocates it (fuzz_png). */
+static void png_chunk_longer_than_file_is_refused(void)
+{
+	const uint16_t grey[4] = {1, 2, 3, 4};
+	const char *const texts[] = {"zmin_m=0", "zmax_m=1"};
+	write_gray16(at("long.png"), 2, 2, grey, texts, 2, -1);
+	size_t size;
+	unsigned char *b = (unsigned char *)slurp(at("long.png"), &size);
+	unsigned char *t = NULL;
+	for (size_t k = 0; b && !t && k + 4 <= size; k++)
+		if (memcmp(b + k, "tEXt", 4) == 0)
+			t = b + k;
+	CHECK(t && t - b >= 12, "long.png has a tEXt chunk");
+	if (!t || t - b < 12) {
+		free(b);
+		return;
+	}
+	memcpy(t - 4, "\x64\x78\x5f\x6d", 4);   /* length 1685610349 */
+	FILE *f = fopen(at("long.png"), "wb");
+	fwrite(b, 1, size, f);
+	fclose(f);
+	free(b);
+	struct ss_raster r;
+	capture_begin();
+	int err = ss_dem_read(at("long.png"), NULL, NULL, &r);
+	const char *msg = capture_end();
+	ss_raster_release(&r);
+	CHECK(err == SS_ERR_INPUT && strstr(msg, "chunk tEXt claims 1685610349 bytes") &&
+	      strstr(msg, "corrupt"), "status %d: %s", err, msg);
+}
+
 static void writes_are_atomic_and_spare_the_input(void)
 {
 	struct rng g = {99};
@@ -777,6 +809,7 @@ int main(void)
 	RUN(png_with_explicit_scale);
 	RUN(png_not_gray16_is_refused);
 	RUN(png_too_short_for_its_size_is_refused);
+	RUN(png_chunk_longer_than_file_is_refused);
 	RUN(writes_are_atomic_and_spare_the_input);
 	RUN(nodata_value_avoids_real_heights);
 	RUN(geotiff_round_trip);

@@ -5,6 +5,7 @@ and nothing written: an existing output keeps its bytes, no new file appears.
 import os
 import re
 import shutil
+import struct
 
 import h5py
 import numpy as np
@@ -169,6 +170,14 @@ def b_mask(ident, data, words, name="mask.png", write=True):
     return Bad(ident, t, [name] + words, with_line(t, "mask ="), files=files)
 
 
+def long_chunk_png():
+    """A 20 x 16 mask with a tEXt chunk that claims 1.7 GB (fuzz_mask): refused
+    before libpng allocates that much."""
+    good = png_bytes([[255] * 20] * 16)
+    head = struct.pack(">I", 0x64785F6D) + b"tEXt" + b"zmin_m\x000"
+    return good[:33] + head + good[33:]
+
+
 def b_initial_file(ident, name, data, words, at_case=True):
     t = edit(BASE, "type = flat\nheight = 0.2\n", f"type = file\nfile = {name}\n")
     files = {name: data} if data is not None else {}
@@ -274,6 +283,7 @@ def bad_inputs():
         b_mask("mask-missing", None, ["cannot open"], write=False),
         b_mask("mask-wrong-size", png_bytes([[255] * 10] * 8), ["10 x 8", "20 x 16"]),
         b_mask("mask-not-png", b"GIF89a this is not a PNG at all\n" * 4, ["PNG"]),
+        b_mask("mask-chunk-too-long", long_chunk_png(), ["tEXt", "1685610349 bytes", "corrupt"]),
         b_initial_file("initial-file-missing", "nothere.asc", None, []),
         b_initial_file("initial-file-wrong-size", "small.asc",
                        asc_grid(nx=10, ny=8), ["10 x 8", "20 x 16"]),
