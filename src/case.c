@@ -736,6 +736,12 @@ static int finish(struct parse *p)
 	if (!is_set(p, "grid", "dy"))
 		c->dy = c->dx;
 	snprintf(c->grid_where, sizeof c->grid_where, "%s", where_of(p, "grid", "nx"));
+	/* shapes are checked against the far corner: it must be a number */
+	if (!isfinite(c->origin_x + c->nx * c->dx) || !isfinite(c->origin_y + c->ny * c->dy))
+		return ss_error_input("%s: [grid] the grid from (%g, %g) m over %d x %d cells of %g x "
+		                      "%g m ends beyond the largest number: expected a finite extent",
+		                      c->grid_where, c->origin_x, c->origin_y, c->nx, c->ny, c->dx,
+		                      c->dy);
 	if ((err = finish_model(p)))
 		return err;
 	if (is_set(p, "time", "max_time") && !c->steady)

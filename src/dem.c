@@ -232,6 +232,20 @@ static int apply_cellsize(const struct ss_dem_read_options *o, const char *spec,
 	return SS_OK;
 }
 
+/* A corner that is known must be finite, and so must the far corner when
+ * the cell size is known too: headers are numbers read from the file. */
+static int check_extent(const char *spec, const char *context, const struct ss_raster *r)
+{
+	const double dy = ss_dem_dy(r);
+	const double x1 = r->x0 + r->nx * r->cellsize, y1 = r->y0 + r->ny * dy;
+	if ((!isnan(r->x0) && (!isfinite(r->x0) || (!isnan(x1) && !isfinite(x1)))) ||
+	    (!isnan(r->y0) && (!isfinite(r->y0) || (!isnan(y1) && !isfinite(y1)))))
+		return ss_error_input_at(context, "'%s': %d x %d cells of %g x %g m from (%g, %g) m "
+		                         "end beyond the largest number: expected a finite extent",
+		                         spec, r->nx, r->ny, r->cellsize, dy, r->x0, r->y0);
+	return SS_OK;
+}
+
 int ss_dem_read(const char *spec, const char *context, const struct ss_dem_read_options *opt,
                 struct ss_raster *r)
 {
@@ -275,6 +289,8 @@ int ss_dem_read(const char *spec, const char *context, const struct ss_dem_read_
 	}
 	if (!err)
 		err = apply_cellsize(opt, spec, context, r);
+	if (!err)
+		err = check_extent(spec, context, r);
 	return err;
 }
 

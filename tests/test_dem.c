@@ -286,6 +286,11 @@ static void asc_malformed_is_refused(void)
 		{"ncols 2\nnrows 2\nncols 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2\n3 4\n",
 		 {"bad.asc:3", "repeats line 1"}},
 		{"ncols 2\nnrows 2\nxllcorner 0\nyllcenter 0\ncellsize 1\n1 2\n3 4\n", {"centre"}},
+		/* the far corner, or a centre's corner, beyond the doubles (fuzz_asc) */
+		{"ncols 2\nnrows 1\nxllcorner 1e308\nyllcorner 0\ncellsize 1e308\n1 2\n",
+		 {"2 x 1 cells of 1e+308 x 1e+308 m from (1e+308, 0)", "finite extent"}},
+		{"ncols 1\nnrows 1\nxllcenter 0\nyllcenter -1.7e308\ncellsize 1.7e308\n1\n",
+		 {"from (-8.5e+307, -inf)", "finite extent"}},
 	};
 	for (size_t a = 0; a < sizeof bad / sizeof *bad; a++) {
 		write_file(at("bad.asc"), bad[a].text);

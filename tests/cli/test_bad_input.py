@@ -298,6 +298,8 @@ def bad_inputs():
         b_initial_file("initial-file-unknown-extension", "init.tif", b"II*\0", [".asc", ".h5"]),
         b_value("grid-too-large", "nx = 20\nny = 16\n", "nx = 2000000\nny = 2000000\n",
                 ["memory", "2000000", "TiB"], needle="nx = 2000000"),
+        b_value("grid-extent-not-finite", "dx = 0.1\n", "dx = 1e307\n",
+                ["[grid]", "20 x 16 cells", "finite extent"], needle="nx = 20"),
     ]
     return out
 
