@@ -5,11 +5,16 @@
 #   make test       build and run every test (C programs, then CLI tests)
 #   make demo       run the default case (cases/door.ini -> out/door.h5)
 #   make OPENMP=0   build without OpenMP (pragmas must still compile)
-#   make SANITIZE=1 AddressSanitizer + UndefinedBehaviorSanitizer
+#   make SANITIZE=1 AddressSanitizer + UndefinedBehaviorSanitizer, in build-san/
+#                   (`make SANITIZE=1 test` runs every test with them)
 #   make V=1        show the full commands
 #
 # User CFLAGS/LDFLAGS are appended last, never overwritten.
 
+# A sanitized build has its own folder: build/ is left as it is.
+ifeq ($(SANITIZE),1)
+  BUILD    ?= build-san
+endif
 BUILD      ?= build
 PKG_CONFIG ?= pkg-config
 PYTHON     ?= /usr/bin/python3
@@ -70,7 +75,18 @@ else
   OMPFLAG := -Wno-unknown-pragmas
 endif
 ifeq ($(SANITIZE),1)
-  SANFLAG := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
+  # float-cast-overflow (not part of `undefined`): a double converted to an
+  # integer it does not fit, NaN included, e.g. a coordinate to a cell index
+  SANFLAG := -fsanitize=address,undefined,float-cast-overflow -fno-omit-frame-pointer \
+             -fno-sanitize-recover=undefined,float-cast-overflow
+  # Run-time options for every program `make SANITIZE=1 test` starts (the CLI
+  # tests' sandslide too): any report (a leak too) exits 86, failing the test
+  # that caused it whatever exit status it expects.
+  # SANDSLIDE_TEST_SCALE shrinks the longest test cases (each test file says
+  # how at its top); every check still runs.
+  export ASAN_OPTIONS ?= detect_leaks=1:strict_string_checks=1:detect_stack_use_after_return=1:exitcode=86
+  export UBSAN_OPTIONS ?= print_stacktrace=1:halt_on_error=1:exitcode=86
+  export SANDSLIDE_TEST_SCALE ?= 0.5
 endif
 ALL_CFLAGS  := $(BASE) $(WARN) $(OMPFLAG) $(SANFLAG) -Iinclude -DSS_VERSION='"$(VERSION)"' \
                $(DEP_CFLAGS) -MMD -MP $(CFLAGS)
@@ -212,6 +228,6 @@ clean:
 	rm -rf $(BUILD)
 
 help:
-	@sed -n '3,12p' Makefile | sed 's/^# \{0,1\}//'
+	@sed -n '3,13p' Makefile | sed 's/^# \{0,1\}//'
 
 -include $(LIB_OBJ:.o=.d) $(MAIN_OBJ:.o=.d) $(TEST_BIN:=.d)

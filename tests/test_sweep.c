@@ -26,6 +26,9 @@
  *
  * About 10 s on 2 idle cores (the reference kernel of the active-tile case is
  * most of it); the seed is fixed (SANDSLIDE_TEST_SEED overrides it).
+ * SANDSLIDE_TEST_SCALE in (0, 1] (tests/scale.h; 0.5 under `make SANITIZE=1
+ * test` and `make race`) shrinks the box of the active-tile case, with
+ * every check kept.
  */
 #include <float.h>
 #include <math.h>
@@ -36,6 +39,7 @@
 #include <time.h>
 
 #include "check.h"
+#include "scale.h"
 #include "sandslide/boundary.h"
 #include "sandslide/closure.h"
 #include "sandslide/diagnostics.h"
@@ -492,7 +496,9 @@ static void test_identity_bedrock(void)
 
 static void test_active_tiles(void)
 {
-	const int nx = 200, ny = 150;
+	/* 200 x 150 cells; SANDSLIDE_TEST_SCALE (scale.h) shrinks the box
+	 * round the same pile */
+	const int nx = test_scaled(200, 40), ny = test_scaled(150, 40);
 	struct scenario sc;
 	scenario_alloc(&sc, nx, ny);
 	sc.name = "corner pile";
@@ -1109,8 +1115,8 @@ int main(void)
 		seed = strtoull(env, NULL, 10);
 	const double t0 = check_now();
 	ss_parallel_set_threads(2);
-	printf("test_sweep: seed %llu, rsqrt %s\n", (unsigned long long)seed,
-	       ss_face_rsqrt_method());
+	printf("test_sweep: seed %llu, rsqrt %s, scale %g\n", (unsigned long long)seed,
+	       ss_face_rsqrt_method(), test_scale());
 	RUN(test_packed_types);
 	{
 		const double t_ = check_now();
