@@ -7,6 +7,7 @@
 #   make OPENMP=0   build without OpenMP (pragmas must still compile)
 #   make SANITIZE=1 AddressSanitizer + UndefinedBehaviorSanitizer, in build-san/
 #                   (`make SANITIZE=1 test` runs every test with them)
+#   make race       data-race check of the OpenMP code: ThreadSanitizer + Archer
 #   make V=1        show the full commands
 #
 # User CFLAGS/LDFLAGS are appended last, never overwritten.
@@ -208,6 +209,36 @@ test check: all $(TEST_BIN) headers-check $(FUZZ_REPLAY)
 	SANDSLIDE=$(abspath $(BUILD)/sandslide) $(PYTHON) -m pytest -q tests/cli || fail=1; \
 	exit $$fail
 
+# ---- data races: make race (ThreadSanitizer + Archer) ----------------------
+# The library, sandslide and the C tests built again with clang
+# -fsanitize=thread against LLVM's libomp into RACE_BUILD, then
+# tests/race.sh runs them on 2 threads (the C tests, and sandslide run with
+# both kernels, relax, render, bench on small cases) with Archer, the OMPT
+# tool of libomp that tells ThreadSanitizer about OpenMP's barriers and
+# reductions, so that what it reports is a real race.  Any report fails;
+# tests/tsan.supp says why it names libomp, Archer and GDAL.
+# Debian packages: DEB_RACE.  -ffp-contract=off keeps clang from fusing
+# a * b + c into FMAs, as gcc in C11 mode does not: the tests compare bits.
+RACE_CC     ?= clang
+RACE_BUILD  ?= build-race
+RACE_CFLAGS := -fsanitize=thread -O1 -g -fno-omit-frame-pointer -ffp-contract=off
+# CI runs it, so `make deps` installs them: 17 packages, 49 MB on a machine
+# with the other dependencies.
+DEB_RACE    := clang libclang-rt-dev libomp-dev
+DEB_TEST    += $(DEB_RACE)
+.PHONY: race
+race:
+	@command -v $(RACE_CC) >/dev/null || { echo "race: $(RACE_CC) not found: install Debian packages $(DEB_RACE)"; exit 1; }
+	@archer=$$(dirname $$($(RACE_CC) -print-resource-dir))/../libarcher.so; \
+	  [ -f "$$archer" ] || { echo "race: $$archer not found: install Debian packages $(DEB_RACE)"; exit 1; }
+	$(MAKE) BUILD=$(RACE_BUILD) CC=$(RACE_CC) SANITIZE=0 OPENMP=1 \
+	  CFLAGS="$(RACE_CFLAGS) $(CFLAGS)" LDFLAGS="-fsanitize=thread $(LDFLAGS)" \
+	  $(RACE_BUILD)/sandslide $(TEST_BIN:$(BUILD)/%=$(RACE_BUILD)/%)
+	@archer=$$(realpath $$(dirname $$($(RACE_CC) -print-resource-dir))/../libarcher.so); \
+	  OMP_TOOL_LIBRARIES=$$archer SANDSLIDE_TEST_SCALE=$${SANDSLIDE_TEST_SCALE:-0.5} \
+	  TSAN_OPTIONS="$${TSAN_OPTIONS:-exitcode=66 suppressions=$(abspath tests/tsan.supp)}" \
+	  sh tests/race.sh $(RACE_BUILD)
+
 demo: all
 	@mkdir -p out
 	./$(BUILD)/sandslide run cases/door.ini -o out/door.h5
@@ -228,6 +259,6 @@ clean:
 	rm -rf $(BUILD)
 
 help:
-	@sed -n '3,13p' Makefile | sed 's/^# \{0,1\}//'
+	@sed -n '3,14p' Makefile | sed 's/^# \{0,1\}//'
 
 -include $(LIB_OBJ:.o=.d) $(MAIN_OBJ:.o=.d) $(TEST_BIN:=.d)
