@@ -171,13 +171,16 @@ FUZZ_REPLAY  := $(FUZZ_NAMES:%=$(FUZZ_BUILD)/replay/fuzz_%)
 FUZZ_REPLAY_RUN = for h in $(FUZZ_NAMES); do \
 	  ./$(FUZZ_BUILD)/replay/fuzz_$$h tests/fuzz/corpus/$$h \
 	    $$(ls -d tests/fuzz/regressions/$$h 2>/dev/null) || exit 1; done
-.PHONY: fuzz fuzz-replay
+.PHONY: fuzz fuzz-replay fuzz-cc
 fuzz: $(FUZZ_BIN)
 fuzz-replay: $(FUZZ_REPLAY)
 	@$(FUZZ_REPLAY_RUN)
+fuzz-cc:
+	@command -v $(FUZZ_CC) >/dev/null || { echo "make fuzz: '$(FUZZ_CC)' not found:" \
+	  "install Debian packages clang and libclang-rt-14-dev (or set FUZZ_CC)"; exit 1; }
 
 # library objects: libFuzzer build in lf/, replay build in replay/
-$(FUZZ_BUILD)/lf/%.o: %.c $(BUILD)/.flags
+$(FUZZ_BUILD)/lf/%.o: %.c $(BUILD)/.flags | fuzz-cc
 	@mkdir -p $(@D)
 	@$(if $(Q),echo '  CLANG   $<')
 	$(Q)$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer-no-link -c $< -o $@
