@@ -169,7 +169,7 @@ FUZZ_LIB_SRC := $(LIB_SRC) $(RENDER_SRC)
 FUZZ_BIN     := $(FUZZ_NAMES:%=$(FUZZ_BUILD)/fuzz_%)
 FUZZ_REPLAY  := $(FUZZ_NAMES:%=$(FUZZ_BUILD)/replay/fuzz_%)
 FUZZ_REPLAY_RUN = for h in $(FUZZ_NAMES); do \
-	  ./$(FUZZ_BUILD)/replay/fuzz_$$h tests/fuzz/corpus/$$h \
+	  $(abspath $(FUZZ_BUILD))/replay/fuzz_$$h tests/fuzz/corpus/$$h \
 	    $$(ls -d tests/fuzz/regressions/$$h 2>/dev/null) || exit 1; done
 .PHONY: fuzz fuzz-replay fuzz-cc
 fuzz: $(FUZZ_BIN)
