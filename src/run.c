@@ -211,7 +211,10 @@ static char *join_overrides(const char *const *v, int n)
 }
 
 /* The case of a run being continued: the text and overrides stored in its
- * file.  A case file named as well must be that same text. */
+ * file.  A case file named as well must be that same text; its files (masks,
+ * DEMs) are then found beside it, so a run started elsewhere can be continued
+ * from any folder.  Without one they are found beside the path the run was
+ * started with (the file's title), relative to the current folder. */
 static int restart_case(const struct ss_run_options *o, const struct ss_restart_info *r,
                         struct ss_case *c)
 {
@@ -219,6 +222,18 @@ static int restart_case(const struct ss_run_options *o, const struct ss_restart_
 	if (o->override_count > 0)
 		return ss_error_input("--restart %s: --set cannot change a run being continued "
 		                      "(it keeps the overrides it was started with)", o->restart);
+	int err = SS_OK;
+	if (o->case_path) {
+		struct ss_case given;
+		err = ss_case_load(&given, o->case_path, NULL, 0);
+		if (!err && strcmp(given.text, r->case_text) != 0)
+			err = ss_error_input("--restart %s: '%s' is not the case that file was run "
+			                     "from ('%s' as it was then); give that case or none",
+			                     o->restart, o->case_path, r->case_path);
+		ss_case_release(&given);
+		if (err)
+			return err;
+	}
 	int n = 0;
 	for (const char *p = r->case_overrides; *p; p++)
 		n += *p == '\n';
@@ -232,18 +247,9 @@ static int restart_case(const struct ss_run_options *o, const struct ss_restart_
 	int m = 0;
 	for (char *line = strtok(copy, "\n"); line && m < n; line = strtok(NULL, "\n"))
 		v[m++] = line;
-	int err = ss_case_parse(c, r->case_path, r->case_text, v, m);
+	err = ss_case_parse(c, o->case_path ? o->case_path : r->case_path, r->case_text, v, m);
 	free(v);
 	free(copy);
-	if (err || !o->case_path)
-		return err;
-	struct ss_case given;
-	err = ss_case_load(&given, o->case_path, NULL, 0);
-	if (!err && strcmp(given.text, r->case_text) != 0)
-		err = ss_error_input("--restart %s: '%s' is not the case that file was run from "
-		                     "('%s' as it was then); give that case or none",
-		                     o->restart, o->case_path, r->case_path);
-	ss_case_release(&given);
 	return err;
 }
 
@@ -307,8 +313,15 @@ int ss_run_case(const struct ss_run_options *o)
 			goto out_case;
 	}
 	if ((err = ss_setup_stepper(&c, o->tile_nx, o->tile_ny,
-	                            o->reference_kernel ? SS_KERNEL_REFERENCE : SS_KERNEL_FAST, &st)))
+	                            o->reference_kernel ? SS_KERNEL_REFERENCE : SS_KERNEL_FAST, &st))) {
+		/* the files of a case named by a path from another folder */
+		if (o->restart && !o->case_path && access(restart.case_path, R_OK) != 0)
+			fprintf(stderr, "sandslide: (the run was started with '%s', which is not "
+			        "here: name the case to find its files beside it,\n"
+			        "    sandslide run --restart %s PATH/TO/CASE.ini)\n",
+			        restart.case_path, o->restart);
 		goto out_case;
+	}
 	if (o->restart && (err = restart_stepper(o, &restart, &st)))
 		goto out_stepper;
 	if (!o->restart && (err = check_not_existing(output, o->force)))

@@ -124,6 +124,27 @@ def test_restart_of_a_finished_run_is_a_no_op_and_case_must_match(tmp_path):
     assert r.returncode == 2 and "--set" in r.stderr, r.stderr
 
 
+def test_restart_from_another_folder_finds_the_case_files_beside_the_named_case(tmp_path):
+    # a case whose initial surface is a file beside it, run from its parent
+    (tmp_path / "proj").mkdir()
+    (tmp_path / "elsewhere").mkdir()
+    rows = "\n".join(" ".join("0.4" if i < 5 else "0.1" for i in range(20)) for _ in range(16))
+    (tmp_path / "proj" / "start.asc").write_text(
+        "ncols 20\nnrows 16\nxllcorner 0\nyllcorner 0\ncellsize 0.1\n" + rows + "\n")
+    write_case(tmp_path / "proj", edit(BASE, "type = flat\nheight = 0.2\n",
+                                       "type = file\nfile = start.asc\n"), "c.ini")
+    assert run(["run", "proj/c.ini", "-o", "o.h5", "-q"], cwd=tmp_path).returncode == 0
+    n = len(snapshots(tmp_path / "o.h5"))
+    # 'proj/c.ini' means nothing from elsewhere/: the message says what to give
+    r = run(["run", "--restart", "../o.h5", "-q"], cwd=tmp_path / "elsewhere")
+    assert r.returncode == 2 and "proj/start.asc" in r.stderr, r.stderr
+    assert "sandslide run --restart ../o.h5 PATH/TO/CASE.ini" in r.stderr, r.stderr
+    # named, the case's files are found beside it
+    r = run(["run", "--restart", "../o.h5", "../proj/c.ini", "-q"], cwd=tmp_path / "elsewhere")
+    assert r.returncode == 0, r.stderr
+    assert len(snapshots(tmp_path / "o.h5")) == n
+
+
 @pytest.mark.parametrize("damage", ["truncated", "garbage", "relax_series", "missing"])
 def test_restart_refuses_files_it_cannot_continue(tmp_path, damage):
     case = write_case(tmp_path, BASE, "case.ini")
