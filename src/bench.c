@@ -250,7 +250,7 @@ int ss_bench_run(const struct ss_bench_options *o)
 		       o->nx, o->ny, tiling.tile_nx, tiling.tile_ny, o->repeats,
 		       ss_face_rsqrt_method());
 		for (int t = 0; t < o->thread_count; t++)
-			printf("%s\"%d\": %.4g", t ? ", " : "", o->threads[t], bandwidth[t]);
+			printf("%s\"%d\": %.6g", t ? ", " : "", o->threads[t], bandwidth[t]);
 		printf("},\n  \"cases\": [");
 	} else {
 		printf("sandslide bench: %d x %d cells, tiles %dx%d, %d repeats per case, "
@@ -281,11 +281,11 @@ int ss_bench_run(const struct ss_bench_options *o)
 				const double roofline = bandwidth[t] / bytes;
 				if (o->json) {
 					printf("%s\n    {\"surface\": \"%s\", \"closure\": \"%s\", "
-					       "\"threads\": %d, \"cell_updates_per_s\": {\"median\": %.4g, "
-					       "\"min\": %.4g, \"max\": %.4g}, \"steps_per_repeat\": %lld, "
-					       "\"active_fraction\": %.4g, \"bytes_per_cell\": %.3g, "
-					       "\"roofline_cell_updates_per_s\": %.4g, "
-					       "\"roofline_fraction\": %.4g}", first ? "" : ",",
+					       "\"threads\": %d, \"cell_updates_per_s\": {\"median\": %.6g, "
+					       "\"min\": %.6g, \"max\": %.6g}, \"steps_per_repeat\": %lld, "
+					       "\"active_fraction\": %.6g, \"bytes_per_cell\": %.3g, "
+					       "\"roofline_cell_updates_per_s\": %.6g, "
+					       "\"roofline_fraction\": %.6g}", first ? "" : ",",
 					       surface_names[s], o->closures[c].label, o->threads[t],
 					       r.median, r.min, r.max, r.steps, r.active_fraction, bytes,
 					       roofline, r.median / roofline);
