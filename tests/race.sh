@@ -53,8 +53,9 @@ for t in test_sweep test_physics test_render test_dem test_closure; do
 	check "$t" "$build/tests/$t"
 done
 
-# 48 x 40 cells of 2.5 cm: a wall block, an open pit, an open east side, a
-# source on for half the run, a bedrock 5 cm under the initial surface
+# 48 x 40 cells of 2.5 cm: a steep cone on a floor 5 cm thick over a flat
+# bedrock at 2 cm, a wall block, an open pit, an open east side, a source
+# on for the first fifth of the run
 cd "$tmp" || exit 1
 cat >case.ini <<'EOF'
 [grid]
@@ -99,8 +100,6 @@ rate = 0.05
 start = 0
 stop = 0.2
 EOF
-# bedrock 5 cm under the cone's surface would need the cone here: a flat
-# base at 0.02 m lies under every cell of the cone (whose floor is 0.05 m)
 {
 	printf 'ncols 48\nnrows 40\nxllcorner 0\nyllcorner 0\ncellsize 0.025\n'
 	j=0
