@@ -124,6 +124,10 @@ static void progress_print(void *context, const struct ss_stepper *st)
 	fflush(stderr);
 }
 
+/* Returned by write_snapshot, without a message, for a state with a
+ * non-finite height: it is not written. */
+enum { STATE_NONFINITE = 1 };
+
 static int write_snapshot(struct ss_snapshot *snap, struct ss_stepper *st, double started,
                           double *seconds_output)
 {
@@ -132,8 +136,7 @@ static int write_snapshot(struct ss_snapshot *snap, struct ss_stepper *st, doubl
 	ss_stepper_diagnostics(st, &d);
 	d.wall_seconds = t0 - started;
 	if (!isfinite(d.volume) || !isfinite(d.max_height))
-		return ss_error_fail("the height became non-finite by t = %g s (step %lld): "
-		                     "not writing this snapshot", st->time, st->steps);
+		return STATE_NONFINITE;
 	const struct ss_restart_state state = {
 		.steps = st->steps,
 		.inflow_sum = st->inflow_sum, .inflow_carry = st->inflow_carry,
@@ -254,13 +257,13 @@ static int restart_case(const struct ss_run_options *o, const struct ss_restart_
 }
 
 /* Put the stepper where the restart file's last snapshot left it. */
-static int restart_stepper(const struct ss_run_options *o, const struct ss_restart_info *r,
+static int restart_stepper(const char *path, const struct ss_restart_info *r,
                            struct ss_stepper *st)
 {
 	const struct ss_grid *g = &st->grid;
 	if (r->nx != g->nx || r->ny != g->ny)
 		return ss_error_input("--restart %s: its snapshots are %d x %d cells, its case "
-		                      "gives %d x %d", o->restart, r->nx, r->ny, g->nx, g->ny);
+		                      "gives %d x %d", path, r->nx, r->ny, g->nx, g->ny);
 	for (int j = 0; j < g->ny; j++)
 		memcpy(st->height + ss_grid_index(g, 0, j), r->height + (size_t)j * g->nx,
 		       (size_t)g->nx * sizeof(double));
@@ -274,6 +277,91 @@ static int restart_stepper(const struct ss_run_options *o, const struct ss_resta
 	st->outflow = st->outflow_sum + st->outflow_carry;
 	ss_stepper_heights_changed(st);
 	return SS_OK;
+}
+
+/*
+ * The last good state of a run whose heights became non-finite in step
+ * `bad_step`, appended to its output as a snapshot: the state after step
+ * bad_step - 1.  An in-place sweep keeps no earlier copy, and a copy would
+ * cost 8 B per cell for a case that should never arise; but a run is
+ * deterministic, and its file holds all that a restart needs, so the steps
+ * since the last snapshot are taken again, towards the same target time,
+ * and the sweep stops one step short.  The caller has closed the file and
+ * released its stepper.  *written: 1 if a snapshot was appended, 0 if the
+ * last one already was that state.
+ */
+static int append_last_good_state(const struct ss_run_options *o, const struct ss_case *c,
+                                  const char *output, double target, long long bad_step,
+                                  double started, double *good_time, int *written)
+{
+	struct ss_restart_info r;
+	struct ss_stepper st;
+	struct ss_snapshot *snap = NULL;
+	double seconds_output = 0.0;
+	memset(&r, 0, sizeof r);
+	memset(&st, 0, sizeof st);
+	*written = 0;
+	int err = ss_snapshot_read_restart(output, &r);
+	if (!err)
+		err = ss_setup_stepper(c, o->tile_nx, o->tile_ny, o->reference_kernel
+		                       ? SS_KERNEL_REFERENCE : SS_KERNEL_FAST, &st);
+	if (!err)
+		err = restart_stepper(output, &r, &st);
+	ss_restart_info_release(&r);
+	if (err || st.steps >= bad_step - 1)
+		goto out;
+	const struct ss_advance_options replay = {
+		.steady_tol = c->steady ? c->steady_tol : 0.0,
+		.max_steps = bad_step - 1 - st.steps,
+	};
+	const enum ss_advance_end end = ss_stepper_advance(&st, target, &replay);
+	if (end != SS_ADVANCE_STEPS || st.steps != bad_step - 1) {
+		err = ss_error_fail("taking the steps since the last snapshot again ended at "
+		                    "step %lld, not %lld", st.steps, bad_step - 1);
+		goto out;
+	}
+	if ((err = ss_snapshot_open_append(&snap, output, &st.grid)))
+		goto out;
+	err = write_snapshot(snap, &st, started, &seconds_output);
+	if (err == STATE_NONFINITE)
+		err = ss_error_fail("step %lld, taken again, was not finite either", st.steps);
+	*written = !err;
+	*good_time = st.time;
+out:
+	if (ss_snapshot_destroy(snap) && !err)
+		err = SS_ERR_FAIL;
+	ss_stepper_release(&st);
+	return err;
+}
+
+/* The guard of SPEC's explicit scheme: a height became NaN or infinite in the
+ * step just taken towards `target` (which the CFL bound should prevent).
+ * Closes the file and releases the stepper, appends the last good state and
+ * says where the trouble began. */
+static int stop_nonfinite(const struct ss_run_options *o, const struct ss_case *c,
+                          const char *output, double target, double started,
+                          struct ss_snapshot **snap, struct ss_stepper *st)
+{
+	char cell[160];
+	first_nonfinite_cell(st, cell, sizeof cell);
+	const long long bad_step = st->steps, count = ss_snapshot_count(*snap);
+	const double bad_time = st->time, last_time = ss_snapshot_last_time(*snap);
+	ss_stepper_release(st);
+	int err = ss_snapshot_destroy(*snap);
+	*snap = NULL;
+	double good_time = last_time;
+	int written = 0;
+	if (!err)
+		err = append_last_good_state(o, c, output, target, bad_step, started, &good_time,
+		                             &written);
+	if (err)
+		return ss_error_fail("the height of %s became non-finite in step %lld (t = %g s); "
+		                     "the %lld snapshots before it, the last at t = %g s, are in "
+		                     "'%s'", cell, bad_step, bad_time, count, last_time, output);
+	return ss_error_fail("the height of %s became non-finite in step %lld (t = %.9g s); "
+	                     "the last good state, after step %lld at t = %.9g s, is snapshot "
+	                     "%lld in '%s'", cell, bad_step, bad_time, bad_step - 1, good_time,
+	                     count - 1 + written, output);
 }
 
 int ss_run_case(const struct ss_run_options *o)
@@ -322,7 +410,7 @@ int ss_run_case(const struct ss_run_options *o)
 			        restart.case_path, o->restart);
 		goto out_case;
 	}
-	if (o->restart && (err = restart_stepper(o, &restart, &st)))
+	if (o->restart && (err = restart_stepper(o->restart, &restart, &st)))
 		goto out_stepper;
 	if (!o->restart && (err = check_not_existing(output, o->force)))
 		goto out_stepper;
@@ -349,8 +437,11 @@ int ss_run_case(const struct ss_run_options *o)
 		};
 		if ((err = ss_snapshot_create(&snap, output, &st.grid, st.cell_types, &meta)))
 			goto out_stepper;
-		if ((err = write_snapshot(snap, &st, started, &seconds_output)) ||
-		    (err = report_snapshot(o, output, snap, &st, &c)))
+		err = write_snapshot(snap, &st, started, &seconds_output);
+		if (err == STATE_NONFINITE)
+			err = ss_error_input("%s: the initial surface has a non-finite height",
+			                     c.path);
+		if (err || (err = report_snapshot(o, output, snap, &st, &c)))
 			goto out_snapshot;
 	}
 
@@ -380,14 +471,11 @@ int ss_run_case(const struct ss_run_options *o)
 		if (target <= st.time)
 			continue;
 		end = ss_stepper_advance(&st, target, &adv);
+		if (end != SS_ADVANCE_NONFINITE && end != SS_ADVANCE_STALLED &&
+		    (err = write_snapshot(snap, &st, started, &seconds_output)) == STATE_NONFINITE)
+			end = SS_ADVANCE_NONFINITE;
 		if (end == SS_ADVANCE_NONFINITE) {
-			char cell[160];
-			first_nonfinite_cell(&st, cell, sizeof cell);
-			err = ss_error_fail("the height of %s became non-finite in step %lld (t = %g "
-			                    "s); the %lld snapshots before it, the last at t = %g s, "
-			                    "are in '%s'", cell, st.steps, st.time,
-			                    ss_snapshot_count(snap), ss_snapshot_last_time(snap),
-			                    output);
+			err = stop_nonfinite(o, &c, output, target, started, &snap, &st);
 			goto out_snapshot;
 		}
 		if (end == SS_ADVANCE_STALLED) {
@@ -397,8 +485,7 @@ int ss_run_case(const struct ss_run_options *o)
 			                    ss_snapshot_count(snap), output);
 			goto out_snapshot;
 		}
-		if ((err = write_snapshot(snap, &st, started, &seconds_output)) ||
-		    (err = report_snapshot(o, output, snap, &st, &c)))
+		if (err || (err = report_snapshot(o, output, snap, &st, &c)))
 			goto out_snapshot;
 		if (end == SS_ADVANCE_STEADY || end == SS_ADVANCE_INTERRUPTED)
 			break;

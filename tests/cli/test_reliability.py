@@ -220,11 +220,44 @@ def test_non_finite_height_stops_with_exit_1_naming_cell_and_step(tmp_path):
     # the NaN is put into cell (20, 15) after step 1500; it is caught by the
     # slope measure or the sweep of the next step, which may have spread it
     # to the neighbours
-    m = re.search(r"cell \((\d+), (\d+)\).* in step (\d+)", p.stderr)
+    m = re.search(r"cell \((\d+), (\d+)\).* in step (\d+) .*"
+                  r"last good state, after step (\d+) at t = (\S+) s, is snapshot (\d+)",
+                  p.stderr)
     assert m, p.stderr
-    i, j, step = map(int, m.groups())
+    i, j, step, good_step, index = (int(m.group(k)) for k in (1, 2, 3, 4, 6))
+    good_time = float(m.group(5))
     assert abs(i - 20) <= 1 and abs(j - 15) <= 1 and step in (1500, 1501), p.stderr
-    t = snapshots(tmp_path / "nan.h5")
-    assert 1 <= len(t) < 21, t
+    assert good_step == step - 1, p.stderr
     with h5open(tmp_path / "nan.h5") as f:
         assert np.isfinite(f["height"][:]).all(), "a non-finite snapshot was written"
+        assert len(f["time"]) == index + 1, "the last good state is not the last snapshot"
+        assert f["steps"][-1] == good_step, \
+            f"the last snapshot is after step {f['steps'][-1]}, not {good_step}"
+        assert f["time"][-1] == pytest.approx(good_time, rel=1e-8) and good_time < 40.0
+    # the last good state was taken again from the snapshot before it: were
+    # it off by a bit, the run continued from it would not be the
+    # uninterrupted run, bit for bit
+    r = run(["run", "--restart", "nan.h5", "-q"], cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert run(["run", case, "-o", "whole.h5", "-q"], cwd=tmp_path).returncode == 0
+    assert_same_snapshots(tmp_path / "nan.h5", tmp_path / "whole.h5")
+
+
+def test_non_finite_height_at_a_snapshot_time_is_not_written(tmp_path):
+    # 4 s between snapshots and a NaN after the step that lands on t = 4:
+    # the snapshot at 4 s would hold it, so the state one step earlier is
+    # written instead
+    case = write_case(tmp_path, edit(POUR, "output_every = 2", "output_every = 4"))
+    assert run(["run", case, "-o", "whole.h5", "-q"], cwd=tmp_path).returncode == 0
+    with h5open(tmp_path / "whole.h5") as f:
+        landing = int(f["steps"][1])
+    env = dict(os.environ, SANDSLIDE_TEST_NAN_STEP=str(landing))
+    p = subprocess.run([SANDSLIDE, "run", case, "-o", "nan.h5", "-q"], cwd=tmp_path,
+                       capture_output=True, text=True, env=env, timeout=300)
+    assert p.returncode == 1, (p.returncode, p.stderr)
+    assert f"in step {landing} " in p.stderr and \
+        f"after step {landing - 1} at" in p.stderr, p.stderr
+    with h5open(tmp_path / "nan.h5") as f:
+        assert list(f["steps"][:]) == [0, landing - 1], list(f["steps"][:])
+        assert np.isfinite(f["height"][:]).all(), "a non-finite snapshot was written"
+        assert 0 < f["time"][-1] < 4.0
