@@ -172,6 +172,21 @@ static hid_t interior_space(const struct ss_grid *g)
 	return m;
 }
 
+/* Rows j0 .. j0 + n - 1 of a (y, x) dataset of nx columns from block, in
+ * memory type mem_type; nonzero on failure. */
+static int write_rows(hid_t dataset, hid_t file_space, int j0, int n, int nx, hid_t mem_type,
+                      const void *block)
+{
+	hsize_t start[2] = {(hsize_t)j0, 0}, count[2] = {(hsize_t)n, (hsize_t)nx};
+	hid_t mem = H5Screate_simple(2, count, NULL);
+	const int bad = mem < 0 ||
+	      H5Sselect_hyperslab(file_space, H5S_SELECT_SET, start, NULL, count, NULL) < 0 ||
+	      H5Dwrite(dataset, mem_type, mem, file_space, H5P_DEFAULT, block) < 0;
+	if (mem >= 0)
+		H5Sclose(mem);
+	return bad;
+}
+
 /* The packed cell types (grid.h) as bytes, a block of rows at a time: a
  * full unpacked copy would cost a byte per cell, 4 times the packed array. */
 static int write_cell_types(hid_t dataset, hid_t file_space, const struct ss_grid *g,
@@ -187,13 +202,7 @@ static int write_cell_types(hid_t dataset, hid_t file_space, const struct ss_gri
 		for (int j = 0; j < n; j++)
 			ss_cell_types_unpack(cell_types, ss_grid_index(g, 0, j0 + j), (size_t)g->nx,
 			                     block + (size_t)j * g->nx);
-		hsize_t start[2] = {(hsize_t)j0, 0}, count[2] = {(hsize_t)n, (hsize_t)g->nx};
-		hid_t mem = H5Screate_simple(2, count, NULL);
-		bad = mem < 0 ||
-		      H5Sselect_hyperslab(file_space, H5S_SELECT_SET, start, NULL, count, NULL) < 0 ||
-		      H5Dwrite(dataset, H5T_NATIVE_UINT8, mem, file_space, H5P_DEFAULT, block) < 0;
-		if (mem >= 0)
-			H5Sclose(mem);
+		bad = write_rows(dataset, file_space, j0, n, g->nx, H5T_NATIVE_UINT8, block);
 	}
 	ss_free(block);
 	return bad;
@@ -222,13 +231,7 @@ static int write_bedrock(hid_t file, hid_t x, hid_t y, const struct ss_grid *g,
 			for (int i = 0; i < g->nx; i++)
 				block[(size_t)j * g->nx + i] = isinf(row[i]) ? NAN : row[i];
 		}
-		hsize_t start[2] = {(hsize_t)j0, 0}, count[2] = {(hsize_t)n, (hsize_t)g->nx};
-		hid_t mem = H5Screate_simple(2, count, NULL);
-		bad = mem < 0 ||
-		      H5Sselect_hyperslab(space, H5S_SELECT_SET, start, NULL, count, NULL) < 0 ||
-		      H5Dwrite(d, H5T_NATIVE_DOUBLE, mem, space, H5P_DEFAULT, block) < 0;
-		if (mem >= 0)
-			H5Sclose(mem);
+		bad = write_rows(d, space, j0, n, g->nx, H5T_NATIVE_DOUBLE, block);
 	}
 	ss_free(block);
 	bad = bad || attr_units(d, "m", "non-erodible bedrock under the sand") ||
