@@ -14,19 +14,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "sandslide/error.h"
 #include "sandslide/grid.h"
 #include "sandslide/parallel.h"
-
-static double now_seconds(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 static int cmp_double(const void *a, const void *b)
 {
@@ -84,9 +76,9 @@ int ss_render_bench(int n, int repeats)
 	err = ss_render_plan_draw(&plan, north, -(ptrdiff_t)n, 0.0, &img, 1);
 	for (int r = 0; r < repeats && !err; r++) {
 		struct ss_render_image again;
-		const double t0 = now_seconds();
+		const double t0 = ss_parallel_wall_seconds();
 		err = ss_render_plan_draw(&plan, north, -(ptrdiff_t)n, 0.0, &again, 1);
-		times[r] = now_seconds() - t0;
+		times[r] = ss_parallel_wall_seconds() - t0;
 		if (!err)
 			ss_render_image_release(&again);
 	}
@@ -100,11 +92,11 @@ int ss_render_bench(int n, int repeats)
 		       times[repeats - 1]);
 		/* the whole of ss_render_field: plan, range and colouring each time */
 		struct ss_render_image once;
-		const double started = now_seconds();
+		const double started = ss_parallel_wall_seconds();
 		err = ss_render_field(&f, &o, &once);
 		if (!err) {
 			printf("ss_render_field (plan and scale included): %.3f s\n",
-			       now_seconds() - started);
+			       ss_parallel_wall_seconds() - started);
 			ss_render_image_release(&once);
 		}
 		char path[4200];
@@ -113,9 +105,9 @@ int ss_render_bench(int n, int repeats)
 		         (long)getpid());
 		const int levels[] = {1, 6};
 		for (int l = 0; l < 2 && !err; l++) {
-			const double t0 = now_seconds();
+			const double t0 = ss_parallel_wall_seconds();
 			err = ss_render_write_png(&img, path, levels[l]);
-			const double s = now_seconds() - t0;
+			const double s = ss_parallel_wall_seconds() - t0;
 			FILE *fp = err ? NULL : fopen(path, "rb");
 			long bytes = 0;
 			if (fp) {

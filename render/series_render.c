@@ -22,7 +22,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "sandslide/error.h"
@@ -30,13 +29,6 @@
 
 /* Frames up to this size are rendered one per thread. */
 #define FRAME_PARALLEL_MAX_PIXELS (16ll << 20)
-
-static double now_seconds(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 /* One integer of a frame range; empty gives `def`.  -1 if malformed. */
 static int parse_index(const char *s, size_t len, long long def, long long *out)
@@ -245,7 +237,7 @@ static int render_frames(const struct ss_render_plan *p, struct ss_render_source
 
 int ss_render_series(const struct ss_render_series_options *o)
 {
-	const double started = now_seconds();
+	const double started = ss_parallel_wall_seconds();
 	int err = ss_render_options_check(&o->look);
 	if (err)
 		return err;
@@ -282,10 +274,10 @@ int ss_render_series(const struct ss_render_series_options *o)
 	if ((err = ss_render_check_dir(o->output_dir, 1)))
 		goto out_plan;
 
-	const double t0 = now_seconds();
+	const double t0 = ss_parallel_wall_seconds();
 	if ((err = render_frames(&plan, &s, sel, n, o->output_dir)))
 		goto out_plan;
-	const double seconds = now_seconds() - t0;
+	const double seconds = ss_parallel_wall_seconds() - t0;
 
 	if (!o->quiet) {
 		const size_t len = strlen(o->output_dir);
@@ -294,7 +286,7 @@ int ss_render_series(const struct ss_render_series_options *o)
 		       n == 1 ? "" : "s", plan.image_w, plan.image_h, o->output_dir,
 		       len && o->output_dir[len - 1] == '/' ? "" : "/", s.time[sel[0]],
 		       s.time[sel[n - 1]], ss_render_style_name(o->look.style), zmin, zmax,
-		       now_seconds() - started, n / fmax(seconds, 1e-9),
+		       ss_parallel_wall_seconds() - started, n / fmax(seconds, 1e-9),
 		       (double)n * plan.image_w * plan.image_h / fmax(seconds, 1e-9) * 1e-6,
 		       ss_parallel_max_threads());
 		char stale[4200];

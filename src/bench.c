@@ -7,7 +7,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "sandslide/error.h"
 #include "sandslide/face.h"
@@ -25,13 +24,6 @@ static const char *const surface_names[] = {"supercritical", "subcritical", "pat
 const char *ss_bench_surface_name(enum ss_bench_surface s)
 {
 	return surface_names[s];
-}
-
-static double now_seconds(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
 static int compare_doubles(const void *a, const void *b)
@@ -67,11 +59,11 @@ static double bandwidth_probe(double *a, size_t n)
 	for (size_t k = 0; k < n; k++)
 		a[k] = 1.0;
 	for (int r = 0; r < 5; r++) {
-		const double t0 = now_seconds();
+		const double t0 = ss_parallel_wall_seconds();
 		#pragma omp parallel for schedule(static)
 		for (size_t k = 0; k < n; k++)
 			a[k] = a[k] * 0.999999 + 1e-9;
-		rates[r] = 16.0 * (double)n / (now_seconds() - t0);
+		rates[r] = 16.0 * (double)n / (ss_parallel_wall_seconds() - t0);
 	}
 	return median(rates, 5);
 }
@@ -162,9 +154,9 @@ static int run_case(const struct ss_bench_options *o, enum ss_bench_surface surf
 	long long steps = o->steps;
 	if (steps <= 0) {
 		/* enough steps for about 0.3 s per timing */
-		const double t0 = now_seconds();
+		const double t0 = ss_parallel_wall_seconds();
 		bench_step(&st, lambda_idle);
-		const double one = now_seconds() - t0;
+		const double one = ss_parallel_wall_seconds() - t0;
 		steps = (long long)ceil(0.3 / fmax(one, 1e-6));
 		steps = steps < 1 ? 1 : steps > 2000 ? 2000 : steps;
 	}
@@ -173,10 +165,10 @@ static int run_case(const struct ss_bench_options *o, enum ss_bench_surface surf
 	const double cells = (double)g.nx * g.ny;
 	st.tile_sweeps = st.tile_slots = 0.0;
 	for (int r = 0; r < repeats; r++) {
-		const double t0 = now_seconds();
+		const double t0 = ss_parallel_wall_seconds();
 		for (long long k = 0; k < steps; k++)
 			bench_step(&st, lambda_idle);
-		rates[r] = cells * (double)steps / (now_seconds() - t0);
+		rates[r] = cells * (double)steps / (ss_parallel_wall_seconds() - t0);
 	}
 	if (st.fast.nonfinite) {
 		ss_stepper_release(&st);

@@ -3,6 +3,8 @@
  */
 #include "sandslide/parallel.h"
 
+#include <time.h>
+
 #ifdef _OPENMP
 #include <omp.h>
 #endif
@@ -41,4 +43,11 @@ int ss_parallel_thread_id(void)
 #else
 	return 0;
 #endif
+}
+
+double ss_parallel_wall_seconds(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }

@@ -10,20 +10,12 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "sandslide/error.h"
 #include "sandslide/parallel.h"
 #include "sandslide/snapshot.h"
 #include "sandslide/stepper.h"
-
-static double now_seconds(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 void ss_relax_options_init(struct ss_relax_options *o)
 {
@@ -220,7 +212,7 @@ static double flow_volume(struct ss_stepper *st)
 static void progress_print(void *context, const struct ss_stepper *st)
 {
 	double *last = context;
-	const double now = now_seconds();
+	const double now = ss_parallel_wall_seconds();
 	if (now - *last < 0.5)
 		return;
 	*last = now;
@@ -275,13 +267,13 @@ static int write_series_snapshot(struct ss_snapshot *snap, struct ss_stepper *st
 {
 	struct ss_diagnostics d;
 	ss_stepper_diagnostics(st, &d);
-	d.wall_seconds = now_seconds() - started;
+	d.wall_seconds = ss_parallel_wall_seconds() - started;
 	return ss_snapshot_append(snap, st->time, st->height, &d, NULL);
 }
 
 int ss_relax_run(const struct ss_relax_options *o, struct ss_relax_report *rep)
 {
-	const double started = now_seconds();
+	const double started = ss_parallel_wall_seconds();
 	struct ss_raster dem, bedrock;
 	struct ss_stepper st;
 	struct ss_snapshot *snap = NULL;
@@ -406,7 +398,7 @@ int ss_relax_run(const struct ss_relax_options *o, struct ss_relax_report *rep)
 		if ((err = ss_dem_write(rep->output, out_format, &dem)))
 			goto out;
 	}
-	rep->wall_seconds = now_seconds() - started;
+	rep->wall_seconds = ss_parallel_wall_seconds() - started;
 	if (o->report && (err = write_report(o->report, o, rep)))
 		goto out;
 	if (!o->quiet) {

@@ -10,7 +10,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "sandslide/case.h"
@@ -19,13 +18,6 @@
 #include "sandslide/setup.h"
 #include "sandslide/snapshot.h"
 #include "sandslide/stepper.h"
-
-static double now_seconds(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 /* "cases/door.ini" -> "out/door.h5" */
 static void default_output(const char *case_path, char *out, size_t size)
@@ -104,7 +96,7 @@ static void progress_print(void *context, const struct ss_stepper *st)
 		p->height[p->nan_cell] = NAN;   /* SANDSLIDE_TEST_NAN_STEP, see below */
 	if (!p->enabled)
 		return;
-	const double now = now_seconds();
+	const double now = ss_parallel_wall_seconds();
 	if (now - p->last_print < 0.5)
 		return;
 	p->last_print = now;
@@ -132,7 +124,7 @@ static int write_snapshot(struct ss_snapshot *snap, struct ss_stepper *st, doubl
                           double *seconds_output)
 {
 	struct ss_diagnostics d;
-	const double t0 = now_seconds();
+	const double t0 = ss_parallel_wall_seconds();
 	ss_stepper_diagnostics(st, &d);
 	d.wall_seconds = t0 - started;
 	if (!isfinite(d.volume) || !isfinite(d.max_height))
@@ -143,7 +135,7 @@ static int write_snapshot(struct ss_snapshot *snap, struct ss_stepper *st, doubl
 		.outflow_sum = st->outflow_sum, .outflow_carry = st->outflow_carry,
 	};
 	int err = ss_snapshot_append(snap, st->time, st->height, &d, &state);
-	*seconds_output += now_seconds() - t0;
+	*seconds_output += ss_parallel_wall_seconds() - t0;
 	return err;
 }
 
@@ -366,7 +358,7 @@ static int stop_nonfinite(const struct ss_run_options *o, const struct ss_case *
 
 int ss_run_case(const struct ss_run_options *o)
 {
-	const double started = now_seconds();
+	const double started = ss_parallel_wall_seconds();
 	struct ss_case c;
 	struct ss_stepper st;
 	struct ss_snapshot *snap = NULL;
@@ -500,7 +492,7 @@ int ss_run_case(const struct ss_run_options *o)
 	}
 
 	if (!o->quiet && end != SS_ADVANCE_INTERRUPTED) {
-		const double wall = now_seconds() - started;
+		const double wall = ss_parallel_wall_seconds() - started;
 		const double updates = (double)st.steps * st.grid.nx * st.grid.ny;
 		printf("wrote %s: %lld snapshots to t = %g s, %lld steps%s\n", output,
 		       ss_snapshot_count(snap), st.time, st.steps,

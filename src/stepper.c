@@ -7,17 +7,9 @@
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
-#include <time.h>
 
 #include "sandslide/error.h"
 #include "sandslide/parallel.h"
-
-static double now_seconds(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 double ss_stepper_memory_bytes(const struct ss_grid *g)
 {
@@ -371,12 +363,12 @@ enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,
 		const double next_event = fmin(next_switch, t_target);
 
 		ss_boundary_fill_heights(g, &st->boundary, st->height);
-		double t0 = now_seconds();
+		double t0 = ss_parallel_wall_seconds();
 		const double s_max = st->kernel == SS_KERNEL_FAST
 			? ss_sweep_fast_begin(&st->fast, g, st->height, st->cell_types)
 			: ss_sweep_fluxes(g, &st->tiling, &st->face_rule, st->height,
 			                  st->cell_type_bytes, st->flux_x, st->flux_y);
-		st->seconds_measure += now_seconds() - t0;
+		st->seconds_measure += ss_parallel_wall_seconds() - t0;
 		if (!isfinite(s_max)) {
 			st->rate_max = NAN;
 			return SS_ADVANCE_NONFINITE;
@@ -403,7 +395,7 @@ enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,
 		else if (st->time + dt == st->time)
 			return SS_ADVANCE_STALLED;
 
-		t0 = now_seconds();
+		t0 = ss_parallel_wall_seconds();
 		if (st->kernel == SS_KERNEL_FAST) {
 			st->tile_sweeps += ss_sweep_fast_awake(&st->fast);
 			st->rate_max = ss_sweep_fast_step(&st->fast, g, &st->face_rule, dt,
@@ -419,7 +411,7 @@ enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,
 			                               st->sources_on ? st->source_rate : NULL,
 			                               st->cell_type_bytes, st->height);
 		}
-		st->seconds_sweep += now_seconds() - t0;
+		st->seconds_sweep += ss_parallel_wall_seconds() - t0;
 		st->tile_slots += tiles;
 		add_compensated(&st->outflow_sum, &st->outflow_carry, dt * outflow_rate(st));
 		add_compensated(&st->inflow_sum, &st->inflow_carry,

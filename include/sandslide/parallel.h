@@ -1,6 +1,6 @@
 /*
  * parallel.h - the only place that calls omp_* (so the code builds with
- * OPENMP=0, where these report one thread).
+ * OPENMP=0, where these report one thread), and the clock that times runs.
  */
 #ifndef SANDSLIDE_PARALLEL_H
 #define SANDSLIDE_PARALLEL_H
@@ -13,5 +13,8 @@ void ss_parallel_set_threads(int n);
 int ss_parallel_thread_id(void);
 /* Processors available to this process. */
 int ss_parallel_processors(void);
+/* Seconds on a monotonic clock (as omp_get_wtime, also without OpenMP):
+ * differences time the phases of a run and the benchmarks. */
+double ss_parallel_wall_seconds(void);
 
 #endif
