@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include "sandslide/error.h"
+#include "sandslide/output.h"
 #include "sandslide/parallel.h"
 #include "sandslide/snapshot.h"
 #include "sandslide/stepper.h"
@@ -48,25 +49,10 @@ static void default_output(const char *dem, char *out, size_t size)
 	snprintf(out, size, "out/%.*s-relaxed%.*s", stem, base, len - stem, base + stem);
 }
 
-/* The output's folder must exist and be writable (out/ is created); an
- * existing output is replaced only with force. */
-static int check_output_folder(const char *path, int is_default, int force)
+/* An existing output is replaced only with force. */
+static int check_not_existing(const char *path, int force)
 {
-	char dir[4096];
-	const char *slash = strrchr(path, '/');
-	if (slash)
-		snprintf(dir, sizeof dir, "%.*s", (int)(slash - path) + (slash == path), path);
-	else
-		snprintf(dir, sizeof dir, ".");
 	struct stat sb;
-	if (is_default && stat(dir, &sb) != 0 && mkdir(dir, 0777) != 0 && errno != EEXIST)
-		return ss_error_input("cannot create output folder '%s': %s", dir, strerror(errno));
-	if (stat(dir, &sb) != 0 || !S_ISDIR(sb.st_mode))
-		return ss_error_input("cannot write '%s': folder '%s' does not exist", path, dir);
-	if (access(dir, W_OK) != 0)
-		return ss_error_input("cannot write '%s': folder '%s' is not writable", path, dir);
-	if (stat(path, &sb) == 0 && S_ISDIR(sb.st_mode))
-		return ss_error_input("cannot write '%s': it is a folder", path);
 	if (!force && stat(path, &sb) == 0)
 		return ss_error_input("'%s' exists: give --force to replace it", path);
 	return SS_OK;
@@ -298,7 +284,8 @@ int ss_relax_run(const struct ss_relax_options *o, struct ss_relax_report *rep)
 		                     "write .asc, .png or .h5", rep->output);
 		goto out;
 	}
-	if ((err = check_output_folder(rep->output, o->output == NULL, o->force)))
+	if ((err = ss_output_check_folder(rep->output, o->output == NULL)) ||
+	    (err = check_not_existing(rep->output, o->force)))
 		goto out;
 	if (o->bedrock) {
 		struct ss_dem_read_options bo = o->read;
@@ -327,6 +314,8 @@ int ss_relax_run(const struct ss_relax_options *o, struct ss_relax_report *rep)
 	rep->volume_before = flow_volume(&st);
 	rep->max_slope_before_deg = steepest_sand_face_deg(&st);
 
+	if (!o->output && (err = ss_output_make_folder(rep->output)))
+		goto out;
 	const int series = out_format == SS_DEM_H5;
 	double every = o->output_every;
 	if (series && isnan(every))

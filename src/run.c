@@ -4,7 +4,6 @@
  */
 #include "sandslide/run.h"
 
-#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -14,6 +13,7 @@
 
 #include "sandslide/case.h"
 #include "sandslide/error.h"
+#include "sandslide/output.h"
 #include "sandslide/parallel.h"
 #include "sandslide/setup.h"
 #include "sandslide/snapshot.h"
@@ -26,33 +26,6 @@ static void default_output(const char *case_path, char *out, size_t size)
 	const char *dot = strrchr(base, '.');
 	int stem = dot && dot != base ? (int)(dot - base) : (int)strlen(base);
 	snprintf(out, size, "out/%.*s.h5", stem, base);
-}
-
-/* The output's folder must exist and be writable (the default folder out/
- * may be missing: it is created when the run starts, in a writable working
- * folder), and the output itself must not be a folder. */
-static int check_output(const char *path, int is_default)
-{
-	char dir[4096];
-	const char *slash = strrchr(path, '/');
-	if (slash)
-		snprintf(dir, sizeof dir, "%.*s", (int)(slash - path) + (slash == path), path);
-	else
-		snprintf(dir, sizeof dir, ".");
-	struct stat sb;
-	if (is_default && stat(dir, &sb) != 0) {
-		if (access(".", W_OK) != 0)
-			return ss_error_input("cannot create output folder '%s': the working folder "
-			                      "is not writable", dir);
-		return SS_OK;
-	}
-	if (stat(dir, &sb) != 0 || !S_ISDIR(sb.st_mode))
-		return ss_error_input("cannot write '%s': folder '%s' does not exist", path, dir);
-	if (access(dir, W_OK) != 0)
-		return ss_error_input("cannot write '%s': folder '%s' is not writable", path, dir);
-	if (stat(path, &sb) == 0 && S_ISDIR(sb.st_mode))
-		return ss_error_input("cannot write '%s': it is a folder", path);
-	return SS_OK;
 }
 
 /* An existing output is replaced only with --force (checked last, so that
@@ -389,7 +362,7 @@ int ss_run_case(const struct ss_run_options *o)
 			snprintf(output, sizeof output, "%s", o->output);
 		else
 			default_output(o->case_path, output, sizeof output);
-		if ((err = check_output(output, o->output == NULL)))
+		if ((err = ss_output_check_folder(output, o->output == NULL)))
 			goto out_case;
 	}
 	if ((err = ss_setup_stepper(&c, o->tile_nx, o->tile_ny,
@@ -412,10 +385,8 @@ int ss_run_case(const struct ss_run_options *o)
 		if ((err = ss_snapshot_open_append(&snap, output, &st.grid)))
 			goto out_stepper;
 	} else {
-		if (!o->output && mkdir("out", 0777) != 0 && errno != EEXIST) {
-			err = ss_error_fail("cannot create output folder 'out': %s", strerror(errno));
+		if (!o->output && (err = ss_output_make_folder(output)))
 			goto out_stepper;
-		}
 		if (!(overrides_text = join_overrides(o->overrides, o->override_count))) {
 			err = ss_error_fail("out of memory");
 			goto out_stepper;
