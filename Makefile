@@ -50,7 +50,7 @@ else
   DEP_LIBS   := $(shell $(PKG_CONFIG) --libs $(PC_MODULES)) -lhdf5_hl
 endif
 
-# Optional GDAL: GeoTIFF and other GDAL rasters in src/dem_gdal.c.  Used
+# Optional GDAL: GeoTIFF and other GDAL rasters in src/io/dem_gdal.c.  Used
 # when pkg-config finds it (GDAL=0 builds without); otherwise .tif input
 # and output fail with "unavailable in this build".  `make deps` installs
 # it so the tests cover it (about 100 packages, 54 MB: 34 s on the dev VM).
@@ -89,7 +89,7 @@ ifeq ($(SANITIZE),1)
   export UBSAN_OPTIONS ?= print_stacktrace=1:halt_on_error=1:exitcode=86
   export SANDSLIDE_TEST_SCALE ?= 0.5
 endif
-ALL_CFLAGS  := $(BASE) $(WARN) $(OMPFLAG) $(SANFLAG) -Iinclude -DSS_VERSION='"$(VERSION)"' \
+ALL_CFLAGS  := $(BASE) $(WARN) $(OMPFLAG) $(SANFLAG) -Iinclude -Isrc -DSS_VERSION='"$(VERSION)"' \
                $(DEP_CFLAGS) -MMD -MP $(CFLAGS)
 ALL_LDFLAGS := $(OMPFLAG) $(SANFLAG) $(LDFLAGS)
 LIBS        := $(DEP_LIBS) -lm
@@ -100,11 +100,14 @@ else
   Q := @
 endif
 
-LIB_SRC  := $(filter-out src/main.c,$(wildcard src/*.c))
+# The library in tiers (src/README.md): base, core, model, io, app; the
+# command line in src/cli/ is the program around it.
+LIB_SRC  := $(filter-out src/cli/%,$(wildcard src/*/*.c))
+CLI_SRC  := $(wildcard src/cli/*.c)
 # The renderer (render/, SPEC section 6) is part of the library.
 RENDER_SRC := $(wildcard render/*.c)
 LIB_OBJ  := $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o) $(RENDER_SRC:render/%.c=$(BUILD)/obj/render/%.o)
-MAIN_OBJ := $(BUILD)/obj/main.o
+MAIN_OBJ := $(CLI_SRC:src/%.c=$(BUILD)/obj/%.o)
 TEST_SRC := $(wildcard tests/test_*.c)
 TEST_BIN := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
 HEADERS  := $(wildcard include/sandslide/*.h)
@@ -163,7 +166,7 @@ FUZZ_NAMES   := case mask asc png
 FUZZ_CC      ?= clang
 FUZZ_BUILD   := $(BUILD)/fuzz
 FUZZ_SAN     := -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
-FUZZ_CFLAGS  := -std=c11 -D_XOPEN_SOURCE=700 -O1 -g $(WARN) -Wno-unknown-pragmas -Iinclude \
+FUZZ_CFLAGS  := -std=c11 -D_XOPEN_SOURCE=700 -O1 -g $(WARN) -Wno-unknown-pragmas -Iinclude -Isrc \
                 -Itests/fuzz -DSS_VERSION='"$(VERSION)"' $(DEP_CFLAGS) $(FUZZ_SAN) -MMD -MP $(CFLAGS)
 FUZZ_LIB_SRC := $(LIB_SRC) $(RENDER_SRC)
 FUZZ_BIN     := $(FUZZ_NAMES:%=$(FUZZ_BUILD)/fuzz_%)

@@ -1,6 +1,6 @@
 /*
  * fuzz_asc.c - the ESRI ASCII grid reader, ss_dem_read on a .asc file
- * (src/dem.c, src/dem_asc.c).
+ * (src/io/dem.c, src/io/dem_asc.c).
  *
  * Input: the file.  A grid that is read must hold what dem.h promises
  * (fuzz_dem.h) and come back bit for bit when written and read again.

@@ -1,5 +1,5 @@
 /*
- * fuzz_case.c - the case-file parser, ss_case_parse (src/case.c).
+ * fuzz_case.c - the case-file parser, ss_case_parse (src/model/case.c).
  *
  * Input: the case text, then up to four --set overrides, each after a NUL
  * byte ("[grid]\nnx = 3 ...\0model.closure=casson\0source s.rate=1").

@@ -1,6 +1,6 @@
 /*
  * fuzz_mask.c - PNG masks of `mask = PNG` shapes, read by
- * ss_shape_rasterize (src/shape.c, libpng's simplified API).
+ * ss_shape_rasterize (src/model/shape.c, libpng's simplified API).
  *
  * Input: the PNG file, its chunk CRCs made right.  The grid takes the size
  * the IHDR chunk states when it is at most 64 x 64 pixels (so that most

@@ -1,6 +1,6 @@
 /*
  * fuzz_png.c - the 16-bit PNG heightmap reader, ss_dem_read on a .png
- * file (src/dem.c, src/dem_png.c).
+ * file (src/io/dem.c, src/io/dem_png.c).
  *
  * Input: the file, its chunk CRCs made right, read twice: with the range
  * of its text chunks (zmin_m, zmax_m), and with a scale, offset and cell

@@ -16,7 +16,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "dem_internal.h"
+#include "io/dem_internal.h"
 #include "sandslide/error.h"
 #include "sandslide/snapshot.h"
 

@@ -22,7 +22,7 @@
  * chunks); each setjmp sits in a small function whose changing state lives
  * behind a pointer, so nothing local is indeterminate after a longjmp.
  */
-#include "dem_internal.h"
+#include "io/dem_internal.h"
 
 #include <errno.h>
 #include <math.h>
@@ -34,7 +34,7 @@
 #include <png.h>
 
 #include "sandslide/error.h"
-#include "sandslide/png_check.h"
+#include "io/png_check.h"
 
 #define KEY_ZMIN "zmin_m"
 #define KEY_ZMAX "zmax_m"

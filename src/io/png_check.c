@@ -2,7 +2,7 @@
  * png_check.c - chunk lengths of a PNG checked against its file's size
  * before libpng reads it (see png_check.h).
  */
-#include "sandslide/png_check.h"
+#include "io/png_check.h"
 
 #include <ctype.h>
 #include <sys/stat.h>

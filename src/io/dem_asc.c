@@ -9,7 +9,7 @@
  * reads back to the same double, so a grid read and written again keeps
  * every bit.
  */
-#include "dem_internal.h"
+#include "io/dem_internal.h"
 
 #include <ctype.h>
 #include <errno.h>

@@ -1,7 +1,7 @@
 /*
  * output.c - checks of an output path (output.h), shared by run and relax.
  */
-#include "sandslide/output.h"
+#include "io/output.h"
 
 #include <errno.h>
 #include <stdio.h>

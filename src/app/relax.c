@@ -13,7 +13,7 @@
 #include <unistd.h>
 
 #include "sandslide/error.h"
-#include "sandslide/output.h"
+#include "io/output.h"
 #include "sandslide/parallel.h"
 #include "sandslide/snapshot.h"
 #include "sandslide/stepper.h"

@@ -14,7 +14,7 @@
 #include <png.h>
 
 #include "sandslide/error.h"
-#include "sandslide/png_check.h"
+#include "io/png_check.h"
 
 /* Even-odd rule: count crossings of the ray from (x, y) towards +x. */
 static int polygon_contains(const double *xy, int n, double x, double y)

@@ -10,7 +10,7 @@
  * geotransform, CRS and nodata value.  GDAL's own messages are silenced
  * and folded into ours, so each error is still printed once.
  */
-#include "dem_internal.h"
+#include "io/dem_internal.h"
 
 #include "sandslide/error.h"
 

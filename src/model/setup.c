@@ -1,7 +1,7 @@
 /*
  * setup.c - from a case to a ready stepper (see setup.h).
  */
-#include "sandslide/setup.h"
+#include "model/setup.h"
 
 #include <math.h>
 #include <string.h>

@@ -13,9 +13,9 @@
 
 #include "sandslide/case.h"
 #include "sandslide/error.h"
-#include "sandslide/output.h"
+#include "io/output.h"
 #include "sandslide/parallel.h"
-#include "sandslide/setup.h"
+#include "model/setup.h"
 #include "sandslide/snapshot.h"
 #include "sandslide/stepper.h"
 
