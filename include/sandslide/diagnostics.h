@@ -1,7 +1,7 @@
 /*
- * diagnostics.h - the per-snapshot record of a run (SPEC section 5): what the
- * stepper measures and the snapshot writer stores, shared by both without
- * either knowing the other.
+ * diagnostics.h - the per-snapshot record of a run (SPEC section 5) and the
+ * counters a restart needs: what the stepper measures and the snapshot
+ * writer stores, shared by both without either knowing the other.
  */
 #ifndef SANDSLIDE_DIAGNOSTICS_H
 #define SANDSLIDE_DIAGNOSTICS_H
@@ -15,6 +15,16 @@ struct ss_diagnostics {
 	double steps;           /* cumulative substeps */
 	double active_fraction; /* tiles swept / tiles, over the last interval */
 	double wall_seconds;    /* wall time since the run started, s */
+};
+
+/* What a restart needs beyond the heights and the time to continue with the
+ * same bits: the step counter and the compensated sums of the inflow and
+ * outflow (stepper.h), stored with every snapshot (root attribute
+ * restart_state, snapshot.h). */
+struct ss_restart_state {
+	long long steps;
+	double inflow_sum, inflow_carry;    /* m^3 */
+	double outflow_sum, outflow_carry;
 };
 
 #endif

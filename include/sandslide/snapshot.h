@@ -39,14 +39,6 @@ struct ss_snapshot_meta {
 	const char *case_overrides; /* the --set values, one per line, or NULL */
 };
 
-/* What a restart needs beyond the heights to continue with the same bits:
- * the step counter and the compensated sums (stepper.h). */
-struct ss_restart_state {
-	long long steps;
-	double inflow_sum, inflow_carry;    /* m^3 */
-	double outflow_sum, outflow_carry;
-};
-
 /* Call first in a program: HDF5 quiet (errors are reported by the callers)
  * and no clean-up at exit, which crashes HDF5 1.10 after a failed close. */
 void ss_snapshot_library_init(void);
@@ -85,6 +77,10 @@ struct ss_restart_info {
 /* SS_ERR_INPUT naming what is missing for a file that cannot be continued
  * (not a sandslide output, no snapshot, no case text or restart state). */
 int ss_snapshot_read_restart(const char *path, struct ss_restart_info *r);
+
+/* The same without the case (left NULL): the last snapshot and its restart
+ * state, as the guard of a run needs them to take its steps again. */
+int ss_snapshot_read_last_state(const char *path, struct ss_restart_info *r);
 void ss_restart_info_release(struct ss_restart_info *r);
 
 /* Snapshots written so far. */

@@ -154,4 +154,18 @@ void ss_stepper_heights_changed(struct ss_stepper *st);
 /* Time of the next source switch after t (INFINITY if none). */
 double ss_stepper_next_source_event(const struct ss_stepper *st, double t);
 
+/* The counters of the current state that a restart needs (diagnostics.h). */
+void ss_stepper_restart_state(const struct ss_stepper *st, struct ss_restart_state *s);
+
+/* Put a prepared stepper in a saved state: time t (s), the heights of
+ * every cell as a snapshot stores them (nx * ny, row-major, south row
+ * first) and the counters s that ss_stepper_restart_state gave.  Stepping
+ * on from it gives the same bits as the run that saved it. */
+void ss_stepper_restore(struct ss_stepper *st, double t, const double *height,
+                        const struct ss_restart_state *s);
+
+/* The first cell (in row order) whose height is not finite: 1 and its
+ * (i, j), or 0 when every height is finite. */
+int ss_stepper_first_nonfinite(const struct ss_stepper *st, int *i, int *j);
+
 #endif

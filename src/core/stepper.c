@@ -5,7 +5,6 @@
 #include "sandslide/stepper.h"
 
 #include <math.h>
-#include <stdio.h>
 #include <string.h>
 
 #include "sandslide/error.h"
@@ -470,4 +469,42 @@ void ss_stepper_diagnostics(struct ss_stepper *st, struct ss_diagnostics *d)
 	d->steps = (double)st->steps;
 	d->active_fraction = st->tile_slots > 0.0 ? st->tile_sweeps / st->tile_slots : 0.0;
 	st->tile_sweeps = st->tile_slots = 0.0;
+}
+
+void ss_stepper_restart_state(const struct ss_stepper *st, struct ss_restart_state *s)
+{
+	s->steps = st->steps;
+	s->inflow_sum = st->inflow_sum;
+	s->inflow_carry = st->inflow_carry;
+	s->outflow_sum = st->outflow_sum;
+	s->outflow_carry = st->outflow_carry;
+}
+
+void ss_stepper_restore(struct ss_stepper *st, double t, const double *height,
+                        const struct ss_restart_state *s)
+{
+	const struct ss_grid *g = &st->grid;
+	for (int j = 0; j < g->ny; j++)
+		memcpy(st->height + ss_grid_index(g, 0, j), height + (size_t)j * g->nx,
+		       (size_t)g->nx * sizeof(double));
+	st->time = t;
+	st->steps = s->steps;
+	st->inflow_sum = s->inflow_sum;
+	st->inflow_carry = s->inflow_carry;
+	st->outflow_sum = s->outflow_sum;
+	st->outflow_carry = s->outflow_carry;
+	/* the totals as ss_stepper_advance forms them after every substep */
+	st->inflow = st->inflow_sum + st->inflow_carry;
+	st->outflow = st->outflow_sum + st->outflow_carry;
+	ss_stepper_heights_changed(st);
+}
+
+int ss_stepper_first_nonfinite(const struct ss_stepper *st, int *i, int *j)
+{
+	const struct ss_grid *g = &st->grid;
+	for (*j = 0; *j < g->ny; ++*j)
+		for (*i = 0; *i < g->nx; ++*i)
+			if (!isfinite(st->height[ss_grid_index(g, *i, *j)]))
+				return 1;
+	return 0;
 }

@@ -886,7 +886,31 @@ void ss_restart_info_release(struct ss_restart_info *r)
 	memset(r, 0, sizeof *r);
 }
 
-int ss_snapshot_read_restart(const char *path, struct ss_restart_info *r)
+/* The restart_state root attribute into *state; -1 if absent or damaged. */
+static int read_restart_state(hid_t file, struct ss_restart_state *state)
+{
+	double v[5] = {NAN, NAN, NAN, NAN, NAN};
+	hid_t a = H5Aexists(file, "restart_state") > 0
+	          ? H5Aopen(file, "restart_state", H5P_DEFAULT) : -1;
+	hid_t as = a >= 0 ? H5Aget_space(a) : -1;
+	const int five = as >= 0 && H5Sget_simple_extent_npoints(as) == 5;
+	if (!(five && H5Aread(a, H5T_NATIVE_DOUBLE, v) >= 0))
+		v[0] = NAN;
+	if (as >= 0)
+		H5Sclose(as);
+	if (a >= 0)
+		H5Aclose(a);
+	if (!(v[0] >= 0.0) || !isfinite(v[1] + v[2] + v[3] + v[4]))
+		return -1;
+	state->steps = (long long)v[0];
+	state->inflow_sum = v[1];
+	state->inflow_carry = v[2];
+	state->outflow_sum = v[3];
+	state->outflow_carry = v[4];
+	return 0;
+}
+
+int ss_snapshot_read_last_state(const char *path, struct ss_restart_info *r)
 {
 	memset(r, 0, sizeof *r);
 	struct ss_snapshot_summary sum;
@@ -900,43 +924,54 @@ int ss_snapshot_read_restart(const char *path, struct ss_restart_info *r)
 	ss_snapshot_summary_release(&sum);
 	if (r->count < 1)
 		return ss_error_input("cannot restart from '%s': it holds no snapshot", path);
-
 	hid_t file = open_file(path);
 	if (file < 0)
 		return SS_ERR_INPUT;
-	r->case_text = read_attr_text(file, "case");
-	r->case_path = read_attr_text(file, "title");
-	r->case_overrides = read_attr_text(file, "case_overrides");
-	double v[5] = {NAN, NAN, NAN, NAN, NAN};
-	hid_t a = H5Aexists(file, "restart_state") > 0
-	          ? H5Aopen(file, "restart_state", H5P_DEFAULT) : -1;
-	hid_t as = a >= 0 ? H5Aget_space(a) : -1;
-	const int five = as >= 0 && H5Sget_simple_extent_npoints(as) == 5;
-	if (!(five && H5Aread(a, H5T_NATIVE_DOUBLE, v) >= 0))
-		v[0] = NAN;
-	if (as >= 0)
-		H5Sclose(as);
-	if (a >= 0)
-		H5Aclose(a);
+	err = read_restart_state(file, &r->state);
 	H5Fclose(file);
-	if (!r->case_text || !r->case_path || !r->case_overrides || !*r->case_text)
-		err = ss_error_input("cannot restart from '%s': it does not hold the case it was "
-		                     "run from (written by sandslide run?)", path);
-	else if (!(v[0] >= 0.0) || !isfinite(v[1] + v[2] + v[3] + v[4]))
-		err = ss_error_input("cannot restart from '%s': its restart state is missing or "
-		                     "damaged (written by an older sandslide?)", path);
-	if (!err) {
-		r->state.steps = (long long)v[0];
-		r->state.inflow_sum = v[1];
-		r->state.inflow_carry = v[2];
-		r->state.outflow_sum = v[3];
-		r->state.outflow_carry = v[4];
-		int nx, ny;
-		err = ss_snapshot_read_field(path, "/height", r->count - 1, &nx, &ny, &r->height);
-	}
+	if (err)
+		return ss_error_input("cannot restart from '%s': its restart state is missing or "
+		                      "damaged (written by an older sandslide?)", path);
+	int nx, ny;
+	err = ss_snapshot_read_field(path, "/height", r->count - 1, &nx, &ny, &r->height);
 	if (err)
 		ss_restart_info_release(r);
 	return err;
+}
+
+int ss_snapshot_read_restart(const char *path, struct ss_restart_info *r)
+{
+	memset(r, 0, sizeof *r);
+	struct ss_snapshot_summary sum;
+	int err = ss_snapshot_read_summary(path, &sum);   /* a sandslide file first */
+	const long long count = sum.count;
+	ss_snapshot_summary_release(&sum);
+	if (err)
+		return err;
+	if (count < 1)
+		return ss_error_input("cannot restart from '%s': it holds no snapshot", path);
+	hid_t file = open_file(path);
+	if (file < 0)
+		return SS_ERR_INPUT;
+	char *text = read_attr_text(file, "case");
+	char *case_path = read_attr_text(file, "title");
+	char *overrides = read_attr_text(file, "case_overrides");
+	H5Fclose(file);
+	if (!text || !case_path || !overrides || !*text)
+		err = ss_error_input("cannot restart from '%s': it does not hold the case it was "
+		                     "run from (written by sandslide run?)", path);
+	if (!err)
+		err = ss_snapshot_read_last_state(path, r);
+	if (err) {
+		free(text);
+		free(case_path);
+		free(overrides);
+		return err;
+	}
+	r->case_text = text;
+	r->case_path = case_path;
+	r->case_overrides = overrides;
+	return SS_OK;
 }
 
 int ss_snapshot_open_append(struct ss_snapshot **out, const char *path,
