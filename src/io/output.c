@@ -1,11 +1,15 @@
 /*
- * output.c - checks of an output path (output.h), shared by run and relax.
+ * output.c - checks and claims of an output path (output.h), shared by run
+ * and relax.
  */
 #include "io/output.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -48,4 +52,126 @@ int ss_output_make_folder(const char *path)
 	if (mkdir(dir, 0777) != 0 && errno != EEXIST)
 		return ss_error_fail("cannot create output folder '%s': %s", dir, strerror(errno));
 	return SS_OK;
+}
+
+int ss_output_check_absent(const char *path, int force, const char *hint)
+{
+	struct stat sb;
+	if (!force && stat(path, &sb) == 0)
+		return ss_error_input("'%s' exists: give --force to replace it%s", path,
+		                      hint ? hint : "");
+	return SS_OK;
+}
+
+/* ---- claims ------------------------------------------------------------ */
+
+struct ss_output_claim {
+	int fd;                 /* holds the flock */
+	char *lock_path;
+};
+
+/* "dir/name.h5" and "dir/name.h5.partial" -> "dir/.name.h5.lock" */
+static char *lock_path_of(const char *path)
+{
+	const char *slash = strrchr(path, '/');
+	const int dir = slash ? (int)(slash - path) + 1 : 0;
+	const char *name = path + dir;
+	int len = (int)strlen(name);
+	static const char partial[] = ".partial";
+	const int plen = (int)sizeof partial - 1;
+	if (len > plen && strcmp(name + len - plen, partial) == 0)
+		len -= plen;
+	const size_t size = strlen(path) + 8;
+	char *lock = malloc(size);
+	if (lock)
+		snprintf(lock, size, "%.*s.%.*s.lock", dir, path, len, name);
+	return lock;
+}
+
+/* The process that holds the lock file open in fd, as its text says. */
+static long holder_of(int fd)
+{
+	char text[32] = "";
+	const ssize_t n = pread(fd, text, sizeof text - 1, 0);
+	return n > 0 ? strtol(text, NULL, 10) : 0;
+}
+
+/* 1 when fd is still the file at path (a run that ends unlinks its lock
+ * file: one opened just before that is no longer the lock). */
+static int still_at(int fd, const char *path)
+{
+	struct stat a, b;
+	return fstat(fd, &a) == 0 && stat(path, &b) == 0 && a.st_dev == b.st_dev &&
+	       a.st_ino == b.st_ino;
+}
+
+/* Our process number into the lock file, for the message of a refused run
+ * (which is all that a failed write costs). */
+static int write_holder(int fd)
+{
+	char pid[32];
+	const int n = snprintf(pid, sizeof pid, "%ld\n", (long)getpid());
+	return ftruncate(fd, 0) == 0 && pwrite(fd, pid, (size_t)n, 0) == n ? 0 : -1;
+}
+
+static int refuse_held(const char *path, const char *lock, long holder)
+{
+	char who[48] = "";
+	if (holder > 0)
+		snprintf(who, sizeof who, " (process %ld)", holder);
+	return ss_error_input("'%s' is being written by another sandslide run%s, which holds "
+	                      "'%s': wait for it to end, or choose another output", path, who,
+	                      lock);
+}
+
+int ss_output_claim(struct ss_output_claim **out, const char *path)
+{
+	*out = NULL;
+	struct ss_output_claim *c = calloc(1, sizeof *c);
+	if (!c || !(c->lock_path = lock_path_of(path))) {
+		free(c);
+		return ss_error_fail("out of memory");
+	}
+	int err = SS_OK;
+	for (int attempt = 0;; attempt++) {
+		c->fd = open(c->lock_path, O_RDWR | O_CREAT | O_CLOEXEC, 0666);
+		if (c->fd < 0) {
+			err = ss_error_fail("cannot create the lock file '%s': %s", c->lock_path,
+			                    strerror(errno));
+			break;
+		}
+		if (flock(c->fd, LOCK_EX | LOCK_NB) != 0) {
+			err = errno == EWOULDBLOCK
+			      ? refuse_held(path, c->lock_path, holder_of(c->fd))
+			      : ss_error_fail("cannot lock '%s': %s", c->lock_path, strerror(errno));
+			close(c->fd);
+			break;
+		}
+		if (still_at(c->fd, c->lock_path)) {
+			(void)write_holder(c->fd);
+			*out = c;
+			return SS_OK;
+		}
+		close(c->fd);
+		if (attempt == 100) {
+			err = ss_error_fail("cannot claim '%s': its lock file '%s' keeps being "
+			                    "replaced", path, c->lock_path);
+			break;
+		}
+	}
+	free(c->lock_path);
+	free(c);
+	return err;
+}
+
+void ss_output_release(struct ss_output_claim *c)
+{
+	if (!c)
+		return;
+	/* unlinked while still locked, so that no other run can take this file
+	 * as its lock and a waiting one sees it is gone (still_at) */
+	unlink(c->lock_path);
+	close(c->fd);
+	free(c->lock_path);
+	free(c);
 }
