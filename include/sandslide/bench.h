@@ -17,6 +17,8 @@
 #ifndef SANDSLIDE_BENCH_H
 #define SANDSLIDE_BENCH_H
 
+#include <stddef.h>
+
 #include "sandslide/closure.h"
 
 #define SS_BENCH_MAX_CASES 8
@@ -34,6 +36,30 @@ struct ss_bench_closure {
 	char label[32];          /* "herschel-bulkley(0.5)" */
 };
 
+/* What the benchmark measured before its cases: the set-up and the
+ * memory bandwidth per thread count. */
+struct ss_bench_header {
+	int nx, ny, tile_nx, tile_ny;      /* cells; tile size used */
+	int repeats;
+	const char *rsqrt;                 /* ss_face_rsqrt_method() */
+	size_t probe_doubles;              /* size of the bandwidth probe's array */
+	int thread_count;
+	const int *threads;                /* thread_count entries */
+	const double *bandwidth;           /* bytes/s, read+write, per entry */
+};
+
+/* One case: a surface, closure and thread count. */
+struct ss_bench_result {
+	enum ss_bench_surface surface;
+	const char *closure;               /* its label */
+	int threads;
+	double median, min, max;           /* cell-updates/s over the repeats */
+	long long steps;                   /* timed steps per repeat */
+	double active_fraction;            /* tiles swept / tiles */
+	double bytes_per_cell;             /* what the sweep's design moves */
+	double roofline;                   /* bandwidth / bytes_per_cell */
+};
+
 struct ss_bench_options {
 	int nx, ny;                                        /* cells */
 	struct ss_bench_closure closures[SS_BENCH_MAX_CASES];
@@ -44,14 +70,17 @@ struct ss_bench_options {
 	int repeats;                                       /* timings per case */
 	int steps;                                         /* per timing; 0: auto */
 	int tile_nx, tile_ny;                              /* < 1: defaults */
-	int json;                                          /* JSON instead of a table */
+	/* the figures, as they come (the caller prints them) */
+	void (*on_header)(void *context, const struct ss_bench_header *h);
+	void (*on_result)(void *context, const struct ss_bench_result *r);
+	void *context;
 };
 
 /* The surface names "supercritical", "subcritical", "patch". */
 const char *ss_bench_surface_name(enum ss_bench_surface s);
 
-/* Run the benchmark, print to stdout.  SS_ERR_INPUT for a bad option (a
- * grid too small for the patch, too little memory), SS_ERR_FAIL otherwise. */
+/* Run the benchmark.  SS_ERR_INPUT for a bad option (a grid too small for
+ * the patch, too little memory), SS_ERR_FAIL otherwise. */
 int ss_bench_run(const struct ss_bench_options *o);
 
 #endif

@@ -9,7 +9,11 @@
  * first.  The output is a raster in the input's format (its georeferencing
  * and nodata kept), or with an .h5 output the full series of snapshots and
  * diagnostics (snapshot.h).  The input is never modified; every output is
- * written under a temporary name and renamed when complete.
+ * written under a temporary name and renamed when complete, and claimed
+ * while the run lasts (no other run may write it meanwhile).  It shares the
+ * time loop of `run` (src/app/drive.h), with its guards: a stop signal ends
+ * the run with the surface as it was then in the output, and a height that
+ * becomes non-finite stops it with the last good state kept.
  */
 #ifndef SANDSLIDE_RELAX_H
 #define SANDSLIDE_RELAX_H
@@ -19,6 +23,7 @@
 #include "sandslide/boundary.h"
 #include "sandslide/closure.h"
 #include "sandslide/dem.h"
+#include "sandslide/progress.h"
 #include "sandslide/shape.h"
 
 struct ss_relax_options {
@@ -45,11 +50,12 @@ struct ss_relax_options {
 	                                     over max_time, else only first and
 	                                     last */
 	const char *report;               /* JSON diagnostics file, or NULL */
-	int quiet;                        /* no progress, no summary */
 	const char *history;              /* the command line */
 	int force;                        /* replace an existing output */
 	const volatile sig_atomic_t *stop_signal; /* non-zero: stop after the
 	                                     substep and write what there is */
+	ss_progress_fn *progress;         /* after every substep (NULL: none) */
+	void *progress_context;
 };
 
 void ss_relax_options_init(struct ss_relax_options *o);
@@ -67,10 +73,14 @@ struct ss_relax_report {
 	double time;                      /* simulated, s */
 	double wall_seconds;
 	int steady;                       /* reached max |dh/dt| < tol */
+	int interrupted;                  /* by *stop_signal: the output holds
+	                                     the surface as it was then */
 	char output[4096];
 };
 
-/* Returns SS_OK, SS_ERR_INPUT or SS_ERR_FAIL (message already printed). */
+/* Returns SS_OK, SS_ERR_INPUT or SS_ERR_FAIL (message already printed);
+ * *report is filled when SS_OK.  Prints nothing else: the caller shows the
+ * progress and the report. */
 int ss_relax_run(const struct ss_relax_options *o, struct ss_relax_report *report);
 
 #endif

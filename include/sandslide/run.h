@@ -3,13 +3,18 @@
  *
  * Everything that can be checked is checked before the output file is
  * touched: the case, the set-up (regions, initial file, memory) and the
- * output folder.  Then snapshot 0 is written at t = 0 and one every
- * output_every seconds (and at the end, or when the state is steady).
+ * output folder.  Then the run claims its output (no other run may write
+ * it meanwhile), writes snapshot 0 at t = 0 and one every output_every
+ * seconds (and at the end, or when the state is steady).  The library
+ * prints nothing but error messages: progress and the summary go to the
+ * caller.
  */
 #ifndef SANDSLIDE_RUN_H
 #define SANDSLIDE_RUN_H
 
 #include <signal.h>
+
+#include "sandslide/progress.h"
 
 /* What a run reports after each snapshot is written and flushed. */
 struct ss_run_snapshot {
@@ -33,7 +38,6 @@ struct ss_run_options {
 	int tile_nx, tile_ny;        /* <= 0: defaults */
 	int reference_kernel;        /* use the reference sweep (sweep.h) */
 	int deflate;                 /* HDF5 deflate level 0..9 */
-	int quiet;                   /* no progress, no summary */
 	const char *history;         /* the command line, for the file */
 	int force;                   /* replace an existing output (else refused) */
 	const char *restart;         /* continue the run in this output from its
@@ -41,13 +45,40 @@ struct ss_run_options {
 	const volatile sig_atomic_t *stop_signal; /* when it becomes non-zero, the
 	                              * run finishes its substep, writes a
 	                              * snapshot and returns SS_OK */
+	ss_progress_fn *progress;    /* after every substep (NULL: none) */
+	void *progress_context;
 	/* Called after every snapshot (NULL: none), e.g. to render it; a
 	 * non-zero return (a status, message printed) stops the run. */
 	int (*on_snapshot)(void *context, const struct ss_run_snapshot *s);
 	void *snapshot_context;
 };
 
-/* Returns SS_OK, SS_ERR_INPUT or SS_ERR_FAIL (message already printed). */
-int ss_run_case(const struct ss_run_options *o);
+/* How a run ended. */
+enum ss_run_end {
+	SS_RUN_DONE,            /* at `end` */
+	SS_RUN_STEADY,          /* end = steady, and it is */
+	SS_RUN_NOT_STEADY,      /* end = steady, stopped by max_time */
+	SS_RUN_INTERRUPTED,     /* by *stop_signal: the last snapshot is then */
+};
+
+/* What the command line says when a run is over. */
+struct ss_run_summary {
+	char output[4096];
+	enum ss_run_end end;
+	long long snapshots;         /* in the file */
+	double time;                 /* simulated time reached, s */
+	long long steps;             /* substeps since t = 0 */
+	long long steps_here;        /* substeps this process took */
+	double cells;                /* of the grid */
+	double wall_seconds;         /* the whole run */
+	double measure_seconds;      /* measuring the largest slope */
+	double sweep_seconds;        /* sweeping */
+	double output_seconds;       /* writing snapshots */
+	int threads;
+};
+
+/* Returns SS_OK, SS_ERR_INPUT or SS_ERR_FAIL (message already printed);
+ * *summary is filled when SS_OK. */
+int ss_run_case(const struct ss_run_options *o, struct ss_run_summary *summary);
 
 #endif

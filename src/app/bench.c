@@ -1,17 +1,18 @@
 /*
- * bench.c - `sandslide bench` (see bench.h).
+ * bench.c - `sandslide bench` (see bench.h): the figures go to the caller's
+ * callbacks as each case ends, so a long benchmark shows its rows as it
+ * goes.
  */
 #include "sandslide/bench.h"
 
 #include <math.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "sandslide/boundary.h"
 #include "sandslide/error.h"
 #include "sandslide/face.h"
 #include "sandslide/parallel.h"
-#include "sandslide/boundary.h"
 #include "sandslide/stepper.h"
 
 #define REPOSE_DEG 35.0
@@ -200,7 +201,8 @@ static double bytes_per_cell(int tile_ny, double plain_fraction)
 	return 16.0 + 32.0 / tile_ny + 0.25 * (1.0 - plain_fraction);
 }
 
-int ss_bench_run(const struct ss_bench_options *o)
+/* The grid and memory the options ask for, checked. */
+static int check_size(const struct ss_bench_options *o)
 {
 	if (o->nx < PATCH_CELLS + 2 || o->ny < PATCH_CELLS + 2)
 		if (o->surfaces[SS_BENCH_PATCH])
@@ -208,8 +210,7 @@ int ss_bench_run(const struct ss_bench_options *o)
 			                      "inside walls) needs at least %d x %d cells", o->nx,
 			                      o->ny, PATCH_CELLS, PATCH_CELLS, PATCH_CELLS + 2,
 			                      PATCH_CELLS + 2);
-	const size_t n = (size_t)o->nx * (size_t)o->ny;
-	const double need = (double)n * 2.0 * sizeof(double);
+	const double need = (double)o->nx * (double)o->ny * 2.0 * sizeof(double);
 	const double have = ss_memory_available_bytes();
 	if (have > 0.0 && need > have) {
 		char nb[32], hb[32];
@@ -217,84 +218,66 @@ int ss_bench_run(const struct ss_bench_options *o)
 		                      o->nx, o->ny, ss_format_bytes(need, nb),
 		                      ss_format_bytes(have, hb));
 	}
-	struct ss_tiling tiling;
-	struct ss_grid g;
-	if (ss_grid_init(&g, o->nx, o->ny, SPACING_M, SPACING_M, 0.0, 0.0))
-		return SS_ERR_INPUT;
-	ss_tiling_init(&tiling, &g, o->tile_nx, o->tile_ny);
+	return SS_OK;
+}
 
-	/* the probe first, on an array of the grid's size but at least 256 MiB,
-	 * far above the last-level cache */
-	double bandwidth[SS_BENCH_MAX_CASES];
-	const size_t probe_n = n > ((size_t)1 << 25) ? n : (size_t)1 << 25;
-	double *probe = ss_alloc(probe_n, sizeof(double), "bandwidth probe array");
+/* The bandwidth probe for each thread count, on an array of the grid's size
+ * but at least 256 MiB, far above the last-level cache. */
+static int probe_bandwidth(const struct ss_bench_options *o, size_t *probe_n,
+                           double bandwidth[SS_BENCH_MAX_CASES])
+{
+	const size_t n = (size_t)o->nx * (size_t)o->ny;
+	*probe_n = n > ((size_t)1 << 25) ? n : (size_t)1 << 25;
+	double *probe = ss_alloc(*probe_n, sizeof(double), "bandwidth probe array");
 	if (!probe)
 		return SS_ERR_FAIL;
 	for (int t = 0; t < o->thread_count; t++) {
 		ss_parallel_set_threads(o->threads[t]);
-		bandwidth[t] = bandwidth_probe(probe, probe_n);
+		bandwidth[t] = bandwidth_probe(probe, *probe_n);
 	}
 	ss_free(probe);
+	return SS_OK;
+}
 
-	if (o->json) {
-		printf("{\n  \"nx\": %d, \"ny\": %d, \"tile_nx\": %d, \"tile_ny\": %d,\n"
-		       "  \"repeats\": %d, \"rsqrt\": \"%s\",\n  \"bandwidth_bytes_per_s\": {",
-		       o->nx, o->ny, tiling.tile_nx, tiling.tile_ny, o->repeats,
-		       ss_face_rsqrt_method());
-		for (int t = 0; t < o->thread_count; t++)
-			printf("%s\"%d\": %.6g", t ? ", " : "", o->threads[t], bandwidth[t]);
-		printf("},\n  \"cases\": [");
-	} else {
-		printf("sandslide bench: %d x %d cells, tiles %dx%d, %d repeats per case, "
-		       "reciprocal sqrt: %s\n", o->nx, o->ny, tiling.tile_nx, tiling.tile_ny,
-		       o->repeats, ss_face_rsqrt_method());
-		printf("memory bandwidth (read+write one array of %zu doubles):", probe_n);
-		for (int t = 0; t < o->thread_count; t++)
-			printf(" %d thread%s %.1f GB/s%s", o->threads[t], o->threads[t] > 1 ? "s" : "",
-			       bandwidth[t] * 1e-9, t + 1 < o->thread_count ? "," : "\n");
-		printf("\n%-14s %-22s %7s  %-34s %6s %6s %6s %8s\n", "surface", "closure", "threads",
-		       "cell-updates/s median [min, max]", "steps", "active", "B/cell",
-		       "roofline");
-	}
-	fflush(stdout);
-
-	int first = 1;
+int ss_bench_run(const struct ss_bench_options *o)
+{
+	struct ss_tiling tiling;
+	struct ss_grid g;
+	double bandwidth[SS_BENCH_MAX_CASES];
+	size_t probe_n;
+	int err = check_size(o);
+	if (err)
+		return err;
+	if (ss_grid_init(&g, o->nx, o->ny, SPACING_M, SPACING_M, 0.0, 0.0))
+		return SS_ERR_INPUT;
+	ss_tiling_init(&tiling, &g, o->tile_nx, o->tile_ny);
+	if ((err = probe_bandwidth(o, &probe_n, bandwidth)))
+		return err;
+	const struct ss_bench_header h = {
+		.nx = o->nx, .ny = o->ny, .tile_nx = tiling.tile_nx, .tile_ny = tiling.tile_ny,
+		.repeats = o->repeats, .rsqrt = ss_face_rsqrt_method(), .probe_doubles = probe_n,
+		.thread_count = o->thread_count, .threads = o->threads, .bandwidth = bandwidth,
+	};
+	if (o->on_header)
+		o->on_header(o->context, &h);
 	for (int s = 0; s < SS_BENCH_SURFACES; s++) {
-		if (!o->surfaces[s])
-			continue;
-		for (int c = 0; c < o->closure_count; c++) {
+		for (int c = 0; c < o->closure_count && o->surfaces[s]; c++) {
 			for (int t = 0; t < o->thread_count; t++) {
 				struct case_result r;
 				ss_parallel_set_threads(o->threads[t]);
-				int err = run_case(o, (enum ss_bench_surface)s, &o->closures[c], &r);
-				if (err)
+				if ((err = run_case(o, (enum ss_bench_surface)s, &o->closures[c], &r)))
 					return err;
 				const double bytes = bytes_per_cell(tiling.tile_ny, r.plain_fraction);
-				const double roofline = bandwidth[t] / bytes;
-				if (o->json) {
-					printf("%s\n    {\"surface\": \"%s\", \"closure\": \"%s\", "
-					       "\"threads\": %d, \"cell_updates_per_s\": {\"median\": %.6g, "
-					       "\"min\": %.6g, \"max\": %.6g}, \"steps_per_repeat\": %lld, "
-					       "\"active_fraction\": %.6g, \"bytes_per_cell\": %.3g, "
-					       "\"roofline_cell_updates_per_s\": %.6g, "
-					       "\"roofline_fraction\": %.6g}", first ? "" : ",",
-					       surface_names[s], o->closures[c].label, o->threads[t],
-					       r.median, r.min, r.max, r.steps, r.active_fraction, bytes,
-					       roofline, r.median / roofline);
-				} else {
-					char range[64];
-					snprintf(range, sizeof range, "%.3g [%.3g, %.3g]", r.median, r.min,
-					         r.max);
-					printf("%-14s %-22s %7d  %-34s %6lld %6.3f %6.2f %8.3f\n",
-					       surface_names[s], o->closures[c].label, o->threads[t], range,
-					       r.steps, r.active_fraction, bytes, r.median / roofline);
-				}
-				fflush(stdout);
-				first = 0;
+				const struct ss_bench_result res = {
+					.surface = (enum ss_bench_surface)s, .closure = o->closures[c].label,
+					.threads = o->threads[t], .median = r.median, .min = r.min,
+					.max = r.max, .steps = r.steps, .active_fraction = r.active_fraction,
+					.bytes_per_cell = bytes, .roofline = bandwidth[t] / bytes,
+				};
+				if (o->on_result)
+					o->on_result(o->context, &res);
 			}
 		}
 	}
-	if (o->json)
-		printf("\n  ]\n}\n");
 	return SS_OK;
 }

@@ -1,6 +1,7 @@
 /*
- * relax.c - the `sandslide relax` driver: DEM -> stepper -> steady surface
- * (see relax.h).
+ * relax.c - `sandslide relax` (see relax.h): DEM -> stepper -> the shared
+ * time loop (drive.h) -> the steady surface, in the input's format or as a
+ * series.
  */
 #include "sandslide/relax.h"
 
@@ -9,11 +10,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
-#include "sandslide/error.h"
+#include "app/drive.h"
 #include "io/output.h"
+#include "sandslide/error.h"
 #include "sandslide/parallel.h"
 #include "sandslide/snapshot.h"
 #include "sandslide/stepper.h"
@@ -47,15 +47,6 @@ static void default_output(const char *dem, char *out, size_t size)
 			dot = p;
 	const int stem = dot && dot != base ? (int)(dot - base) : len;
 	snprintf(out, size, "out/%.*s-relaxed%.*s", stem, base, len - stem, base + stem);
-}
-
-/* An existing output is replaced only with force. */
-static int check_not_existing(const char *path, int force)
-{
-	struct stat sb;
-	if (!force && stat(path, &sb) == 0)
-		return ss_error_input("'%s' exists: give --force to replace it", path);
-	return SS_OK;
 }
 
 /*
@@ -195,18 +186,6 @@ static double flow_volume(struct ss_stepper *st)
 	return d.volume;
 }
 
-static void progress_print(void *context, const struct ss_stepper *st)
-{
-	double *last = context;
-	const double now = ss_parallel_wall_seconds();
-	if (now - *last < 0.5)
-		return;
-	*last = now;
-	fprintf(stderr, "\r  t = %.6g s  steps %lld  max|dh/dt| %.2e m/s   ", st->time,
-	        st->steps, st->rate_max);
-	fflush(stderr);
-}
-
 static int write_report(const char *path, const struct ss_relax_options *o,
                         const struct ss_relax_report *r)
 {
@@ -248,163 +227,174 @@ static void heights_to_raster(const struct ss_stepper *st, struct ss_raster *r)
 				r->values[(size_t)j * g->nx + i] = st->height[ss_grid_index(g, i, j)];
 }
 
-static int write_series_snapshot(struct ss_snapshot *snap, struct ss_stepper *st,
-                                 double started)
+/* Everything one relaxation holds, released by ss_relax_run. */
+struct relax {
+	const struct ss_relax_options *o;
+	struct ss_raster dem, bedrock;
+	enum ss_dem_format format;        /* of the output */
+	struct ss_stepper st;
+	struct ss_drive drive;
+	double *h0;                       /* the initial heights, halo layout */
+};
+
+/* The driver's rebuild: the DEM's stepper at t = 0. */
+static int rebuild(void *context, struct ss_stepper *st)
 {
-	struct ss_diagnostics d;
-	ss_stepper_diagnostics(st, &d);
-	d.wall_seconds = ss_parallel_wall_seconds() - started;
-	return ss_snapshot_append(snap, st->time, st->height, &d, NULL);
+	const struct relax *x = context;
+	return build_stepper(x->o, &x->dem, x->o->bedrock ? &x->bedrock : NULL, st);
+}
+
+/* The inputs and the output's name and format, all checked. */
+static int read_inputs(struct relax *x, struct ss_relax_report *rep)
+{
+	const struct ss_relax_options *o = x->o;
+	if (o->output)
+		snprintf(rep->output, sizeof rep->output, "%s", o->output);
+	else
+		default_output(o->dem, rep->output, sizeof rep->output);
+	int err = ss_dem_read(o->dem, NULL, &o->read, &x->dem);
+	if (!err)
+		err = ss_dem_format_from_path(rep->output, "-o", &x->format);
+	if (!err && x->format == SS_DEM_GDAL && !ss_dem_gdal_available())
+		err = ss_error_input("-o %s: GeoTIFF output needs a build with GDAL (libgdal-dev); "
+		                     "write .asc, .png or .h5", rep->output);
+	if (!err)
+		err = ss_output_check_folder(rep->output, o->output == NULL);
+	if (err || !o->bedrock)
+		return err;
+	struct ss_dem_read_options bo = o->read;
+	if ((err = ss_dem_read(o->bedrock, "--bedrock", &bo, &x->bedrock)))
+		return err;
+	if (x->bedrock.nx != x->dem.nx || x->bedrock.ny != x->dem.ny)
+		return ss_error_input("--bedrock %s is %d x %d cells: expected the DEM's %d x %d",
+		                      o->bedrock, x->bedrock.nx, x->bedrock.ny, x->dem.nx, x->dem.ny);
+	return SS_OK;
+}
+
+/* The initial state's measures, and a copy of it to count what moved. */
+static int measure_before(struct relax *x, struct ss_relax_report *rep)
+{
+	const struct ss_grid *g = &x->st.grid;
+	const size_t cells = ss_grid_storage_cells(g);
+	if (!(x->h0 = ss_alloc(cells, sizeof *x->h0, "initial heights")))
+		return SS_ERR_FAIL;
+	memcpy(x->h0, x->st.height, cells * sizeof *x->h0);
+	rep->nx = g->nx;
+	rep->ny = g->ny;
+	rep->dx = g->dx;
+	rep->dy = g->dy;
+	rep->volume_before = flow_volume(&x->st);
+	rep->max_slope_before_deg = steepest_sand_face_deg(&x->st);
+	return SS_OK;
+}
+
+/* The loop's settings, the claim of the output and, for .h5, the series. */
+static int open_output(struct relax *x, const struct ss_relax_report *rep)
+{
+	const struct ss_relax_options *o = x->o;
+	struct ss_drive *d = &x->drive;
+	const int series = x->format == SS_DEM_H5;
+	d->end = o->max_time;
+	d->steady_tol = o->tol;
+	d->output_every = !isnan(o->output_every) ? o->output_every
+	                : series && isfinite(o->max_time) ? o->max_time / 20.0 : INFINITY;
+	d->stop_signal = o->stop_signal;
+	d->progress = o->progress;
+	d->progress_context = o->progress_context;
+	d->rebuild = rebuild;
+	d->rebuild_context = x;
+	int err = ss_drive_claim(d, rep->output, o->output == NULL, o->force, 0, NULL);
+	if (err || !series)
+		return err;
+	const struct ss_snapshot_meta meta = {
+		.title = o->dem, .history = o->history ? o->history : "",
+		.case_text = "", .closure = ss_closure_name(o->closure),
+		.repose_angle_deg = o->angle_deg, .nu = o->nu, .gamma = o->gamma,
+		.bedrock = x->st.bedrock,
+	};
+	return ss_drive_create(d, &meta);
+}
+
+/* The end state's measures; cells moved and half the volume moved. */
+static void measure_after(struct relax *x, enum ss_drive_end end, struct ss_relax_report *rep)
+{
+	struct ss_stepper *st = &x->st;
+	const struct ss_grid *g = &st->grid;
+	rep->steady = end == SS_DRIVE_STEADY;
+	rep->interrupted = end == SS_DRIVE_INTERRUPTED;
+	rep->steps = st->steps;
+	rep->time = st->time;
+	rep->inflow = st->inflow;
+	rep->outflow = st->outflow;
+	rep->volume_after = flow_volume(st);
+	rep->max_slope_after_deg = steepest_sand_face_deg(st);
+	double moved = 0.0;
+	for (int j = 0; j < g->ny; j++) {
+		for (int i = 0; i < g->nx; i++) {
+			const ptrdiff_t k = ss_grid_index(g, i, j);
+			if (ss_cell_type_get(st->cell_types, k) != SS_CELL_FLOW ||
+			    st->height[k] == x->h0[k])
+				continue;
+			rep->cells_moved++;
+			moved += fabs(st->height[k] - x->h0[k]);
+		}
+	}
+	rep->volume_moved = 0.5 * moved * g->dx * g->dy;
+}
+
+/* The relaxed surface as a raster in the input's format (a series is
+ * written as it goes). */
+static int write_raster(struct relax *x, const char *path)
+{
+	if (x->format == SS_DEM_H5)
+		return SS_OK;
+	heights_to_raster(&x->st, &x->dem);
+	return ss_dem_write(path, x->format, &x->dem);
+}
+
+/* The guard fired: the last good state goes to a raster output too. */
+static int nonfinite(struct relax *x, const char *path)
+{
+	const int kept = x->drive.trouble.good_step >= 0;
+	int err = kept ? write_raster(x, path) : SS_OK;
+	if (err)
+		return err;
+	return ss_drive_nonfinite_error(&x->drive, kept && x->format != SS_DEM_H5 ? path : NULL);
 }
 
 int ss_relax_run(const struct ss_relax_options *o, struct ss_relax_report *rep)
 {
 	const double started = ss_parallel_wall_seconds();
-	struct ss_raster dem, bedrock;
-	struct ss_stepper st;
-	struct ss_snapshot *snap = NULL;
-	double *h0 = NULL;
-	int err;
-
+	struct relax x;
+	memset(&x, 0, sizeof x);
 	memset(rep, 0, sizeof *rep);
-	memset(&st, 0, sizeof st);
-	memset(&bedrock, 0, sizeof bedrock);
+	x.o = o;
+	ss_drive_init(&x.drive, &x.st, started);
 	ss_parallel_set_threads(o->threads > 0 ? o->threads : ss_parallel_processors());
-	if (o->output)
-		snprintf(rep->output, sizeof rep->output, "%s", o->output);
-	else
-		default_output(o->dem, rep->output, sizeof rep->output);
-	enum ss_dem_format out_format;
-	if ((err = ss_dem_read(o->dem, NULL, &o->read, &dem)))
-		goto out;
-	if ((err = ss_dem_format_from_path(rep->output, "-o", &out_format)))
-		goto out;
-	if (out_format == SS_DEM_GDAL && !ss_dem_gdal_available()) {
-		err = ss_error_input("-o %s: GeoTIFF output needs a build with GDAL (libgdal-dev); "
-		                     "write .asc, .png or .h5", rep->output);
-		goto out;
-	}
-	if ((err = ss_output_check_folder(rep->output, o->output == NULL)) ||
-	    (err = check_not_existing(rep->output, o->force)))
-		goto out;
-	if (o->bedrock) {
-		struct ss_dem_read_options bo = o->read;
-		if ((err = ss_dem_read(o->bedrock, "--bedrock", &bo, &bedrock)))
-			goto out;
-		if (bedrock.nx != dem.nx || bedrock.ny != dem.ny) {
-			err = ss_error_input("--bedrock %s is %d x %d cells: expected the DEM's %d x %d",
-			                     o->bedrock, bedrock.nx, bedrock.ny, dem.nx, dem.ny);
-			goto out;
-		}
-	}
-	if ((err = build_stepper(o, &dem, o->bedrock ? &bedrock : NULL, &st)))
-		goto out;
 
-	const struct ss_grid *g = &st.grid;
-	rep->nx = g->nx;
-	rep->ny = g->ny;
-	rep->dx = g->dx;
-	rep->dy = g->dy;
-	const size_t cells = ss_grid_storage_cells(g);
-	if (!(h0 = ss_alloc(cells, sizeof *h0, "initial heights"))) {
-		err = SS_ERR_FAIL;
-		goto out;
-	}
-	memcpy(h0, st.height, cells * sizeof *h0);
-	rep->volume_before = flow_volume(&st);
-	rep->max_slope_before_deg = steepest_sand_face_deg(&st);
-
-	if (!o->output && (err = ss_output_make_folder(rep->output)))
-		goto out;
-	const int series = out_format == SS_DEM_H5;
-	double every = o->output_every;
-	if (series && isnan(every))
-		every = isfinite(o->max_time) ? o->max_time / 20.0 : INFINITY;
-	if (series) {
-		struct ss_snapshot_meta meta = {
-			.title = o->dem, .history = o->history ? o->history : "",
-			.case_text = "", .closure = ss_closure_name(o->closure),
-			.repose_angle_deg = o->angle_deg, .nu = o->nu, .gamma = o->gamma,
-			.bedrock = st.bedrock,
-		};
-		if ((err = ss_snapshot_create(&snap, rep->output, g, st.cell_types, &meta)) ||
-		    (err = write_series_snapshot(snap, &st, started)))
-			goto out;
-	}
-
-	double last_print = started;
-	const int show = !o->quiet && isatty(fileno(stderr));
-	struct ss_advance_options adv = {
-		.steady_tol = o->tol,
-		.progress = show ? progress_print : NULL,
-		.context = &last_print,
-		.stop = o->stop_signal,
-	};
-	enum ss_advance_end end = SS_ADVANCE_REACHED;
-	for (long long k = 1; st.time < o->max_time; k++) {
-		const double target = fmin((double)k * every, o->max_time);
-		end = ss_stepper_advance(&st, target, &adv);
-		if (end == SS_ADVANCE_NONFINITE || end == SS_ADVANCE_STALLED) {
-			err = ss_error_fail("the surface became %s at t = %g s (step %lld)",
-			                    end == SS_ADVANCE_NONFINITE ? "non-finite"
-			                    : "too steep for the time step", st.time, st.steps);
-			goto out;
-		}
-		if (snap && (err = write_series_snapshot(snap, &st, started)))
-			goto out;
-		if (end == SS_ADVANCE_STEADY || end == SS_ADVANCE_INTERRUPTED || isinf(target))
-			break;
-	}
-	if (show)
-		fputc('\n', stderr);
-	if (end == SS_ADVANCE_INTERRUPTED) {
-		fflush(stdout);
-		fprintf(stderr, "sandslide: interrupted at t = %g s (step %lld): '%s' holds the "
-		        "surface as it was then, not relaxed\n", st.time, st.steps, rep->output);
-	}
-	rep->steady = end == SS_ADVANCE_STEADY;
-	rep->steps = st.steps;
-	rep->time = st.time;
-	rep->inflow = st.inflow;
-	rep->outflow = st.outflow;
-	rep->volume_after = flow_volume(&st);
-	rep->max_slope_after_deg = steepest_sand_face_deg(&st);
-	double moved = 0.0;
-	for (int j = 0; j < g->ny; j++) {
-		for (int i = 0; i < g->nx; i++) {
-			const ptrdiff_t k = ss_grid_index(g, i, j);
-			if (ss_cell_type_get(st.cell_types, k) != SS_CELL_FLOW ||
-			    st.height[k] == h0[k])
-				continue;
-			rep->cells_moved++;
-			moved += fabs(st.height[k] - h0[k]);
-		}
-	}
-	rep->volume_moved = 0.5 * moved * g->dx * g->dy;
-
-	if (!series) {
-		heights_to_raster(&st, &dem);
-		if ((err = ss_dem_write(rep->output, out_format, &dem)))
-			goto out;
+	enum ss_drive_end end = SS_DRIVE_END;
+	int err = read_inputs(&x, rep);
+	if (!err)
+		err = rebuild(&x, &x.st);
+	if (!err)
+		err = measure_before(&x, rep);
+	if (!err)
+		err = open_output(&x, rep);
+	if (!err)
+		err = ss_drive_run(&x.drive, &end);
+	if (!err && end == SS_DRIVE_NONFINITE)
+		err = nonfinite(&x, rep->output);
+	if (!err) {
+		measure_after(&x, end, rep);
+		err = write_raster(&x, rep->output);
 	}
 	rep->wall_seconds = ss_parallel_wall_seconds() - started;
-	if (o->report && (err = write_report(o->report, o, rep)))
-		goto out;
-	if (!o->quiet) {
-		printf("wrote %s: %d x %d cells, %s after %lld steps (t = %g s)\n", rep->output,
-		       rep->nx, rep->ny, rep->steady ? "steady" : "NOT steady by --max-time",
-		       rep->steps, rep->time);
-		printf("cells moved %lld, volume moved %.6g m^3, steepest sand face %.4f -> "
-		       "%.4f deg (repose %g), wall %.3f s\n", rep->cells_moved, rep->volume_moved,
-		       rep->max_slope_before_deg, rep->max_slope_after_deg, o->angle_deg,
-		       rep->wall_seconds);
-	}
-out:
-	if (ss_snapshot_destroy(snap) && !err)
-		err = SS_ERR_FAIL;
-	ss_free(h0);
-	ss_stepper_release(&st);
-	ss_raster_release(&bedrock);
-	ss_raster_release(&dem);
+	if (!err && o->report)
+		err = write_report(o->report, o, rep);
+	err = ss_drive_finish(&x.drive, err);
+	ss_free(x.h0);
+	ss_stepper_release(&x.st);
+	ss_raster_release(&x.bedrock);
+	ss_raster_release(&x.dem);
 	return err;
 }

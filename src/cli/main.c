@@ -1,17 +1,22 @@
 /*
  * main.c - the `sandslide` command line (SPEC section 3): parse the
- * arguments, dispatch to the library, turn its status into the exit code
- * (0 success, 1 failure while running, 2 bad usage or bad input).
+ * arguments (each command's options are one table, options.h, which also
+ * gives its --help), dispatch to the library, print what it returns
+ * (print.h) and turn its status into the exit code (0 success, 1 failure
+ * while running, 2 bad usage or bad input).
  */
 #include <errno.h>
-#include <limits.h>
 #include <math.h>
 #include <signal.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
+#include "base/strings.h"
+#include "cli/options.h"
+#include "cli/print.h"
 #include "sandslide/bench.h"
 #include "sandslide/dem.h"
 #include "sandslide/error.h"
@@ -20,6 +25,8 @@
 #include "sandslide/render.h"
 #include "sandslide/run.h"
 #include "sandslide/snapshot.h"
+
+#define COUNT(a) ((int)(sizeof(a) / sizeof((a)[0])))
 
 static const char usage_main[] =
 	"usage: sandslide <command> [options]\n"
@@ -36,147 +43,6 @@ static const char usage_main[] =
 	"\n"
 	"  sandslide --version    print the version\n"
 	"  sandslide CMD --help   options of a command\n";
-
-static const char usage_run[] =
-	"usage: sandslide run CASE.ini [-o OUT.h5] [--threads N] [--set SECTION.KEY=VALUE ...]\n"
-	"       sandslide run --restart OUT.h5 [CASE.ini] [--threads N]\n"
-	"\n"
-	"  -o, --output OUT.h5   output file (default out/<case name>.h5; its folder\n"
-	"                        must exist unless it is the default out/)\n"
-	"  --force               replace OUT.h5 if it exists (else refused)\n"
-	"  --restart OUT.h5      continue the run in OUT.h5 from its last snapshot,\n"
-	"                        appending to it, with the case stored in it (a\n"
-	"                        CASE.ini given too must be that case, and its\n"
-	"                        files are found beside it); the snapshots are\n"
-	"                        those of a run never interrupted\n"
-	"  --threads N           OpenMP threads (default: all processors)\n"
-	"  --set S.K=VALUE       override key K of section S of the case, e.g.\n"
-	"                        --set model.closure=casson, --set 'source pour.rate=0.002'\n"
-	"  --tile NXxNY          cells per tile of the sweep (default 256x128, smaller\n"
-	"                        on small grids); results\n"
-	"                        are the same bits for any tile size and thread count\n"
-	"  --reference-kernel    use the plain two-pass sweep the fast one is tested\n"
-	"                        against (same bits, several times slower)\n"
-	"  --deflate N           HDF5 deflate level of /height, 0 (off, default) to 9\n"
-	"  -q, --quiet           no progress line and no summary\n"
-	"  --frames DIR          also draw each snapshot as it is written, to\n"
-	"                        DIR/frame_00000.png, ... (shaded; the look options\n"
-	"                        of `sandslide render --help` apply, e.g. --label)\n"
-	"\n"
-	"Writes OUT.h5 (SPEC section 5) and the XDMF sidecar OUT.xmf, flushed after\n"
-	"every snapshot.  Ctrl-C (SIGINT) or SIGTERM finish the substep, write a\n"
-	"snapshot and exit 130 or 143 naming the command that continues the run.\n"
-	"Exit status: 0 done, 1 failure while running, 2 bad input.\n";
-
-static const char usage_relax[] =
-	"usage: sandslide relax DEM [-o OUT] [--angle DEG] [--closure NAME] [--nu V]\n"
-	"                       [--tol X] [--max-time T] [--threads N] [...]\n"
-	"\n"
-	"Relaxes a digital elevation model to the repose angle: every slope steeper\n"
-	"than it slides until the surface is steady, the volume conserved.\n"
-	"\n"
-	"  DEM                   .asc (ESRI ASCII grid), .png (16-bit greyscale),\n"
-	"                        FILE.h5[:/dataset] (sandslide HDF5, last snapshot),\n"
-	"                        .tif and other GDAL rasters (builds with GDAL)\n"
-	"  -o, --output OUT      .asc, .png, .tif: the relaxed raster; .h5: the whole\n"
-	"                        series with diagnostics (default out/<DEM>-relaxed\n"
-	"                        with the input's extension)\n"
-	"  --angle DEG           repose angle (default 35)\n"
-	"  --closure NAME        " SS_CLOSURE_NAMES " (default coulomb)\n"
-	"  --gamma G             herschel-bulkley exponent (default 1)\n"
-	"  --nu V                m^2/s (default 1): sets the time scale only\n"
-	"  --tol X               steady when max |dh/dt| < X m/s (default 1e-9)\n"
-	"  --max-time T          stop at T s even if not steady (default: none)\n"
-	"  --threads N           OpenMP threads (default: all processors)\n"
-	"  --sides wall|open     the four sides of the DEM (default wall)\n"
-	"  --nodata wall|open    cells without data (default open: sand leaves there)\n"
-	"  --open-level M        height held on open cells and sides (default: the\n"
-	"                        lowest height of the DEM)\n"
-	"  --bedrock FILE        non-erodible base, a raster of the DEM's size: only\n"
-	"                        the sand above it moves\n"
-	"  --add-sand SHAPE      pour sand on rect=X0,Y0,X1,Y1 or disk=X,Y,R (m)\n"
-	"  --sand-rate R         at R m/s (needed with --add-sand)\n"
-	"  --sand-duration S     for S seconds from t = 0 (needed with --add-sand)\n"
-	"  --dx M                cell size, for files that do not give one\n"
-	"  --zscale Z            PNG: m per grey level (default: the file's range)\n"
-	"  --zoffset Z0          PNG: height of grey 0, m (default 0)\n"
-	"  --output-every T      .h5 output: a snapshot every T s\n"
-	"  --report FILE.json    write the diagnostics for scripts\n"
-	"  --force               replace OUT if it exists (else refused)\n"
-	"  -q, --quiet           no progress line and no summary\n"
-	"\n"
-	"Prints cells and volume moved, steepest face before and after, steps and\n"
-	"wall time.  The input is never modified; the output is written under a\n"
-	"temporary name and renamed when complete.  Exit status: 0 done, 1\n"
-	"failure while running, 2 bad input.\n";
-
-static const char usage_info[] =
-	"usage: sandslide info FILE.h5\n"
-	"\n"
-	"Prints the grid, model, cell counts and the diagnostics of every snapshot\n"
-	"(first and last ten when there are more than twenty).\n";
-
-static const char usage_render[] =
-	"usage: sandslide render FILE.h5 [-o DIR] [--frames A:B:STEP | --time T] [options]\n"
-	"       sandslide render --bench [N]\n"
-	"\n"
-	"Draws the snapshots of a sandslide output file as PNG pictures,\n"
-	"DIR/frame_00000.png, frame_00001.png, ... in time order (SPEC section 6).\n"
-	"\n"
-	"  -o, --output DIR      folder of the frames (default frames/, created if\n"
-	"                        missing)\n"
-	"  --frames A:B:STEP     snapshots A, A+STEP, ... before B, as a Python slice\n"
-	"                        (negative counts from the end; parts may be left out)\n"
-	"  --time T              only the snapshot nearest T seconds\n"
-	"  --video FILE.mp4      assemble the frames with ffmpeg (H.264, yuv420p) if it\n"
-	"                        is on PATH; without it the frames are kept\n"
-	"  --fps N               frames per second of the video (default 24)\n"
-	"  --threads N           OpenMP threads (default: all processors)\n"
-	"  -q, --quiet           no summary\n"
-	"  --bench [N]           time the shaded style on an N x N grid (default 4096)\n"
-	"\n"
-	"The look of the frames (also for `sandslide run --frames`):\n"
-	"  --style NAME          shaded (default): colour map x hillshade, 8-bit RGB;\n"
-	"                        gray16: 16-bit grey heights, zmin..zmax in the PNG text;\n"
-	"                        oblique: perspective view, walls as raised blocks\n"
-	"  --cmap NAME           dune (default; perceptually uniform), terrain, gray\n"
-	"  --zmin Z, --zmax Z    height scale, m (default: the lowest and highest sand\n"
-	"                        of the whole file, so all frames share it)\n"
-	"  --azimuth DEG         light from this compass bearing (default 315: north-west)\n"
-	"  --altitude DEG        light above the horizon (default 45)\n"
-	"  --zscale S            vertical exaggeration of shading and view (default 1)\n"
-	"  --contour DZ          contour lines every DZ m (shaded)\n"
-	"  --label               draw the simulated time on each frame\n"
-	"  --colorbar            add a colour bar with the height scale\n"
-	"  --max-size PX         at most PX pixels a side (cells are area-averaged)\n"
-	"  --scale K             K pixels per cell (default 1 for gray16, otherwise\n"
-	"                        enough for a side of 512 px)\n"
-	"  --view-azimuth DEG    oblique: the camera's bearing from the centre (200)\n"
-	"  --view-elevation DEG  oblique: the camera above the horizon (45)\n"
-	"  --compression N       zlib level of the PNGs, 0 to 9 (default 6)\n"
-	"\n"
-	"Each PNG holds the time, the height scale and the snapshot in text chunks;\n"
-	"a frame is written under a temporary name and renamed when complete.\n"
-	"Exit status: 0 done, 1 failure while rendering, 2 bad input.\n";
-
-static const char usage_bench[] =
-	"usage: sandslide bench [--nx N] [--ny N] [--closure NAME|all] [--threads 1,2]\n"
-	"                       [--surface NAME|all] [--repeats N] [--steps N] [--tile NXxNY]\n"
-	"                       [--json]\n"
-	"\n"
-	"  --nx N, --ny N        grid size (default 8192 x 8192)\n"
-	"  --closure NAME|all    coulomb, bingham, herschel-bulkley (gamma 0.5 and 2),\n"
-	"                        casson, or all (default)\n"
-	"  --threads LIST        thread counts, comma-separated (default 1,2)\n"
-	"  --surface NAME|all    supercritical (every face slides), subcritical (none\n"
-	"                        does), patch (a 512 x 512 ramp on a flat floor), all\n"
-	"  --repeats N           timings per case (default 5); median, min and max\n"
-	"  --steps N             steps per timing (default: about 0.3 s worth)\n"
-	"  --tile NXxNY          tile size of the sweep (default 256x128)\n"
-	"  --json                one JSON document instead of a table\n"
-	"\n"
-	"Also measures the memory bandwidth (read+write of one array) in the same run\n"
-	"and reports the fraction of that roofline each case reaches.\n";
 
 /* The signal that asked a run to stop (SIGINT or SIGTERM), 0 while none
  * did: the run finishes its substep, writes a snapshot and returns, and the
@@ -203,294 +69,95 @@ static void install_signal_handlers(void)
 	signal(SIGXFSZ, SIG_IGN);
 }
 
-static int usage_error(const char *usage, const char *fmt, const char *arg)
+/* The exit status of a command that a signal may have stopped. */
+static int exit_status(int status)
 {
-	fflush(stdout);
-	fputs("sandslide: ", stderr);
-	fprintf(stderr, fmt, arg);
-	fprintf(stderr, "\n\n%s", usage);
-	return 2;
+	const int code = ss_status_exit_code(status);
+	return code == 0 && stop_signal ? 128 + stop_signal : code;
 }
 
-static int parse_int(const char *s, int lo, int hi, int *out)
+static struct cli_option threads_option(int *threads)
 {
-	char *end;
-	errno = 0;
-	long v = strtol(s, &end, 10);
-	if (end == s || *end || errno || v < lo || v > hi)
-		return -1;
-	*out = (int)v;
-	return 0;
-}
-
-static int parse_double(const char *s, double *out)
-{
-	char *end;
-	errno = 0;
-	double v = s ? strtod(s, &end) : NAN;
-	if (!s || end == s || *end || errno || !isfinite(v))
-		return -1;
-	*out = v;
-	return 0;
-}
-
-/*
- * One option of the look of frames (`render`, and `run --frames`) at
- * argv[*k]: 1 if it was one (*k then points at its last word), 0 if not,
- * 2 after a usage error.  Ranges are checked by ss_render_options_check.
- */
-static int parse_look_option(int argc, char **argv, int *k, struct ss_render_options *o,
-                             const char *usage)
-{
-	const char *a = argv[*k], *next = *k + 1 < argc ? argv[*k + 1] : NULL;
-	struct {
-		const char *name;
-		double *value;
-	} const numbers[] = {
-		{"--zmin", &o->zmin}, {"--zmax", &o->zmax}, {"--azimuth", &o->azimuth_deg},
-		{"--altitude", &o->altitude_deg}, {"--zscale", &o->zscale},
-		{"--contour", &o->contour}, {"--view-azimuth", &o->view_azimuth_deg},
-		{"--view-elevation", &o->view_elevation_deg},
+	return (struct cli_option){
+		.name = "--threads", .value = "N", .kind = CLI_INT, .target = threads,
+		.lo = 1, .hi = 4096, .expected = "an integer from 1 to 4096",
+		.help = "OpenMP threads (default: all processors)",
 	};
-	for (size_t n = 0; n < sizeof numbers / sizeof numbers[0]; n++) {
-		if (strcmp(a, numbers[n].name))
-			continue;
-		if (parse_double(next, numbers[n].value))
-			return usage_error(usage, "%s needs a finite number", a);
-		++*k;
-		return 1;
-	}
-	if (!strcmp(a, "--label")) {
-		o->label = 1;
-	} else if (!strcmp(a, "--colorbar")) {
-		o->colorbar = 1;
-	} else if (!strcmp(a, "--style")) {
-		if (!next || ss_render_style_parse(next, &o->style))
-			return usage_error(usage, "--style '%s': expected " SS_RENDER_STYLE_NAMES,
-			                   next ? next : "");
-		++*k;
-	} else if (!strcmp(a, "--cmap")) {
-		if (!next || ss_render_cmap_parse(next, &o->cmap))
-			return usage_error(usage, "--cmap '%s': expected " SS_RENDER_CMAP_NAMES,
-			                   next ? next : "");
-		++*k;
-	} else if (!strcmp(a, "--max-size")) {
-		if (!next || parse_int(next, 8, 65536, &o->max_size))
-			return usage_error(usage, "--max-size '%s': expected 8 to 65536 px",
-			                   next ? next : "");
-		++*k;
-	} else if (!strcmp(a, "--scale")) {
-		if (!next || parse_int(next, 1, 100, &o->scale))
-			return usage_error(usage, "--scale '%s': expected 1 to 100 px per cell",
-			                   next ? next : "");
-		++*k;
-	} else if (!strcmp(a, "--compression")) {
-		if (!next || parse_int(next, 0, 9, &o->compression))
-			return usage_error(usage, "--compression '%s': expected 0 to 9",
-			                   next ? next : "");
-		++*k;
-	} else {
-		return 0;
-	}
-	return 1;
 }
 
-/* The command line as one string, for the history attribute. */
-static char *join_args(int argc, char **argv)
+/* ---- the look of frames: `render` and `run --frames` ------------------- */
+
+static int parse_style(const char *word, void *target)
 {
-	size_t n = 1;
-	for (int k = 0; k < argc; k++)
-		n += strlen(argv[k]) + 1;
-	char *s = malloc(n);
-	if (!s)
-		return NULL;
-	s[0] = '\0';
-	for (int k = 0; k < argc; k++) {
-		if (k)
-			strcat(s, " ");
-		strcat(s, argv[k]);
-	}
-	return s;
+	return ss_render_style_parse(word, target);
 }
 
-/* "NXxNY" into two positive ints; -1 if malformed. */
-static int parse_tile(const char *s, int *tx, int *ty)
+static int parse_cmap(const char *word, void *target)
 {
-	const char *x = s ? strchr(s, 'x') : NULL;
-	char buf[32];
-	if (!x || x - s >= (ptrdiff_t)sizeof buf)
-		return -1;
-	snprintf(buf, sizeof buf, "%.*s", (int)(x - s), s);
-	return parse_int(buf, 1, 1 << 20, tx) || parse_int(x + 1, 1, 1 << 20, ty) ? -1 : 0;
+	return ss_render_cmap_parse(word, target);
 }
 
-static int add_bench_closure(struct ss_bench_options *o, enum ss_closure_kind kind,
-                             double gamma)
+enum { LOOK_OPTIONS = 16 };
+
+/* Any finite number: ss_render_options_check says what a look accepts. */
+#define NUMBER(n, v, t, h)                                                          \
+	{.name = n, .value = v, .kind = CLI_REAL, .target = t, .lo = -INFINITY,     \
+	 .hi = INFINITY, .expected = "a finite number", .help = h}
+
+/* The look options into out (LOOK_OPTIONS entries); each sets *given. */
+static void look_options(struct cli_option *out, struct ss_render_options *o, int *given,
+                         int hidden)
 {
-	struct ss_bench_closure *c = &o->closures[o->closure_count++];
-	c->kind = kind;
-	c->gamma = gamma;
-	if (kind == SS_CLOSURE_HERSCHEL_BULKLEY)
-		snprintf(c->label, sizeof c->label, "herschel-bulkley(%g)", gamma);
-	else
-		snprintf(c->label, sizeof c->label, "%s", ss_closure_name(kind));
-	return 0;
+	const struct cli_option table[LOOK_OPTIONS] = {
+		{.help = "The look of the frames (also for `sandslide run --frames`):\n"},
+		{.name = "--style", .value = "NAME", .kind = CLI_PARSE, .target = &o->style,
+		 .parse = parse_style, .expected = SS_RENDER_STYLE_NAMES,
+		 .help = "shaded (default): colour map x hillshade, 8-bit RGB;\n"
+		         "gray16: 16-bit grey heights, zmin..zmax in the PNG text;\n"
+		         "oblique: perspective view, walls as raised blocks"},
+		{.name = "--cmap", .value = "NAME", .kind = CLI_PARSE, .target = &o->cmap,
+		 .parse = parse_cmap, .expected = SS_RENDER_CMAP_NAMES,
+		 .help = "dune (default; perceptually uniform), terrain, gray"},
+		NUMBER("--zmin", "Z", &o->zmin,
+		       "bottom of the height scale, m (default: the lowest\n"
+		       "sand of the whole file, so all frames share it)"),
+		NUMBER("--zmax", "Z", &o->zmax,
+		       "top of the height scale, m (default: the highest sand)"),
+		NUMBER("--azimuth", "DEG", &o->azimuth_deg,
+		       "light from this compass bearing (default 315: north-west)"),
+		NUMBER("--altitude", "DEG", &o->altitude_deg,
+		       "light above the horizon (default 45)"),
+		NUMBER("--zscale", "S", &o->zscale,
+		       "vertical exaggeration of shading and view (default 1)"),
+		NUMBER("--contour", "DZ", &o->contour,
+		       "contour lines every DZ m (shaded)"),
+		{.name = "--label", .kind = CLI_FLAG, .target = &o->label,
+		 .help = "draw the simulated time on each frame"},
+		{.name = "--colorbar", .kind = CLI_FLAG, .target = &o->colorbar,
+		 .help = "add a colour bar with the height scale"},
+		{.name = "--max-size", .value = "PX", .kind = CLI_INT, .target = &o->max_size,
+		 .lo = 8, .hi = 65536, .expected = "8 to 65536 px",
+		 .help = "at most PX pixels a side (cells are area-averaged)"},
+		{.name = "--scale", .value = "K", .kind = CLI_INT, .target = &o->scale,
+		 .lo = 1, .hi = 100, .expected = "1 to 100 px per cell",
+		 .help = "K pixels per cell (default 1 for gray16, otherwise\n"
+		         "enough for a side of 512 px)"},
+		NUMBER("--view-azimuth", "DEG", &o->view_azimuth_deg,
+		       "oblique: the camera's bearing from the centre (200)"),
+		NUMBER("--view-elevation", "DEG", &o->view_elevation_deg,
+		       "oblique: the camera above the horizon (45)"),
+		{.name = "--compression", .value = "N", .kind = CLI_INT, .target = &o->compression,
+		 .lo = 0, .hi = 9, .expected = "0 to 9",
+		 .help = "zlib level of the PNGs, 0 to 9 (default 6)"},
+	};
+	for (int k = 0; k < LOOK_OPTIONS; k++) {
+		out[k] = table[k];
+		out[k].given = out[k].name ? given : NULL;
+		out[k].hidden = hidden;
+	}
 }
 
-static int cmd_bench(int argc, char **argv)
-{
-	struct ss_bench_options o = {0};
-	const char *closure = "all", *surface = "all", *threads = "1,2";
-	o.nx = o.ny = 8192;
-	o.repeats = 5;
-	for (int k = 2; k < argc; k++) {
-		const char *a = argv[k], *next = k + 1 < argc ? argv[k + 1] : NULL;
-		if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
-			fputs(usage_bench, stdout);
-			return 0;
-		} else if (!strcmp(a, "--json")) {
-			o.json = 1;
-		} else if (!strcmp(a, "--nx") || !strcmp(a, "--ny")) {
-			if (!next || parse_int(next, 1, 1 << 20, a[3] == 'x' ? &o.nx : &o.ny))
-				return usage_error(usage_bench, "%s: expected a cell count from 1 to "
-				                   "1048576", a);
-			k++;
-		} else if (!strcmp(a, "--repeats")) {
-			if (!next || parse_int(next, 1, 64, &o.repeats))
-				return usage_error(usage_bench, "--repeats '%s': expected 1 to 64",
-				                   next ? next : "");
-			k++;
-		} else if (!strcmp(a, "--steps")) {
-			if (!next || parse_int(next, 1, 1000000, &o.steps))
-				return usage_error(usage_bench, "--steps '%s': expected 1 to 1000000",
-				                   next ? next : "");
-			k++;
-		} else if (!strcmp(a, "--tile")) {
-			if (!next || parse_tile(next, &o.tile_nx, &o.tile_ny))
-				return usage_error(usage_bench, "--tile '%s': expected NXxNY, e.g. 256x64",
-				                   next ? next : "");
-			k++;
-		} else if (!strcmp(a, "--closure") && next) {
-			closure = argv[++k];
-		} else if (!strcmp(a, "--surface") && next) {
-			surface = argv[++k];
-		} else if (!strcmp(a, "--threads") && next) {
-			threads = argv[++k];
-		} else {
-			return usage_error(usage_bench, "unknown option or missing value: '%s'", a);
-		}
-	}
-
-	enum ss_closure_kind kind;
-	if (!strcmp(closure, "all")) {
-		add_bench_closure(&o, SS_CLOSURE_COULOMB, 1.0);
-		add_bench_closure(&o, SS_CLOSURE_BINGHAM, 1.0);
-		add_bench_closure(&o, SS_CLOSURE_HERSCHEL_BULKLEY, 0.5);
-		add_bench_closure(&o, SS_CLOSURE_HERSCHEL_BULKLEY, 2.0);
-		add_bench_closure(&o, SS_CLOSURE_CASSON, 1.0);
-	} else if (!strcmp(closure, "herschel-bulkley")) {
-		add_bench_closure(&o, SS_CLOSURE_HERSCHEL_BULKLEY, 0.5);
-		add_bench_closure(&o, SS_CLOSURE_HERSCHEL_BULKLEY, 2.0);
-	} else if (ss_closure_parse(closure, &kind) == 0) {
-		add_bench_closure(&o, kind, 1.0);
-	} else {
-		return usage_error(usage_bench, "--closure '%s': expected all, "
-		                   SS_CLOSURE_NAMES, closure);
-	}
-
-	int matched = 0;
-	for (int s = 0; s < SS_BENCH_SURFACES; s++) {
-		o.surfaces[s] = !strcmp(surface, "all") ||
-		                !strcmp(surface, ss_bench_surface_name((enum ss_bench_surface)s));
-		matched |= o.surfaces[s];
-	}
-	if (!matched)
-		return usage_error(usage_bench, "--surface '%s': expected all, supercritical, "
-		                   "subcritical or patch", surface);
-
-	for (const char *p = threads; *p;) {
-		char buf[16];
-		size_t len = strcspn(p, ",");
-		if (len == 0 || len >= sizeof buf || o.thread_count == SS_BENCH_MAX_CASES)
-			return usage_error(usage_bench, "--threads '%s': expected a list such as "
-			                   "1,2 (at most 8 entries)", threads);
-		memcpy(buf, p, len);
-		buf[len] = '\0';
-		if (parse_int(buf, 1, 4096, &o.threads[o.thread_count++]))
-			return usage_error(usage_bench, "--threads '%s': expected a list such as "
-			                   "1,2 (at most 8 entries)", threads);
-		p += len + (p[len] == ',');
-	}
-	return ss_status_exit_code(ss_bench_run(&o));
-}
-
-static int cmd_render(int argc, char **argv)
-{
-	struct ss_render_series_options o = {0};
-	ss_render_options_default(&o.look);
-	o.output_dir = "frames";
-	o.time = NAN;
-	o.fps = 24;
-	int threads = 0, bench = 0, bench_n = 4096;
-
-	for (int k = 2; k < argc; k++) {
-		const char *a = argv[k], *next = k + 1 < argc ? argv[k + 1] : NULL;
-		const int look = parse_look_option(argc, argv, &k, &o.look, usage_render);
-		if (look == 2)
-			return 2;
-		if (look)
-			continue;
-		if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
-			fputs(usage_render, stdout);
-			return 0;
-		} else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
-			if (!next || !*next)
-				return usage_error(usage_render, "%s needs a folder", a);
-			o.output_dir = argv[++k];
-		} else if (!strcmp(a, "--frames")) {
-			if (!next)
-				return usage_error(usage_render, "%s needs A:B:STEP", a);
-			o.frames = argv[++k];
-		} else if (!strcmp(a, "--time")) {
-			if (parse_double(next, &o.time))
-				return usage_error(usage_render, "--time '%s': expected a time in s",
-				                   next ? next : "");
-			k++;
-		} else if (!strcmp(a, "--video")) {
-			if (!next || !*next)
-				return usage_error(usage_render, "%s needs a file name", a);
-			o.video = argv[++k];
-		} else if (!strcmp(a, "--fps")) {
-			if (!next || parse_int(next, 1, 240, &o.fps))
-				return usage_error(usage_render, "--fps '%s': expected 1 to 240",
-				                   next ? next : "");
-			k++;
-		} else if (!strcmp(a, "--threads")) {
-			if (!next || parse_int(next, 1, 4096, &threads))
-				return usage_error(usage_render, "--threads '%s': expected an integer "
-				                   "from 1 to 4096", next ? next : "");
-			k++;
-		} else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
-			o.quiet = 1;
-		} else if (!strcmp(a, "--bench")) {
-			bench = 1;
-			if (next && parse_int(next, 16, 32768, &bench_n) == 0)
-				k++;
-		} else if (a[0] == '-' && a[1]) {
-			return usage_error(usage_render, "unknown option '%s'", a);
-		} else if (o.input) {
-			return usage_error(usage_render, "one file only (got a second: '%s')", a);
-		} else {
-			o.input = a;
-		}
-	}
-	ss_parallel_set_threads(threads > 0 ? threads : ss_parallel_processors());
-	if (bench)
-		return ss_status_exit_code(ss_render_bench(bench_n, 5));
-	if (!o.input)
-		return usage_error(usage_render, "%s", "render needs a sandslide output file");
-	return ss_status_exit_code(ss_render_series(&o));
-}
+/* ---- run ------------------------------------------------------------------ */
 
 /* `run --frames`: render each snapshot the run reports. */
 static int render_run_snapshot(void *context, const struct ss_run_snapshot *s)
@@ -500,141 +167,160 @@ static int render_run_snapshot(void *context, const struct ss_run_snapshot *s)
 	return ss_render_frames_add(context, s->path, s->index, &b);
 }
 
+/* What the long commands (run, relax) share: the stop signals caught and,
+ * on a terminal unless quiet, a progress line (the callback to give). */
+static ss_progress_fn *watch(int quiet, const volatile sig_atomic_t **stop)
+{
+	install_signal_handlers();
+	*stop = &stop_signal;
+	return !quiet && isatty(fileno(stderr)) ? cli_print_progress : NULL;
+}
+
+/* The first argument that is one of the n options (for messages). */
+static const char *first_of(const struct cli_option *options, int n, int argc, char **argv)
+{
+	for (int k = 2; k < argc; k++)
+		for (int m = 0; m < n; m++) {
+			const size_t len = options[m].name ? strlen(options[m].name) : 0;
+			if (len && !strncmp(argv[k], options[m].name, len) &&
+			    (argv[k][len] == '\0' || argv[k][len] == '='))
+				return argv[k];
+		}
+	return "a look option";
+}
+
+/* The run with what the command line gave (the frames to draw, if any). */
+static int run_with_frames(int argc, char **argv, struct ss_run_options *o,
+                           const char *frames_dir, const struct ss_render_options *look,
+                           int quiet)
+{
+	struct ss_render_frames *frames = NULL;
+	struct ss_run_summary s;
+	char *history = NULL;
+	int err = frames_dir ? ss_render_frames_create(&frames, frames_dir, look) : SS_OK;
+	if (!err && !(history = ss_strings_join((const char *const *)argv, argc, " ", 0)))
+		err = SS_ERR_FAIL;
+	if (!err) {
+		o->history = history;
+		o->on_snapshot = frames ? render_run_snapshot : NULL;
+		o->snapshot_context = frames;
+		o->progress = watch(quiet, &o->stop_signal);
+		err = ss_run_case(o, &s);
+		cli_progress_done();
+	}
+	if (!err)
+		cli_print_run_end(&s, quiet);
+	if (!err && frames && !quiet)
+		printf("wrote %lld frames to %s%s\n", ss_render_frames_count(frames), frames_dir,
+		       frames_dir[strlen(frames_dir) - 1] == '/' ? "" : "/");
+	free(history);
+	ss_render_frames_destroy(frames);
+	return err;
+}
+
 static int cmd_run(int argc, char **argv)
 {
 	struct ss_run_options o = {0};
-	const char **overrides = calloc((size_t)argc, sizeof *overrides);
-	if (!overrides)
-		return ss_status_exit_code(ss_error_fail("out of memory"));
-	int status = 2;
-	const char *frames_dir = NULL, *look_option = NULL;
 	struct ss_render_options look;
+	struct cli_list sets = {calloc((size_t)argc, sizeof(char *)), 0};
+	const char *case_path = NULL, *frames_dir = NULL;
+	int quiet = 0, look_given = 0, tile[2] = {0, 0};
+	if (!sets.v)
+		return ss_status_exit_code(ss_error_fail("out of memory"));
 	ss_render_options_default(&look);
-	struct ss_render_frames *frames = NULL;
-
-	for (int k = 2; k < argc; k++) {
-		const char *a = argv[k];
-		const char *next = k + 1 < argc ? argv[k + 1] : NULL;
-		const int is_look = parse_look_option(argc, argv, &k, &look, usage_run);
-		if (is_look == 2)
-			goto out;
-		if (is_look) {
-			look_option = a;
-			continue;
-		}
-		if (!strcmp(a, "--frames")) {
-			if (!next || !*next) {
-				status = usage_error(usage_run, "%s needs a folder", a);
-				goto out;
-			}
-			frames_dir = argv[++k];
-		} else if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
-			fputs(usage_run, stdout);
-			status = 0;
-			goto out;
-		} else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
-			if (!next) {
-				status = usage_error(usage_run, "%s needs a file name", a);
-				goto out;
-			}
-			o.output = argv[++k];
-		} else if (!strcmp(a, "--threads")) {
-			if (!next || parse_int(next, 1, 4096, &o.threads)) {
-				status = usage_error(usage_run, "--threads '%s': expected an integer "
-				                     "from 1 to 4096", next ? next : "");
-				goto out;
-			}
-			k++;
-		} else if (!strcmp(a, "--set") || !strcmp(a, "-P")) {
-			if (!next) {
-				status = usage_error(usage_run, "%s needs SECTION.KEY=VALUE", a);
-				goto out;
-			}
-			overrides[o.override_count++] = argv[++k];
-		} else if (!strncmp(a, "--set=", 6)) {
-			overrides[o.override_count++] = a + 6;
-		} else if (!strcmp(a, "--tile")) {
-			if (!next || parse_tile(next, &o.tile_nx, &o.tile_ny)) {
-				status = usage_error(usage_run, "--tile '%s': expected NXxNY, e.g. 256x64",
-				                     next ? next : "");
-				goto out;
-			}
-			k++;
-		} else if (!strcmp(a, "--deflate")) {
-			if (!next || parse_int(next, 0, 9, &o.deflate)) {
-				status = usage_error(usage_run, "--deflate '%s': expected 0 to 9",
-				                     next ? next : "");
-				goto out;
-			}
-			k++;
-		} else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
-			o.quiet = 1;
-		} else if (!strcmp(a, "--reference-kernel")) {
-			o.reference_kernel = 1;
-		} else if (!strcmp(a, "--force")) {
-			o.force = 1;
-		} else if (!strcmp(a, "--restart")) {
-			if (!next) {
-				status = usage_error(usage_run, "%s needs the output file to continue", a);
-				goto out;
-			}
-			o.restart = argv[++k];
-		} else if (a[0] == '-' && a[1]) {
-			status = usage_error(usage_run, "unknown option '%s'", a);
-			goto out;
-		} else if (o.case_path) {
-			status = usage_error(usage_run, "one case file only (got a second: '%s')", a);
-			goto out;
-		} else {
-			o.case_path = a;
-		}
+	struct cli_option options[10 + LOOK_OPTIONS] = {
+		{.name = "--output", .alias = "-o", .value = "OUT.h5", .kind = CLI_TEXT,
+		 .target = &o.output,
+		 .help = "output file (default out/<case name>.h5; its folder\n"
+		         "must exist unless it is the default out/)"},
+		{.name = "--force", .kind = CLI_FLAG, .target = &o.force,
+		 .help = "replace OUT.h5 if it exists (else refused)"},
+		{.name = "--restart", .value = "OUT.h5", .kind = CLI_TEXT, .target = &o.restart,
+		 .help = "continue the run in OUT.h5 from its last snapshot,\n"
+		         "appending to it, with the case stored in it (a\n"
+		         "CASE.ini given too must be that case, and its\n"
+		         "files are found beside it); the snapshots are\n"
+		         "those of a run never interrupted"},
+		threads_option(&o.threads),
+		{.name = "--set", .alias = "-P", .value = "SECTION.KEY=VALUE", .kind = CLI_LIST,
+		 .target = &sets,
+		 .help = "override key KEY of section SECTION of the case, e.g.\n"
+		         "--set model.closure=casson, --set 'source pour.rate=0.002'"},
+		{.name = "--tile", .value = "NXxNY", .kind = CLI_PARSE, .target = tile,
+		 .parse = cli_parse_tile, .expected = "NXxNY, e.g. 256x64",
+		 .help = "cells per tile of the sweep (default 256x128, smaller\n"
+		         "on small grids); results are the same bits for any\n"
+		         "tile size and thread count"},
+		{.name = "--reference-kernel", .kind = CLI_FLAG, .target = &o.reference_kernel,
+		 .help = "use the plain two-pass sweep the fast one is tested\n"
+		         "against (same bits, several times slower)"},
+		{.name = "--deflate", .value = "N", .kind = CLI_INT, .target = &o.deflate,
+		 .lo = 0, .hi = 9, .expected = "0 to 9",
+		 .help = "HDF5 deflate level of /height, 0 (off, default) to 9"},
+		{.name = "--quiet", .alias = "-q", .kind = CLI_FLAG, .target = &quiet,
+		 .help = "no progress line and no summary"},
+		{.name = "--frames", .value = "DIR", .kind = CLI_TEXT, .target = &frames_dir,
+		 .help = "also draw each snapshot as it is written, to\n"
+		         "DIR/frame_00000.png, ... (shaded; the look options\n"
+		         "of `sandslide render --help` apply, e.g. --label)"},
+	};
+	look_options(options + 10, &look, &look_given, 1);
+	struct cli_command cmd = {
+		.usage = "usage: sandslide run CASE.ini [-o OUT.h5] [--threads N] "
+		         "[--set SECTION.KEY=VALUE ...]\n"
+		         "       sandslide run --restart OUT.h5 [CASE.ini] [--threads N]\n",
+		.options = options, .option_count = COUNT(options),
+		.outro = "Writes OUT.h5 (SPEC section 5) and the XDMF sidecar OUT.xmf, flushed after\n"
+		         "every snapshot.  Ctrl-C (SIGINT) or SIGTERM finish the substep, write a\n"
+		         "snapshot and exit 130 or 143 naming the command that continues the run.\n"
+		         "Another run writing the same output is refused, --force or not.\n"
+		         "Exit status: 0 done, 1 failure while running, 2 bad input.\n",
+		.what = "case file", .args = &case_path, .max_args = 1,
+	};
+	int status = cli_parse(&cmd, argc, argv, 2);
+	if (status == CLI_GO_ON && !case_path && !o.restart)
+		status = cli_usage_error(&cmd, "run needs a case file (or --restart OUT.h5)");
+	if (status == CLI_GO_ON && look_given && !frames_dir)
+		status = cli_usage_error(&cmd, "%s sets the look of frames: it needs --frames DIR",
+		                         first_of(options + 10, LOOK_OPTIONS, argc, argv));
+	if (status == CLI_GO_ON) {
+		o.case_path = case_path;
+		o.overrides = sets.v;
+		o.override_count = sets.n;
+		o.tile_nx = tile[0];
+		o.tile_ny = tile[1];
+		status = exit_status(run_with_frames(argc, argv, &o, frames_dir, &look, quiet));
 	}
-	if (!o.case_path && !o.restart) {
-		status = usage_error(usage_run, "%s", "run needs a case file (or --restart OUT.h5)");
-		goto out;
-	}
-	if (look_option && !frames_dir) {
-		status = usage_error(usage_run, "%s sets the look of frames: it needs --frames DIR",
-		                     look_option);
-		goto out;
-	}
-	if (frames_dir) {
-		if ((status = ss_status_exit_code(ss_render_frames_create(&frames, frames_dir, &look))))
-			goto out;
-		o.on_snapshot = render_run_snapshot;
-		o.snapshot_context = frames;
-	}
-	o.overrides = overrides;
-	char *history = join_args(argc, argv);
-	o.history = history;
-	o.stop_signal = &stop_signal;
-	install_signal_handlers();
-	status = ss_status_exit_code(ss_run_case(&o));
-	if (status == 0 && stop_signal)
-		status = 128 + stop_signal;
-	free(history);
-	if (frames && !o.quiet)
-		printf("wrote %lld frames to %s%s\n", ss_render_frames_count(frames), frames_dir,
-		       frames_dir[strlen(frames_dir) - 1] == '/' ? "" : "/");
-out:
-	ss_render_frames_destroy(frames);
-	free(overrides);
+	free(sets.v);
 	return status;
 }
 
-/* A number in [lo, hi]; -1 if malformed. */
-static int parse_real(const char *s, double lo, double hi, double *out)
+/* ---- relax ---------------------------------------------------------------- */
+
+static int parse_closure(const char *word, void *target)
 {
-	double v;
-	if (parse_double(s, &v) || !(v >= lo && v <= hi))
+	return ss_closure_parse(word, target);
+}
+
+static int parse_sides(const char *word, void *target)
+{
+	return ss_side_kind_parse(word, target) || *(enum ss_side_kind *)target == SS_SIDE_PERIODIC
+	       ? -1 : 0;
+}
+
+static int parse_nodata(const char *word, void *target)
+{
+	enum ss_cell_type *type = target;
+	if (strcmp(word, "wall") && strcmp(word, "open"))
 		return -1;
-	*out = v;
+	*type = !strcmp(word, "wall") ? SS_CELL_WALL : SS_CELL_OPEN;
 	return 0;
 }
 
 /* rect=X0,Y0,X1,Y1 or disk=X,Y,R into a shape; -1 if malformed. */
-static int parse_sand_shape(const char *s, struct ss_shape *shape)
+static int parse_sand_shape(const char *s, void *target)
 {
+	struct ss_shape *shape = target;
 	const int rect = !strncmp(s, "rect=", 5), disk = !strncmp(s, "disk=", 5);
 	if (!rect && !disk)
 		return -1;
@@ -657,202 +343,362 @@ static int parse_sand_shape(const char *s, struct ss_shape *shape)
 	return 0;
 }
 
+/* A number > 0 (up to 1e300) for relax's table. */
+#define POSITIVE(n, v, t, e, h)                                                      \
+	{.name = n, .value = v, .kind = CLI_REAL, .target = t, .lo = 1e-300, .hi = 1e300, \
+	 .expected = e, .help = h}
+
 static int cmd_relax(int argc, char **argv)
 {
 	struct ss_relax_options o;
+	int quiet = 0, have_rate = 0, have_duration = 0;
 	ss_relax_options_init(&o);
-	int have_rate = 0, have_duration = 0;
-	for (int k = 2; k < argc; k++) {
-		const char *a = argv[k], *next = k + 1 < argc ? argv[k + 1] : NULL;
-		if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
-			fputs(usage_relax, stdout);
-			return 0;
-		} else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
-			o.quiet = 1;
-			continue;
-		} else if (!strcmp(a, "--force")) {
-			o.force = 1;
-			continue;
-		} else if (a[0] != '-' || !a[1]) {
-			if (o.dem)
-				return usage_error(usage_relax, "one DEM only (got a second: '%s')", a);
-			o.dem = a;
-			continue;
-		}
-		if (!next)
-			return usage_error(usage_relax, "%s needs a value", a);
-		k++;
-		if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
-			o.output = next;
-		} else if (!strcmp(a, "--angle")) {
-			if (parse_real(next, 1e-9, 90.0 - 1e-9, &o.angle_deg))
-				return usage_error(usage_relax, "--angle '%s': expected degrees in "
-				                   "(0, 90)", next);
-		} else if (!strcmp(a, "--closure")) {
-			if (ss_closure_parse(next, &o.closure))
-				return usage_error(usage_relax, "--closure '%s': expected "
-				                   SS_CLOSURE_NAMES, next);
-		} else if (!strcmp(a, "--gamma")) {
-			if (parse_real(next, 1e-6, 1e6, &o.gamma))
-				return usage_error(usage_relax, "--gamma '%s': expected a number > 0",
-				                   next);
-		} else if (!strcmp(a, "--nu")) {
-			if (parse_real(next, 1e-300, 1e300, &o.nu))
-				return usage_error(usage_relax, "--nu '%s': expected m^2/s > 0", next);
-		} else if (!strcmp(a, "--tol")) {
-			if (parse_real(next, 1e-300, 1e300, &o.tol))
-				return usage_error(usage_relax, "--tol '%s': expected m/s > 0", next);
-		} else if (!strcmp(a, "--max-time")) {
-			if (parse_real(next, 1e-300, 1e300, &o.max_time))
-				return usage_error(usage_relax, "--max-time '%s': expected s > 0", next);
-		} else if (!strcmp(a, "--output-every")) {
-			if (parse_real(next, 1e-300, 1e300, &o.output_every))
-				return usage_error(usage_relax, "--output-every '%s': expected s > 0",
-				                   next);
-		} else if (!strcmp(a, "--cfl")) {
-			if (parse_real(next, 1e-9, 1.0, &o.cfl))
-				return usage_error(usage_relax, "--cfl '%s': expected (0, 1]", next);
-		} else if (!strcmp(a, "--threads")) {
-			if (parse_int(next, 1, 4096, &o.threads))
-				return usage_error(usage_relax, "--threads '%s': expected an integer "
-				                   "from 1 to 4096", next);
-		} else if (!strcmp(a, "--sides")) {
-			if (strcmp(next, "wall") && strcmp(next, "open"))
-				return usage_error(usage_relax, "--sides '%s': expected wall or open",
-				                   next);
-			o.sides = !strcmp(next, "wall") ? SS_SIDE_WALL : SS_SIDE_OPEN;
-		} else if (!strcmp(a, "--nodata")) {
-			if (strcmp(next, "wall") && strcmp(next, "open"))
-				return usage_error(usage_relax, "--nodata '%s': expected wall or open",
-				                   next);
-			o.nodata_type = !strcmp(next, "wall") ? SS_CELL_WALL : SS_CELL_OPEN;
-		} else if (!strcmp(a, "--open-level")) {
-			if (parse_real(next, -1e300, 1e300, &o.open_level))
-				return usage_error(usage_relax, "--open-level '%s': expected a height "
-				                   "in m", next);
-		} else if (!strcmp(a, "--bedrock")) {
-			o.bedrock = next;
-		} else if (!strcmp(a, "--add-sand")) {
-			if (parse_sand_shape(next, &o.sand_shape))
-				return usage_error(usage_relax, "--add-sand '%s': expected "
-				                   "rect=X0,Y0,X1,Y1 (X0 < X1, Y0 < Y1) or disk=X,Y,R "
-				                   "(R > 0), in m", next);
-			o.add_sand = 1;
-		} else if (!strcmp(a, "--sand-rate")) {
-			if (parse_real(next, 1e-300, 1e300, &o.sand_rate))
-				return usage_error(usage_relax, "--sand-rate '%s': expected m/s > 0",
-				                   next);
-			have_rate = 1;
-		} else if (!strcmp(a, "--sand-duration")) {
-			if (parse_real(next, 1e-300, 1e300, &o.sand_duration))
-				return usage_error(usage_relax, "--sand-duration '%s': expected s > 0",
-				                   next);
-			have_duration = 1;
-		} else if (!strcmp(a, "--dx")) {
-			if (parse_real(next, 1e-300, 1e300, &o.read.cellsize))
-				return usage_error(usage_relax, "--dx '%s': expected m > 0", next);
-		} else if (!strcmp(a, "--zscale")) {
-			if (parse_real(next, 1e-300, 1e300, &o.read.zscale))
-				return usage_error(usage_relax, "--zscale '%s': expected m per grey "
-				                   "level > 0", next);
-		} else if (!strcmp(a, "--zoffset")) {
-			if (parse_real(next, -1e300, 1e300, &o.read.zoffset))
-				return usage_error(usage_relax, "--zoffset '%s': expected m", next);
-		} else if (!strcmp(a, "--report")) {
-			o.report = next;
-		} else {
-			return usage_error(usage_relax, "unknown option '%s'", a);
-		}
-	}
+	const struct cli_option options[] = {
+		{.name = "--output", .alias = "-o", .value = "OUT", .kind = CLI_TEXT,
+		 .target = &o.output,
+		 .help = ".asc, .png, .tif: the relaxed raster; .h5: the whole\n"
+		         "series with diagnostics (default out/<DEM>-relaxed\n"
+		         "with the input's extension)"},
+		{.name = "--angle", .value = "DEG", .kind = CLI_REAL, .target = &o.angle_deg,
+		 .lo = 1e-9, .hi = 90.0 - 1e-9, .expected = "degrees in (0, 90)",
+		 .help = "repose angle (default 35)"},
+		{.name = "--closure", .value = "NAME", .kind = CLI_PARSE, .target = &o.closure,
+		 .parse = parse_closure, .expected = SS_CLOSURE_NAMES,
+		 .help = SS_CLOSURE_NAMES " (default coulomb)"},
+		{.name = "--gamma", .value = "G", .kind = CLI_REAL, .target = &o.gamma, .lo = 1e-6,
+		 .hi = 1e6, .expected = "a number > 0",
+		 .help = "herschel-bulkley exponent (default 1)"},
+		POSITIVE("--nu", "V", &o.nu, "m^2/s > 0", "m^2/s (default 1): sets the time scale only"),
+		POSITIVE("--tol", "X", &o.tol, "m/s > 0",
+		         "steady when max |dh/dt| < X m/s (default 1e-9)"),
+		POSITIVE("--max-time", "T", &o.max_time, "s > 0",
+		         "stop at T s even if not steady (default: none)"),
+		{.name = "--cfl", .value = "C", .kind = CLI_REAL, .target = &o.cfl, .lo = 1e-9,
+		 .hi = 1.0, .expected = "(0, 1]",
+		 .help = "fraction of the stable forward-Euler step (default 0.9)"},
+		threads_option(&o.threads),
+		{.name = "--sides", .value = "wall|open", .kind = CLI_PARSE, .target = &o.sides,
+		 .parse = parse_sides, .expected = "wall or open",
+		 .help = "the four sides of the DEM (default wall)"},
+		{.name = "--nodata", .value = "wall|open", .kind = CLI_PARSE,
+		 .target = &o.nodata_type, .parse = parse_nodata, .expected = "wall or open",
+		 .help = "cells without data (default open: sand leaves there)"},
+		{.name = "--open-level", .value = "M", .kind = CLI_REAL, .target = &o.open_level,
+		 .lo = -1e300, .hi = 1e300, .expected = "a height in m",
+		 .help = "height held on open cells and sides (default: the\n"
+		         "lowest height of the DEM)"},
+		{.name = "--bedrock", .value = "FILE", .kind = CLI_TEXT, .target = &o.bedrock,
+		 .help = "non-erodible base, a raster of the DEM's size: only\n"
+		         "the sand above it moves"},
+		{.name = "--add-sand", .value = "SHAPE", .kind = CLI_PARSE, .target = &o.sand_shape,
+		 .parse = parse_sand_shape, .given = &o.add_sand,
+		 .expected = "rect=X0,Y0,X1,Y1 (X0 < X1, Y0 < Y1) or disk=X,Y,R (R > 0), in m",
+		 .help = "pour sand on rect=X0,Y0,X1,Y1 or disk=X,Y,R (m)"},
+		{.name = "--sand-rate", .value = "R", .kind = CLI_REAL, .target = &o.sand_rate,
+		 .lo = 1e-300, .hi = 1e300, .expected = "m/s > 0", .given = &have_rate,
+		 .help = "at R m/s (needed with --add-sand)"},
+		{.name = "--sand-duration", .value = "S", .kind = CLI_REAL,
+		 .target = &o.sand_duration, .lo = 1e-300, .hi = 1e300, .expected = "s > 0",
+		 .given = &have_duration,
+		 .help = "for S seconds from t = 0 (needed with --add-sand)"},
+		POSITIVE("--dx", "M", &o.read.cellsize, "m > 0",
+		         "cell size, for files that do not give one"),
+		POSITIVE("--zscale", "Z", &o.read.zscale, "m per grey level > 0",
+		         "PNG: m per grey level (default: the file's range)"),
+		{.name = "--zoffset", .value = "Z0", .kind = CLI_REAL, .target = &o.read.zoffset,
+		 .lo = -1e300, .hi = 1e300, .expected = "m",
+		 .help = "PNG: height of grey 0, m (default 0)"},
+		POSITIVE("--output-every", "T", &o.output_every, "s > 0",
+		         ".h5 output: a snapshot every T s"),
+		{.name = "--report", .value = "FILE.json", .kind = CLI_TEXT, .target = &o.report,
+		 .help = "write the diagnostics for scripts"},
+		{.name = "--force", .kind = CLI_FLAG, .target = &o.force,
+		 .help = "replace OUT if it exists (else refused)"},
+		{.name = "--quiet", .alias = "-q", .kind = CLI_FLAG, .target = &quiet,
+		 .help = "no progress line and no summary"},
+	};
+	struct cli_command cmd = {
+		.usage = "usage: sandslide relax DEM [-o OUT] [--angle DEG] [--closure NAME] "
+		         "[--nu V]\n"
+		         "                       [--tol X] [--max-time T] [--threads N] [...]\n",
+		.intro = "Relaxes a digital elevation model to the repose angle: every slope steeper\n"
+		         "than it slides until the surface is steady, the volume conserved.\n"
+		         "\n"
+		         "  DEM                   .asc (ESRI ASCII grid), .png (16-bit greyscale),\n"
+		         "                        FILE.h5[:/dataset] (sandslide HDF5, last snapshot),\n"
+		         "                        .tif and other GDAL rasters (builds with GDAL)\n",
+		.options = options, .option_count = COUNT(options),
+		.outro = "Prints cells and volume moved, steepest face before and after, steps and\n"
+		         "wall time.  The input is never modified; the output is written under a\n"
+		         "temporary name and renamed when complete, and another run writing it is\n"
+		         "refused.  Ctrl-C (SIGINT) or SIGTERM finish the substep and write the\n"
+		         "surface as it is then (exit 130 or 143).  Exit status: 0 done, 1\n"
+		         "failure while running, 2 bad input.\n",
+		.what = "DEM", .args = &o.dem, .max_args = 1,
+	};
+	int status = cli_parse(&cmd, argc, argv, 2);
+	if (status != CLI_GO_ON)
+		return status;
 	if (!o.dem)
-		return usage_error(usage_relax, "%s", "relax needs a DEM");
+		return cli_usage_error(&cmd, "relax needs a DEM");
 	if (o.add_sand != (have_rate && have_duration) || (!o.add_sand && (have_rate || have_duration)))
-		return usage_error(usage_relax, "%s", "--add-sand, --sand-rate and "
-		                   "--sand-duration go together");
+		return cli_usage_error(&cmd, "--add-sand, --sand-rate and --sand-duration go together");
 	if (!isnan(o.read.zoffset) && isnan(o.read.zscale))
-		return usage_error(usage_relax, "%s", "--zoffset needs --zscale");
-	char *history = join_args(argc, argv);
-	o.history = history;
+		return cli_usage_error(&cmd, "--zoffset needs --zscale");
 	struct ss_relax_report report;
-	o.stop_signal = &stop_signal;
-	install_signal_handlers();
-	int status = ss_status_exit_code(ss_relax_run(&o, &report));
-	if (status == 0 && stop_signal)
-		status = 128 + stop_signal;
+	char *history = ss_strings_join((const char *const *)argv, argc, " ", 0);
+	if (!history)
+		return 1;
+	o.history = history;
+	o.progress = watch(quiet, &o.stop_signal);
+	const int err = ss_relax_run(&o, &report);
+	cli_progress_done();
+	if (!err)
+		cli_print_relax_end(&report, o.angle_deg, quiet);
 	free(history);
-	return status;
+	return exit_status(err);
 }
 
-static void print_diag_row(const struct ss_snapshot_summary *s, long long k)
+/* ---- render --------------------------------------------------------------- */
+
+static int cmd_render(int argc, char **argv)
 {
-	const struct ss_diagnostics *d = &s->diag[k];
-	printf("  %5lld %12.6g %13.6e %11.4e %11.4e %10.5g %9.4f %9.0f %7.3f %9.3f\n", k,
-	       s->time[k], d->volume, d->inflow, d->outflow, d->max_height, d->max_slope_deg,
-	       d->steps, d->active_fraction, d->wall_seconds);
+	struct ss_render_series_options o = {0};
+	struct cli_optional_int bench = {0, 4096};
+	int threads = 0, look_given = 0;
+	ss_render_options_default(&o.look);
+	o.output_dir = "frames";
+	o.time = NAN;
+	o.fps = 24;
+	struct cli_option options[8 + LOOK_OPTIONS] = {
+		{.name = "--output", .alias = "-o", .value = "DIR", .kind = CLI_TEXT,
+		 .target = &o.output_dir,
+		 .help = "folder of the frames (default frames/, created if\nmissing)"},
+		{.name = "--frames", .value = "A:B:STEP", .kind = CLI_TEXT, .target = &o.frames,
+		 .help = "snapshots A, A+STEP, ... before B, as a Python slice\n"
+		         "(negative counts from the end; parts may be left out)"},
+		{.name = "--time", .value = "T", .kind = CLI_REAL, .target = &o.time,
+		 .lo = -INFINITY, .hi = INFINITY, .expected = "a time in s",
+		 .help = "only the snapshot nearest T seconds"},
+		{.name = "--video", .value = "FILE.mp4", .kind = CLI_TEXT, .target = &o.video,
+		 .help = "assemble the frames with ffmpeg (H.264, yuv420p) if it\n"
+		         "is on PATH; without it the frames are kept"},
+		{.name = "--fps", .value = "N", .kind = CLI_INT, .target = &o.fps, .lo = 1,
+		 .hi = 240, .expected = "1 to 240",
+		 .help = "frames per second of the video (default 24)"},
+		threads_option(&threads),
+		{.name = "--quiet", .alias = "-q", .kind = CLI_FLAG, .target = &o.quiet,
+		 .help = "no summary"},
+		{.name = "--bench", .value = "[N]", .kind = CLI_OPTIONAL_INT, .target = &bench,
+		 .lo = 16, .hi = 32768,
+		 .help = "time the shaded style on an N x N grid (default 4096)"},
+	};
+	look_options(options + 8, &o.look, &look_given, 0);
+	const char *input = NULL;
+	struct cli_command cmd = {
+		.usage = "usage: sandslide render FILE.h5 [-o DIR] [--frames A:B:STEP | --time T] "
+		         "[options]\n"
+		         "       sandslide render --bench [N]\n",
+		.intro = "Draws the snapshots of a sandslide output file as PNG pictures,\n"
+		         "DIR/frame_00000.png, frame_00001.png, ... in time order (SPEC section 6).\n",
+		.options = options, .option_count = COUNT(options),
+		.outro = "Each PNG holds the time, the height scale and the snapshot in text chunks;\n"
+		         "a frame is written under a temporary name and renamed when complete.\n"
+		         "Exit status: 0 done, 1 failure while rendering, 2 bad input.\n",
+		.what = "file", .args = &input, .max_args = 1,
+	};
+	const int status = cli_parse(&cmd, argc, argv, 2);
+	if (status != CLI_GO_ON)
+		return status;
+	ss_parallel_set_threads(threads > 0 ? threads : ss_parallel_processors());
+	if (bench.given)
+		return ss_status_exit_code(ss_render_bench(bench.value, 5));
+	if (!input)
+		return cli_usage_error(&cmd, "render needs a sandslide output file");
+	o.input = input;
+	return ss_status_exit_code(ss_render_series(&o));
 }
+
+/* ---- bench ---------------------------------------------------------------- */
+
+static void add_bench_closure(struct ss_bench_options *o, enum ss_closure_kind kind,
+                              double gamma)
+{
+	struct ss_bench_closure *c = &o->closures[o->closure_count++];
+	c->kind = kind;
+	c->gamma = gamma;
+	if (kind == SS_CLOSURE_HERSCHEL_BULKLEY)
+		snprintf(c->label, sizeof c->label, "herschel-bulkley(%g)", gamma);
+	else
+		snprintf(c->label, sizeof c->label, "%s", ss_closure_name(kind));
+}
+
+/* --closure NAME|all: herschel-bulkley stands for gamma 0.5 and 2. */
+static int parse_bench_closures(const char *word, void *target)
+{
+	struct ss_bench_options *o = target;
+	enum ss_closure_kind kind;
+	const int all = !strcmp(word, "all");
+	if (!all && ss_closure_parse(word, &kind))
+		return -1;
+	o->closure_count = 0;
+	for (int k = SS_CLOSURE_COULOMB; k <= SS_CLOSURE_CASSON; k++) {
+		if (!all && k != (int)kind)
+			continue;
+		if (k == SS_CLOSURE_HERSCHEL_BULKLEY) {
+			add_bench_closure(o, SS_CLOSURE_HERSCHEL_BULKLEY, 0.5);
+			add_bench_closure(o, SS_CLOSURE_HERSCHEL_BULKLEY, 2.0);
+		} else {
+			add_bench_closure(o, (enum ss_closure_kind)k, 1.0);
+		}
+	}
+	return 0;
+}
+
+static int parse_bench_surfaces(const char *word, void *target)
+{
+	struct ss_bench_options *o = target;
+	int matched = 0;
+	for (int s = 0; s < SS_BENCH_SURFACES; s++) {
+		o->surfaces[s] = !strcmp(word, "all") ||
+		                 !strcmp(word, ss_bench_surface_name((enum ss_bench_surface)s));
+		matched |= o->surfaces[s];
+	}
+	return matched ? 0 : -1;
+}
+
+/* --threads 1,2: at most SS_BENCH_MAX_CASES counts. */
+static int parse_bench_threads(const char *word, void *target)
+{
+	struct ss_bench_options *o = target;
+	o->thread_count = 0;
+	for (const char *p = word; *p;) {
+		char buf[16];
+		const size_t len = strcspn(p, ",");
+		if (len == 0 || len >= sizeof buf || o->thread_count == SS_BENCH_MAX_CASES)
+			return -1;
+		memcpy(buf, p, len);
+		buf[len] = '\0';
+		if (cli_parse_int(buf, 1, 4096, &o->threads[o->thread_count++]))
+			return -1;
+		p += len + (p[len] == ',');
+	}
+	return o->thread_count > 0 ? 0 : -1;
+}
+
+static int cmd_bench(int argc, char **argv)
+{
+	struct ss_bench_options o = {.nx = 8192, .ny = 8192, .repeats = 5};
+	struct cli_bench b = {0};
+	int tile[2] = {0, 0};
+	parse_bench_closures("all", &o);
+	parse_bench_surfaces("all", &o);
+	parse_bench_threads("1,2", &o);
+	const struct cli_option options[] = {
+		{.name = "--nx", .value = "N", .kind = CLI_INT, .target = &o.nx, .lo = 1,
+		 .hi = 1 << 20, .expected = "a cell count from 1 to 1048576",
+		 .help = "cells along x (default 8192)"},
+		{.name = "--ny", .value = "N", .kind = CLI_INT, .target = &o.ny, .lo = 1,
+		 .hi = 1 << 20, .expected = "a cell count from 1 to 1048576",
+		 .help = "cells along y (default 8192)"},
+		{.name = "--closure", .value = "NAME|all", .kind = CLI_PARSE, .target = &o,
+		 .parse = parse_bench_closures, .expected = "all, " SS_CLOSURE_NAMES,
+		 .help = "coulomb, bingham, herschel-bulkley (gamma 0.5 and 2),\n"
+		         "casson, or all (default)"},
+		{.name = "--threads", .value = "LIST", .kind = CLI_PARSE, .target = &o,
+		 .parse = parse_bench_threads,
+		 .expected = "a list such as 1,2 (at most 8 entries from 1 to 4096)",
+		 .help = "thread counts, comma-separated (default 1,2)"},
+		{.name = "--surface", .value = "NAME|all", .kind = CLI_PARSE, .target = &o,
+		 .parse = parse_bench_surfaces,
+		 .expected = "all, supercritical, subcritical or patch",
+		 .help = "supercritical (every face slides), subcritical (none\n"
+		         "does), patch (a 512 x 512 ramp on a flat floor), all"},
+		{.name = "--repeats", .value = "N", .kind = CLI_INT, .target = &o.repeats, .lo = 1,
+		 .hi = 64, .expected = "1 to 64",
+		 .help = "timings per case (default 5); median, min and max"},
+		{.name = "--steps", .value = "N", .kind = CLI_INT, .target = &o.steps, .lo = 1,
+		 .hi = 1000000, .expected = "1 to 1000000",
+		 .help = "steps per timing (default: about 0.3 s worth)"},
+		{.name = "--tile", .value = "NXxNY", .kind = CLI_PARSE, .target = tile,
+		 .parse = cli_parse_tile, .expected = "NXxNY, e.g. 256x64",
+		 .help = "tile size of the sweep (default 256x128)"},
+		{.name = "--json", .kind = CLI_FLAG, .target = &b.json,
+		 .help = "one JSON document instead of a table"},
+	};
+	struct cli_command cmd = {
+		.usage = "usage: sandslide bench [--nx N] [--ny N] [--closure NAME|all] "
+		         "[--threads 1,2]\n"
+		         "                       [--surface NAME|all] [--repeats N] [--steps N] "
+		         "[--tile NXxNY]\n"
+		         "                       [--json]\n",
+		.options = options, .option_count = COUNT(options),
+		.outro = "Also measures the memory bandwidth (read+write of one array) in the same run\n"
+		         "and reports the fraction of that roofline each case reaches.\n",
+		.what = "benchmark", .max_args = 0,
+	};
+	const int status = cli_parse(&cmd, argc, argv, 2);
+	if (status != CLI_GO_ON)
+		return status;
+	o.tile_nx = tile[0];
+	o.tile_ny = tile[1];
+	o.on_header = cli_bench_header;
+	o.on_result = cli_bench_result;
+	o.context = &b;
+	const int err = ss_bench_run(&o);
+	if (!err)
+		cli_bench_done(&b);
+	return ss_status_exit_code(err);
+}
+
+/* ---- info ----------------------------------------------------------------- */
 
 static int cmd_info(int argc, char **argv)
 {
 	const char *path = NULL;
-	for (int k = 2; k < argc; k++) {
-		if (!strcmp(argv[k], "-h") || !strcmp(argv[k], "--help")) {
-			fputs(usage_info, stdout);
-			return 0;
-		}
-		if (argv[k][0] == '-' && argv[k][1])
-			return usage_error(usage_info, "unknown option '%s'", argv[k]);
-		if (path)
-			return usage_error(usage_info, "one file only (got a second: '%s')", argv[k]);
-		path = argv[k];
-	}
+	struct cli_command cmd = {
+		.usage = "usage: sandslide info FILE.h5\n",
+		.intro = "Prints the grid, model, cell counts and the diagnostics of every snapshot\n"
+		         "(first and last ten when there are more than twenty).\n",
+		.what = "file", .args = &path, .max_args = 1,
+	};
+	const int status = cli_parse(&cmd, argc, argv, 2);
+	if (status != CLI_GO_ON)
+		return status;
 	if (!path)
-		return usage_error(usage_info, "%s", "info needs a file");
-
+		return cli_usage_error(&cmd, "info needs a file");
 	struct ss_snapshot_summary s;
-	int err = ss_snapshot_read_summary(path, &s);
+	const int err = ss_snapshot_read_summary(path, &s);
 	if (err)
 		return ss_status_exit_code(err);
-	printf("file       %s (%s)\n", path, s.source);
-	printf("title      %s\n", s.title);
-	printf("grid       %d x %d cells, dx = %g m, dy = %g m, lower-left corner (%g, %g) m\n",
-	       s.nx, s.ny, s.dx, s.dy, s.origin_x, s.origin_y);
-	printf("cells      %lld flow, %lld wall, %lld open\n", s.flow_cells, s.wall_cells,
-	       s.open_cells);
-	printf("model      %s, repose angle %g deg, nu = %g m^2/s", s.closure,
-	       s.repose_angle_deg, s.nu);
-	if (!strcmp(s.closure, "herschel-bulkley"))
-		printf(", gamma = %g", s.gamma);
-	printf("\n");
-	if (s.count == 0) {
-		printf("snapshots  none\n");
-	} else {
-		printf("snapshots  %lld, t = %g .. %g s\n", s.count, s.time[0], s.time[s.count - 1]);
-		printf("  %5s %12s %13s %11s %11s %10s %9s %9s %7s %9s\n", "index", "time_s",
-		       "volume_m3", "inflow_m3", "outflow_m3", "max_h_m", "slope_deg", "steps",
-		       "active", "wall_s");
-		for (long long k = 0; k < s.count; k++) {
-			if (s.count > 20 && k == 10) {
-				printf("  %5s (%lld more)\n", "...", s.count - 20);
-				k = s.count - 10;
-			}
-			print_diag_row(&s, k);
-		}
-		const struct ss_diagnostics *first = &s.diag[0], *last = &s.diag[s.count - 1];
-		const double balance = (last->volume - first->volume) - (last->inflow - last->outflow);
-		const double scale = fmax(fmax(fabs(last->volume), fabs(first->volume)),
-		                          fmax(last->inflow, last->outflow));
-		printf("volume balance  (V_last - V_0) - (inflow - outflow) = %.3e m^3 "
-		       "(%.2e relative)\n", balance, scale > 0 ? fabs(balance) / scale : 0.0);
-	}
+	cli_print_info(path, &s);
 	ss_snapshot_summary_release(&s);
 	return 0;
 }
 
+/* ---- main ----------------------------------------------------------------- */
+
+static int main_usage_error(const char *fmt, const char *arg)
+{
+	fflush(stdout);
+	fputs("sandslide: ", stderr);
+	fprintf(stderr, fmt, arg);
+	fprintf(stderr, "\n\n%s", usage_main);
+	return 2;
+}
+
 int main(int argc, char **argv)
 {
+	static const struct {
+		const char *name;
+		int (*run)(int argc, char **argv);
+	} commands[] = {
+		{"run", cmd_run}, {"info", cmd_info}, {"bench", cmd_bench},
+		{"render", cmd_render}, {"relax", cmd_relax},
+	};
 	ss_snapshot_library_init();
 	if (argc < 2)
-		return usage_error(usage_main, "%s", "no command given");
+		return main_usage_error("%s", "no command given");
 	const char *cmd = argv[1];
 	if (!strcmp(cmd, "-h") || !strcmp(cmd, "--help") || !strcmp(cmd, "help")) {
 		fputs(usage_main, stdout);
@@ -868,16 +714,9 @@ int main(int argc, char **argv)
 		       ss_parallel_processors(), ss_dem_gdal_available() ? "on" : "off");
 		return 0;
 	}
-	if (!strcmp(cmd, "run"))
-		return cmd_run(argc, argv);
-	if (!strcmp(cmd, "info"))
-		return cmd_info(argc, argv);
-	if (!strcmp(cmd, "bench"))
-		return cmd_bench(argc, argv);
-	if (!strcmp(cmd, "render"))
-		return cmd_render(argc, argv);
-	if (!strcmp(cmd, "relax"))
-		return cmd_relax(argc, argv);
-	return usage_error(usage_main, "unknown command '%s': expected run, relax, info, "
-	                   "render or bench", cmd);
+	for (int k = 0; k < COUNT(commands); k++)
+		if (!strcmp(cmd, commands[k].name))
+			return commands[k].run(argc, argv);
+	return main_usage_error("unknown command '%s': expected run, relax, info, render or bench",
+	                        cmd);
 }

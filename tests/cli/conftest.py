@@ -1,7 +1,9 @@
 """Shared helpers for the sandslide command-line and file-format tests.
 
 The binary is found through the environment variable SANDSLIDE (an
-absolute path); it defaults to build/sandslide of this checkout.  Every
+absolute path); it defaults to build/sandslide of this checkout.  The one
+with the test hook of the non-finite guard, SANDSLIDE_NAN, defaults to
+tests/sandslide-nan beside it (`make test` builds both).  Every
 test writes its files under pytest's tmp_path.
 """
 import os
@@ -17,6 +19,9 @@ import pytest
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 SANDSLIDE = os.environ.get("SANDSLIDE", os.path.join(ROOT, "build", "sandslide"))
+# sandslide with the test hook of the non-finite guard (tests/hooks/nan_step.c)
+SANDSLIDE_NAN = os.environ.get("SANDSLIDE_NAN", os.path.join(os.path.dirname(SANDSLIDE),
+                                                              "tests", "sandslide-nan"))
 CASES = os.path.join(ROOT, "cases")
 
 # A small valid case: 20 x 16 cells of 0.1 m, grid [0, 2] x [0, 1.6] m.

@@ -10,7 +10,7 @@ import time
 import numpy as np
 import pytest
 
-from conftest import BASE, SANDSLIDE, edit, h5open, run, wait_for
+from conftest import BASE, SANDSLIDE, SANDSLIDE_NAN, edit, h5open, run, wait_for
 
 # 40 x 30 cells poured by a source next to an open side: about 10^4 steps
 # over 40 s of simulated time, a snapshot every 2 s
@@ -209,12 +209,26 @@ def test_full_disk_gives_exit_1_and_keeps_earlier_snapshots(tmp_path):
 
 
 # ---- the non-finite guard --------------------------------------------------------
+# No input reaches it (the CFL bound keeps heights finite), so these tests
+# run sandslide-nan, sandslide linked with the test hook tests/hooks/nan_step.c:
+# with SANDSLIDE_TEST_NAN_STEP=N the middle cell's height becomes NaN after
+# substep N.
+
+
+def test_the_real_sandslide_has_no_test_hook(tmp_path):
+    case = write_case(tmp_path, BASE, "case.ini")
+    env = dict(os.environ, SANDSLIDE_TEST_NAN_STEP="3")
+    p = subprocess.run([SANDSLIDE, "run", case, "-o", "o.h5", "-q"], cwd=tmp_path,
+                       capture_output=True, text=True, env=env, timeout=120)
+    assert p.returncode == 0, (p.returncode, p.stderr)
+    with h5open(tmp_path / "o.h5") as f:
+        assert f["steps"][-1] > 3 and np.isfinite(f["height"][:]).all()
 
 
 def test_non_finite_height_stops_with_exit_1_naming_cell_and_step(tmp_path):
     case = write_case(tmp_path)
     env = dict(os.environ, SANDSLIDE_TEST_NAN_STEP="1500")
-    p = subprocess.run([SANDSLIDE, "run", case, "-o", "nan.h5", "-q"], cwd=tmp_path,
+    p = subprocess.run([SANDSLIDE_NAN, "run", case, "-o", "nan.h5", "-q"], cwd=tmp_path,
                        capture_output=True, text=True, env=env, timeout=300)
     assert p.returncode == 1, (p.returncode, p.stderr)
     # the NaN is put into cell (20, 15) after step 1500; it is caught by the
@@ -252,7 +266,7 @@ def test_non_finite_height_at_a_snapshot_time_is_not_written(tmp_path):
     with h5open(tmp_path / "whole.h5") as f:
         landing = int(f["steps"][1])
     env = dict(os.environ, SANDSLIDE_TEST_NAN_STEP=str(landing))
-    p = subprocess.run([SANDSLIDE, "run", case, "-o", "nan.h5", "-q"], cwd=tmp_path,
+    p = subprocess.run([SANDSLIDE_NAN, "run", case, "-o", "nan.h5", "-q"], cwd=tmp_path,
                        capture_output=True, text=True, env=env, timeout=300)
     assert p.returncode == 1, (p.returncode, p.stderr)
     assert f"in step {landing} " in p.stderr and \
@@ -261,3 +275,95 @@ def test_non_finite_height_at_a_snapshot_time_is_not_written(tmp_path):
         assert list(f["steps"][:]) == [0, landing - 1], list(f["steps"][:])
         assert np.isfinite(f["height"][:]).all(), "a non-finite snapshot was written"
         assert 0 < f["time"][-1] < 4.0
+
+
+# ---- relax has the same guarantees (one time loop, src/app/drive.c) ------------
+
+
+def write_cliff(path, nx, ny, dx=0.1):
+    """A 1.5 m plateau ending in a vertical cliff over a rough floor, as an
+    ESRI ASCII grid (rows north first, %.17g)."""
+    rng = np.random.default_rng(11)
+    h = 0.02 * rng.random((ny, nx))
+    h[:, : nx // 3] += 1.5
+    rows = "\n".join(" ".join(repr(float(v)) for v in h[j]) for j in range(ny - 1, -1, -1))
+    path.write_text(f"ncols {nx}\nnrows {ny}\nxllcorner 0\nyllcorner 0\ncellsize {dx!r}\n"
+                    + rows + "\n")
+
+
+def read_asc_values(path):
+    tokens = path.read_text().split()
+    head = dict(zip(tokens[0:10:2], tokens[1:10:2]))
+    nx, ny = int(head["ncols"]), int(head["nrows"])
+    return np.array([float(t) for t in tokens[10:10 + nx * ny]]).reshape(ny, nx)[::-1]
+
+
+@pytest.mark.parametrize("sig, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
+def test_relax_signal_keeps_the_input_and_every_snapshot(tmp_path, sig, code):
+    write_cliff(tmp_path / "cliff.asc", 160, 120)
+    before = (tmp_path / "cliff.asc").read_bytes()
+    p = start(["relax", "cliff.asc", "-o", "cut.h5", "--output-every", "0.02", "-q"],
+              tmp_path)
+    assert wait_for(lambda: (tmp_path / "cut.h5").exists() and
+                    len(snapshots(tmp_path / "cut.h5")) >= 3, 60), "relax wrote nothing"
+    p.send_signal(sig)
+    out, err = p.communicate(timeout=60)
+    if p.returncode == 0:
+        pytest.skip("relax ended before the signal arrived (machine too fast)")
+    assert p.returncode == code, (p.returncode, err)
+    assert "interrupted" in err and "cut.h5" in err, err
+    assert (tmp_path / "cliff.asc").read_bytes() == before, "the input was modified"
+    with h5open(tmp_path / "cut.h5") as f:
+        n = len(f["time"])
+        assert n >= 3 and f["height"].shape[0] == n
+        assert np.isfinite(f["height"][:]).all()
+        assert np.all(np.diff(f["steps"][:]) >= 0)
+    assert not list(tmp_path.glob(".*.lock")), "the claim of the output was left behind"
+
+
+def test_relax_signal_with_a_raster_output_writes_the_surface_then(tmp_path):
+    write_cliff(tmp_path / "cliff.asc", 160, 120)
+    before = (tmp_path / "cliff.asc").read_bytes()
+    p = start(["relax", "cliff.asc", "-o", "cut.asc"], tmp_path)
+    time.sleep(1.0)
+    p.send_signal(signal.SIGTERM)
+    out, err = p.communicate(timeout=60)
+    if p.returncode == 0:
+        pytest.skip("relax ended before the signal arrived (machine too fast)")
+    assert p.returncode == 143, (p.returncode, err)
+    assert "not relaxed" in err, err
+    assert (tmp_path / "cliff.asc").read_bytes() == before, "the input was modified"
+    h = read_asc_values(tmp_path / "cut.asc")
+    assert h.shape == (120, 160) and np.isfinite(h).all()
+
+
+def test_relax_non_finite_height_keeps_the_last_good_state(tmp_path):
+    """The guard of relax, once with a raster output (the steps taken again
+    from the DEM, through the same targets) and once with a series (from its
+    last snapshot): both keep the state after the step before, the same
+    bits."""
+    write_cliff(tmp_path / "cliff.asc", 40, 30)
+    before = (tmp_path / "cliff.asc").read_bytes()
+    env = dict(os.environ, SANDSLIDE_TEST_NAN_STEP="700")
+    outs = {}
+    for out in ("good.asc", "good.h5"):
+        p = subprocess.run([SANDSLIDE_NAN, "relax", "cliff.asc", "-o", out, "-q",
+                            "--output-every", "0.05"],
+                           cwd=tmp_path, capture_output=True, text=True, env=env, timeout=300)
+        assert p.returncode == 1, (out, p.returncode, p.stderr)
+        assert len(p.stderr.splitlines()) == 1, p.stderr
+        m = re.search(r"cell \((\d+), (\d+)\).* in step (\d+) \(t = (\S+) s\); "
+                      r"the last good state, after step (\d+) at t = (\S+) s, is", p.stderr)
+        assert m and out in p.stderr, p.stderr
+        i, j, step, good_step = (int(m.group(k)) for k in (1, 2, 3, 5))
+        assert abs(i - 20) <= 1 and abs(j - 15) <= 1 and step in (700, 701), p.stderr
+        assert good_step == step - 1, p.stderr
+        outs[out] = good_step
+    assert (tmp_path / "cliff.asc").read_bytes() == before, "the input was modified"
+    h = read_asc_values(tmp_path / "good.asc")
+    with h5open(tmp_path / "good.h5") as f:
+        assert f["steps"][-1] == outs["good.h5"]
+        assert len(f["time"]) >= 3, "the series should have snapshots before the NaN"
+        last = f["height"][-1]
+    assert np.isfinite(h).all()
+    assert np.array_equal(h, last), "the two ways to the last good state disagree"

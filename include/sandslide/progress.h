@@ -1,0 +1,23 @@
+/*
+ * progress.h - what `run` and `relax` report after each substep.  The
+ * library calls back; the command line decides whether and how to show it
+ * (on a terminal, at most twice a second).
+ */
+#ifndef SANDSLIDE_PROGRESS_H
+#define SANDSLIDE_PROGRESS_H
+
+struct ss_progress {
+	double time;            /* simulated time now, s */
+	double time_start;      /* where this process started (a restart: > 0), s */
+	double end;             /* s; INFINITY: until steady */
+	double steady_tol;      /* m/s: steady when max |dh/dt| falls below it */
+	long long steps;        /* substeps since t = 0 */
+	long long steps_here;   /* substeps taken by this process */
+	double rate_max;        /* max |dh/dt| of the last substep, m/s */
+	double cells;           /* cells of the grid */
+	double wall_seconds;    /* since the command started, s */
+};
+
+typedef void ss_progress_fn(void *context, const struct ss_progress *p);
+
+#endif

@@ -1,0 +1,269 @@
+/*
+ * drive.c - the time loop of `run` and `relax` (see drive.h).
+ */
+#include "app/drive.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "sandslide/error.h"
+#include "sandslide/parallel.h"
+
+void ss_drive_init(struct ss_drive *d, struct ss_stepper *st, double started)
+{
+	memset(d, 0, sizeof *d);
+	d->stepper = st;
+	d->output_every = INFINITY;
+	d->end = INFINITY;
+	d->started = started;
+	d->trouble.good_step = -1;
+	d->trouble.good_snapshot = -1;
+}
+
+int ss_drive_claim(struct ss_drive *d, const char *output, int make_folder, int force,
+                   int appending, const char *hint)
+{
+	snprintf(d->output, sizeof d->output, "%s", output);
+	int err = make_folder ? ss_output_make_folder(output) : SS_OK;
+	if (!err && !d->claim)
+		err = ss_output_claim(&d->claim, output);
+	if (!err && !appending)
+		err = ss_output_check_absent(output, force, hint);
+	return err;
+}
+
+long long ss_drive_snapshots(const struct ss_drive *d)
+{
+	return d->snapshot ? ss_snapshot_count(d->snapshot) : 0;
+}
+
+/* Returned by keep_state, without a message, for a state with a non-finite
+ * height: it is not written. */
+enum { STATE_NONFINITE = 1 };
+
+/* The state at a target: checked and, with a series, appended with its
+ * diagnostics and restart state. */
+static int keep_state(struct ss_drive *d)
+{
+	struct ss_stepper *st = d->stepper;
+	struct ss_diagnostics diag;
+	struct ss_restart_state state;
+	const double t0 = ss_parallel_wall_seconds();
+	ss_stepper_diagnostics(st, &diag);
+	diag.wall_seconds = t0 - d->started;
+	if (!isfinite(diag.volume) || !isfinite(diag.max_height))
+		return STATE_NONFINITE;
+	if (!d->snapshot)
+		return SS_OK;
+	ss_stepper_restart_state(st, &state);
+	const int err = ss_snapshot_append(d->snapshot, st->time, st->height, &diag, &state);
+	d->seconds_output += ss_parallel_wall_seconds() - t0;
+	return err;
+}
+
+/* Tell on_snapshot that the last snapshot is in the file. */
+static int announce(const struct ss_drive *d)
+{
+	if (!d->snapshot || !d->on_snapshot)
+		return SS_OK;
+	return d->on_snapshot(d->snapshot_context, d->output, ss_snapshot_count(d->snapshot) - 1,
+	                      d->stepper->time);
+}
+
+int ss_drive_create(struct ss_drive *d, const struct ss_snapshot_meta *meta)
+{
+	const struct ss_stepper *st = d->stepper;
+	int err = ss_snapshot_create(&d->snapshot, d->output, &st->grid, st->cell_types, meta);
+	if (!err)
+		err = keep_state(d);
+	if (err == STATE_NONFINITE)
+		err = ss_error_input("%s: the initial surface has a non-finite height", meta->title);
+	return err ? err : announce(d);
+}
+
+int ss_drive_append(struct ss_drive *d)
+{
+	return ss_snapshot_open_append(&d->snapshot, d->output, &d->stepper->grid);
+}
+
+/* The first target after t: k * output_every clipped to the end (k counts
+ * on from *k, which is left at the target's k). */
+static double next_target(const struct ss_drive *d, double t, long long *k)
+{
+	for (;; ++*k) {
+		const double target = fmin((double)*k * d->output_every, d->end);
+		if (target > t)
+			return target;
+	}
+}
+
+/* ss_progress from the stepper after each substep. */
+static void report_progress(void *context, const struct ss_stepper *st)
+{
+	const struct ss_drive *d = context;
+	const struct ss_progress p = {
+		.time = st->time, .time_start = d->time_start, .end = d->end,
+		.steady_tol = d->steady_tol, .steps = st->steps,
+		.steps_here = st->steps - d->steps_start, .rate_max = st->rate_max,
+		.cells = (double)st->grid.nx * st->grid.ny,
+		.wall_seconds = ss_parallel_wall_seconds() - d->started,
+	};
+	d->progress(d->progress_context, &p);
+}
+
+/* Take the steps of the loop again on st, towards the same targets, until
+ * it has taken last_step steps. */
+static int replay(const struct ss_drive *d, struct ss_stepper *st, long long last_step)
+{
+	struct ss_advance_options o = {.steady_tol = d->steady_tol};
+	long long k = 1;
+	enum ss_advance_end e = SS_ADVANCE_REACHED;
+	while (st->steps < last_step && st->time < d->end &&
+	       (e == SS_ADVANCE_REACHED || e == SS_ADVANCE_STEPS)) {
+		o.max_steps = last_step - st->steps;
+		e = ss_stepper_advance(st, next_target(d, st->time, &k), &o);
+	}
+	if (st->steps != last_step)
+		return ss_error_fail("taking the steps since the last snapshot again ended at "
+		                     "step %lld, not %lld", st->steps, last_step);
+	return SS_OK;
+}
+
+/* A fresh stepper in the state the guard restarts from: the last snapshot
+ * of the series, or t = 0 without one. */
+static int restart_point(struct ss_drive *d, struct ss_stepper *fresh)
+{
+	int err = d->rebuild(d->rebuild_context, fresh);
+	if (err || !d->snapshot)
+		return err;
+	const int closed = ss_snapshot_destroy(d->snapshot);
+	d->snapshot = NULL;
+	if (closed)
+		return closed;
+	struct ss_restart_info r;
+	err = ss_snapshot_read_last_state(d->output, &r);
+	if (!err)
+		ss_stepper_restore(fresh, r.time, r.height, &r.state);
+	ss_restart_info_release(&r);
+	if (!err)
+		err = ss_snapshot_open_append(&d->snapshot, d->output, &fresh->grid);
+	return err;
+}
+
+/*
+ * The guard (drive.h): a height became non-finite in the substep just
+ * taken.  Keeps the state after the step before in d->stepper and, with a
+ * series, as its last snapshot.  Errors on the way are printed; what the
+ * guard found is left for ss_drive_nonfinite_error.
+ */
+static void keep_last_good_state(struct ss_drive *d)
+{
+	struct ss_drive_trouble *t = &d->trouble;
+	struct ss_stepper *st = d->stepper, fresh;
+	int i, j;
+	snprintf(t->cell, sizeof t->cell, "a cell");
+	if (ss_stepper_first_nonfinite(st, &i, &j))
+		snprintf(t->cell, sizeof t->cell, "cell (%d, %d) at x = %g m, y = %g m", i, j,
+		         ss_grid_x(&st->grid, i), ss_grid_y(&st->grid, j));
+	t->step = st->steps;
+	t->time = st->time;
+	memset(&fresh, 0, sizeof fresh);
+	int err = restart_point(d, &fresh);
+	if (!err && fresh.steps < t->step - 1)
+		err = replay(d, &fresh, t->step - 1);
+	if (err) {
+		ss_stepper_release(&fresh);
+		return;
+	}
+	ss_stepper_release(st);
+	*st = fresh;   /* the stepper owns only heap arrays: a move */
+	t->good_step = st->steps;
+	t->good_time = st->time;
+	if (!d->snapshot)
+		return;
+	const long long before = ss_snapshot_count(d->snapshot);
+	const int on = before > 0 && ss_snapshot_last_time(d->snapshot) == st->time;
+	if (!on && (err = keep_state(d)) != SS_OK) {
+		if (err == STATE_NONFINITE)
+			ss_error_fail("step %lld, taken again, was not finite either", st->steps);
+		t->good_step = -1;
+		return;
+	}
+	t->good_snapshot = ss_snapshot_count(d->snapshot) - 1;
+}
+
+int ss_drive_nonfinite_error(const struct ss_drive *d, const char *kept_in)
+{
+	const struct ss_drive_trouble *t = &d->trouble;
+	char where[4400];
+	if (t->good_step >= 0 && t->good_snapshot >= 0)
+		snprintf(where, sizeof where, "the last good state, after step %lld at t = %.9g s, "
+		         "is snapshot %lld in '%s'", t->good_step, t->good_time, t->good_snapshot,
+		         d->output);
+	else if (t->good_step >= 0 && kept_in)
+		snprintf(where, sizeof where, "the last good state, after step %lld at t = %.9g s, "
+		         "is in '%s'", t->good_step, t->good_time, kept_in);
+	else if (d->snapshot)
+		snprintf(where, sizeof where, "the %lld snapshots before it, the last at t = %g s, "
+		         "are in '%s'", ss_snapshot_count(d->snapshot),
+		         ss_snapshot_last_time(d->snapshot), d->output);
+	else
+		snprintf(where, sizeof where, "nothing was written to '%s'", d->output);
+	return ss_error_fail("the height of %s became non-finite in step %lld (t = %.9g s); %s",
+	                     t->cell, t->step, t->time, where);
+}
+
+static int stalled(const struct ss_drive *d)
+{
+	const struct ss_stepper *st = d->stepper;
+	char where[4200] = "";
+	if (d->snapshot)
+		snprintf(where, sizeof where, "; %lld snapshots are in '%s'",
+		         ss_snapshot_count(d->snapshot), d->output);
+	return ss_error_fail("the time step fell below the resolution of t = %g s (step %lld): "
+	                     "the surface is too steep for this grid%s", st->time, st->steps,
+	                     where);
+}
+
+int ss_drive_run(struct ss_drive *d, enum ss_drive_end *end)
+{
+	struct ss_stepper *st = d->stepper;
+	const struct ss_advance_options adv = {
+		.steady_tol = d->steady_tol,
+		.progress = d->progress ? report_progress : NULL,
+		.context = d,
+		.stop = d->stop_signal,
+	};
+	d->time_start = st->time;
+	d->steps_start = st->steps;
+	*end = SS_DRIVE_END;
+	for (long long k = 1; st->time < d->end;) {
+		const enum ss_advance_end e = ss_stepper_advance(st, next_target(d, st->time, &k), &adv);
+		if (e == SS_ADVANCE_STALLED)
+			return stalled(d);
+		int err = e == SS_ADVANCE_NONFINITE ? STATE_NONFINITE : keep_state(d);
+		if (err == STATE_NONFINITE) {
+			keep_last_good_state(d);
+			*end = SS_DRIVE_NONFINITE;
+			return SS_OK;
+		}
+		if (err || (err = announce(d)))
+			return err;
+		if (e == SS_ADVANCE_STEADY || e == SS_ADVANCE_INTERRUPTED) {
+			*end = e == SS_ADVANCE_STEADY ? SS_DRIVE_STEADY : SS_DRIVE_INTERRUPTED;
+			break;
+		}
+	}
+	return SS_OK;
+}
+
+int ss_drive_finish(struct ss_drive *d, int err)
+{
+	if (ss_snapshot_destroy(d->snapshot) && !err)
+		err = SS_ERR_FAIL;
+	d->snapshot = NULL;
+	ss_output_release(d->claim);
+	d->claim = NULL;
+	return err;
+}

@@ -1,0 +1,198 @@
+/*
+ * print.c - what the commands print (see print.h).
+ */
+#include "cli/print.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+static void format_duration(double s, char *buf, size_t size)
+{
+	if (!isfinite(s) || s < 0)
+		snprintf(buf, size, "?");
+	else if (s < 60)
+		snprintf(buf, size, "%.0fs", s);
+	else if (s < 3600)
+		snprintf(buf, size, "%dm%02ds", (int)(s / 60), (int)fmod(s, 60));
+	else
+		snprintf(buf, size, "%dh%02dm", (int)(s / 3600), (int)fmod(s / 60, 60));
+}
+
+/* The progress line of this process. */
+static struct {
+	double last_print;          /* wall seconds of the last line */
+	int shown;                  /* a line is on the terminal */
+} progress;
+
+void cli_print_progress(void *context, const struct ss_progress *p)
+{
+	(void)context;
+	if (p->wall_seconds - progress.last_print < 0.5)
+		return;
+	progress.last_print = p->wall_seconds;
+	progress.shown = 1;
+	const double rate = (double)p->steps_here * p->cells / fmax(p->wall_seconds, 1e-9);
+	char tail[64];
+	if (isfinite(p->end)) {
+		/* the remaining time at the pace of this process so far */
+		const double done = p->time - p->time_start;
+		char d[24];
+		format_duration(done > 0.0 ? p->wall_seconds * (p->end - p->time) / done : NAN,
+		                d, sizeof d);
+		snprintf(tail, sizeof tail, "/ %.6g s  ETA %s", p->end, d);
+	} else {
+		snprintf(tail, sizeof tail, "s (steady below %.1e m/s)", p->steady_tol);
+	}
+	fprintf(stderr, "\r  t = %.6g %s  steps %lld  %.3g cells/s  max|dh/dt| %.2e m/s   ",
+	        p->time, tail, p->steps, rate, p->rate_max);
+	fflush(stderr);
+}
+
+void cli_progress_done(void)
+{
+	if (progress.shown)
+		fputc('\n', stderr);
+	progress.shown = 0;
+}
+
+void cli_print_run_end(const struct ss_run_summary *s, int quiet)
+{
+	if (s->end == SS_RUN_INTERRUPTED) {
+		fflush(stdout);
+		fprintf(stderr, "sandslide: interrupted at t = %g s (step %lld): snapshot %lld is "
+		        "in '%s'; continue with\n    sandslide run --restart %s\n", s->time,
+		        s->steps, s->snapshots - 1, s->output, s->output);
+		return;
+	}
+	if (quiet)
+		return;
+	printf("wrote %s: %lld snapshots to t = %g s, %lld steps%s\n", s->output, s->snapshots,
+	       s->time, s->steps, s->end == SS_RUN_STEADY ? " (steady)"
+	       : s->end == SS_RUN_NOT_STEADY ? " (not steady by max_time)" : "");
+	printf("wall %.3f s: slope %.3f s, sweep %.3f s, output %.3f s; "
+	       "%.3g cell-updates/s on %d threads\n", s->wall_seconds, s->measure_seconds,
+	       s->sweep_seconds, s->output_seconds,
+	       (double)s->steps_here * s->cells / fmax(s->measure_seconds + s->sweep_seconds, 1e-9),
+	       s->threads);
+}
+
+void cli_print_relax_end(const struct ss_relax_report *r, double angle_deg, int quiet)
+{
+	if (r->interrupted) {
+		fflush(stdout);
+		fprintf(stderr, "sandslide: interrupted at t = %g s (step %lld): '%s' holds the "
+		        "surface as it was then, not relaxed\n", r->time, r->steps, r->output);
+	}
+	if (quiet)
+		return;
+	printf("wrote %s: %d x %d cells, %s after %lld steps (t = %g s)\n", r->output, r->nx,
+	       r->ny, r->steady ? "steady" : r->interrupted ? "NOT steady (interrupted)"
+	       : "NOT steady by --max-time", r->steps, r->time);
+	printf("cells moved %lld, volume moved %.6g m^3, steepest sand face %.4f -> "
+	       "%.4f deg (repose %g), wall %.3f s\n", r->cells_moved, r->volume_moved,
+	       r->max_slope_before_deg, r->max_slope_after_deg, angle_deg, r->wall_seconds);
+}
+
+void cli_bench_header(void *context, const struct ss_bench_header *h)
+{
+	const struct cli_bench *b = context;
+	if (b->json) {
+		printf("{\n  \"nx\": %d, \"ny\": %d, \"tile_nx\": %d, \"tile_ny\": %d,\n"
+		       "  \"repeats\": %d, \"rsqrt\": \"%s\",\n  \"bandwidth_bytes_per_s\": {",
+		       h->nx, h->ny, h->tile_nx, h->tile_ny, h->repeats, h->rsqrt);
+		for (int t = 0; t < h->thread_count; t++)
+			printf("%s\"%d\": %.6g", t ? ", " : "", h->threads[t], h->bandwidth[t]);
+		printf("},\n  \"cases\": [");
+	} else {
+		printf("sandslide bench: %d x %d cells, tiles %dx%d, %d repeats per case, "
+		       "reciprocal sqrt: %s\n", h->nx, h->ny, h->tile_nx, h->tile_ny, h->repeats,
+		       h->rsqrt);
+		printf("memory bandwidth (read+write one array of %zu doubles):", h->probe_doubles);
+		for (int t = 0; t < h->thread_count; t++)
+			printf(" %d thread%s %.1f GB/s%s", h->threads[t], h->threads[t] > 1 ? "s" : "",
+			       h->bandwidth[t] * 1e-9, t + 1 < h->thread_count ? "," : "\n");
+		printf("\n%-14s %-22s %7s  %-34s %6s %6s %6s %8s\n", "surface", "closure", "threads",
+		       "cell-updates/s median [min, max]", "steps", "active", "B/cell", "roofline");
+	}
+	fflush(stdout);
+}
+
+void cli_bench_result(void *context, const struct ss_bench_result *r)
+{
+	struct cli_bench *b = context;
+	const char *surface = ss_bench_surface_name(r->surface);
+	if (b->json) {
+		printf("%s\n    {\"surface\": \"%s\", \"closure\": \"%s\", \"threads\": %d, "
+		       "\"cell_updates_per_s\": {\"median\": %.6g, \"min\": %.6g, \"max\": %.6g}, "
+		       "\"steps_per_repeat\": %lld, \"active_fraction\": %.6g, "
+		       "\"bytes_per_cell\": %.3g, \"roofline_cell_updates_per_s\": %.6g, "
+		       "\"roofline_fraction\": %.6g}", b->rows ? "," : "", surface, r->closure,
+		       r->threads, r->median, r->min, r->max, r->steps, r->active_fraction,
+		       r->bytes_per_cell, r->roofline, r->median / r->roofline);
+	} else {
+		char range[64];
+		snprintf(range, sizeof range, "%.3g [%.3g, %.3g]", r->median, r->min, r->max);
+		printf("%-14s %-22s %7d  %-34s %6lld %6.3f %6.2f %8.3f\n", surface, r->closure,
+		       r->threads, range, r->steps, r->active_fraction, r->bytes_per_cell,
+		       r->median / r->roofline);
+	}
+	b->rows++;
+	fflush(stdout);
+}
+
+void cli_bench_done(const struct cli_bench *b)
+{
+	if (b->json)
+		printf("\n  ]\n}\n");
+}
+
+static void print_diag_row(const struct ss_snapshot_summary *s, long long k)
+{
+	const struct ss_diagnostics *d = &s->diag[k];
+	printf("  %5lld %12.6g %13.6e %11.4e %11.4e %10.5g %9.4f %9.0f %7.3f %9.3f\n", k,
+	       s->time[k], d->volume, d->inflow, d->outflow, d->max_height, d->max_slope_deg,
+	       d->steps, d->active_fraction, d->wall_seconds);
+}
+
+/* The snapshots' diagnostics (first and last ten of more than twenty) and
+ * the volume balance. */
+static void print_series(const struct ss_snapshot_summary *s)
+{
+	printf("snapshots  %lld, t = %g .. %g s\n", s->count, s->time[0], s->time[s->count - 1]);
+	printf("  %5s %12s %13s %11s %11s %10s %9s %9s %7s %9s\n", "index", "time_s",
+	       "volume_m3", "inflow_m3", "outflow_m3", "max_h_m", "slope_deg", "steps",
+	       "active", "wall_s");
+	for (long long k = 0; k < s->count; k++) {
+		if (s->count > 20 && k == 10) {
+			printf("  %5s (%lld more)\n", "...", s->count - 20);
+			k = s->count - 10;
+		}
+		print_diag_row(s, k);
+	}
+	const struct ss_diagnostics *first = &s->diag[0], *last = &s->diag[s->count - 1];
+	const double balance = (last->volume - first->volume) - (last->inflow - last->outflow);
+	const double scale = fmax(fmax(fabs(last->volume), fabs(first->volume)),
+	                          fmax(last->inflow, last->outflow));
+	printf("volume balance  (V_last - V_0) - (inflow - outflow) = %.3e m^3 "
+	       "(%.2e relative)\n", balance, scale > 0 ? fabs(balance) / scale : 0.0);
+}
+
+void cli_print_info(const char *path, const struct ss_snapshot_summary *s)
+{
+	printf("file       %s (%s)\n", path, s->source);
+	printf("title      %s\n", s->title);
+	printf("grid       %d x %d cells, dx = %g m, dy = %g m, lower-left corner (%g, %g) m\n",
+	       s->nx, s->ny, s->dx, s->dy, s->origin_x, s->origin_y);
+	printf("cells      %lld flow, %lld wall, %lld open\n", s->flow_cells, s->wall_cells,
+	       s->open_cells);
+	printf("model      %s, repose angle %g deg, nu = %g m^2/s", s->closure,
+	       s->repose_angle_deg, s->nu);
+	if (!strcmp(s->closure, "herschel-bulkley"))
+		printf(", gamma = %g", s->gamma);
+	printf("\n");
+	if (s->count == 0)
+		printf("snapshots  none\n");
+	else
+		print_series(s);
+}
