@@ -455,3 +455,29 @@ def test_shipped_case_reaches_repose_angle(tmp_path, name):
         assert abs(slope[-1] - 35.0) < 0.5, \
             f"{name}: final max_slope_deg {slope[-1]} is not within 0.5 deg of 35"
         assert np.all(np.isfinite(f["height"][-1]))
+
+
+def test_options_take_name_equals_value(tmp_path):
+    """Every option with a value takes --name=VALUE as well (src/cli/options.c)."""
+    write(tmp_path, BASE)
+    run_ok(["run", "case.ini", "--output=o.h5", "--threads=1", "--set=model.nu=0.2",
+            "--quiet"], cwd=tmp_path)
+    with h5open(tmp_path / "o.h5") as f:
+        assert f.attrs["nu"] == 0.2
+
+
+@pytest.mark.parametrize("command, options", [
+    ("run", ["--output", "--force", "--restart", "--threads", "--set", "--tile",
+             "--reference-kernel", "--deflate", "--quiet", "--frames"]),
+    ("relax", ["--angle", "--closure", "--cfl", "--sides", "--nodata", "--add-sand",
+               "--output-every", "--report"]),
+    ("render", ["--frames", "--time", "--video", "--bench", "--style", "--zmin",
+                "--view-elevation", "--compression"]),
+    ("bench", ["--nx", "--ny", "--closure", "--threads", "--surface", "--json"]),
+])
+def test_help_lists_every_option_each_on_its_own_line(command, options):
+    r = run_ok([command, "--help"])
+    lines = r.stdout.splitlines()
+    for name in options:
+        assert any(l.lstrip().startswith((name + " ", name)) or f", {name}" in l
+                   for l in lines), f"{command} --help lacks {name}: {r.stdout}"
