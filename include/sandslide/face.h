@@ -16,8 +16,8 @@
  * With AVX-512 the reciprocal square roots are vrsqrt14pd refined by two
  * Newton steps (relative error below 1e-15 against 1/sqrt); elsewhere they
  * are 1/sqrt.  Herschel-Bulkley with gamma = 1/2 (e^3) and gamma = 2
- * (e sqrt e) avoids pow().  tests/test_face.c holds these to the formulas of
- * closure.h (SPEC section 1).
+ * (e sqrt e) avoids pow().  tests/test_sweep.c (test_face_formula) holds
+ * these to the formulas of closure.h (SPEC section 1).
  *
  * The function is compiled once (face.c) and works on a row of faces, so the
  * reference sweep (one face per call) and the fast sweep (a row per call)
