@@ -129,6 +129,149 @@ static int header_key(const char *name, int *center)
 	return -1;
 }
 
+/* The header as read: a value per key, where it was set, which corner. */
+struct asc_header {
+	double val[K_COUNT];
+	int seen[K_COUNT], line[K_COUNT], center[K_COUNT];
+};
+
+/* The "key value" pairs before the first number; sc is left at it. */
+static int read_header(struct scan *sc, const char *path, const char *context,
+                       struct asc_header *h)
+{
+	char tok[128], key[128];
+	memset(h, 0, sizeof *h);
+	for (int k = 0; k < K_COUNT; k++)
+		h->val[k] = NAN;
+	const char *mark = sc->s;
+	int mark_line = sc->line;
+	while (next_token(sc, tok, sizeof tok)) {
+		if (!isalpha((unsigned char)tok[0]) || !strcasecmp(tok, "nan") ||
+		    !strcasecmp(tok, "inf") || !strcasecmp(tok, "infinity")) {
+			sc->s = mark;   /* the first value: rewind */
+			sc->line = mark_line;
+			break;
+		}
+		snprintf(key, sizeof key, "%s", tok);
+		const int key_line = sc->line;
+		int is_center;
+		const int k = header_key(key, &is_center);
+		double v;
+		if (k < 0)
+			return ss_error_input_at(context, "%s:%d: unknown header key '%s': expected "
+			                         "ncols, nrows, xllcorner or xllcenter, yllcorner or "
+			                         "yllcenter, cellsize (or dx and dy), NODATA_value",
+			                         path, key_line, key);
+		if (h->seen[k])
+			return ss_error_input_at(context, "%s:%d: header key '%s' repeats line %d", path,
+			                         key_line, key, h->line[k]);
+		if (!next_token(sc, tok, sizeof tok) || to_double(tok, &v))
+			return ss_error_input_at(context, "%s:%d: header key '%s' has no numeric value",
+			                         path, key_line, key);
+		h->seen[k] = 1;
+		h->line[k] = key_line;
+		h->center[k] = is_center;
+		h->val[k] = v;
+		mark = sc->s;
+		mark_line = sc->line;
+	}
+	return SS_OK;
+}
+
+/* The header's size, corner, cell size and nodata value into r, checked. */
+static int apply_header(const struct asc_header *h, const char *path, const char *context,
+                        struct ss_raster *r)
+{
+	for (int k = K_NCOLS; k <= K_NROWS; k++)
+		if (!h->seen[k] || !(h->val[k] >= 1 && h->val[k] <= 1 << 30 &&
+		                     h->val[k] == floor(h->val[k])))
+			return ss_error_input_at(context, "%s: ESRI ASCII header needs ncols and nrows, "
+			                         "integers from 1 to 2^30", path);
+	if (!h->seen[K_XLL] || !h->seen[K_YLL] || !isfinite(h->val[K_XLL]) ||
+	    !isfinite(h->val[K_YLL]))
+		return ss_error_input_at(context, "%s: ESRI ASCII header needs the lower-left "
+		                         "corner: xllcorner and yllcorner (or xllcenter and "
+		                         "yllcenter), finite numbers", path);
+	if (h->center[K_XLL] != h->center[K_YLL])
+		return ss_error_input_at(context, "%s:%d: mixes a corner and a centre: expected "
+		                         "xllcorner with yllcorner, or xllcenter with yllcenter",
+		                         path, h->line[K_YLL]);
+	const int square = h->seen[K_CELL] && !h->seen[K_DX] && !h->seen[K_DY];
+	if (!square && !(!h->seen[K_CELL] && h->seen[K_DX] && h->seen[K_DY]))
+		return ss_error_input_at(context, "%s: ESRI ASCII header needs cellsize, or dx and "
+		                         "dy (not both forms)", path);
+	const double dx = square ? h->val[K_CELL] : h->val[K_DX];
+	const double dy = square ? h->val[K_CELL] : h->val[K_DY];
+	if (!(dx > 0.0 && dy > 0.0 && isfinite(dx) && isfinite(dy)))
+		return ss_error_input_at(context, "%s: ESRI ASCII cell size %g x %g: expected "
+		                         "numbers > 0", path, dx, dy);
+	r->nx = (int)h->val[K_NCOLS];
+	r->ny = (int)h->val[K_NROWS];
+	r->cellsize = dx;
+	r->cellsize_y = dy;
+	r->asc_center = h->center[K_XLL];
+	r->x0 = r->asc_center ? h->val[K_XLL] - 0.5 * dx : h->val[K_XLL];
+	r->y0 = r->asc_center ? h->val[K_YLL] - 0.5 * dy : h->val[K_YLL];
+	r->has_nodata_value = h->seen[K_NODATA];
+	r->nodata_value = h->seen[K_NODATA] ? h->val[K_NODATA] : NAN;
+	return SS_OK;
+}
+
+/* One value of the grid, file row `row` (north first), column i, into r;
+ * a NODATA_value marks the cell. */
+static int store_value(struct ss_raster *r, const char *tok, int line, int row, int i,
+                       const char *path, const char *context)
+{
+	const size_t n = (size_t)r->nx * (size_t)r->ny;
+	const size_t m = (size_t)(r->ny - 1 - row) * r->nx + i;
+	const double nodata = r->nodata_value;
+	double v;
+	if (to_double(tok, &v))
+		return ss_error_input_at(context, "%s:%d: '%s' (row %d, column %d) is not a number",
+		                         path, line, tok, row + 1, i + 1);
+	if (r->has_nodata_value && (v == nodata || (isnan(v) && isnan(nodata)))) {
+		if (!r->nodata && !(r->nodata = ss_alloc(n, 1, "nodata flags")))
+			return SS_ERR_FAIL;
+		r->nodata[m] = 1;
+		v = 0.0;
+	} else if (!isfinite(v)) {
+		return ss_error_input_at(context, "%s:%d: height '%s' (row %d, column %d) is not "
+		                         "finite: heights must be finite numbers (mark missing "
+		                         "cells with NODATA_value)", path, line, tok, row + 1, i + 1);
+	}
+	r->values[m] = v;
+	return SS_OK;
+}
+
+/* The nrows x ncols values after the header, north row first; exactly
+ * that many. */
+static int read_values(struct scan *sc, const char *path, const char *context,
+                       struct ss_raster *r)
+{
+	char tok[128];
+	/* a short file is refused before the heights are allocated: a header
+	 * of a few bytes must not claim gigabytes */
+	const size_t n = (size_t)r->nx * (size_t)r->ny;
+	const size_t given = count_tokens(sc->s, n);
+	if (given < n)
+		return ss_error_input_at(context, "%s: ends after %zu of %d x %d values", path, given,
+		                         r->nx, r->ny);
+	if (!(r->values = ss_alloc(n, sizeof(double), "raster heights")))
+		return SS_ERR_FAIL;
+	for (int row = 0; row < r->ny; row++) {
+		for (int i = 0; i < r->nx; i++) {
+			next_token(sc, tok, sizeof tok);   /* counted above */
+			const int err = store_value(r, tok, sc->line, row, i, path, context);
+			if (err)
+				return err;
+		}
+	}
+	if (next_token(sc, tok, sizeof tok))
+		return ss_error_input_at(context, "%s:%d: more values than ncols x nrows = %d x %d",
+		                         path, sc->line, r->nx, r->ny);
+	return SS_OK;
+}
+
 int ss_dem_read_asc(const char *path, const char *context, const struct ss_dem_read_options *opt,
                     struct ss_raster *r)
 {
@@ -138,146 +281,10 @@ int ss_dem_read_asc(const char *path, const char *context, const struct ss_dem_r
 	if (!text)
 		return err;
 	struct scan sc = {text, 1};
-	char tok[128];
-	double v, val[K_COUNT];
-	int seen[K_COUNT] = {0}, line[K_COUNT] = {0}, center[K_COUNT] = {0};
-	for (int k = 0; k < K_COUNT; k++)
-		val[k] = NAN;
-
-	/* header: "key value" pairs until the first number */
-	const char *mark = sc.s;
-	int mark_line = sc.line;
-	while (next_token(&sc, tok, sizeof tok)) {
-		if (!isalpha((unsigned char)tok[0]) || !strcasecmp(tok, "nan") ||
-		    !strcasecmp(tok, "inf") || !strcasecmp(tok, "infinity")) {
-			sc.s = mark;   /* the first value: rewind */
-			sc.line = mark_line;
-			break;
-		}
-		char key[128];
-		snprintf(key, sizeof key, "%s", tok);
-		const int key_line = sc.line;
-		int is_center;
-		const int k = header_key(key, &is_center);
-		if (k < 0) {
-			err = ss_error_input_at(context, "%s:%d: unknown header key '%s': expected ncols, "
-			                        "nrows, xllcorner or xllcenter, yllcorner or yllcenter, "
-			                        "cellsize (or dx and dy), NODATA_value", path, key_line,
-			                        key);
-			goto out;
-		}
-		if (seen[k]) {
-			err = ss_error_input_at(context, "%s:%d: header key '%s' repeats line %d", path,
-			                        key_line, key, line[k]);
-			goto out;
-		}
-		if (!next_token(&sc, tok, sizeof tok) || to_double(tok, &v)) {
-			err = ss_error_input_at(context, "%s:%d: header key '%s' has no numeric value",
-			                        path, key_line, key);
-			goto out;
-		}
-		seen[k] = 1;
-		line[k] = key_line;
-		center[k] = is_center;
-		val[k] = v;
-		mark = sc.s;
-		mark_line = sc.line;
-	}
-	for (int k = K_NCOLS; k <= K_NROWS; k++) {
-		if (!seen[k] || !(val[k] >= 1 && val[k] <= 1 << 30 && val[k] == floor(val[k]))) {
-			err = ss_error_input_at(context, "%s: ESRI ASCII header needs ncols and nrows, "
-			                        "integers from 1 to 2^30", path);
-			goto out;
-		}
-	}
-	if (!seen[K_XLL] || !seen[K_YLL] || !isfinite(val[K_XLL]) || !isfinite(val[K_YLL])) {
-		err = ss_error_input_at(context, "%s: ESRI ASCII header needs the lower-left corner: "
-		                        "xllcorner and yllcorner (or xllcenter and yllcenter), finite "
-		                        "numbers", path);
-		goto out;
-	}
-	if (center[K_XLL] != center[K_YLL]) {
-		err = ss_error_input_at(context, "%s:%d: mixes a corner and a centre: expected "
-		                        "xllcorner with yllcorner, or xllcenter with yllcenter", path,
-		                        line[K_YLL]);
-		goto out;
-	}
-	double dx, dy;
-	if (seen[K_CELL] && !seen[K_DX] && !seen[K_DY]) {
-		dx = dy = val[K_CELL];
-	} else if (!seen[K_CELL] && seen[K_DX] && seen[K_DY]) {
-		dx = val[K_DX];
-		dy = val[K_DY];
-	} else {
-		err = ss_error_input_at(context, "%s: ESRI ASCII header needs cellsize, or dx and dy "
-		                        "(not both forms)", path);
-		goto out;
-	}
-	if (!(dx > 0.0 && dy > 0.0 && isfinite(dx) && isfinite(dy))) {
-		err = ss_error_input_at(context, "%s: ESRI ASCII cell size %g x %g: expected numbers > 0",
-		                        path, dx, dy);
-		goto out;
-	}
-	const int have_nodata = seen[K_NODATA];
-	const double nodata = val[K_NODATA];
-	r->nx = (int)val[K_NCOLS];
-	r->ny = (int)val[K_NROWS];
-	r->cellsize = dx;
-	r->cellsize_y = dy;
-	r->asc_center = center[K_XLL];
-	r->x0 = r->asc_center ? val[K_XLL] - 0.5 * dx : val[K_XLL];
-	r->y0 = r->asc_center ? val[K_YLL] - 0.5 * dy : val[K_YLL];
-	r->has_nodata_value = have_nodata;
-	r->nodata_value = have_nodata ? nodata : NAN;
-
-	/* a short file is refused before the heights are allocated: a
-	 * header of a few bytes must not claim gigabytes */
-	const size_t n = (size_t)r->nx * (size_t)r->ny;
-	const size_t given = count_tokens(sc.s, n);
-	if (given < n) {
-		err = ss_error_input_at(context, "%s: ends after %zu of %d x %d values", path, given,
-		                        r->nx, r->ny);
-		goto out;
-	}
-	r->values = ss_alloc(n, sizeof(double), "raster heights");
-	if (!r->values) {
-		err = SS_ERR_FAIL;
-		goto out;
-	}
-	for (int row = 0; row < r->ny; row++) {   /* north row first in the file */
-		const int j = r->ny - 1 - row;
-		for (int i = 0; i < r->nx; i++) {
-			if (!next_token(&sc, tok, sizeof tok)) {
-				err = ss_error_input_at(context, "%s: ends after %d of %d x %d values", path,
-				                        row * r->nx + i, r->nx, r->ny);
-				goto out;
-			}
-			if (to_double(tok, &v)) {
-				err = ss_error_input_at(context, "%s:%d: '%s' (row %d, column %d) is not a "
-				                        "number", path, sc.line, tok, row + 1, i + 1);
-				goto out;
-			}
-			if (have_nodata && (v == nodata || (isnan(v) && isnan(nodata)))) {
-				if (!r->nodata && !(r->nodata = ss_alloc(n, 1, "nodata flags"))) {
-					err = SS_ERR_FAIL;
-					goto out;
-				}
-				r->nodata[(size_t)j * r->nx + i] = 1;
-				v = 0.0;
-			} else if (!isfinite(v)) {
-				err = ss_error_input_at(context, "%s:%d: height '%s' (row %d, column %d) is not "
-				                        "finite: heights must be finite numbers (mark missing "
-				                        "cells with NODATA_value)", path, sc.line, tok,
-				                        row + 1, i + 1);
-				goto out;
-			}
-			r->values[(size_t)j * r->nx + i] = v;
-		}
-	}
-	if (next_token(&sc, tok, sizeof tok))
-		err = ss_error_input_at(context, "%s:%d: more values than ncols x nrows = %d x %d", path,
-		                        sc.line, r->nx, r->ny);
-out:
+	struct asc_header h;
+	if (!(err = read_header(&sc, path, context, &h)) &&
+	    !(err = apply_header(&h, path, context, r)))
+		err = read_values(&sc, path, context, r);
 	free(text);
 	return err;
 }

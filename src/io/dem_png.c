@@ -157,136 +157,169 @@ static int read_meta(png_structp png, png_infop info, const char *path, const ch
 	return SS_OK;
 }
 
-int ss_dem_read_png(const char *path, const char *context, const struct ss_dem_read_options *opt,
-                    struct ss_raster *r)
+/* A PNG being read: the file, libpng's structures and what they decoded. */
+struct png_reader {
+	FILE *f;
+	png_structp png;
+	png_infop info, end;
+	struct png_job job;
+};
+
+static void reader_close(struct png_reader *rd)
 {
-	FILE *f = fopen(path, "rb");
-	if (!f)
+	png_destroy_read_struct(rd->png ? &rd->png : NULL, rd->info ? &rd->info : NULL,
+	                        rd->end ? &rd->end : NULL);
+	ss_free(rd->job.rows);
+	ss_free(rd->job.pixels);
+	if (rd->f)
+		fclose(rd->f);
+}
+
+/* Open path and check what libpng does not before it reads: the
+ * signature, and that every chunk fits in the file (png_check.h). */
+static int reader_open(struct png_reader *rd, const char *path, const char *context)
+{
+	memset(rd, 0, sizeof *rd);
+	if (!(rd->f = fopen(path, "rb")))
 		return ss_error_input_at(context, "cannot open '%s': %s", path, strerror(errno));
 	png_byte sig[8];
-	if (fread(sig, 1, 8, f) != 8 || png_sig_cmp(sig, 0, 8)) {
-		fclose(f);
-		return ss_error_input_at(context, "'%s' is not a PNG file: expected a 16-bit greyscale "
-		                         "PNG heightmap", path);
-	}
+	if (fread(sig, 1, 8, rd->f) != 8 || png_sig_cmp(sig, 0, 8))
+		return ss_error_input_at(context, "'%s' is not a PNG file: expected a 16-bit "
+		                         "greyscale PNG heightmap", path);
 	char chunk[5];
 	unsigned long chunk_bytes;
-	if (ss_png_check_chunks(f, chunk, &chunk_bytes)) {
-		fclose(f);
-		return ss_error_input_at(context, "cannot decode PNG '%s': chunk %s claims %lu bytes, "
-		                         "more than the file holds: the file is truncated or corrupt",
-		                         path, chunk, chunk_bytes);
-	}
-	struct png_job job;
-	memset(&job, 0, sizeof job);
+	if (ss_png_check_chunks(rd->f, chunk, &chunk_bytes))
+		return ss_error_input_at(context, "cannot decode PNG '%s': chunk %s claims %lu "
+		                         "bytes, more than the file holds: the file is truncated "
+		                         "or corrupt", path, chunk, chunk_bytes);
 	struct stat st;
-	job.file_bytes = fstat(fileno(f), &st) == 0 ? (double)st.st_size : INFINITY;
-	int err = SS_OK;
-	png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, job.message, on_error,
-	                                         on_warning);
-	png_infop info = png ? png_create_info_struct(png) : NULL;
-	png_infop end = png ? png_create_info_struct(png) : NULL;
-	if (!png || !info || !end) {
-		err = ss_error_fail("cannot read '%s': out of memory in libpng", path);
-		goto out;
-	}
-	switch (decode(png, info, end, f, &job)) {
+	rd->job.file_bytes = fstat(fileno(rd->f), &st) == 0 ? (double)st.st_size : INFINITY;
+	rd->png = png_create_read_struct(PNG_LIBPNG_VER_STRING, rd->job.message, on_error,
+	                                 on_warning);
+	rd->info = rd->png ? png_create_info_struct(rd->png) : NULL;
+	rd->end = rd->png ? png_create_info_struct(rd->png) : NULL;
+	if (!rd->png || !rd->info || !rd->end)
+		return ss_error_fail("cannot read '%s': out of memory in libpng", path);
+	return SS_OK;
+}
+
+/* Decode the image, saying why one is refused. */
+static int reader_decode(struct png_reader *rd, const char *path, const char *context)
+{
+	const struct png_job *job = &rd->job;
+	switch (decode(rd->png, rd->info, rd->end, rd->f, &rd->job)) {
 	case DECODE_OK:
 		break;
 	case DECODE_PNG_ERROR:
-		err = ss_error_input_at(context, "cannot decode PNG '%s': %s", path, job.message);
-		goto out;
+		return ss_error_input_at(context, "cannot decode PNG '%s': %s", path, job->message);
 	case DECODE_NOT_GRAY16:
-		err = ss_error_input_at(context, "'%s' is a %d-bit %s PNG: expected a 16-bit greyscale "
-		                        "heightmap (colour type grey, bit depth 16, no alpha)", path,
-		                        job.bit_depth, color_name(job.color_type));
-		goto out;
+		return ss_error_input_at(context, "'%s' is a %d-bit %s PNG: expected a 16-bit "
+		                         "greyscale heightmap (colour type grey, bit depth 16, no "
+		                         "alpha)", path, job->bit_depth, color_name(job->color_type));
 	case DECODE_NO_MEMORY:
-		err = SS_ERR_FAIL;
-		goto out;
+		return SS_ERR_FAIL;
 	case DECODE_TOO_SHORT:
-		err = ss_error_input_at(context, "cannot decode PNG '%s': %.0f bytes cannot hold "
-		                        "%u x %u 16-bit pixels: the file is truncated or corrupt",
-		                        path, job.file_bytes, (unsigned)job.width,
-		                        (unsigned)job.height);
-		goto out;
+		return ss_error_input_at(context, "cannot decode PNG '%s': %.0f bytes cannot hold "
+		                         "%u x %u 16-bit pixels: the file is truncated or corrupt",
+		                         path, job->file_bytes, (unsigned)job->width,
+		                         (unsigned)job->height);
 	}
-	if (job.width > 1u << 30 || job.height > 1u << 30) {
-		err = ss_error_input_at(context, "'%s' is %u x %u pixels: at most 2^30 a side", path,
-		                        (unsigned)job.width, (unsigned)job.height);
-		goto out;
-	}
+	if (job->width > 1u << 30 || job->height > 1u << 30)
+		return ss_error_input_at(context, "'%s' is %u x %u pixels: at most 2^30 a side",
+		                         path, (unsigned)job->width, (unsigned)job->height);
+	return SS_OK;
+}
 
-	struct png_meta m = {NAN, NAN, NAN, NAN, NAN, NAN};
-	if ((err = read_meta(png, info, path, context, &m)) ||
-	    (err = read_meta(png, end, path, context, &m)))
-		goto out;
-	if ((!isnan(m.dx) && !(m.dx > 0.0)) || (!isnan(m.dy) && !(m.dy > 0.0))) {
-		err = ss_error_input_at(context, "%s: text chunk " KEY_DX " or " KEY_DY " is not > 0",
-		                        path);
-		goto out;
-	}
-	/* how grey becomes height, and which greys are no data */
-	const int given = !isnan(opt->zscale);
-	if (!given && (isnan(m.zmin) || isnan(m.zmax))) {
-		err = ss_error_input_at(context, "%s: 16-bit PNG without a height range (no text "
-		                        "chunks " KEY_ZMIN " and " KEY_ZMAX "): give the vertical scale "
-		                        "zscale (m per grey level) and zoffset (m at grey 0)", path);
-		goto out;
-	}
-	const double zscale = given ? opt->zscale : (m.zmax - m.zmin) / 65534.0;
-	const double zoffset = given ? (isnan(opt->zoffset) ? 0.0 : opt->zoffset) : 0.0;
+/* How grey becomes height: zoffset + zscale * grey with the options' scale,
+ * else the gray16 rule between the text chunks' zmin and zmax. */
+struct grey_map {
+	int given;              /* the options' zscale */
+	double zscale, zoffset;
+	int trns_grey;          /* the tRNS grey (no data), or NO_GREY */
+	struct png_meta m;
+};
+
+static int grey_map(const struct png_reader *rd, const struct ss_dem_read_options *opt,
+                    const char *path, const char *context, struct grey_map *g)
+{
+	int err;
+	g->m = (struct png_meta){NAN, NAN, NAN, NAN, NAN, NAN};
+	if ((err = read_meta(rd->png, rd->info, path, context, &g->m)) ||
+	    (err = read_meta(rd->png, rd->end, path, context, &g->m)))
+		return err;
+	if ((!isnan(g->m.dx) && !(g->m.dx > 0.0)) || (!isnan(g->m.dy) && !(g->m.dy > 0.0)))
+		return ss_error_input_at(context, "%s: text chunk " KEY_DX " or " KEY_DY " is not > 0",
+		                         path);
+	g->given = !isnan(opt->zscale);
+	if (!g->given && (isnan(g->m.zmin) || isnan(g->m.zmax)))
+		return ss_error_input_at(context, "%s: 16-bit PNG without a height range (no text "
+		                         "chunks " KEY_ZMIN " and " KEY_ZMAX "): give the vertical "
+		                         "scale zscale (m per grey level) and zoffset (m at grey 0)",
+		                         path);
+	g->zscale = g->given ? opt->zscale : (g->m.zmax - g->m.zmin) / 65534.0;
+	g->zoffset = g->given && !isnan(opt->zoffset) ? opt->zoffset : 0.0;
 	png_color_16p trns = NULL;
-	const int trns_grey = png_get_tRNS(png, info, NULL, NULL, &trns) && trns ? trns->gray
-	                                                                         : NO_GREY;
-	const int zero_nodata = !given;   /* the gray16 rule: grey 0 is no data */
+	g->trns_grey = png_get_tRNS(rd->png, rd->info, NULL, NULL, &trns) && trns ? trns->gray
+	                                                                        : NO_GREY;
+	return SS_OK;
+}
 
-	r->nx = (int)job.width;
-	r->ny = (int)job.height;
-	if (!given) {
-		r->png_zmin = m.zmin;
-		r->png_zmax = m.zmax;
-	}
-	r->cellsize = m.dx;
-	r->cellsize_y = isnan(m.dy) ? m.dx : m.dy;
-	r->x0 = m.x0;
-	r->y0 = m.y0;
+/* The pixels as heights into r (south row first), no data where grey 0
+ * (the gray16 rule) or the tRNS grey says. */
+static int greys_to_heights(const struct png_reader *rd, const struct grey_map *g,
+                            const char *path, const char *context, struct ss_raster *r)
+{
 	const size_t n = (size_t)r->nx * (size_t)r->ny;
-	r->values = ss_alloc(n, sizeof(double), "raster heights");
-	if (!r->values) {
-		err = SS_ERR_FAIL;
-		goto out;
-	}
+	if (!(r->values = ss_alloc(n, sizeof(double), "raster heights")))
+		return SS_ERR_FAIL;
 	for (int row = 0; row < r->ny; row++) {   /* north row first in the file */
 		const size_t j = (size_t)(r->ny - 1 - row);
-		const uint8_t *p = job.rows[row];
+		const uint8_t *p = rd->job.rows[row];
 		for (int i = 0; i < r->nx; i++) {
 			const int grey = p[2 * i] << 8 | p[2 * i + 1];
-			if (grey == trns_grey || (grey == 0 && zero_nodata)) {
-				if (!r->nodata && !(r->nodata = ss_alloc(n, 1, "nodata flags"))) {
-					err = SS_ERR_FAIL;
-					goto out;
-				}
+			if (grey == g->trns_grey || (grey == 0 && !g->given)) {
+				if (!r->nodata && !(r->nodata = ss_alloc(n, 1, "nodata flags")))
+					return SS_ERR_FAIL;
 				r->nodata[j * r->nx + i] = 1;
 				continue;
 			}
 			/* both ends of the stored range come back exactly */
-			const double h = given ? zoffset + zscale * grey
-			               : grey == 65535 ? m.zmax : m.zmin + (grey - 1) * zscale;
-			if (!isfinite(h)) {
-				err = ss_error_input_at(context, "%s: grey %d at row %d, column %d (from the "
-				                        "north-west) gives height %g: the range is too large",
-				                        path, grey, row + 1, i + 1, h);
-				goto out;
-			}
+			const double h = g->given ? g->zoffset + g->zscale * grey
+			               : grey == 65535 ? g->m.zmax : g->m.zmin + (grey - 1) * g->zscale;
+			if (!isfinite(h))
+				return ss_error_input_at(context, "%s: grey %d at row %d, column %d (from "
+				                         "the north-west) gives height %g: the range is too "
+				                         "large", path, grey, row + 1, i + 1, h);
 			r->values[j * r->nx + i] = h;
 		}
 	}
-out:
-	png_destroy_read_struct(png ? &png : NULL, info ? &info : NULL, end ? &end : NULL);
-	ss_free(job.rows);
-	ss_free(job.pixels);
-	fclose(f);
+	return SS_OK;
+}
+
+int ss_dem_read_png(const char *path, const char *context, const struct ss_dem_read_options *opt,
+                    struct ss_raster *r)
+{
+	struct png_reader rd;
+	struct grey_map g;
+	int err = reader_open(&rd, path, context);
+	if (!err)
+		err = reader_decode(&rd, path, context);
+	if (!err)
+		err = grey_map(&rd, opt, path, context, &g);
+	if (!err) {
+		r->nx = (int)rd.job.width;
+		r->ny = (int)rd.job.height;
+		if (!g.given) {
+			r->png_zmin = g.m.zmin;
+			r->png_zmax = g.m.zmax;
+		}
+		r->cellsize = g.m.dx;
+		r->cellsize_y = isnan(g.m.dy) ? g.m.dx : g.m.dy;
+		r->x0 = g.m.x0;
+		r->y0 = g.m.y0;
+		err = greys_to_heights(&rd, &g, path, context, r);
+	}
+	reader_close(&rd);
 	return err;
 }
 
