@@ -14,6 +14,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "sandslide/error.h"
@@ -43,24 +44,48 @@ static void synthetic(int n, double *h, uint8_t *type)
 		}
 }
 
-int ss_render_bench(int n, int repeats)
+/* The PNG encoding of img, once per level of report->png_levels, timed. */
+static int time_png(const struct ss_render_image *img, struct ss_render_bench_report *report)
+{
+	char path[4200];
+	const char *dir = getenv("TMPDIR");
+	snprintf(path, sizeof path, "%s/sandslide-bench-%ld.png", dir && *dir ? dir : "/tmp",
+	         (long)getpid());
+	int err = SS_OK;
+	for (int l = 0; l < 2 && !err; l++) {
+		const double t0 = ss_parallel_wall_seconds();
+		err = ss_render_write_png(img, path, report->png_levels[l]);
+		report->png[l] = ss_parallel_wall_seconds() - t0;
+		struct stat st;
+		report->png_bytes[l] = !err && stat(path, &st) == 0 ? (double)st.st_size : 0.0;
+		remove(path);
+	}
+	return err;
+}
+
+int ss_render_bench(int n, int repeats, struct ss_render_bench_report *report)
 {
 	if (n < 16 || n > 32768 || repeats < 1 || repeats > 100)
 		return ss_error_input("--bench %d: expected a grid of 16 to 32768 cells a side "
 		                      "(and 1 to 100 repeats)", n);
+	*report = (struct ss_render_bench_report){.n = n, .repeats = repeats,
+	                                          .threads = ss_parallel_max_threads(),
+	                                          .png_levels = {1, 6}};
 	const size_t cells = (size_t)n * n;
 	double *h = ss_alloc(cells, sizeof *h, "bench heights");
 	uint8_t *type = ss_alloc(cells, 1, "bench cell types");
-	double *times = calloc((size_t)repeats, sizeof *times);
+	double *times = ss_alloc((size_t)repeats, sizeof *times, "bench timings");
 	if (!h || !type || !times) {
 		ss_free(h);
 		ss_free(type);
-		free(times);
-		return times ? SS_ERR_FAIL : ss_error_fail("out of memory");
+		ss_free(times);
+		return SS_ERR_FAIL;
 	}
 	synthetic(n, h, type);
 	struct ss_render_options o;
 	ss_render_options_default(&o);
+	o.scale = 1;   /* one pixel per cell, as the frames below are fed (the
+	                  default enlarges grids under 512 cells a side) */
 	const struct ss_render_field f = {n, n, 1e-3, 1e-3, n, h, type, 0.0};
 
 	/* As in a series: the plan (scale, pixel types) once, then per frame
@@ -85,45 +110,22 @@ int ss_render_bench(int n, int repeats)
 	ss_render_plan_release(&plan);
 	if (!err) {
 		qsort(times, (size_t)repeats, sizeof *times, cmp_double);
-		const double mpx = (double)cells * 1e-6;
-		printf("shaded %d x %d (%.1f Mpixel), %d threads, %d repeats: median %.3f s = %.1f "
-		       "Mpixel/s (min %.3f s, max %.3f s)\n", n, n, mpx, ss_parallel_max_threads(),
-		       repeats, times[repeats / 2], mpx / times[repeats / 2], times[0],
-		       times[repeats - 1]);
+		report->median = times[repeats / 2];
+		report->min = times[0];
+		report->max = times[repeats - 1];
 		/* the whole of ss_render_field: plan, range and colouring each time */
 		struct ss_render_image once;
 		const double started = ss_parallel_wall_seconds();
-		err = ss_render_field(&f, &o, &once);
-		if (!err) {
-			printf("ss_render_field (plan and scale included): %.3f s\n",
-			       ss_parallel_wall_seconds() - started);
+		if (!(err = ss_render_field(&f, &o, &once))) {
+			report->field = ss_parallel_wall_seconds() - started;
 			ss_render_image_release(&once);
 		}
-		char path[4200];
-		const char *dir = getenv("TMPDIR");
-		snprintf(path, sizeof path, "%s/sandslide-bench-%ld.png", dir && *dir ? dir : "/tmp",
-		         (long)getpid());
-		const int levels[] = {1, 6};
-		for (int l = 0; l < 2 && !err; l++) {
-			const double t0 = ss_parallel_wall_seconds();
-			err = ss_render_write_png(&img, path, levels[l]);
-			const double s = ss_parallel_wall_seconds() - t0;
-			FILE *fp = err ? NULL : fopen(path, "rb");
-			long bytes = 0;
-			if (fp) {
-				fseek(fp, 0, SEEK_END);
-				bytes = ftell(fp);
-				fclose(fp);
-			}
-			remove(path);
-			if (!err)
-				printf("png encoding, zlib level %d (serial): %.3f s = %.1f Mpixel/s, "
-				       "%.1f MB\n", levels[l], s, mpx / s, bytes * 1e-6);
-		}
 	}
+	if (!err)
+		err = time_png(&img, report);
 	ss_render_image_release(&img);
 out_free:
-	free(times);
+	ss_free(times);
 	ss_free(type);
 	ss_free(h);
 	return err;

@@ -206,11 +206,21 @@ void ss_render_frames_destroy(struct ss_render_frames *fr);
  */
 int ss_render_video(const char *dir, long long count, int fps, const char *video);
 
+/* What ss_render_bench measured, s. */
+struct ss_render_bench_report {
+	int n, repeats, threads;
+	double median, min, max;    /* colouring one frame (plan made once) */
+	double field;               /* ss_render_field: plan, scale and colouring */
+	int png_levels[2];          /* zlib levels timed */
+	double png[2];              /* encoding the frame at each level (serial) */
+	double png_bytes[2];        /* the file it made */
+};
+
 /*
  * Throughput of the shaded style on an n x n synthetic grid (walls, open
  * cells, slopes), one frame rendered `repeats` times, and of the PNG
- * encoding; prints the median, min and max in Mpixel/s.
+ * encoding, into *report (the caller prints it).
  */
-int ss_render_bench(int n, int repeats);
+int ss_render_bench(int n, int repeats, struct ss_render_bench_report *report);
 
 #endif

@@ -483,8 +483,13 @@ static int cmd_render(int argc, char **argv)
 	if (status != CLI_GO_ON)
 		return status;
 	ss_parallel_set_threads(a.threads > 0 ? a.threads : ss_parallel_processors());
-	if (a.bench)
-		return ss_status_exit_code(ss_render_bench(a.bench_n, 5));
+	if (a.bench) {
+		struct ss_render_bench_report report;
+		const int err = ss_render_bench(a.bench_n, 5, &report);
+		if (!err)
+			cli_print_render_bench(&report);
+		return ss_status_exit_code(err);
+	}
 	if (!a.o.input)
 		return cli_usage_error(&cmd, "render needs a sandslide output file");
 	return ss_status_exit_code(ss_render_series(&a.o));

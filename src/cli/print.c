@@ -196,3 +196,15 @@ void cli_print_info(const char *path, const struct ss_snapshot_summary *s)
 	else
 		print_series(s);
 }
+
+void cli_print_render_bench(const struct ss_render_bench_report *r)
+{
+	const double mpx = (double)r->n * r->n * 1e-6;
+	printf("shaded %d x %d (%.1f Mpixel), %d threads, %d repeats: median %.3f s = %.1f "
+	       "Mpixel/s (min %.3f s, max %.3f s)\n", r->n, r->n, mpx, r->threads, r->repeats,
+	       r->median, mpx / r->median, r->min, r->max);
+	printf("ss_render_field (plan and scale included): %.3f s\n", r->field);
+	for (int l = 0; l < 2; l++)
+		printf("png encoding, zlib level %d (serial): %.3f s = %.1f Mpixel/s, %.1f MB\n",
+		       r->png_levels[l], r->png[l], mpx / r->png[l], r->png_bytes[l] * 1e-6);
+}

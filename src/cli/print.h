@@ -10,6 +10,7 @@
 #include "sandslide/bench.h"
 #include "sandslide/progress.h"
 #include "sandslide/relax.h"
+#include "sandslide/render.h"
 #include "sandslide/run.h"
 #include "sandslide/snapshot.h"
 
@@ -35,5 +36,7 @@ void cli_bench_result(void *context, const struct ss_bench_result *r);
 void cli_bench_done(const struct cli_bench *b);
 
 void cli_print_info(const char *path, const struct ss_snapshot_summary *s);
+
+void cli_print_render_bench(const struct ss_render_bench_report *r);
 
 #endif

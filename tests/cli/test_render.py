@@ -343,3 +343,12 @@ def test_help_and_usage(tmp_path):
     assert r.returncode == 2 and "needs a sandslide output file" in r.stderr
     r = run(["render", "x.h5", "--bogus"])
     assert r.returncode == 2 and "unknown option" in r.stderr
+
+
+@pytest.mark.parametrize("n", [64, 600])
+def test_render_bench_small_and_large_grids(n):
+    """--bench times one pixel per cell: a grid under 512 cells a side, which
+    frames enlarge by default, used to crash it (found in issue 12)."""
+    r = run_ok(["render", "--bench", str(n), "--threads", "1"])
+    assert f"shaded {n} x {n}" in r.stdout and "png encoding, zlib level 6" in r.stdout, \
+        r.stdout
