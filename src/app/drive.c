@@ -168,6 +168,8 @@ static void keep_last_good_state(struct ss_drive *d)
 		         ss_grid_x(&st->grid, i), ss_grid_y(&st->grid, j));
 	t->step = st->steps;
 	t->time = st->time;
+	t->snapshots = ss_drive_snapshots(d);
+	t->last_time = d->snapshot ? ss_snapshot_last_time(d->snapshot) : NAN;
 	memset(&fresh, 0, sizeof fresh);
 	int err = restart_point(d, &fresh);
 	if (!err && fresh.steps < t->step - 1)
@@ -204,10 +206,9 @@ int ss_drive_nonfinite_error(const struct ss_drive *d, const char *kept_in)
 	else if (t->good_step >= 0 && kept_in)
 		snprintf(where, sizeof where, "the last good state, after step %lld at t = %.9g s, "
 		         "is in '%s'", t->good_step, t->good_time, kept_in);
-	else if (d->snapshot)
+	else if (t->snapshots > 0)
 		snprintf(where, sizeof where, "the %lld snapshots before it, the last at t = %g s, "
-		         "are in '%s'", ss_snapshot_count(d->snapshot),
-		         ss_snapshot_last_time(d->snapshot), d->output);
+		         "are in '%s'", t->snapshots, t->last_time, d->output);
 	else
 		snprintf(where, sizeof where, "nothing was written to '%s'", d->output);
 	return ss_error_fail("the height of %s became non-finite in step %lld (t = %.9g s); %s",

@@ -51,6 +51,8 @@ struct ss_drive_trouble {
 	long long good_step;    /* the state kept is after this step; -1: none */
 	double good_time;       /* s */
 	long long good_snapshot; /* its index in the series; -1: not in one */
+	long long snapshots;    /* in the series when the guard fired */
+	double last_time;       /* of the last of them, s */
 };
 
 struct ss_drive {
