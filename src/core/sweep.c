@@ -28,13 +28,6 @@ void ss_tiling_init(struct ss_tiling *t, const struct ss_grid *g,
 	t->tiles_y = (g->ny + t->tile_ny - 1) / t->tile_ny;
 }
 
-/* A face carries flux when neither side is a wall and one side flows. */
-static inline int face_is_active(uint8_t a, uint8_t b)
-{
-	return a != SS_CELL_WALL && b != SS_CELL_WALL &&
-	       (a == SS_CELL_FLOW || b == SS_CELL_FLOW);
-}
-
 /* Central difference of h at cell k along the direction with neighbour
  * offset `step`, a wall neighbour replaced by the cell itself (SPEC section
  * 2, mirror ghost), times 1/(2 spacing). */
@@ -61,7 +54,7 @@ static inline double face_flux(const struct ss_face_rule *rule,
                                double *restrict s2_max)
 {
 	const ptrdiff_t b = a + normal;
-	if (!face_is_active(type[a], type[b]))
+	if (!ss_face_carries(type[a], type[b]))
 		return 0.0;
 	const double g_n = (h[b] - h[a]) * inv_spacing;
 	const double g_t = 0.5 * (central_difference(h, type, a, along, inv_2along) +

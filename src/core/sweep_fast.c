@@ -23,15 +23,9 @@ static inline uint8_t type_at(const uint8_t *t, ptrdiff_t k)
 	return (uint8_t)ss_cell_type_get(t, k);
 }
 
-/* A face carries flux when neither side is a wall and one side flows. */
-static inline int face_carries(uint8_t a, uint8_t b)
-{
-	return a != SS_CELL_WALL && b != SS_CELL_WALL &&
-	       (a == SS_CELL_FLOW || b == SS_CELL_FLOW);
-}
-
-/* face_carries for widened types, with no short-circuit (which would be
- * control flow and stop vectorisation). */
+/* ss_face_carries (sweep.h) for widened types, with the same truth table
+ * but & and | for && and ||: a short-circuit is control flow, which stops
+ * the row loops that call this from vectorising. */
 static inline int64_t wide_carries(int64_t a, int64_t b)
 {
 	return (a != SS_CELL_WALL) & (b != SS_CELL_WALL) &
@@ -78,7 +72,7 @@ static inline uint64_t face_slope2_bits(const double *h, const uint8_t *t,
 	                    (type_at(t, b - along) == SS_CELL_WALL ? h[b] : h[b - along])) *
 	                   inv_2along;
 	const double gn = (h[b] - h[a]) * inv_spacing, gt = 0.5 * (cda + cdb);
-	return face_carries(type_at(t, a), type_at(t, b)) ? bits_of(gn * gn + gt * gt) : 0;
+	return ss_face_carries(type_at(t, a), type_at(t, b)) ? bits_of(gn * gn + gt * gt) : 0;
 }
 
 /* The larger of a and b as a select (fmax() is a library call). */
