@@ -562,13 +562,9 @@ double ss_sweep_fast_begin(struct ss_sweep_fast *f, const struct ss_grid *g,
 
 /* ---- the tile kernel -------------------------------------------------- */
 
-/* Cell types widened to 64 bits for the row loops: a select between
- * doubles on a 64-bit condition vectorises, on a byte it does not. */
-typedef int64_t wide_type;
-
 struct row_buffers {
 	double *row[3], *cdx[3], *cdy, *gn, *gt, *fx, *fy[2];
-	wide_type *type[4];
+	int64_t *type[4];
 	double *west_old, *east_save;
 };
 
@@ -588,16 +584,17 @@ static struct row_buffers buffers_of(const struct ss_sweep_fast *f, int thread)
 	b.fy[0] = p + 10 * w;
 	b.fy[1] = p + 11 * w;
 	for (int k = 0; k < 4; k++)
-		b.type[k] = (wide_type *)(p + (size_t)(12 + k) * w);
+		b.type[k] = (int64_t *)(p + (size_t)(12 + k) * w);
 	b.west_old = p + 16 * w;
 	b.east_save = b.west_old + ((size_t)f->tiling.tile_ny + 7) / 8 * 8;
 	return b;
 }
 
 /* Types of the cells at positions 0 .. W + 1 of row j, from the packed
- * types t. */
+ * types t, widened to 64 bits for the row loops: a select between doubles
+ * on a 64-bit condition vectorises, on a byte it does not. */
 static inline void widen_types(const struct ss_grid *g, int W, int i0, int j,
-                               const uint8_t *restrict t, wide_type *restrict wide)
+                               const uint8_t *restrict t, int64_t *restrict wide)
 {
 	const ptrdiff_t k = ss_grid_index(g, i0 - 1, j);
 	for (int x = 0; x <= W + 1; x++)
@@ -608,7 +605,7 @@ static inline void widen_types(const struct ss_grid *g, int W, int i0, int j,
  * positions 1 .. W; a wall neighbour is replaced by the cell itself (mirror
  * ghost). */
 static inline void central_x(int plain, int W, double inv_2dx,
-                             const double *restrict b, const wide_type *restrict tt,
+                             const double *restrict b, const int64_t *restrict tt,
                              double *restrict cd)
 {
 	if (plain) {
@@ -628,7 +625,7 @@ static inline void central_x(int plain, int W, double inv_2dx,
  * Returns whether a face that can carry flux is above the critical slope. */
 static inline int face_row(const struct ss_face_rule *rule, int n,
                            const double *restrict gn, const double *restrict gt,
-                           const wide_type *restrict ta, const wide_type *restrict tb,
+                           const int64_t *restrict ta, const int64_t *restrict tb,
                            double *restrict flux)
 {
 	const double tan_cr2 = rule->tan_cr2;
@@ -650,8 +647,8 @@ static inline int face_row(const struct ss_face_rule *rule, int n,
 static inline int y_faces(const struct ss_face_rule *rule, int plain, int W,
                           double inv_dy, const double *restrict a,
                           const double *restrict b, const double *restrict cdx_a,
-                          const double *restrict cdx_b, const wide_type *ta,
-                          const wide_type *tb, struct row_buffers *w,
+                          const double *restrict cdx_b, const int64_t *ta,
+                          const int64_t *tb, struct row_buffers *w,
                           double *restrict fy)
 {
 	for (int x = 1; x <= W; x++) {
@@ -715,8 +712,8 @@ static void sweep_tile(struct ss_sweep_fast *f, const struct ss_grid *g,
 		for (int j = j0; j < j1; j++)
 			w->west_old[j - j0] = h[ss_grid_index(g, i0 - 1, j)];
 
-	wide_type *type_prev = w->type[0], *type_cur = w->type[1], *type_next = w->type[2];
-	wide_type *type_back = w->type[3];   /* row j - 2 */
+	int64_t *type_prev = w->type[0], *type_cur = w->type[1], *type_next = w->type[2];
+	int64_t *type_back = w->type[3];   /* row j - 2 */
 	memcpy(prev, f->ring_south + ty * stride + i0, (size_t)(W + 2) * sizeof(double));
 	load_row(cur, h + ss_grid_index(g, 0, j0), i0, W, w->west_old[0]);
 	if (!plain) {
@@ -790,7 +787,7 @@ static void sweep_tile(struct ss_sweep_fast *f, const struct ss_grid *g,
 		}
 		w->east_save[j - j0] = cur[W];
 		uint64_t row_max = 0;
-		const wide_type *tc = type_cur + 1;
+		const int64_t *tc = type_cur + 1;
 		double *hn = h_row + i0;
 		if (plain) {
 			for (int x = 0; x < W; x++) {
@@ -856,7 +853,7 @@ static void sweep_tile(struct ss_sweep_fast *f, const struct ss_grid *g,
 		tmp = fy_south;
 		fy_south = fy_north;
 		fy_north = tmp;
-		wide_type *tt = type_back;
+		int64_t *tt = type_back;
 		type_back = type_prev;
 		type_prev = type_cur;
 		type_cur = type_next;
