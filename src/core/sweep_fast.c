@@ -343,21 +343,14 @@ static size_t row_doubles(const struct ss_tiling *t)
 	return ((size_t)t->tile_nx + 2 + 7) / 8 * 8;   /* 64 B aligned rows */
 }
 
-int ss_sweep_fast_init(struct ss_sweep_fast *f, const struct ss_grid *g,
-                       const struct ss_tiling *tiling, int threads,
-                       int periodic_x, int periodic_y,
-                       const uint8_t *cell_types,
-                       const struct ss_open_face *open_faces,
-                       size_t open_face_count)
+/* The per-tile flags, ring rows, row buffers and open-face tables of f
+ * (f->tiling, f->tiles and f->threads set). */
+static int alloc_tables(struct ss_sweep_fast *f, const struct ss_grid *g,
+                        size_t open_face_count)
 {
-	memset(f, 0, sizeof *f);
-	f->tiling = *tiling;
 	const struct ss_tiling *t = &f->tiling;
-	f->tiles = t->tiles_x * t->tiles_y;
-	f->threads = threads > 0 ? threads : 1;
-	f->periodic_x = periodic_x;
-	f->periodic_y = periodic_y;
 	const size_t tiles = (size_t)f->tiles;
+
 	f->scratch_doubles = 16 * row_doubles(t) + 2 * (((size_t)t->tile_ny + 7) / 8 * 8);
 	f->sweep = ss_alloc(tiles, 1, "tile flags");
 	f->sweep_next = ss_alloc(tiles, 1, "tile flags");
@@ -375,15 +368,21 @@ int ss_sweep_fast_init(struct ss_sweep_fast *f, const struct ss_grid *g,
 	                         sizeof *f->open_slots, "open faces");
 	if (!f->sweep || !f->sweep_next || !f->moving || !f->edges_changed || !f->plain ||
 	    !f->has_source || !f->row_list || !f->ring_south || !f->ring_north ||
-	    !f->scratch || !f->open_first || !f->open_slots) {
-		ss_sweep_fast_release(f);
+	    !f->scratch || !f->open_first || !f->open_slots)
 		return SS_ERR_FAIL;
-	}
+	return SS_OK;
+}
 
-	/* plain tiles: every cell of the tile and of its ring flows */
+/* Plain tiles: every cell of the tile and of its ring flows, so their row
+ * loops need no types. */
+static void mark_plain_tiles(struct ss_sweep_fast *f, const struct ss_grid *g,
+                             const uint8_t *cell_types)
+{
+	const struct ss_tiling *t = &f->tiling;
+
 	for (int ty = 0; ty < t->tiles_y; ty++) {
 		for (int tx = 0; tx < t->tiles_x; tx++) {
-			const struct ss_tile_span s = ss_tiling_span(&f->tiling, g, tx, ty);
+			const struct ss_tile_span s = ss_tiling_span(t, g, tx, ty);
 			int plain = 1;
 			for (int j = s.j0 - 1; j <= s.j1 && plain; j++)
 				for (int i = s.i0 - 1; i <= s.i1; i++)
@@ -391,57 +390,88 @@ int ss_sweep_fast_init(struct ss_sweep_fast *f, const struct ss_grid *g,
 			f->plain[ty * t->tiles_x + tx] = (uint8_t)plain;
 		}
 	}
+}
 
-	/* open faces: tile of the flow cell, row, position; counting sort by
-	 * tile, then by row within a tile (the list is in row order already) */
-	size_t *tile_of = ss_alloc(open_face_count ? open_face_count : 1, sizeof *tile_of,
-	                           "open faces");
-	if (!tile_of) {
-		ss_sweep_fast_release(f);
-		return SS_ERR_FAIL;
-	}
+/* Open face m as the sweep finds it: the row and buffer position in the
+ * tile of its flow cell, and which of the row's faces it is.  Returns that
+ * tile. */
+static size_t open_slot_of(const struct ss_tiling *t, const struct ss_grid *g,
+                           const struct ss_open_face *o, size_t m,
+                           struct ss_open_face_slot *slot)
+{
 	const ptrdiff_t stride = g->stride;
-	for (size_t m = 0; m < open_face_count; m++) {
-		const struct ss_open_face *o = &open_faces[m];
-		const ptrdiff_t step = o->axis == 0 ? 1 : stride;
-		const ptrdiff_t cell = o->sign > 0 ? o->index - step : o->index;
-		const int i = (int)(cell % stride) - SS_GRID_GHOST;
-		const int j = (int)(cell / stride) - SS_GRID_GHOST;
-		const int tx = i / t->tile_nx, ty = j / t->tile_ny;
-		const int i0 = tx * t->tile_nx;
-		struct ss_open_face_slot *slot = &f->open_slots[m];
-		slot->face = m;
-		slot->j = j;
-		if (o->axis == 0) {
-			const int i_east = (int)(o->index % stride) - SS_GRID_GHOST;
-			slot->which = 0;
-			slot->x = i_east - i0;
-		} else {
-			slot->which = o->sign > 0 ? 2 : 1;
-			slot->x = i - i0 + 1;
-		}
-		tile_of[m] = (size_t)ty * t->tiles_x + tx;
+	const ptrdiff_t step = o->axis == 0 ? 1 : stride;
+	/* the face is west (south) of o->index; the flow cell is the side
+	 * positive flux leaves */
+	const ptrdiff_t cell = o->sign > 0 ? o->index - step : o->index;
+	const int i = (int)(cell % stride) - SS_GRID_GHOST;
+	const int j = (int)(cell / stride) - SS_GRID_GHOST;
+	const int tx = i / t->tile_nx, ty = j / t->tile_ny;
+	const int i0 = tx * t->tile_nx;
+
+	slot->face = m;
+	slot->j = j;
+	if (o->axis == 0) {
+		const int i_east = (int)(o->index % stride) - SS_GRID_GHOST;
+		slot->which = 0;
+		slot->x = i_east - i0;
+	} else {
+		slot->which = o->sign > 0 ? 2 : 1;
+		slot->x = i - i0 + 1;
+	}
+	return (size_t)ty * t->tiles_x + tx;
+}
+
+/* The open faces into f->open_slots grouped by tile, f->open_first[t] ..
+ * f->open_first[t + 1] those of tile t: a counting sort, stable, so each
+ * tile's stay in row order (the stepper's list is). */
+static int sort_open_slots(struct ss_sweep_fast *f, const struct ss_grid *g,
+                           const struct ss_open_face *open_faces, size_t count)
+{
+	const size_t n = count ? count : 1, tiles = (size_t)f->tiles;
+	struct ss_open_face_slot *slots = ss_alloc(n, sizeof *slots, "open faces");
+	size_t *tile_of = ss_alloc(n, sizeof *tile_of, "open faces");
+	size_t *fill = ss_alloc(tiles, sizeof *fill, "open faces");
+	int status = SS_ERR_FAIL;
+
+	if (!slots || !tile_of || !fill)
+		goto out_free;
+	for (size_t m = 0; m < count; m++) {
+		tile_of[m] = open_slot_of(&f->tiling, g, &open_faces[m], m, &slots[m]);
 		f->open_first[tile_of[m] + 1]++;
 	}
 	for (size_t k = 0; k < tiles; k++)
 		f->open_first[k + 1] += f->open_first[k];
-	struct ss_open_face_slot *sorted = ss_alloc(open_face_count ? open_face_count : 1,
-	                                            sizeof *sorted, "open faces");
-	size_t *fill = ss_alloc(tiles, sizeof *fill, "open faces");
-	if (!sorted || !fill) {
-		ss_free(sorted);
-		ss_free(fill);
-		ss_free(tile_of);
+	for (size_t m = 0; m < count; m++)
+		f->open_slots[f->open_first[tile_of[m]] + fill[tile_of[m]]++] = slots[m];
+	status = SS_OK;
+out_free:
+	ss_free(fill);
+	ss_free(tile_of);
+	ss_free(slots);
+	return status;
+}
+
+int ss_sweep_fast_init(struct ss_sweep_fast *f, const struct ss_grid *g,
+                       const struct ss_tiling *tiling, int threads,
+                       int periodic_x, int periodic_y,
+                       const uint8_t *cell_types,
+                       const struct ss_open_face *open_faces,
+                       size_t open_face_count)
+{
+	memset(f, 0, sizeof *f);
+	f->tiling = *tiling;
+	f->tiles = tiling->tiles_x * tiling->tiles_y;
+	f->threads = threads > 0 ? threads : 1;
+	f->periodic_x = periodic_x;
+	f->periodic_y = periodic_y;
+	if (alloc_tables(f, g, open_face_count) ||
+	    sort_open_slots(f, g, open_faces, open_face_count)) {
 		ss_sweep_fast_release(f);
 		return SS_ERR_FAIL;
 	}
-	for (size_t m = 0; m < open_face_count; m++)
-		sorted[f->open_first[tile_of[m]] + fill[tile_of[m]]++] = f->open_slots[m];
-	ss_free(f->open_slots);
-	f->open_slots = sorted;
-	ss_free(fill);
-	ss_free(tile_of);
-	memset(f->sweep, 1, tiles);
+	mark_plain_tiles(f, g, cell_types);
+	memset(f->sweep, 1, (size_t)f->tiles);
 	return SS_OK;
 }
 
