@@ -52,6 +52,14 @@ static inline double double_of(uint64_t u)
 	return x;
 }
 
+/* The maximum whose bits are m (0 for none); a NaN sets *bad. */
+static inline double max_of_bits(uint64_t m, int *bad)
+{
+	const double max = double_of(m);
+	*bad |= max != max;
+	return max;
+}
+
 /*
  * The bits of s^2 of one face, between cells a and b = a + normal (0 if it
  * cannot carry flux): g_n over the face, g_t the mean of both cells'
@@ -95,19 +103,23 @@ static inline void unpack_wide(const uint8_t *restrict t, ptrdiff_t k, int n,
 /*
  * Largest s^2 of the x-faces (i - 1 | i), ia <= i <= ib, of row j, read
  * from the grid (the rows j - 1 .. j + 1 must hold one state).
+ *
+ * slope2_x_faces and slope2_y_faces are one measure along the two axes,
+ * written twice on purpose: each spells its stencil with fixed offsets
+ * (x: three rows, neighbours in the row above and below; y: two rows,
+ * neighbours left and right) so that its loops vectorise on contiguous
+ * loads, as the tile kernel spells its x- and y-face loops apart.
  */
 static double slope2_x_faces(const struct ss_grid *g, const double *h,
                              const uint8_t *t, int plain, int j, int ia, int ib,
                              int *bad)
 {
 	const double inv_dx = 1.0 / g->dx, inv_2dy = 0.5 / g->dy;
-	const double *hm = h + ss_grid_index(g, 0, j - 1);
-	const double *h0 = h + ss_grid_index(g, 0, j);
-	const double *hp = h + ss_grid_index(g, 0, j + 1);
-	const ptrdiff_t km = ss_grid_index(g, 0, j - 1), k0 = ss_grid_index(g, 0, j);
-	const ptrdiff_t kp = ss_grid_index(g, 0, j + 1);
+	const ptrdiff_t km = ss_grid_index(g, 0, j - 1), k0 = km + g->stride, kp = k0 + g->stride;
+	const double *hm = h + km, *h0 = h + k0, *hp = h + kp;
 	uint64_t m = 0;
 	if (plain) {
+		/* g_n = (h[i] - h[i-1]) / dx, g_t = (cd_y[i-1] + cd_y[i]) / 2 */
 		for (int i = ia; i <= ib; i++) {
 			const double cda = (hp[i - 1] - hm[i - 1]) * inv_2dy;
 			const double cdb = (hp[i] - hm[i]) * inv_2dy;
@@ -139,9 +151,7 @@ static double slope2_x_faces(const struct ss_grid *g, const double *h,
 			}
 		}
 	}
-	const double max = double_of(m);
-	*bad |= max != max;
-	return max;
+	return max_of_bits(m, bad);
 }
 
 /* Largest s^2 of the y-faces (j - 1 | j) of cells ia <= i <= ib. */
@@ -150,11 +160,11 @@ static double slope2_y_faces(const struct ss_grid *g, const double *h,
                              int *bad)
 {
 	const double inv_dy = 1.0 / g->dy, inv_2dx = 0.5 / g->dx;
-	const double *ha = h + ss_grid_index(g, 0, j - 1);
-	const double *hb = h + ss_grid_index(g, 0, j);
-	const ptrdiff_t ka = ss_grid_index(g, 0, j - 1), kb = ss_grid_index(g, 0, j);
+	const ptrdiff_t ka = ss_grid_index(g, 0, j - 1), kb = ka + g->stride;
+	const double *ha = h + ka, *hb = h + kb;
 	uint64_t m = 0;
 	if (plain) {
+		/* g_n = (h[i, j] - h[i, j-1]) / dy, g_t = (cd_x[i, j-1] + cd_x[i, j]) / 2 */
 		for (int i = ia; i <= ib; i++) {
 			const double cda = (ha[i + 1] - ha[i - 1]) * inv_2dx;
 			const double cdb = (hb[i + 1] - hb[i - 1]) * inv_2dx;
@@ -183,9 +193,7 @@ static double slope2_y_faces(const struct ss_grid *g, const double *h,
 			}
 		}
 	}
-	const double max = double_of(m);
-	*bad |= max != max;
-	return max;
+	return max_of_bits(m, bad);
 }
 
 /*
@@ -215,16 +223,14 @@ static double slope2_plain_pair(const struct ss_grid *g, const double *h, int j,
 		const uint64_t q = qx > qy ? qx : qy;
 		m = q > m ? q : m;
 	}
-	const double max = double_of(m);
-	*bad |= max != max;
-	return max;
+	return max_of_bits(m, bad);
 }
 
 /*
- * Largest s^2 of the x-face (i - 1 | i) and the y-face (j - 1 | j) of cell i
- * in rows ja <= j <= jb: a column of a tile's west or east edge in one loop
- * (x-faces of rows ja .. jb - 1 only when with_x; the same expressions as
- * slope2_x_faces and slope2_y_faces).
+ * Largest s^2 of the x-faces (i_x - 1 | i_x) of rows ja .. jb - 1 and the
+ * y-faces (j - 1 | j) of cell i_y, ja <= j <= jb: a column of a tile's west
+ * or east edge in one loop (the same expressions as slope2_x_faces and
+ * slope2_y_faces).
  */
 static double slope2_column(const struct ss_grid *g, const double *h,
                             const uint8_t *t, int plain, int i_x, int i_y, int ja,
@@ -250,9 +256,7 @@ static double slope2_column(const struct ss_grid *g, const double *h,
 				m = q > m ? q : m;
 			}
 		}
-		const double max = double_of(m);
-		*bad |= max != max;
-		return max;
+		return max_of_bits(m, bad);
 	}
 	for (int j = ja; j <= jb; j++) {
 		uint64_t q = face_slope2_bits(h, t, ss_grid_index(g, i_y, j) - s, s, 1,
@@ -264,9 +268,7 @@ static double slope2_column(const struct ss_grid *g, const double *h,
 			m = q > m ? q : m;
 		}
 	}
-	const double max = double_of(m);
-	*bad |= max != max;
-	return max;
+	return max_of_bits(m, bad);
 }
 
 /*
@@ -306,9 +308,7 @@ static double slope2_mixed_pair(const struct ss_grid *g, const double *h, int j,
 		const uint64_t q = qx > qy ? qx : qy;
 		m = q > m ? q : m;
 	}
-	const double max = double_of(m);
-	*bad |= max != max;
-	return max;
+	return max_of_bits(m, bad);
 }
 
 /* Largest s^2 over every face of the grid that can carry flux. */
