@@ -68,7 +68,10 @@ static inline double central_difference(const double *restrict h,
 /*
  * The flux through the face between cells a (west/south) and b = a + normal
  * (east/north): g_n across the face, g_t the mean of both cells' central
- * differences along it (offset `along`).
+ * differences along it (offset `along`).  sweep_fast.c spells the same
+ * expressions again, a row of faces at a time so that they vectorise: two
+ * copies on purpose, this one the plain statement the other is tested
+ * against bit for bit.
  */
 static inline double face_flux(const struct ss_face_rule *rule,
                                const double *restrict h,
