@@ -28,11 +28,28 @@ void ss_tiling_init(struct ss_tiling *t, const struct ss_grid *g,
 	t->tiles_y = (g->ny + t->tile_ny - 1) / t->tile_ny;
 }
 
-/* A face carries flux when neither side is a wall and one side flows. */
-static inline int face_is_active(uint8_t a, uint8_t b)
+/* Tile number `tile` of t, counted row by row: the unit of the passes'
+ * parallel loops. */
+static inline struct ss_tile_span span_of(const struct ss_tiling *t,
+                                          const struct ss_grid *g, int tile)
 {
-	return a != SS_CELL_WALL && b != SS_CELL_WALL &&
-	       (a == SS_CELL_FLOW || b == SS_CELL_FLOW);
+	return ss_tiling_span(t, g, tile % t->tiles_x, tile / t->tiles_x);
+}
+
+/* The faces tile sp writes: the x-faces (i - 1 | i) of its rows for
+ * i0 <= i < x_end, the y-faces (j - 1 | j) of its columns for
+ * j0 <= j < y_end.  The last tile of a row (column) also owns the east
+ * (north) face of the block, so that each face has one writer. */
+struct face_ends {
+	int x_end, y_end;
+};
+
+static inline struct face_ends faces_of(const struct ss_grid *g, struct ss_tile_span sp)
+{
+	struct face_ends e;
+	e.x_end = sp.i1 == g->nx ? sp.i1 + 1 : sp.i1;
+	e.y_end = sp.j1 == g->ny ? sp.j1 + 1 : sp.j1;
+	return e;
 }
 
 /* Central difference of h at cell k along the direction with neighbour
@@ -51,7 +68,10 @@ static inline double central_difference(const double *restrict h,
 /*
  * The flux through the face between cells a (west/south) and b = a + normal
  * (east/north): g_n across the face, g_t the mean of both cells' central
- * differences along it (offset `along`).
+ * differences along it (offset `along`).  sweep_fast.c spells the same
+ * expressions again, a row of faces at a time so that they vectorise: two
+ * copies on purpose, this one the plain statement the other is tested
+ * against bit for bit.
  */
 static inline double face_flux(const struct ss_face_rule *rule,
                                const double *restrict h,
@@ -61,7 +81,7 @@ static inline double face_flux(const struct ss_face_rule *rule,
                                double *restrict s2_max)
 {
 	const ptrdiff_t b = a + normal;
-	if (!face_is_active(type[a], type[b]))
+	if (!ss_face_carries(type[a], type[b]))
 		return 0.0;
 	const double g_n = (h[b] - h[a]) * inv_spacing;
 	const double g_t = 0.5 * (central_difference(h, type, a, along, inv_2along) +
@@ -89,20 +109,17 @@ double ss_sweep_fluxes(const struct ss_grid *g, const struct ss_tiling *t,
 
 	#pragma omp parallel for schedule(static) reduction(max:s2_max)
 	for (int tile = 0; tile < tiles; tile++) {
-		const struct ss_tile_span sp = ss_tiling_span(t, g, tile % t->tiles_x,
-		                                              tile / t->tiles_x);
-		/* the last tile of a row (column) also owns the east (north) face */
-		const int x_end = sp.i1 == g->nx ? sp.i1 + 1 : sp.i1;
-		const int y_end = sp.j1 == g->ny ? sp.j1 + 1 : sp.j1;
+		const struct ss_tile_span sp = span_of(t, g, tile);
+		const struct face_ends e = faces_of(g, sp);
 		double s2 = 0.0;
 		for (int j = sp.j0; j < sp.j1; j++) {
-			for (int i = sp.i0; i < x_end; i++) {
+			for (int i = sp.i0; i < e.x_end; i++) {
 				const ptrdiff_t k = ss_grid_index(g, i, j);
 				flux_x[k] = face_flux(rule, h, type, k - 1, 1, stride,
 				                      inv_dx, inv_2dy, &s2);
 			}
 		}
-		for (int j = sp.j0; j < y_end; j++) {
+		for (int j = sp.j0; j < e.y_end; j++) {
 			for (int i = sp.i0; i < sp.i1; i++) {
 				const ptrdiff_t k = ss_grid_index(g, i, j);
 				flux_y[k] = face_flux(rule, h, type, k - stride, stride, 1,
@@ -115,6 +132,9 @@ double ss_sweep_fluxes(const struct ss_grid *g, const struct ss_tiling *t,
 	return sqrt(s2_max);
 }
 
+/* The face loops of ss_sweep_fluxes again, and not folded into them: the
+ * limit needs dt, which the stepper takes from the largest slope that pass
+ * returns. */
 void ss_sweep_limit(const struct ss_grid *g, const struct ss_tiling *t, double dt,
                     const double *restrict height, const double *restrict bedrock,
                     double *restrict flux_x, double *restrict flux_y)
@@ -125,18 +145,16 @@ void ss_sweep_limit(const struct ss_grid *g, const struct ss_tiling *t, double d
 
 	#pragma omp parallel for schedule(static)
 	for (int tile = 0; tile < tiles; tile++) {
-		const struct ss_tile_span sp = ss_tiling_span(t, g, tile % t->tiles_x,
-		                                              tile / t->tiles_x);
-		const int x_end = sp.i1 == g->nx ? sp.i1 + 1 : sp.i1;
-		const int y_end = sp.j1 == g->ny ? sp.j1 + 1 : sp.j1;
+		const struct ss_tile_span sp = span_of(t, g, tile);
+		const struct face_ends e = faces_of(g, sp);
 		for (int j = sp.j0; j < sp.j1; j++) {
-			for (int i = sp.i0; i < x_end; i++) {
+			for (int i = sp.i0; i < e.x_end; i++) {
 				const ptrdiff_t k = ss_grid_index(g, i, j);
 				flux_x[k] = ss_face_limit(flux_x[k], height[k - 1] - bedrock[k - 1],
 				                          height[k] - bedrock[k], limit_x);
 			}
 		}
-		for (int j = sp.j0; j < y_end; j++) {
+		for (int j = sp.j0; j < e.y_end; j++) {
 			for (int i = sp.i0; i < sp.i1; i++) {
 				const ptrdiff_t k = ss_grid_index(g, i, j);
 				flux_y[k] = ss_face_limit(flux_y[k], height[k - stride] - bedrock[k - stride],
@@ -160,8 +178,7 @@ double ss_sweep_update(const struct ss_grid *g, const struct ss_tiling *t,
 
 	#pragma omp parallel for schedule(static) reduction(max:rate_max)
 	for (int tile = 0; tile < tiles; tile++) {
-		const struct ss_tile_span sp = ss_tiling_span(t, g, tile % t->tiles_x,
-		                                              tile / t->tiles_x);
+		const struct ss_tile_span sp = span_of(t, g, tile);
 		for (int j = sp.j0; j < sp.j1; j++) {
 			for (int i = sp.i0; i < sp.i1; i++) {
 				const ptrdiff_t k = ss_grid_index(g, i, j);

@@ -23,15 +23,9 @@ static inline uint8_t type_at(const uint8_t *t, ptrdiff_t k)
 	return (uint8_t)ss_cell_type_get(t, k);
 }
 
-/* A face carries flux when neither side is a wall and one side flows. */
-static inline int face_carries(uint8_t a, uint8_t b)
-{
-	return a != SS_CELL_WALL && b != SS_CELL_WALL &&
-	       (a == SS_CELL_FLOW || b == SS_CELL_FLOW);
-}
-
-/* face_carries for widened types, with no short-circuit (which would be
- * control flow and stop vectorisation). */
+/* ss_face_carries (sweep.h) for widened types, with the same truth table
+ * but & and | for && and ||: a short-circuit is control flow, which stops
+ * the row loops that call this from vectorising. */
 static inline int64_t wide_carries(int64_t a, int64_t b)
 {
 	return (a != SS_CELL_WALL) & (b != SS_CELL_WALL) &
@@ -58,6 +52,14 @@ static inline double double_of(uint64_t u)
 	return x;
 }
 
+/* The maximum whose bits are m (0 for none); a NaN sets *bad. */
+static inline double max_of_bits(uint64_t m, int *bad)
+{
+	const double max = double_of(m);
+	*bad |= max != max;
+	return max;
+}
+
 /*
  * The bits of s^2 of one face, between cells a and b = a + normal (0 if it
  * cannot carry flux): g_n over the face, g_t the mean of both cells'
@@ -78,7 +80,7 @@ static inline uint64_t face_slope2_bits(const double *h, const uint8_t *t,
 	                    (type_at(t, b - along) == SS_CELL_WALL ? h[b] : h[b - along])) *
 	                   inv_2along;
 	const double gn = (h[b] - h[a]) * inv_spacing, gt = 0.5 * (cda + cdb);
-	return face_carries(type_at(t, a), type_at(t, b)) ? bits_of(gn * gn + gt * gt) : 0;
+	return ss_face_carries(type_at(t, a), type_at(t, b)) ? bits_of(gn * gn + gt * gt) : 0;
 }
 
 /* The larger of a and b as a select (fmax() is a library call). */
@@ -101,19 +103,23 @@ static inline void unpack_wide(const uint8_t *restrict t, ptrdiff_t k, int n,
 /*
  * Largest s^2 of the x-faces (i - 1 | i), ia <= i <= ib, of row j, read
  * from the grid (the rows j - 1 .. j + 1 must hold one state).
+ *
+ * slope2_x_faces and slope2_y_faces are one measure along the two axes,
+ * written twice on purpose: each spells its stencil with fixed offsets
+ * (x: three rows, neighbours in the row above and below; y: two rows,
+ * neighbours left and right) so that its loops vectorise on contiguous
+ * loads, as the tile kernel spells its x- and y-face loops apart.
  */
 static double slope2_x_faces(const struct ss_grid *g, const double *h,
                              const uint8_t *t, int plain, int j, int ia, int ib,
                              int *bad)
 {
 	const double inv_dx = 1.0 / g->dx, inv_2dy = 0.5 / g->dy;
-	const double *hm = h + ss_grid_index(g, 0, j - 1);
-	const double *h0 = h + ss_grid_index(g, 0, j);
-	const double *hp = h + ss_grid_index(g, 0, j + 1);
-	const ptrdiff_t km = ss_grid_index(g, 0, j - 1), k0 = ss_grid_index(g, 0, j);
-	const ptrdiff_t kp = ss_grid_index(g, 0, j + 1);
+	const ptrdiff_t km = ss_grid_index(g, 0, j - 1), k0 = km + g->stride, kp = k0 + g->stride;
+	const double *hm = h + km, *h0 = h + k0, *hp = h + kp;
 	uint64_t m = 0;
 	if (plain) {
+		/* g_n = (h[i] - h[i-1]) / dx, g_t = (cd_y[i-1] + cd_y[i]) / 2 */
 		for (int i = ia; i <= ib; i++) {
 			const double cda = (hp[i - 1] - hm[i - 1]) * inv_2dy;
 			const double cdb = (hp[i] - hm[i]) * inv_2dy;
@@ -145,9 +151,7 @@ static double slope2_x_faces(const struct ss_grid *g, const double *h,
 			}
 		}
 	}
-	const double max = double_of(m);
-	*bad |= max != max;
-	return max;
+	return max_of_bits(m, bad);
 }
 
 /* Largest s^2 of the y-faces (j - 1 | j) of cells ia <= i <= ib. */
@@ -156,11 +160,11 @@ static double slope2_y_faces(const struct ss_grid *g, const double *h,
                              int *bad)
 {
 	const double inv_dy = 1.0 / g->dy, inv_2dx = 0.5 / g->dx;
-	const double *ha = h + ss_grid_index(g, 0, j - 1);
-	const double *hb = h + ss_grid_index(g, 0, j);
-	const ptrdiff_t ka = ss_grid_index(g, 0, j - 1), kb = ss_grid_index(g, 0, j);
+	const ptrdiff_t ka = ss_grid_index(g, 0, j - 1), kb = ka + g->stride;
+	const double *ha = h + ka, *hb = h + kb;
 	uint64_t m = 0;
 	if (plain) {
+		/* g_n = (h[i, j] - h[i, j-1]) / dy, g_t = (cd_x[i, j-1] + cd_x[i, j]) / 2 */
 		for (int i = ia; i <= ib; i++) {
 			const double cda = (ha[i + 1] - ha[i - 1]) * inv_2dx;
 			const double cdb = (hb[i + 1] - hb[i - 1]) * inv_2dx;
@@ -189,9 +193,7 @@ static double slope2_y_faces(const struct ss_grid *g, const double *h,
 			}
 		}
 	}
-	const double max = double_of(m);
-	*bad |= max != max;
-	return max;
+	return max_of_bits(m, bad);
 }
 
 /*
@@ -221,16 +223,14 @@ static double slope2_plain_pair(const struct ss_grid *g, const double *h, int j,
 		const uint64_t q = qx > qy ? qx : qy;
 		m = q > m ? q : m;
 	}
-	const double max = double_of(m);
-	*bad |= max != max;
-	return max;
+	return max_of_bits(m, bad);
 }
 
 /*
- * Largest s^2 of the x-face (i - 1 | i) and the y-face (j - 1 | j) of cell i
- * in rows ja <= j <= jb: a column of a tile's west or east edge in one loop
- * (x-faces of rows ja .. jb - 1 only when with_x; the same expressions as
- * slope2_x_faces and slope2_y_faces).
+ * Largest s^2 of the x-faces (i_x - 1 | i_x) of rows ja .. jb - 1 and the
+ * y-faces (j - 1 | j) of cell i_y, ja <= j <= jb: a column of a tile's west
+ * or east edge in one loop (the same expressions as slope2_x_faces and
+ * slope2_y_faces).
  */
 static double slope2_column(const struct ss_grid *g, const double *h,
                             const uint8_t *t, int plain, int i_x, int i_y, int ja,
@@ -256,9 +256,7 @@ static double slope2_column(const struct ss_grid *g, const double *h,
 				m = q > m ? q : m;
 			}
 		}
-		const double max = double_of(m);
-		*bad |= max != max;
-		return max;
+		return max_of_bits(m, bad);
 	}
 	for (int j = ja; j <= jb; j++) {
 		uint64_t q = face_slope2_bits(h, t, ss_grid_index(g, i_y, j) - s, s, 1,
@@ -270,9 +268,7 @@ static double slope2_column(const struct ss_grid *g, const double *h,
 			m = q > m ? q : m;
 		}
 	}
-	const double max = double_of(m);
-	*bad |= max != max;
-	return max;
+	return max_of_bits(m, bad);
 }
 
 /*
@@ -312,9 +308,7 @@ static double slope2_mixed_pair(const struct ss_grid *g, const double *h, int j,
 		const uint64_t q = qx > qy ? qx : qy;
 		m = q > m ? q : m;
 	}
-	const double max = double_of(m);
-	*bad |= max != max;
-	return max;
+	return max_of_bits(m, bad);
 }
 
 /* Largest s^2 over every face of the grid that can carry flux. */
@@ -349,21 +343,14 @@ static size_t row_doubles(const struct ss_tiling *t)
 	return ((size_t)t->tile_nx + 2 + 7) / 8 * 8;   /* 64 B aligned rows */
 }
 
-int ss_sweep_fast_init(struct ss_sweep_fast *f, const struct ss_grid *g,
-                       const struct ss_tiling *tiling, int threads,
-                       int periodic_x, int periodic_y,
-                       const uint8_t *cell_types,
-                       const struct ss_open_face *open_faces,
-                       size_t open_face_count)
+/* The per-tile flags, ring rows, row buffers and open-face tables of f
+ * (f->tiling, f->tiles and f->threads set). */
+static int alloc_tables(struct ss_sweep_fast *f, const struct ss_grid *g,
+                        size_t open_face_count)
 {
-	memset(f, 0, sizeof *f);
-	f->tiling = *tiling;
 	const struct ss_tiling *t = &f->tiling;
-	f->tiles = t->tiles_x * t->tiles_y;
-	f->threads = threads > 0 ? threads : 1;
-	f->periodic_x = periodic_x;
-	f->periodic_y = periodic_y;
 	const size_t tiles = (size_t)f->tiles;
+
 	f->scratch_doubles = 16 * row_doubles(t) + 2 * (((size_t)t->tile_ny + 7) / 8 * 8);
 	f->sweep = ss_alloc(tiles, 1, "tile flags");
 	f->sweep_next = ss_alloc(tiles, 1, "tile flags");
@@ -381,15 +368,21 @@ int ss_sweep_fast_init(struct ss_sweep_fast *f, const struct ss_grid *g,
 	                         sizeof *f->open_slots, "open faces");
 	if (!f->sweep || !f->sweep_next || !f->moving || !f->edges_changed || !f->plain ||
 	    !f->has_source || !f->row_list || !f->ring_south || !f->ring_north ||
-	    !f->scratch || !f->open_first || !f->open_slots) {
-		ss_sweep_fast_release(f);
+	    !f->scratch || !f->open_first || !f->open_slots)
 		return SS_ERR_FAIL;
-	}
+	return SS_OK;
+}
 
-	/* plain tiles: every cell of the tile and of its ring flows */
+/* Plain tiles: every cell of the tile and of its ring flows, so their row
+ * loops need no types. */
+static void mark_plain_tiles(struct ss_sweep_fast *f, const struct ss_grid *g,
+                             const uint8_t *cell_types)
+{
+	const struct ss_tiling *t = &f->tiling;
+
 	for (int ty = 0; ty < t->tiles_y; ty++) {
 		for (int tx = 0; tx < t->tiles_x; tx++) {
-			const struct ss_tile_span s = ss_tiling_span(&f->tiling, g, tx, ty);
+			const struct ss_tile_span s = ss_tiling_span(t, g, tx, ty);
 			int plain = 1;
 			for (int j = s.j0 - 1; j <= s.j1 && plain; j++)
 				for (int i = s.i0 - 1; i <= s.i1; i++)
@@ -397,57 +390,88 @@ int ss_sweep_fast_init(struct ss_sweep_fast *f, const struct ss_grid *g,
 			f->plain[ty * t->tiles_x + tx] = (uint8_t)plain;
 		}
 	}
+}
 
-	/* open faces: tile of the flow cell, row, position; counting sort by
-	 * tile, then by row within a tile (the list is in row order already) */
-	size_t *tile_of = ss_alloc(open_face_count ? open_face_count : 1, sizeof *tile_of,
-	                           "open faces");
-	if (!tile_of) {
-		ss_sweep_fast_release(f);
-		return SS_ERR_FAIL;
-	}
+/* Open face m as the sweep finds it: the row and buffer position in the
+ * tile of its flow cell, and which of the row's faces it is.  Returns that
+ * tile. */
+static size_t open_slot_of(const struct ss_tiling *t, const struct ss_grid *g,
+                           const struct ss_open_face *o, size_t m,
+                           struct ss_open_face_slot *slot)
+{
 	const ptrdiff_t stride = g->stride;
-	for (size_t m = 0; m < open_face_count; m++) {
-		const struct ss_open_face *o = &open_faces[m];
-		const ptrdiff_t step = o->axis == 0 ? 1 : stride;
-		const ptrdiff_t cell = o->sign > 0 ? o->index - step : o->index;
-		const int i = (int)(cell % stride) - SS_GRID_GHOST;
-		const int j = (int)(cell / stride) - SS_GRID_GHOST;
-		const int tx = i / t->tile_nx, ty = j / t->tile_ny;
-		const int i0 = tx * t->tile_nx;
-		struct ss_open_face_slot *slot = &f->open_slots[m];
-		slot->face = m;
-		slot->j = j;
-		if (o->axis == 0) {
-			const int i_east = (int)(o->index % stride) - SS_GRID_GHOST;
-			slot->which = 0;
-			slot->x = i_east - i0;
-		} else {
-			slot->which = o->sign > 0 ? 2 : 1;
-			slot->x = i - i0 + 1;
-		}
-		tile_of[m] = (size_t)ty * t->tiles_x + tx;
+	const ptrdiff_t step = o->axis == 0 ? 1 : stride;
+	/* the face is west (south) of o->index; the flow cell is the side
+	 * positive flux leaves */
+	const ptrdiff_t cell = o->sign > 0 ? o->index - step : o->index;
+	const int i = (int)(cell % stride) - SS_GRID_GHOST;
+	const int j = (int)(cell / stride) - SS_GRID_GHOST;
+	const int tx = i / t->tile_nx, ty = j / t->tile_ny;
+	const int i0 = tx * t->tile_nx;
+
+	slot->face = m;
+	slot->j = j;
+	if (o->axis == 0) {
+		const int i_east = (int)(o->index % stride) - SS_GRID_GHOST;
+		slot->which = 0;
+		slot->x = i_east - i0;
+	} else {
+		slot->which = o->sign > 0 ? 2 : 1;
+		slot->x = i - i0 + 1;
+	}
+	return (size_t)ty * t->tiles_x + tx;
+}
+
+/* The open faces into f->open_slots grouped by tile, f->open_first[t] ..
+ * f->open_first[t + 1] those of tile t: a counting sort, stable, so each
+ * tile's stay in row order (the stepper's list is). */
+static int sort_open_slots(struct ss_sweep_fast *f, const struct ss_grid *g,
+                           const struct ss_open_face *open_faces, size_t count)
+{
+	const size_t n = count ? count : 1, tiles = (size_t)f->tiles;
+	struct ss_open_face_slot *slots = ss_alloc(n, sizeof *slots, "open faces");
+	size_t *tile_of = ss_alloc(n, sizeof *tile_of, "open faces");
+	size_t *fill = ss_alloc(tiles, sizeof *fill, "open faces");
+	int status = SS_ERR_FAIL;
+
+	if (!slots || !tile_of || !fill)
+		goto out_free;
+	for (size_t m = 0; m < count; m++) {
+		tile_of[m] = open_slot_of(&f->tiling, g, &open_faces[m], m, &slots[m]);
 		f->open_first[tile_of[m] + 1]++;
 	}
 	for (size_t k = 0; k < tiles; k++)
 		f->open_first[k + 1] += f->open_first[k];
-	struct ss_open_face_slot *sorted = ss_alloc(open_face_count ? open_face_count : 1,
-	                                            sizeof *sorted, "open faces");
-	size_t *fill = ss_alloc(tiles, sizeof *fill, "open faces");
-	if (!sorted || !fill) {
-		ss_free(sorted);
-		ss_free(fill);
-		ss_free(tile_of);
+	for (size_t m = 0; m < count; m++)
+		f->open_slots[f->open_first[tile_of[m]] + fill[tile_of[m]]++] = slots[m];
+	status = SS_OK;
+out_free:
+	ss_free(fill);
+	ss_free(tile_of);
+	ss_free(slots);
+	return status;
+}
+
+int ss_sweep_fast_init(struct ss_sweep_fast *f, const struct ss_grid *g,
+                       const struct ss_tiling *tiling, int threads,
+                       int periodic_x, int periodic_y,
+                       const uint8_t *cell_types,
+                       const struct ss_open_face *open_faces,
+                       size_t open_face_count)
+{
+	memset(f, 0, sizeof *f);
+	f->tiling = *tiling;
+	f->tiles = tiling->tiles_x * tiling->tiles_y;
+	f->threads = threads > 0 ? threads : 1;
+	f->periodic_x = periodic_x;
+	f->periodic_y = periodic_y;
+	if (alloc_tables(f, g, open_face_count) ||
+	    sort_open_slots(f, g, open_faces, open_face_count)) {
 		ss_sweep_fast_release(f);
 		return SS_ERR_FAIL;
 	}
-	for (size_t m = 0; m < open_face_count; m++)
-		sorted[f->open_first[tile_of[m]] + fill[tile_of[m]]++] = f->open_slots[m];
-	ss_free(f->open_slots);
-	f->open_slots = sorted;
-	ss_free(fill);
-	ss_free(tile_of);
-	memset(f->sweep, 1, tiles);
+	mark_plain_tiles(f, g, cell_types);
+	memset(f->sweep, 1, (size_t)f->tiles);
 	return SS_OK;
 }
 
@@ -568,14 +592,70 @@ double ss_sweep_fast_begin(struct ss_sweep_fast *f, const struct ss_grid *g,
 
 /* ---- the tile kernel -------------------------------------------------- */
 
-/* Cell types widened to 64 bits for the row loops: a select between
- * doubles on a 64-bit condition vectorises, on a byte it does not. */
-typedef int64_t wide_type;
+/*
+ * What every tile of a step shares: the arguments of ss_sweep_fast_step and
+ * what follows from them, built once per step and read by every thread.
+ * The phase helpers take what their loops need into locals first: a store
+ * to the heights could otherwise, for the compiler, change a field.
+ */
+struct tile_ctx {
+	struct ss_sweep_fast *f;
+	const struct ss_grid *g;
+	const struct ss_face_rule *rule;
+	const double *restrict src;    /* source rate, m/s by storage index; NULL: none */
+	const double *restrict bed;    /* bedrock, m by storage index; NULL: none */
+	const uint8_t *restrict type;  /* packed cell types (grid.h) */
+	double *restrict h;            /* heights, m by storage index, swept in place */
+	double *restrict open_flux;    /* m^2/s, by the stepper's open-face list */
+	ptrdiff_t stride;              /* g->stride */
+	double dt;                     /* s */
+	double inv_dx, inv_dy;         /* 1/dx, 1/dy, 1/m */
+	double inv_2dx, inv_2dy;       /* 1/(2 dx), 1/(2 dy): central differences */
+	double limit_x, limit_y;       /* 0.25 dx/dt, 0.25 dy/dt, m/s (ss_face_limit) */
+};
 
+/*
+ * The three-row ring a tile's row loop reads from, by buffer position x (cell
+ * i0 - 1 + x), while it sweeps row j: the old heights of rows j - 1, j and
+ * j + 1, their central differences along x (positions 1 .. W), the fluxes
+ * through the y-faces (j - 1 | j) and (j | j + 1), and the widened types of
+ * rows j - 2 .. j + 1.  ring_rotate moves it one row north by turning
+ * pointers; no row is copied.
+ */
+struct ring {
+	double *prev, *cur, *next;              /* old h, m */
+	double *cdx_prev, *cdx_cur, *cdx_next;  /* dh/dx, central */
+	double *fy_south, *fy_north;            /* F, m^2/s, positions 1 .. W */
+	int64_t *type_back, *type_prev, *type_cur, *type_next;  /* rows j - 2 .. j + 1 */
+};
+
+static inline void ring_rotate(struct ring *r)
+{
+	double *row = r->prev, *cdx = r->cdx_prev, *fy = r->fy_south;
+	int64_t *type = r->type_back;
+
+	r->prev = r->cur;
+	r->cur = r->next;
+	r->next = row;
+	r->cdx_prev = r->cdx_cur;
+	r->cdx_cur = r->cdx_next;
+	r->cdx_next = cdx;
+	r->fy_south = r->fy_north;
+	r->fy_north = fy;
+	r->type_back = r->type_prev;
+	r->type_prev = r->type_cur;
+	r->type_cur = r->type_next;
+	r->type_next = type;
+}
+
+/* A thread's buffers, rows of row_doubles() from f->scratch; by position. */
 struct row_buffers {
-	double *row[3], *cdx[3], *cdy, *gn, *gt, *fx, *fy[2];
-	wide_type *type[4];
-	double *west_old, *east_save;
+	struct ring ring;          /* where each tile's ring starts */
+	double *cdy;               /* dh/dy, central, of row j, positions 0 .. W + 1 */
+	double *gn, *gt;           /* g_n, g_t of a row of faces; then gn + 1 the rates */
+	double *fx;                /* F of the x-faces of row j, positions 0 .. W */
+	double *west_old;          /* old column i0 - 1 of the tile, by j - j0 */
+	double *east_save;         /* old column i1 - 1, the next tile's west_old */
 };
 
 static struct row_buffers buffers_of(const struct ss_sweep_fast *f, int thread)
@@ -583,27 +663,32 @@ static struct row_buffers buffers_of(const struct ss_sweep_fast *f, int thread)
 	const size_t w = row_doubles(&f->tiling);
 	double *p = f->scratch + (size_t)thread * f->scratch_doubles;
 	struct row_buffers b;
-	for (int k = 0; k < 3; k++) {
-		b.row[k] = p + (size_t)k * w;
-		b.cdx[k] = p + (size_t)(3 + k) * w;
-	}
+	b.ring.prev = p;
+	b.ring.cur = p + w;
+	b.ring.next = p + 2 * w;
+	b.ring.cdx_prev = p + 3 * w;
+	b.ring.cdx_cur = p + 4 * w;
+	b.ring.cdx_next = p + 5 * w;
 	b.cdy = p + 6 * w;
 	b.gn = p + 7 * w;
 	b.gt = p + 8 * w;
 	b.fx = p + 9 * w;
-	b.fy[0] = p + 10 * w;
-	b.fy[1] = p + 11 * w;
-	for (int k = 0; k < 4; k++)
-		b.type[k] = (wide_type *)(p + (size_t)(12 + k) * w);
+	b.ring.fy_south = p + 10 * w;
+	b.ring.fy_north = p + 11 * w;
+	b.ring.type_prev = (int64_t *)(p + 12 * w);
+	b.ring.type_cur = (int64_t *)(p + 13 * w);
+	b.ring.type_next = (int64_t *)(p + 14 * w);
+	b.ring.type_back = (int64_t *)(p + 15 * w);
 	b.west_old = p + 16 * w;
 	b.east_save = b.west_old + ((size_t)f->tiling.tile_ny + 7) / 8 * 8;
 	return b;
 }
 
 /* Types of the cells at positions 0 .. W + 1 of row j, from the packed
- * types t. */
+ * types t, widened to 64 bits for the row loops: a select between doubles
+ * on a 64-bit condition vectorises, on a byte it does not. */
 static inline void widen_types(const struct ss_grid *g, int W, int i0, int j,
-                               const uint8_t *restrict t, wide_type *restrict wide)
+                               const uint8_t *restrict t, int64_t *restrict wide)
 {
 	const ptrdiff_t k = ss_grid_index(g, i0 - 1, j);
 	for (int x = 0; x <= W + 1; x++)
@@ -611,16 +696,17 @@ static inline void widen_types(const struct ss_grid *g, int W, int i0, int j,
 }
 
 /* Central differences along x of buffer row b (types tt by position),
- * positions 1 .. W; a wall neighbour is replaced by the cell itself (mirror
- * ghost). */
+ * positions 1 .. W. */
 static inline void central_x(int plain, int W, double inv_2dx,
-                             const double *restrict b, const wide_type *restrict tt,
+                             const double *restrict b, const int64_t *restrict tt,
                              double *restrict cd)
 {
 	if (plain) {
+		/* cd[x] = (h[x+1] - h[x-1]) / 2dx */
 		for (int x = 1; x <= W; x++)
 			cd[x] = (b[x + 1] - b[x - 1]) * inv_2dx;
 	} else {
+		/* the same, a wall neighbour replaced by h[x] (mirror ghost) */
 		for (int x = 1; x <= W; x++) {
 			const double hp = tt[x + 1] == SS_CELL_WALL ? b[x] : b[x + 1];
 			const double hm = tt[x - 1] == SS_CELL_WALL ? b[x] : b[x - 1];
@@ -634,7 +720,7 @@ static inline void central_x(int plain, int W, double inv_2dx,
  * Returns whether a face that can carry flux is above the critical slope. */
 static inline int face_row(const struct ss_face_rule *rule, int n,
                            const double *restrict gn, const double *restrict gt,
-                           const wide_type *restrict ta, const wide_type *restrict tb,
+                           const int64_t *restrict ta, const int64_t *restrict tb,
                            double *restrict flux)
 {
 	const double tan_cr2 = rule->tan_cr2;
@@ -643,6 +729,7 @@ static inline int face_row(const struct ss_face_rule *rule, int n,
 	if (!ta)
 		return any;
 	if (any) {
+		/* F = 0 where the face cannot carry flux; sliding: s^2 > tan^2 a_cr */
 		for (int k = 0; k < n; k++) {
 			const int64_t carries = wide_carries(ta[k], tb[k]);
 			flux[k] = carries ? flux[k] : 0.0;
@@ -656,10 +743,11 @@ static inline int face_row(const struct ss_face_rule *rule, int n,
 static inline int y_faces(const struct ss_face_rule *rule, int plain, int W,
                           double inv_dy, const double *restrict a,
                           const double *restrict b, const double *restrict cdx_a,
-                          const double *restrict cdx_b, const wide_type *ta,
-                          const wide_type *tb, struct row_buffers *w,
+                          const double *restrict cdx_b, const int64_t *ta,
+                          const int64_t *tb, struct row_buffers *w,
                           double *restrict fy)
 {
+	/* g_n = (b[x] - a[x]) / dy, g_t = (cdx_a[x] + cdx_b[x]) / 2 */
 	for (int x = 1; x <= W; x++) {
 		w->gn[x] = (b[x] - a[x]) * inv_dy;
 		w->gt[x] = 0.5 * (cdx_a[x] + cdx_b[x]);
@@ -674,14 +762,10 @@ static inline void limit_y_faces(int W, double limit, const double *restrict a,
                                  const double *restrict b, const double *restrict bed_a,
                                  const double *restrict bed_b, double *restrict fy)
 {
+	/* |F| <= (h - b) dy / (4 dt) of the cell it leaves */
 	for (int x = 1; x <= W; x++)
 		fy[x] = ss_face_limit(fy[x], a[x] - bed_a[x], b[x] - bed_b[x], limit);
 }
-
-struct tile_result {
-	double rate_max, s2_max;
-	int bad;
-};
 
 /* Old row j of the tile into buf: the tile's cells and the east neighbour
  * from the grid (not yet swept this step), the west neighbour from west. */
@@ -693,186 +777,303 @@ static inline void load_row(double *restrict buf, const double *restrict h_row,
 	buf[W + 1] = h_row[i0 + W];
 }
 
-static void sweep_tile(struct ss_sweep_fast *f, const struct ss_grid *g,
-                       const struct ss_face_rule *rule, double dt,
-                       const double *restrict src, const double *restrict bed,
-                       const uint8_t *restrict type,
-                       double *restrict h, double *restrict open_flux,
-                       int tx, int ty, int west_swept, struct row_buffers *w,
-                       struct tile_result *res)
+/* One tile while it is swept: where it is, and what its rows found. */
+struct tile {
+	int index;                 /* ty * tiles_x + tx */
+	int i0, W, j0, j1;         /* cells [i0, i0 + W) x [j0, j1) */
+	int plain;                 /* f->plain[index] */
+	const double *ring_north;  /* the saved old row j1, by position */
+	const struct ss_open_face_slot *slot, *slot_end;  /* open faces to write */
+	int moving;                /* a face above the critical slope, or a source */
+	int edges;                 /* SS_EDGE_* of the edges whose cells changed */
+	int bad;                   /* a NaN slope or rate was seen */
+	double rate_max;           /* max |dh/dt| over its flow cells, m/s */
+	double s2_max;             /* max s^2 over the faces measured behind */
+};
+
+struct tile_result {
+	double rate_max, s2_max;
+	int bad;
+};
+
+/* The y-faces (j | j + 1) between ring rows cur and next into fy_north,
+ * with the central differences of next and the bedrock limit; returns
+ * whether one is above the critical slope. */
+static inline int north_y_faces(const struct tile_ctx *c, const struct tile *t,
+                                struct row_buffers *w, const struct ring *r, int j)
 {
-	const int tile = ty * f->tiling.tiles_x + tx;
+	central_x(t->plain, t->W, c->inv_2dx, r->next, r->type_next, r->cdx_next);
+	const int moving = y_faces(c->rule, t->plain, t->W, c->inv_dy, r->cur, r->next,
+	                           r->cdx_cur, r->cdx_next, r->type_cur, r->type_next, w,
+	                           r->fy_north);
+	if (c->bed) {
+		const double *bed_cur = c->bed + ss_grid_index(c->g, t->i0 - 1, j);
+		limit_y_faces(t->W, c->limit_y, r->cur, r->next, bed_cur, bed_cur + c->stride,
+		              r->fy_north);
+	}
+	return moving;
+}
+
+/*
+ * Start of tile (tx, ty): its span and open faces; the old west column from
+ * the grid unless the tile to the west handed it over; then the ring as if
+ * row j0 - 1 had just been swept: cur the saved south ring row, next row j0,
+ * the y-faces (j0 - 1 | j0) between them, turned to stand at row j0.
+ */
+static inline struct tile tile_begin(const struct tile_ctx *c, struct row_buffers *w,
+                                     struct ring *r, int tx, int ty, int west_swept)
+{
+	const struct ss_sweep_fast *f = c->f;
+	const struct ss_grid *g = c->g;
 	const struct ss_tile_span s = ss_tiling_span(&f->tiling, g, tx, ty);
-	const int i0 = s.i0, W = s.i1 - s.i0, j0 = s.j0, j1 = s.j1;
-	const int plain = f->plain[tile];
-	const ptrdiff_t stride = g->stride;
-	const double inv_dx = 1.0 / g->dx, inv_dy = 1.0 / g->dy;
-	const double inv_2dx = 0.5 / g->dx, inv_2dy = 0.5 / g->dy;
-	const double limit_x = 0.25 * g->dx / dt, limit_y = 0.25 * g->dy / dt;
-	double *prev = w->row[0], *cur = w->row[1], *next = w->row[2];
-	double *cdx_prev = w->cdx[0], *cdx_cur = w->cdx[1], *cdx_next = w->cdx[2];
-	double *fy_south = w->fy[0], *fy_north = w->fy[1];
-	const struct ss_open_face_slot *slot = f->open_slots + f->open_first[tile];
-	const struct ss_open_face_slot *slot_end = f->open_slots + f->open_first[tile + 1];
-	int moving = f->has_source[tile], edges = 0, bad = 0;
-	double rate_max = 0.0, s2_max = 0.0;
+	struct tile t = { .i0 = s.i0, .W = s.i1 - s.i0, .j0 = s.j0, .j1 = s.j1 };
 
+	t.index = ty * f->tiling.tiles_x + tx;
+	t.plain = f->plain[t.index];
+	t.ring_north = f->ring_north + ty * c->stride + t.i0;
+	t.slot = f->open_slots + f->open_first[t.index];
+	t.slot_end = f->open_slots + f->open_first[t.index + 1];
+	t.moving = f->has_source[t.index];
 	if (!west_swept)
-		for (int j = j0; j < j1; j++)
-			w->west_old[j - j0] = h[ss_grid_index(g, i0 - 1, j)];
-
-	wide_type *type_prev = w->type[0], *type_cur = w->type[1], *type_next = w->type[2];
-	wide_type *type_back = w->type[3];   /* row j - 2 */
-	memcpy(prev, f->ring_south + ty * stride + i0, (size_t)(W + 2) * sizeof(double));
-	load_row(cur, h + ss_grid_index(g, 0, j0), i0, W, w->west_old[0]);
-	if (!plain) {
-		widen_types(g, W, i0, j0 - 1, type, type_prev);
-		widen_types(g, W, i0, j0, type, type_cur);
+		for (int j = t.j0; j < t.j1; j++)
+			w->west_old[j - t.j0] = c->h[ss_grid_index(g, t.i0 - 1, j)];
+	memcpy(r->cur, f->ring_south + ty * c->stride + t.i0,
+	       (size_t)(t.W + 2) * sizeof(double));
+	load_row(r->next, c->h + ss_grid_index(g, 0, t.j0), t.i0, t.W, w->west_old[0]);
+	if (!t.plain) {
+		widen_types(g, t.W, t.i0, t.j0 - 1, c->type, r->type_cur);
+		widen_types(g, t.W, t.i0, t.j0, c->type, r->type_next);
 	}
-	central_x(plain, W, inv_2dx, prev, type_prev, cdx_prev);
-	central_x(plain, W, inv_2dx, cur, type_cur, cdx_cur);
-	moving |= y_faces(rule, plain, W, inv_dy, prev, cur, cdx_prev, cdx_cur,
-	                  type_prev, type_cur, w, fy_south);
-	if (bed)
-		limit_y_faces(W, limit_y, prev, cur, bed + ss_grid_index(g, i0 - 1, j0 - 1),
-		              bed + ss_grid_index(g, i0 - 1, j0), fy_south);
+	central_x(t.plain, t.W, c->inv_2dx, r->cur, r->type_cur, r->cdx_cur);
+	t.moving |= north_y_faces(c, &t, w, r, t.j0 - 1);
+	ring_rotate(r);
+	return t;
+}
 
-	for (int j = j0; j < j1; j++) {
-		double *h_row = h + ss_grid_index(g, 0, j);
-		if (j + 2 < j1) {
-			/* each row of a tile starts a new page, where the hardware
-			 * prefetcher starts cold: ask for the row after next */
-			const char *ahead = (const char *)(h + ss_grid_index(g, i0, j + 2));
-			for (size_t b = 0; b < (size_t)W * sizeof(double); b += 64)
-				__builtin_prefetch(ahead + b, 1, 3);
+/* Old row j + 1 into the ring's next (from the saved north ring row for the
+ * tile's last row), with its widened types. */
+static inline void ring_load_next(const struct tile_ctx *c, const struct tile *t,
+                                  const struct row_buffers *w, struct ring *r, int j)
+{
+	const struct ss_grid *g = c->g;
+	const int i0 = t->i0, W = t->W;
+
+	if (j + 2 < t->j1) {
+		/* each row of a tile starts a new page, where the hardware
+		 * prefetcher starts cold: ask for the row after next */
+		const char *ahead = (const char *)(c->h + ss_grid_index(g, i0, j + 2));
+		for (size_t b = 0; b < (size_t)W * sizeof(double); b += 64)
+			__builtin_prefetch(ahead + b, 1, 3);
+	}
+	if (j + 1 < t->j1)
+		load_row(r->next, c->h + ss_grid_index(g, 0, j + 1), i0, W,
+		         w->west_old[j + 1 - t->j0]);
+	else
+		memcpy(r->next, t->ring_north, (size_t)(W + 2) * sizeof(double));
+	if (!t->plain)
+		widen_types(g, W, i0, j + 1, c->type, r->type_next);
+}
+
+/* The x-faces of row j (positions 0 .. W) into w->fx, bedrock-limited, and
+ * the y-faces (j | j + 1); the y-faces (j - 1 | j) the row before gave.
+ * Returns whether a face is above the critical slope. */
+static inline int row_fluxes(const struct tile_ctx *c, const struct tile *t,
+                             struct row_buffers *w, const struct ring *r, int j)
+{
+	const int W = t->W;
+	const double *prev = r->prev, *cur = r->cur, *next = r->next;
+	const double inv_dx = c->inv_dx, inv_2dy = c->inv_2dy;
+
+	if (t->plain) {
+		/* cd_y[x] = (h[x, j+1] - h[x, j-1]) / 2dy */
+		for (int x = 0; x <= W + 1; x++)
+			w->cdy[x] = (next[x] - prev[x]) * inv_2dy;
+	} else {
+		/* the same, a wall neighbour replaced by h[x, j] (mirror ghost) */
+		for (int x = 0; x <= W + 1; x++) {
+			const double hp = r->type_next[x] == SS_CELL_WALL ? cur[x] : next[x];
+			const double hm = r->type_prev[x] == SS_CELL_WALL ? cur[x] : prev[x];
+			w->cdy[x] = (hp - hm) * inv_2dy;
 		}
-		if (j + 1 < j1)
-			load_row(next, h + ss_grid_index(g, 0, j + 1), i0, W, w->west_old[j + 1 - j0]);
-		else
-			memcpy(next, f->ring_north + ty * stride + i0, (size_t)(W + 2) * sizeof(double));
-		if (!plain)
-			widen_types(g, W, i0, j + 1, type, type_next);
+	}
+	/* g_n = (h[x+1] - h[x]) / dx, g_t = (cd_y[x] + cd_y[x+1]) / 2 */
+	for (int x = 0; x <= W; x++) {
+		w->gn[x] = (cur[x + 1] - cur[x]) * inv_dx;
+		w->gt[x] = 0.5 * (w->cdy[x] + w->cdy[x + 1]);
+	}
+	int moving = face_row(c->rule, W + 1, w->gn, w->gt, t->plain ? NULL : r->type_cur,
+	                      t->plain ? NULL : r->type_cur + 1, w->fx);
+	if (c->bed) {
+		const double *bed_cur = c->bed + ss_grid_index(c->g, t->i0 - 1, j);
+		const double limit_x = c->limit_x;
+		/* |F| <= (h - b) dx / (4 dt) of the cell it leaves */
+		for (int x = 0; x <= W; x++)
+			w->fx[x] = ss_face_limit(w->fx[x], cur[x] - bed_cur[x],
+			                         cur[x + 1] - bed_cur[x + 1], limit_x);
+	}
+	moving |= north_y_faces(c, t, w, r, j);
+	return moving;
+}
 
-		/* x-faces of row j, positions 0 .. W */
-		if (plain) {
-			for (int x = 0; x <= W + 1; x++)
-				w->cdy[x] = (next[x] - prev[x]) * inv_2dy;
-		} else {
-			for (int x = 0; x <= W + 1; x++) {
-				const double hp = type_next[x] == SS_CELL_WALL ? cur[x] : next[x];
-				const double hm = type_prev[x] == SS_CELL_WALL ? cur[x] : prev[x];
-				w->cdy[x] = (hp - hm) * inv_2dy;
-			}
+/* Forward Euler on the flow cells of row j, in place, as ss_sweep_update;
+ * max |dh/dt| into t (INFINITY on NaN); keeps the old east cell for the
+ * next tile. */
+static inline void row_update(const struct tile_ctx *c, struct tile *t,
+                              struct row_buffers *w, const struct ring *r, int j)
+{
+	const int W = t->W;
+	const double *fx = w->fx, *fy_south = r->fy_south, *fy_north = r->fy_north;
+	const double *cur = r->cur;
+	const double inv_dx = c->inv_dx, inv_dy = c->inv_dy, dt = c->dt;
+	double *rate = w->gn + 1;             /* free again: rate of cell x */
+
+	/* dh/dt = -(F_e - F_w)/dx - (F_n - F_s)/dy + q */
+	for (int x = 1; x <= W; x++)
+		rate[x - 1] = (fx[x - 1] - fx[x]) * inv_dx +
+		              (fy_south[x] - fy_north[x]) * inv_dy;
+	if (c->src) {
+		const double *src_row = c->src + ss_grid_index(c->g, t->i0, j);
+		for (int x = 0; x < W; x++)
+			rate[x] += src_row[x];
+	}
+	w->east_save[j - t->j0] = cur[W];
+	uint64_t row_max = 0;
+	const int64_t *tc = r->type_cur + 1;
+	double *hn = c->h + ss_grid_index(c->g, 0, j) + t->i0;
+	if (t->plain) {
+		/* h += dt dh/dt; max |dh/dt| as the integer max of its bits */
+		for (int x = 0; x < W; x++) {
+			hn[x] = cur[x + 1] + dt * rate[x];
+			const uint64_t a = bits_of(fabs(rate[x]));
+			row_max = a > row_max ? a : row_max;
 		}
-		for (int x = 0; x <= W; x++) {
-			w->gn[x] = (cur[x + 1] - cur[x]) * inv_dx;
-			w->gt[x] = 0.5 * (w->cdy[x] + w->cdy[x + 1]);
+	} else {
+		/* the same on flow cells only */
+		for (int x = 0; x < W; x++) {
+			const int flows = tc[x] == SS_CELL_FLOW;
+			hn[x] = flows ? cur[x + 1] + dt * rate[x] : cur[x + 1];
+			const uint64_t a = flows ? bits_of(fabs(rate[x])) : 0;
+			row_max = a > row_max ? a : row_max;
 		}
-		moving |= face_row(rule, W + 1, w->gn, w->gt, plain ? NULL : type_cur,
-		                   plain ? NULL : type_cur + 1, w->fx);
-		const double *bed_cur = bed ? bed + ss_grid_index(g, i0 - 1, j) : NULL;
-		if (bed)
-			for (int x = 0; x <= W; x++)
-				w->fx[x] = ss_face_limit(w->fx[x], cur[x] - bed_cur[x],
-				                         cur[x + 1] - bed_cur[x + 1], limit_x);
+	}
+	const double row_rate_max = double_of(row_max);
+	const int row_nan = row_rate_max != row_rate_max;
+	t->rate_max = row_nan ? INFINITY : max2(t->rate_max, row_rate_max);
+	t->bad |= row_nan;
+}
 
-		/* y-faces (j | j + 1) */
-		central_x(plain, W, inv_2dx, next, type_next, cdx_next);
-		moving |= y_faces(rule, plain, W, inv_dy, cur, next, cdx_cur, cdx_next,
-		                  type_cur, type_next, w, fy_north);
-		if (bed)
-			limit_y_faces(W, limit_y, cur, next, bed_cur, bed_cur + stride, fy_north);
+/* SS_EDGE_* of the tile's edges where row j changed a cell (new h against
+ * the ring's old row): the neighbours that see them must be swept next. */
+static inline int row_edges(const struct tile_ctx *c, const struct tile *t,
+                            const struct ring *r, int j)
+{
+	const double *h_row = c->h + ss_grid_index(c->g, 0, j), *cur = r->cur;
+	const int i0 = t->i0, W = t->W;
+	int edges = 0;
 
-		/* forward Euler, as ss_sweep_update */
-		const double *fx = w->fx;
-		double *rate = w->gn + 1;             /* free again: rate of cell x */
+	if (h_row[i0] != cur[1])
+		edges |= SS_EDGE_WEST;
+	if (h_row[i0 + W - 1] != cur[W])
+		edges |= SS_EDGE_EAST;
+	if (j == t->j0 || j == t->j1 - 1) {
+		int changed = 0;
 		for (int x = 1; x <= W; x++)
-			rate[x - 1] = (fx[x - 1] - fx[x]) * inv_dx +
-			              (fy_south[x] - fy_north[x]) * inv_dy;
-		if (src) {
-			const double *src_row = src + ss_grid_index(g, i0, j);
-			for (int x = 0; x < W; x++)
-				rate[x] += src_row[x];
-		}
-		w->east_save[j - j0] = cur[W];
-		uint64_t row_max = 0;
-		const wide_type *tc = type_cur + 1;
-		double *hn = h_row + i0;
-		if (plain) {
-			for (int x = 0; x < W; x++) {
-				hn[x] = cur[x + 1] + dt * rate[x];
-				const uint64_t a = bits_of(fabs(rate[x]));
-				row_max = a > row_max ? a : row_max;
-			}
-		} else {
-			for (int x = 0; x < W; x++) {
-				const int flows = tc[x] == SS_CELL_FLOW;
-				hn[x] = flows ? cur[x + 1] + dt * rate[x] : cur[x + 1];
-				const uint64_t a = flows ? bits_of(fabs(rate[x])) : 0;
-				row_max = a > row_max ? a : row_max;
-			}
-		}
-		const double row_rate_max = double_of(row_max);
-		const int row_nan = row_rate_max != row_rate_max;
-		rate_max = row_nan ? INFINITY : max2(rate_max, row_rate_max);
-		bad |= row_nan;
-
-		if (h_row[i0] != cur[1])
-			edges |= SS_EDGE_WEST;
-		if (h_row[i0 + W - 1] != cur[W])
-			edges |= SS_EDGE_EAST;
-		if (j == j0 || j == j1 - 1) {
-			int changed = 0;
-			for (int x = 1; x <= W; x++)
-				changed |= h_row[i0 + x - 1] != cur[x];
-			if (changed)
-				edges |= (j == j0 ? SS_EDGE_SOUTH : 0) | (j == j1 - 1 ? SS_EDGE_NORTH : 0);
-		}
-
-		for (; slot < slot_end && slot->j == j; slot++)
-			open_flux[slot->face] = slot->which == 0 ? fx[slot->x]
-			                      : slot->which == 1 ? fy_south[slot->x] : fy_north[slot->x];
-
-		/* the new state's faces inside the tile, one row behind */
-		if (j >= j0 + 2) {
-			s2_max = max2(s2_max, plain
-			              ? slope2_plain_pair(g, h, j, i0 + 1, i0 + W - 2, &bad)
-			              : slope2_mixed_pair(g, h, j, i0, 2, W - 1, type_back,
-			                                  type_prev, type_cur, &bad));
-			if (W >= 2)   /* the last interior x-face, not paired */
-				s2_max = max2(s2_max, slope2_x_faces(g, h, type, plain, j - 1, i0 + W - 1,
-				                                     i0 + W - 1, &bad));
-		} else {
-			if (j >= j0 + 1)
-				s2_max = max2(s2_max, slope2_y_faces(g, h, type, plain, j, i0 + 1,
-				                                     i0 + W - 2, &bad));
-			if (j >= j0 + 2)
-				s2_max = max2(s2_max, slope2_x_faces(g, h, type, plain, j - 1, i0 + 1,
-				                                     i0 + W - 1, &bad));
-		}
-
-		double *tmp = prev;
-		prev = cur;
-		cur = next;
-		next = tmp;
-		tmp = cdx_prev;
-		cdx_prev = cdx_cur;
-		cdx_cur = cdx_next;
-		cdx_next = tmp;
-		tmp = fy_south;
-		fy_south = fy_north;
-		fy_north = tmp;
-		wide_type *tt = type_back;
-		type_back = type_prev;
-		type_prev = type_cur;
-		type_cur = type_next;
-		type_next = tt;
+			changed |= h_row[i0 + x - 1] != cur[x];
+		if (changed)
+			edges |= (j == t->j0 ? SS_EDGE_SOUTH : 0) | (j == t->j1 - 1 ? SS_EDGE_NORTH : 0);
 	}
-	f->moving[tile] = (uint8_t)(moving != 0);
-	f->edges_changed[tile] = (uint8_t)edges;
-	res->rate_max = rate_max;
-	res->s2_max = s2_max;
-	res->bad = bad;
+	return edges;
+}
+
+/* The fluxes of row j's faces to open cells, for the stepper's balance. */
+static inline void row_open_fluxes(const struct tile_ctx *c, struct tile *t,
+                                   const struct row_buffers *w, const struct ring *r,
+                                   int j)
+{
+	const struct ss_open_face_slot *slot = t->slot;
+
+	for (; slot < t->slot_end && slot->j == j; slot++)
+		c->open_flux[slot->face] = slot->which == 0 ? w->fx[slot->x]
+		                         : slot->which == 1 ? r->fy_south[slot->x]
+		                         : r->fy_north[slot->x];
+	t->slot = slot;
+}
+
+/*
+ * The new state's slopes one row behind the update, while the rows are in
+ * cache: at row j the faces whose stencil rows j - 2 .. j are all new.  The
+ * faces whose stencil reaches into another tile are left to
+ * ss_sweep_fast_begin.
+ */
+static inline void row_measure_behind(const struct tile_ctx *c, struct tile *t,
+                                      const struct ring *r, int j)
+{
+	const struct ss_grid *g = c->g;
+	const int i0 = t->i0, W = t->W, plain = t->plain;
+	int bad = 0;
+
+	if (j >= t->j0 + 2) {
+		/* x-faces of row j - 1 and y-faces (j - 1 | j) */
+		t->s2_max = max2(t->s2_max, plain
+		                 ? slope2_plain_pair(g, c->h, j, i0 + 1, i0 + W - 2, &bad)
+		                 : slope2_mixed_pair(g, c->h, j, i0, 2, W - 1, r->type_back,
+		                                     r->type_prev, r->type_cur, &bad));
+		if (W >= 2)   /* the last interior x-face, not paired */
+			t->s2_max = max2(t->s2_max, slope2_x_faces(g, c->h, c->type, plain, j - 1,
+			                                           i0 + W - 1, i0 + W - 1, &bad));
+	} else if (j >= t->j0 + 1) {
+		/* j = j0 + 1: the y-faces (j0 | j0 + 1); row j0's x-faces reach
+		 * row j0 - 1.  Spelled >= on purpose: gcc then splits the row
+		 * loop at j0 + 1, not j0 + 2, and with == the sweep ran 7-10 %
+		 * slower (gcc 12, 1 thread, 2048^2 and 4096^2: the same work,
+		 * more time in load_row's memcpy) */
+		t->s2_max = max2(t->s2_max, slope2_y_faces(g, c->h, c->type, plain, j, i0 + 1,
+		                                           i0 + W - 2, &bad));
+	}
+	t->bad |= bad;
+}
+
+/*
+ * Sweep tile (tx, ty) in place: every flow cell advances by one forward
+ * Euler step of SPEC section 2,
+ *
+ *     h += dt (-(F_e - F_w)/dx - (F_n - F_s)/dy + q),
+ *     F = -nu f_sl(s) g_n / s,   s = sqrt(g_n^2 + g_t^2),
+ *
+ * with g_n the difference across a face over the spacing and g_t the mean
+ * of the two cells' central differences along it (a wall neighbour replaced
+ * by the cell: mirror ghost), F = 0 where ss_face_carries says no, then the
+ * bedrock limit.  The arithmetic of every face and cell is the reference
+ * sweep's (sweep.c), so the bits are the same.
+ *
+ * Why it reads this way: the heights are the only grid-sized array, so the
+ * old state lives in a three-row ring (row j + 1 is copied before row j is
+ * overwritten; the tile rows around keep theirs in f->ring_south/north, the
+ * tile to the west hands over its old east column).  Each face is computed
+ * once: the y-faces (j | j + 1) serve rows j and j + 1.  The slopes of the
+ * new state are measured one row behind, while in cache, so the next dt
+ * needs no pass of its own.  Also notes for plan_next whether the tile moved
+ * and which of its edges changed, and writes the fluxes of its open faces.
+ */
+static inline struct tile_result sweep_tile(const struct tile_ctx *c,
+                                            struct row_buffers *w, int tx, int ty,
+                                            int west_swept)
+{
+	struct ring r = w->ring;
+	struct tile t = tile_begin(c, w, &r, tx, ty, west_swept);
+
+	for (int j = t.j0; j < t.j1; j++) {
+		ring_load_next(c, &t, w, &r, j);
+		t.moving |= row_fluxes(c, &t, w, &r, j);
+		row_update(c, &t, w, &r, j);
+		t.edges |= row_edges(c, &t, &r, j);
+		row_open_fluxes(c, &t, w, &r, j);
+		row_measure_behind(c, &t, &r, j);
+		ring_rotate(&r);
+	}
+	c->f->moving[t.index] = (uint8_t)(t.moving != 0);
+	c->f->edges_changed[t.index] = (uint8_t)t.edges;
+	return (struct tile_result){ t.rate_max, t.s2_max, t.bad };
 }
 
 /* Which tiles the next step sweeps: those that moved, those under a source,
@@ -933,11 +1134,20 @@ double ss_sweep_fast_step(struct ss_sweep_fast *f, const struct ss_grid *g,
 {
 	const struct ss_tiling *t = &f->tiling;
 	const int rows = list_rows(f);
+	const struct tile_ctx ctx = {
+		.f = f, .g = g, .rule = rule,
+		.src = source_rate, .bed = bedrock, .type = cell_types,
+		.h = height, .open_flux = open_flux,
+		.stride = g->stride, .dt = dt,
+		.inv_dx = 1.0 / g->dx, .inv_dy = 1.0 / g->dy,
+		.inv_2dx = 0.5 / g->dx, .inv_2dy = 0.5 / g->dy,
+		.limit_x = 0.25 * g->dx / dt, .limit_y = 0.25 * g->dy / dt,
+	};
 	double rate_max = 0.0, s2_max = 0.0;
 	int bad = 0;
 
-	#pragma omp parallel num_threads(f->threads) reduction(max:rate_max, s2_max) \
-		reduction(|:bad) if(rows > 1)
+	#pragma omp parallel num_threads(f->threads) \
+		reduction(max:rate_max, s2_max) reduction(|:bad) if(rows > 1)
 	{
 		struct row_buffers w = buffers_of(f, ss_parallel_thread_id());
 		#pragma omp for schedule(dynamic, 1)
@@ -945,14 +1155,11 @@ double ss_sweep_fast_step(struct ss_sweep_fast *f, const struct ss_grid *g,
 			const int ty = f->row_list[r];
 			int west_swept = 0;
 			for (int tx = 0; tx < t->tiles_x; tx++) {
-				const int tile = ty * t->tiles_x + tx;
-				if (!f->sweep[tile]) {
+				if (!f->sweep[ty * t->tiles_x + tx]) {
 					west_swept = 0;
 					continue;
 				}
-				struct tile_result res;
-				sweep_tile(f, g, rule, dt, source_rate, bedrock, cell_types, height,
-				           open_flux, tx, ty, west_swept, &w, &res);
+				const struct tile_result res = sweep_tile(&ctx, &w, tx, ty, west_swept);
 				rate_max = max2(rate_max, res.rate_max);
 				s2_max = max2(s2_max, res.s2_max);
 				bad |= res.bad;
