@@ -20,19 +20,12 @@
 
 void ss_relax_options_init(struct ss_relax_options *o)
 {
-	memset(o, 0, sizeof *o);
+	*o = (struct ss_relax_options){
+		.closure = SS_CLOSURE_COULOMB, .angle_deg = 35.0, .gamma = 1.0, .nu = 1.0,
+		.tol = 1e-9, .max_time = INFINITY, .cfl = 0.9, .sides = SS_SIDE_WALL,
+		.nodata_type = SS_CELL_OPEN, .open_level = NAN, .output_every = NAN,
+	};
 	ss_dem_read_options_init(&o->read);
-	o->closure = SS_CLOSURE_COULOMB;
-	o->angle_deg = 35.0;
-	o->gamma = 1.0;
-	o->nu = 1.0;
-	o->tol = 1e-9;
-	o->max_time = INFINITY;
-	o->cfl = 0.9;
-	o->sides = SS_SIDE_WALL;
-	o->nodata_type = SS_CELL_OPEN;
-	o->open_level = NAN;
-	o->output_every = NAN;
 }
 
 /* "dir/name.asc" -> "out/name-relaxed.asc"; "FILE.h5:/dataset" -> .h5 */

@@ -220,26 +220,18 @@ int ss_face_fluxes(const struct ss_face_rule *r, int n,
 		const int m = n - base < CHUNK ? n - base : CHUNK;
 		const double *restrict gn = g_n + base;
 		any |= slopes_and_rsqrt(m, r->tan_cr2, gn, g_t + base, s2, inv_s, inv_w, slides);
+		/* each form a call with a constant `form`, so that the inlined
+		 * f_over_s keeps only that form's loop (no switch per face) */
+#define FORM(form) case form: f_over_s(form, r, m, s2, inv_s, inv_w, fos); break
 		switch (r->form) {
-		case SS_FACE_COULOMB:
-			f_over_s(SS_FACE_COULOMB, r, m, s2, inv_s, inv_w, fos);
-			break;
-		case SS_FACE_BINGHAM:
-			f_over_s(SS_FACE_BINGHAM, r, m, s2, inv_s, inv_w, fos);
-			break;
-		case SS_FACE_HB_POW:
-			f_over_s(SS_FACE_HB_POW, r, m, s2, inv_s, inv_w, fos);
-			break;
-		case SS_FACE_HB_CUBE:
-			f_over_s(SS_FACE_HB_CUBE, r, m, s2, inv_s, inv_w, fos);
-			break;
-		case SS_FACE_HB_THREE_HALVES:
-			f_over_s(SS_FACE_HB_THREE_HALVES, r, m, s2, inv_s, inv_w, fos);
-			break;
-		case SS_FACE_CASSON:
-			f_over_s(SS_FACE_CASSON, r, m, s2, inv_s, inv_w, fos);
-			break;
+		FORM(SS_FACE_COULOMB);
+		FORM(SS_FACE_BINGHAM);
+		FORM(SS_FACE_HB_POW);
+		FORM(SS_FACE_HB_CUBE);
+		FORM(SS_FACE_HB_THREE_HALVES);
+		FORM(SS_FACE_CASSON);
 		}
+#undef FORM
 		for (int k = 0; k < m; k++)
 			flux[base + k] = slides[k] != 0.0 ? -(nu * gn[k]) * fos[k] : 0.0;
 	}
