@@ -116,6 +116,17 @@ double ss_sweep_max_slope(const struct ss_grid *g, const double *restrict height
                           const uint8_t *restrict cell_types);
 
 /*
+ * The same over the faces whose stencil (both cells and their neighbours
+ * along the face) lies in sand: every flow cell of it more than `bare` m
+ * above the bedrock (m, with halo, as the stepper keeps it).  Bare rock may
+ * stay steeper than the repose angle for ever, and so may a face next to a
+ * rock cliff, whose step enters the tangential difference.
+ */
+double ss_sweep_max_sand_slope(const struct ss_grid *g, const double *restrict height,
+                               const uint8_t *restrict cell_types,
+                               const double *restrict bedrock, double bare);
+
+/*
  * The fast sweep (sweep_fast.c): one in-place pass per step over the tiles
  * that can move, with the same face function and update as the reference.
  *

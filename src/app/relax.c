@@ -44,62 +44,20 @@ static void default_output(const char *dem, char *out, size_t size)
 
 /*
  * The steepest face of the sand, as an angle: faces that can carry flux
- * (SPEC section 2) whose stencil (both cells and their neighbours along the
- * face) lies in sand at least 1e-6 min(dx, dy) thick.  Bare rock may be
- * steeper than the repose angle for ever, and so may the slope measured
- * next to a rock cliff, whose step enters the tangential difference; a cell
- * at the top of a cliff drains geometrically (a quarter of its sand per
- * face and step, face.h), so it never quite reaches 0.  Without bedrock
- * this is ss_sweep_max_slope.
+ * (SPEC section 2) whose stencil lies in sand at least 1e-6 min(dx, dy)
+ * thick (ss_sweep_max_sand_slope).  A cell at the top of a rock cliff
+ * drains geometrically (a quarter of its sand per face and step, face.h),
+ * so it never quite reaches 0.  Without bedrock this is every face.
  */
 static double steepest_sand_face_deg(struct ss_stepper *st)
 {
 	const struct ss_grid *g = &st->grid;
 	ss_boundary_fill_heights(g, &st->boundary, st->height);
-	if (!st->bedrock)
-		return atan(ss_sweep_max_slope(g, st->height, st->cell_types)) * (180.0 / M_PI);
-	const double *h = st->height, *b = st->bedrock;
-	const double bare = 1e-6 * fmin(g->dx, g->dy);   /* m */
-	const uint8_t *t = st->cell_types;
-	double s2_max = 0.0;
-	for (int axis = 0; axis < 2; axis++) {
-		const ptrdiff_t normal = axis == 0 ? 1 : g->stride, along = axis == 0 ? g->stride : 1;
-		const double dn = axis == 0 ? g->dx : g->dy, da = axis == 0 ? g->dy : g->dx;
-		#pragma omp parallel for schedule(static) reduction(max:s2_max)
-		for (int j = 0; j <= g->ny; j++) {
-			for (int i = 0; i <= g->nx; i++) {
-				if ((axis == 0 && j == g->ny) || (axis == 1 && i == g->nx))
-					continue;
-				const ptrdiff_t kb = ss_grid_index(g, i, j), ka = kb - normal;
-				const enum ss_cell_type ta = ss_cell_type_get(t, ka);
-				const enum ss_cell_type tb = ss_cell_type_get(t, kb);
-				if (ta == SS_CELL_WALL || tb == SS_CELL_WALL ||
-				    (ta != SS_CELL_FLOW && tb != SS_CELL_FLOW))
-					continue;
-				const ptrdiff_t stencil[6] = {ka, kb, ka + along, ka - along,
-				                              kb + along, kb - along};
-				int in_sand = 1;
-				for (int m = 0; m < 6; m++)
-					in_sand &= ss_cell_type_get(t, stencil[m]) != SS_CELL_FLOW ||
-					           h[stencil[m]] - b[stencil[m]] > bare;
-				if (!in_sand)
-					continue;
-				double gt = 0.0;
-				const ptrdiff_t cells[2] = {ka, kb};
-				for (int m = 0; m < 2; m++) {
-					const ptrdiff_t k = cells[m];
-					const double up = ss_cell_type_get(t, k + along) == SS_CELL_WALL
-					                  ? h[k] : h[k + along];
-					const double down = ss_cell_type_get(t, k - along) == SS_CELL_WALL
-					                    ? h[k] : h[k - along];
-					gt += 0.5 * (up - down) / (2.0 * da);
-				}
-				const double gn = (h[kb] - h[ka]) / dn, s2 = gn * gn + gt * gt;
-				s2_max = s2 > s2_max ? s2 : s2_max;
-			}
-		}
-	}
-	return atan(sqrt(s2_max)) * (180.0 / M_PI);
+	const double s = st->bedrock
+	               ? ss_sweep_max_sand_slope(g, st->height, st->cell_types, st->bedrock,
+	                                         1e-6 * fmin(g->dx, g->dy))
+	               : ss_sweep_max_slope(g, st->height, st->cell_types);
+	return atan(s) * (180.0 / M_PI);
 }
 
 /* The stepper for raster r: grid, closure, cell types (nodata), heights,

@@ -336,6 +336,51 @@ double ss_sweep_max_slope(const struct ss_grid *g, const double *restrict height
 	return bad ? NAN : sqrt(m);
 }
 
+/* 1 when the stencil of the face between a and a + normal (both cells and
+ * their neighbours along the face) lies in sand thicker than `bare`: a
+ * flow cell there holds more than bare above the bedrock b. */
+static inline int stencil_in_sand(const double *h, const double *b, const uint8_t *t,
+                                  ptrdiff_t a, ptrdiff_t normal, ptrdiff_t along,
+                                  double bare)
+{
+	const ptrdiff_t cells[6] = {a, a + normal, a + along, a - along, a + normal + along,
+	                            a + normal - along};
+	int in_sand = 1;
+	for (int m = 0; m < 6; m++)
+		in_sand &= type_at(t, cells[m]) != SS_CELL_FLOW || h[cells[m]] - b[cells[m]] > bare;
+	return in_sand;
+}
+
+double ss_sweep_max_sand_slope(const struct ss_grid *g, const double *restrict height,
+                               const uint8_t *restrict cell_types,
+                               const double *restrict bedrock, double bare)
+{
+	const ptrdiff_t s = g->stride;
+	const double inv_dx = 1.0 / g->dx, inv_dy = 1.0 / g->dy;
+	const double inv_2dx = 0.5 / g->dx, inv_2dy = 0.5 / g->dy;
+	uint64_t m = 0;
+	/* the x-faces (i - 1 | i) of rows 0 .. ny - 1, the y-faces (j - 1 | j)
+	 * of columns 0 .. nx - 1, with the kernel's arithmetic (s^2 as bits) */
+	#pragma omp parallel for schedule(static) reduction(max:m)
+	for (int j = 0; j <= g->ny; j++) {
+		for (int i = 0; i <= g->nx; i++) {
+			const ptrdiff_t k = ss_grid_index(g, i, j);
+			uint64_t q = 0;
+			if (j < g->ny && stencil_in_sand(height, bedrock, cell_types, k - 1, 1, s, bare))
+				q = face_slope2_bits(height, cell_types, k - 1, 1, s, inv_dx, inv_2dy);
+			if (i < g->nx && stencil_in_sand(height, bedrock, cell_types, k - s, s, 1, bare)) {
+				const uint64_t y = face_slope2_bits(height, cell_types, k - s, s, 1, inv_dy,
+				                                    inv_2dx);
+				q = y > q ? y : q;
+			}
+			m = q > m ? q : m;
+		}
+	}
+	int bad = 0;
+	const double m2 = max_of_bits(m, &bad);
+	return bad ? NAN : sqrt(m2);
+}
+
 /* ---- set-up ---------------------------------------------------------- */
 
 static size_t row_doubles(const struct ss_tiling *t)
