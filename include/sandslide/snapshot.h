@@ -1,6 +1,7 @@
 /*
  * snapshot.h - the HDF5 output of a run (SPEC section 5) and its XDMF
- * sidecar.  This module is the only code that includes <hdf5.h>.
+ * sidecar.  src/io/snapshot_write.c writes it and src/io/snapshot_read.c
+ * reads it; render/series.c has a reader of its own (for now).
  *
  * Layout (netCDF-4 / CF-1.8 compatible, dimensions as HDF5 dimension scales):
  *   /height      float64 (time, y, x), chunked, extendible in time
