@@ -594,19 +594,32 @@ double ss_snapshot_last_time(const struct ss_snapshot *s)
 	return s->count > 0 ? s->times[s->count - 1] : NAN;
 }
 
-static int read_series(hid_t file, const char *name, long long count, double *out)
+/* A file to continue must be a sandslide file (ss_snapshot_file_open) of
+ * grid g with at least one snapshot, and every series and cell type in it
+ * must read (the summary): the appends that follow extend them all.  Its
+ * times go into s, for the sidecar. */
+static int check_append(struct ss_snapshot *s, const char *path, const struct ss_grid *g)
 {
-	hid_t d = H5Dopen2(file, name, H5P_DEFAULT);
-	if (d < 0)
-		return -1;
-	hid_t fs = H5Dget_space(d);
-	hsize_t n = 0;
-	int ok = H5Sget_simple_extent_ndims(fs) == 1 &&
-	         H5Sget_simple_extent_dims(fs, &n, NULL) == 1 && n == (hsize_t)count;
-	herr_t r = ok ? H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, out) : -1;
-	H5Sclose(fs);
-	H5Dclose(d);
-	return r < 0 ? -1 : 0;
+	struct ss_snapshot_file f;
+	struct ss_snapshot_summary sum;
+	memset(&sum, 0, sizeof sum);
+	int err = ss_snapshot_file_open(&f, path);
+	if (!err)
+		err = ss_snapshot_file_summary(&f, &sum);
+	if (!err && (f.nx != g->nx || f.ny != g->ny || f.count < 1))
+		err = ss_error_input("cannot open '%s' to continue it: not a sandslide output of "
+		                     "this %d x %d grid", path, g->nx, g->ny);
+	if (!err) {
+		s->count = f.count;
+		s->times_cap = f.count + 64;
+		if (!(s->times = calloc((size_t)s->times_cap, sizeof *s->times)))
+			err = ss_error_fail("out of memory");
+		else
+			memcpy(s->times, f.time, (size_t)f.count * sizeof *s->times);
+	}
+	ss_snapshot_summary_release(&sum);
+	ss_snapshot_file_close(&f);
+	return err;
 }
 
 int ss_snapshot_open_append(struct ss_snapshot **out, const char *path,
@@ -617,10 +630,17 @@ int ss_snapshot_open_append(struct ss_snapshot **out, const char *path,
 	struct ss_snapshot *s = snapshot_alloc(path, g);
 	if (!s)
 		return ss_error_fail("out of memory");
+	int err = check_append(s, path, g);
+	if (err) {
+		ss_snapshot_destroy(s);
+		return err;
+	}
 	hid_t fapl = writer_access();
+	errno = 0;
 	s->file = H5Fopen(path, H5F_ACC_RDWR, fapl);
 	H5Pclose(fapl);
 	int bad = s->file < 0;
+	const int e = errno;
 	if (!bad) {
 		s->height = H5Dopen2(s->file, "height", H5P_DEFAULT);
 		s->time = H5Dopen2(s->file, "time", H5P_DEFAULT);
@@ -628,24 +648,10 @@ int ss_snapshot_open_append(struct ss_snapshot **out, const char *path,
 		for (int k = 0; k < SS_SNAPSHOT_DIAG_COUNT && !bad; k++)
 			bad = (s->diag[k] = H5Dopen2(s->file, ss_snapshot_diag_name(k), H5P_DEFAULT)) < 0;
 	}
-	hsize_t dims[3] = {0, 0, 0};
-	if (!bad) {
-		hid_t fs = H5Dget_space(s->height);
-		bad = H5Sget_simple_extent_ndims(fs) != 3 ||
-		      H5Sget_simple_extent_dims(fs, dims, NULL) != 3 ||
-		      dims[1] != (hsize_t)g->ny || dims[2] != (hsize_t)g->nx || dims[0] < 1;
-		H5Sclose(fs);
-	}
-	if (!bad) {
-		s->count = (long long)dims[0];
-		s->times_cap = s->count + 64;
-		s->times = calloc((size_t)s->times_cap, sizeof *s->times);
-		bad = !s->times || read_series(s->file, "time", s->count, s->times);
-	}
 	if (bad) {
 		ss_snapshot_destroy(s);
-		return ss_error_input("cannot open '%s' to continue it: not a sandslide output of "
-		                      "this %d x %d grid", path, g->nx, g->ny);
+		return ss_error_input("cannot open '%s' to continue it%s%s", path, e ? ": " : "",
+		                      e ? strerror(e) : "");
 	}
 	*out = s;
 	return SS_OK;
