@@ -139,16 +139,21 @@ int ss_snapshot_read_field(const char *path, const char *dataset, long long inde
  * A sandslide file, open for reading.  A file is one when it has
  *   - a root attribute `source` (a string, fixed or variable length)
  *     starting with "sandslide",
- *   - /height (time, y, x) of numbers, with 1 <= y, x <= 2^30,
+ *   - /height (time, y, x) of numbers, with 1 <= y, x <= 2^30, its last
+ *     snapshot stored,
  *   - /time (time) of numbers, as many as /height has snapshots,
  *   - /cell_type (y, x) of numbers, of the size of a snapshot,
  *   - positive finite root attributes dx and dy;
  * /x and /y are optional: their first values give the lower-left corner.
+ * Numbers are IEEE floats or standard integers of either byte order.
  *
- * A file that says it is one but whose sizes cannot be true is damaged
- * (SS_ERR_INPUT, "... is damaged: ..."): every size is checked against the
- * file before anything of that size is allocated, by this reader or by
- * HDF5 (a dataset's values, its chunks, a string), and so is every read.
+ * A file whose sizes cannot be true is damaged (SS_ERR_INPUT, "... is
+ * damaged: ..."): every size is checked against the file before anything
+ * of that size is allocated, by this reader or by HDF5 (a dataset's
+ * values, its chunks, a string), and a read that fails is damage too.
+ * What HDF5 decodes before any size reaches the reader (object headers,
+ * heaps) is beyond these checks: tests/fuzz/README.md lists the damaged
+ * files that crash or hang Debian's libhdf5 1.10.8 itself.
  */
 struct ss_snapshot_file_h5;     /* opaque: the HDF5 handles */
 
