@@ -368,7 +368,9 @@ def sandslide_outputs(binary, d):
         f.write("ncols 3\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n0 0 0\n0 0 9\n")
     for args in (["run", "c.ini", "-o", "run.h5", "--deflate", "6", "-q"],
                  ["relax", "d.asc", "-o", "relax.h5", "-q"]):
-        subprocess.run([binary] + args, cwd=d, check=True, capture_output=True)
+        # argv[0] "sandslide": the history attribute holds no local path
+        subprocess.run(["sandslide"] + args, executable=binary, cwd=d, check=True,
+                       capture_output=True)
     for name in ("run", "relax"):
         with open(os.path.join(d, name + ".h5"), "rb") as f:
             put("h5", "sandslide-" + name, f.read())
