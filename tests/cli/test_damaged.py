@@ -22,7 +22,7 @@ import pytest
 from conftest import BASE, SANDSLIDE, edit, h5open, run_ok
 
 SCALE = float(os.environ.get("SANDSLIDE_TEST_SCALE") or 1)
-STEP = int(251 / SCALE)
+STEP = int(307 / SCALE)
 SERIES = ["time", "volume", "inflow", "outflow", "max_height", "max_slope_deg", "steps",
           "active_fraction", "wall_seconds"]
 SMALL = edit(edit(BASE, "nx = 20\n", "nx = 6\n"), "ny = 16\n", "ny = 5\n")
