@@ -154,7 +154,7 @@ headers-check: $(BUILD)/.flags
 
 # ---- fuzzing (tests/fuzz/) --------------------------------------------------
 # One harness per input reader: case (ss_case_parse), mask (PNG masks of
-# shapes), asc and png (ss_dem_read).
+# shapes), asc and png (ss_dem_read), h5 (the HDF5 reader, snapshot.h).
 #   make fuzz         libFuzzer binaries $(BUILD)/fuzz/fuzz_NAME, built with
 #                     clang (FUZZ_CC), the library compiled again with the same
 #                     sanitizers; tests/fuzz/README.md says how to run them
@@ -162,7 +162,7 @@ headers-check: $(BUILD)/.flags
 #                     main() (tests/fuzz/replay.c), run over
 #                     tests/fuzz/corpus/NAME/ and tests/fuzz/regressions/NAME/:
 #                     no clang needed; `make test` runs it too
-FUZZ_NAMES   := case mask asc png
+FUZZ_NAMES   := case mask asc png h5
 FUZZ_CC      ?= clang
 FUZZ_BUILD   := $(BUILD)/fuzz
 FUZZ_SAN     := -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer

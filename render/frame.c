@@ -194,32 +194,33 @@ static int snapshot_heights(const struct ss_render_plan *p, struct ss_render_sou
                             long long t, double **buf, double **acc_w, const double **h,
                             ptrdiff_t *stride, int parallel)
 {
+	struct ss_snapshot_file *f = &s->file;
 	*acc_w = NULL;
-	const int block = ss_render_source_block_rows(s);
+	const int block = ss_snapshot_file_block_rows(f);
 	if (ss_render_resampler_is_identity(&p->rs)) {
-		*buf = ss_alloc((size_t)s->nx * (size_t)s->ny, sizeof **buf, "snapshot heights");
+		*buf = ss_alloc((size_t)f->nx * (size_t)f->ny, sizeof **buf, "snapshot heights");
 		if (!*buf)
 			return SS_ERR_FAIL;
-		for (int j0 = 0; j0 < s->ny; j0 += block) {
-			const int rows = s->ny - j0 < block ? s->ny - j0 : block;
-			int err = ss_render_source_read_rows(s, t, j0, rows, *buf + (size_t)j0 * s->nx);
+		for (int j0 = 0; j0 < f->ny; j0 += block) {
+			const int rows = f->ny - j0 < block ? f->ny - j0 : block;
+			int err = ss_snapshot_file_read_rows(f, t, j0, rows, *buf + (size_t)j0 * f->nx);
 			if (err)
 				return err;
 		}
-		*h = *buf + (size_t)(s->ny - 1) * s->nx;
-		*stride = -(ptrdiff_t)s->nx;
+		*h = *buf + (size_t)(f->ny - 1) * f->nx;
+		*stride = -(ptrdiff_t)f->nx;
 		return SS_OK;
 	}
-	double *rows_buf = ss_alloc((size_t)block * (size_t)s->nx, sizeof *rows_buf, "height rows");
+	double *rows_buf = ss_alloc((size_t)block * (size_t)f->nx, sizeof *rows_buf, "height rows");
 	if (!rows_buf || alloc_accumulators(p, buf, acc_w)) {
 		ss_free(rows_buf);
 		return SS_ERR_FAIL;
 	}
 	int err = SS_OK;
-	for (int j0 = 0; j0 < s->ny && !err; j0 += block) {
-		const int rows = s->ny - j0 < block ? s->ny - j0 : block;
-		if (!(err = ss_render_source_read_rows(s, t, j0, rows, rows_buf)))
-			ss_render_resample_rows(&p->rs, rows_buf, s->nx, s->cell_type, s->nx, j0, rows,
+	for (int j0 = 0; j0 < f->ny && !err; j0 += block) {
+		const int rows = f->ny - j0 < block ? f->ny - j0 : block;
+		if (!(err = ss_snapshot_file_read_rows(f, t, j0, rows, rows_buf)))
+			ss_render_resample_rows(&p->rs, rows_buf, f->nx, s->cell_type, f->nx, j0, rows,
 			                        *buf, *acc_w, parallel);
 	}
 	ss_free(rows_buf);
@@ -239,13 +240,13 @@ int ss_render_plan_snapshot(const struct ss_render_plan *p, struct ss_render_sou
 	int err = snapshot_heights(p, s, t, &buf, &w, &h, &stride, parallel);
 	if (!err) {
 		struct ss_render_image img;
-		err = ss_render_plan_draw(p, h, stride, s->time[t], &img, parallel);
+		err = ss_render_plan_draw(p, h, stride, s->file.time[t], &img, parallel);
 		if (!err) {
 			img.snapshot = t;
-			snprintf(img.source, sizeof img.source, "%s", s->path);
+			snprintf(img.source, sizeof img.source, "%s", s->file.name);
 			if (p->look.style != SS_RENDER_OBLIQUE) {
-				img.x0 = s->origin_x;
-				img.y0 = s->origin_y;
+				img.x0 = s->file.origin_x;
+				img.y0 = s->file.origin_y;
 			}
 			err = ss_render_write_png(&img, path, p->look.compression);
 			ss_render_image_release(&img);

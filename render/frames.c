@@ -90,7 +90,7 @@ int ss_render_frames_add(struct ss_render_frames *fr, const char *path, long lon
 	int err = ss_render_source_open(&s, path);
 	if (err)
 		return err;
-	if (index < 0 || index >= s.count) {
+	if (index < 0 || index >= s.file.count) {
 		err = ss_error_fail("'%s' has no snapshot %lld to render", path, index);
 		goto out_source;
 	}
@@ -108,8 +108,8 @@ int ss_render_frames_add(struct ss_render_frames *fr, const char *path, long lon
 			ss_render_plan_release(&fr->plan);
 		fr->planned = 0;
 		if ((err = series_scale(fr, &s, index, bounds, &zmin, &zmax)) ||
-		    (err = ss_render_plan_init(&fr->plan, &fr->look, s.nx, s.ny, s.dx, s.dy,
-		                               s.cell_type, s.nx, zmin, zmax, 1)))
+		    (err = ss_render_plan_init(&fr->plan, &fr->look, s.file.nx, s.file.ny, s.file.dx,
+		                               s.file.dy, s.cell_type, s.file.nx, zmin, zmax, 1)))
 			goto out_source;
 		fr->planned = 1;
 	}

@@ -1,7 +1,8 @@
 /*
  * internal.h - what the files of render/ share and nothing else sees (the
  * public interface is include/sandslide/render.h).  No HDF5 or libpng type
- * appears here: series.c alone includes <hdf5.h>, png.c alone <png.h>.
+ * appears here: the files are read through include/sandslide/snapshot.h,
+ * and png.c alone includes <png.h>.
  */
 #ifndef SANDSLIDE_RENDER_INTERNAL_H
 #define SANDSLIDE_RENDER_INTERNAL_H
@@ -10,6 +11,7 @@
 #include <stdint.h>
 
 #include "sandslide/render.h"
+#include "sandslide/snapshot.h"
 
 #define SS_RENDER_BACKGROUND 0xff               /* white: oblique sky, colour bar */
 
@@ -144,33 +146,19 @@ int ss_render_colorbar_width(int pic_w, int pic_h, double zmin, double zmax);
 void ss_render_draw_colorbar(struct ss_render_image *img, int x0, int pic_h,
                              enum ss_render_cmap cmap, double zmin, double zmax);
 
-/* ---- series.c: the HDF5 file (the only includer of <hdf5.h>) --------- */
+/* ---- series.c: a sandslide file and its cell types ------------------ */
 
-struct ss_render_h5;                /* the open file: opaque */
-
+/* The file (sizes, geometry, times; heights are read through it with
+ * ss_snapshot_file_read_rows) and its cell types, read once. */
 struct ss_render_source {
-	char path[4096];
-	int nx, ny;                 /* cells */
-	long long count;            /* snapshots */
-	double dx, dy;              /* m */
-	double origin_x, origin_y;  /* lower-left corner, m (NAN if unknown) */
-	double *time;               /* count entries, s */
+	struct ss_snapshot_file file;
 	uint8_t *cell_type;         /* nx * ny, south row first */
-	struct ss_render_h5 *h5;
 };
 
 /* Open and check a sandslide output file (SS_ERR_INPUT with a message if
- * it is not one) and read its times and cell types. */
+ * it is not one or is damaged) and read its cell types. */
 int ss_render_source_open(struct ss_render_source *s, const char *path);
 void ss_render_source_close(struct ss_render_source *s);
-
-/* Rows j0 .. j0 + rows - 1 of snapshot t into buf (rows * nx, south row
- * first).  Safe to call from several threads (one read at a time). */
-int ss_render_source_read_rows(struct ss_render_source *s, long long t, int j0, int rows,
-                               double *buf);
-
-/* Rows per read: whole HDF5 chunks, about 8 MB. */
-int ss_render_source_block_rows(const struct ss_render_source *s);
 
 /* Lowest and highest finite height on flow and open cells of snapshots
  * first .. last (inclusive); +INFINITY/-INFINITY when there are none. */

@@ -91,10 +91,10 @@ static int select_time(const struct ss_render_source *s, double t, long long **o
 {
 	double lo = INFINITY, hi = -INFINITY;
 	long long best = 0;
-	for (long long k = 0; k < s->count; k++) {
-		lo = fmin(lo, s->time[k]);
-		hi = fmax(hi, s->time[k]);
-		if (fabs(s->time[k] - t) < fabs(s->time[best] - t))
+	for (long long k = 0; k < s->file.count; k++) {
+		lo = fmin(lo, s->file.time[k]);
+		hi = fmax(hi, s->file.time[k]);
+		if (fabs(s->file.time[k] - t) < fabs(s->file.time[best] - t))
 			best = k;
 	}
 	if (!(t >= lo && t <= hi))
@@ -128,7 +128,7 @@ static int sort_by_time(const struct ss_render_source *s, long long *sel, long l
 	if (!v)
 		return ss_error_fail("out of memory");
 	for (long long k = 0; k < n; k++)
-		v[k] = (struct timed){s->time[sel[k]], sel[k]};
+		v[k] = (struct timed){s->file.time[sel[k]], sel[k]};
 	qsort(v, (size_t)n, sizeof *v, by_time);
 	for (long long k = 0; k < n; k++)
 		sel[k] = v[k].k;
@@ -200,11 +200,11 @@ static int select_frames(const struct ss_render_series_options *o,
 	if (o->frames && !isnan(o->time))
 		return ss_error_input("--frames and --time choose snapshots in two ways: give one");
 	if (o->frames)
-		err = select_range(o->frames, s->count, sel, n);
+		err = select_range(o->frames, s->file.count, sel, n);
 	else if (!isnan(o->time))
 		err = select_time(s, o->time, sel, n);
 	else
-		err = select_range("0:", s->count, sel, n);
+		err = select_range("0:", s->file.count, sel, n);
 	return err ? err : sort_by_time(s, *sel, *n);
 }
 
@@ -248,7 +248,7 @@ int ss_render_series(const struct ss_render_series_options *o)
 	if ((err = ss_render_source_open(&s, o->input)))
 		return err;
 	long long *sel = NULL, n = 0;
-	if (s.count == 0) {
+	if (s.file.count == 0) {
 		err = ss_error_input("'%s' holds no snapshots: nothing to render", o->input);
 		goto out_source;
 	}
@@ -263,13 +263,13 @@ int ss_render_series(const struct ss_render_series_options *o)
 		double lo, hi;
 		char what[4200];
 		snprintf(what, sizeof what, "'%s'", o->input);
-		if ((err = ss_render_source_range(&s, 0, s.count - 1, &lo, &hi)) ||
+		if ((err = ss_render_source_range(&s, 0, s.file.count - 1, &lo, &hi)) ||
 		    (err = ss_render_scale_resolve(&zmin, &zmax, lo, hi, what)))
 			goto out_source;
 	}
 	struct ss_render_plan plan;
-	if ((err = ss_render_plan_init(&plan, &o->look, s.nx, s.ny, s.dx, s.dy, s.cell_type, s.nx,
-	                               zmin, zmax, 1)))
+	if ((err = ss_render_plan_init(&plan, &o->look, s.file.nx, s.file.ny, s.file.dx, s.file.dy,
+	                               s.cell_type, s.file.nx, zmin, zmax, 1)))
 		goto out_source;
 	if ((err = ss_render_check_dir(o->output_dir, 1)))
 		goto out_plan;
@@ -284,8 +284,8 @@ int ss_render_series(const struct ss_render_series_options *o)
 		printf("wrote %lld frame%s of %d x %d px to %s%s (t = %g .. %g s, %s, heights %g .. "
 		       "%g m) in %.2f s: %.1f frames/s, %.1f Mpixel/s on %d threads\n", n,
 		       n == 1 ? "" : "s", plan.image_w, plan.image_h, o->output_dir,
-		       len && o->output_dir[len - 1] == '/' ? "" : "/", s.time[sel[0]],
-		       s.time[sel[n - 1]], ss_render_style_name(o->look.style), zmin, zmax,
+		       len && o->output_dir[len - 1] == '/' ? "" : "/", s.file.time[sel[0]],
+		       s.file.time[sel[n - 1]], ss_render_style_name(o->look.style), zmin, zmax,
 		       ss_parallel_wall_seconds() - started, n / fmax(seconds, 1e-9),
 		       (double)n * plan.image_w * plan.image_h / fmax(seconds, 1e-9) * 1e-6,
 		       ss_parallel_max_threads());

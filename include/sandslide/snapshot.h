@@ -1,6 +1,9 @@
 /*
- * snapshot.h - the HDF5 output of a run (SPEC section 5) and its XDMF
- * sidecar.  This module is the only code that includes <hdf5.h>.
+ * snapshot.h - the HDF5 output of a run (SPEC section 5), its XDMF
+ * sidecar, and the one reader of such files.  src/io/snapshot_write.c
+ * (the writer) and src/io/snapshot_read.c (every read: `info`, restarts,
+ * the renderer, .h5 DEMs) are the only code that includes <hdf5.h>; no
+ * HDF5 type appears here.
  *
  * Layout (netCDF-4 / CF-1.8 compatible, dimensions as HDF5 dimension scales):
  *   /height      float64 (time, y, x), chunked, extendible in time
@@ -19,6 +22,7 @@
 #ifndef SANDSLIDE_SNAPSHOT_H
 #define SANDSLIDE_SNAPSHOT_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 #include "sandslide/diagnostics.h"
@@ -58,7 +62,8 @@ int ss_snapshot_append(struct ss_snapshot *s, double time_s, const double *heigh
                        const struct ss_diagnostics *d, const struct ss_restart_state *state);
 
 /* Reopen an output of grid g to append snapshots to it (a restart).
- * SS_ERR_INPUT if it is not a sandslide output of that grid. */
+ * SS_ERR_INPUT if it is not a sandslide output (ss_snapshot_file_open) of
+ * that grid with at least one snapshot. */
 int ss_snapshot_open_append(struct ss_snapshot **out, const char *path,
                             const struct ss_grid *g);
 
@@ -75,7 +80,8 @@ struct ss_restart_info {
 };
 
 /* SS_ERR_INPUT naming what is missing for a file that cannot be continued
- * (not a sandslide output, no snapshot, no case text or restart state). */
+ * (not a sandslide output, damaged, no snapshot, no case text or restart
+ * state). */
 int ss_snapshot_read_restart(const char *path, struct ss_restart_info *r);
 
 /* The same without the case (left NULL): the last snapshot and its restart
@@ -108,17 +114,86 @@ struct ss_snapshot_summary {
 	long long flow_cells, wall_cells, open_cells;
 };
 
-/* Read the summary of a sandslide file; SS_ERR_INPUT if it is not one. */
+/* Read the summary of a sandslide file; SS_ERR_INPUT if it is not one or
+ * is damaged. */
 int ss_snapshot_read_summary(const char *path, struct ss_snapshot_summary *sum);
 void ss_snapshot_summary_release(struct ss_snapshot_summary *sum);
 
 /*
- * Read a 2-D field from an HDF5 file: dataset (default "/height") is either
- * (time, y, x), in which case snapshot `index` is read (negative: from the
- * end, -1 the last), or (y, x).  *values is allocated (nx * ny, south row
- * first) and owned by the caller (ss_free).
+ * Read a 2-D field from an HDF5 file: dataset is any (time, y, x) variable,
+ * in which case snapshot `index` is read (negative: from the end, -1 the
+ * last), or (y, x) variable of any HDF5 file; without a dataset (NULL or
+ * "") snapshot `index` of /height of a sandslide file.  *values is
+ * allocated (nx * ny, south row first) and owned by the caller (ss_free).
  */
 int ss_snapshot_read_field(const char *path, const char *dataset, long long index,
                            int *nx, int *ny, double **values);
+
+/* ---- the reader ------------------------------------------------------ */
+
+/*
+ * A sandslide file, open for reading.  A file is one when it has
+ *   - a root attribute `source` (a string, fixed or variable length)
+ *     starting with "sandslide",
+ *   - /height (time, y, x) of numbers, with 1 <= y, x <= 2^30, its last
+ *     snapshot stored,
+ *   - /time (time) of numbers, as many as /height has snapshots,
+ *   - /cell_type (y, x) of numbers, of the size of a snapshot,
+ *   - positive finite root attributes dx and dy;
+ * /x and /y are optional: their first values give the lower-left corner.
+ * Numbers are IEEE floats or standard integers of either byte order.
+ *
+ * A file whose sizes cannot be true is damaged (SS_ERR_INPUT, "... is
+ * damaged: ..."): every size is checked against the file before anything
+ * of that size is allocated, by this reader or by HDF5 (a dataset's
+ * values, its chunks, a string), and a read that fails is damage too.
+ * What HDF5 decodes before any size reaches the reader (object headers,
+ * heaps) is beyond these checks: tests/fuzz/README.md lists the damaged
+ * files that crash or hang Debian's libhdf5 1.10.8 itself.
+ */
+struct ss_snapshot_file_h5;     /* opaque: the HDF5 handles */
+
+struct ss_snapshot_file {
+	char *name;                 /* the path, or the name given to an image */
+	int nx, ny;                 /* cells */
+	long long count;            /* snapshots */
+	double dx, dy;              /* cell size, m */
+	double origin_x, origin_y;  /* lower-left corner, m (NAN without /x, /y) */
+	double *time;               /* count entries, s */
+	struct ss_snapshot_file_h5 *h5;
+};
+
+/* Open and check a sandslide file and read its times.  SS_ERR_INPUT with
+ * a message if it is not one, cannot be read or is damaged; on failure f
+ * holds nothing to close (closing it is harmless). */
+int ss_snapshot_file_open(struct ss_snapshot_file *f, const char *path);
+
+/* The same for a file image of size bytes in memory (HDF5's core driver),
+ * named `name` in messages; data is copied. */
+int ss_snapshot_file_open_image(struct ss_snapshot_file *f, const char *name,
+                                const void *data, size_t size);
+
+/* Close the file and free what it holds; a zeroed or closed f is a no-op. */
+void ss_snapshot_file_close(struct ss_snapshot_file *f);
+
+/* Rows j0 .. j0 + rows - 1 of snapshot t of /height into out (rows * nx
+ * values, south row first).  May be called from several OpenMP threads at
+ * once (HDF5 is called by one at a time).  SS_ERR_INPUT if the file is
+ * damaged there (a checksum that does not match, say). */
+int ss_snapshot_file_read_rows(struct ss_snapshot_file *f, long long t, int j0, int rows,
+                               double *out);
+
+/* Rows j0 .. j0 + rows - 1 of /cell_type into out (rows * nx, south row
+ * first); SS_ERR_INPUT if a value is not a cell type (0 flow, 1 wall,
+ * 2 open) or the rows cannot be read.  Thread-safe as read_rows. */
+int ss_snapshot_file_read_cell_types(struct ss_snapshot_file *f, int j0, int rows,
+                                     uint8_t *out);
+
+/* Rows per read that take whole chunks of /height, about 8 MB of them. */
+int ss_snapshot_file_block_rows(const struct ss_snapshot_file *f);
+
+/* ss_snapshot_read_summary and ss_snapshot_read_restart of an open file. */
+int ss_snapshot_file_summary(struct ss_snapshot_file *f, struct ss_snapshot_summary *sum);
+int ss_snapshot_file_restart(struct ss_snapshot_file *f, struct ss_restart_info *r);
 
 #endif

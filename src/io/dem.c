@@ -149,8 +149,37 @@ static int gdal_unavailable(const char *path, const char *context)
 /* ------------------------------------------------------------------ */
 /* reading                                                              */
 
-/* sandslide HDF5: "file.h5" (last snapshot of /height, with the run's cell
- * size and corner) or "file.h5:/dataset" (no geometry). */
+/* The last snapshot of a sandslide file, with its cell size and corner. */
+static int read_h5_output(const char *path, struct ss_raster *r)
+{
+	struct ss_snapshot_file f;
+	int err = ss_snapshot_file_open(&f, path);
+	if (!err && f.count < 1)
+		err = ss_error_input("'%s' holds no snapshot", path);
+	if (!err && !(r->values = ss_alloc((size_t)f.nx * (size_t)f.ny, sizeof *r->values,
+	                                   "input heights")))
+		err = SS_ERR_FAIL;
+	if (!err)
+		err = ss_snapshot_file_read_rows(&f, f.count - 1, 0, f.ny, r->values);
+	if (!err) {
+		r->nx = f.nx;
+		r->ny = f.ny;
+		r->cellsize = f.dx;
+		r->cellsize_y = f.dy;
+		r->x0 = f.origin_x;
+		r->y0 = f.origin_y;
+	} else {
+		ss_free(r->values);
+		r->values = NULL;
+	}
+	ss_snapshot_file_close(&f);
+	return err;
+}
+
+/* sandslide HDF5: "file.h5" (the last snapshot of a sandslide file, with
+ * the run's cell size and corner) or "file.h5:/dataset" (any (y, x) or
+ * (time, y, x) variable of any HDF5 file: its last snapshot, no
+ * geometry). */
 static int read_h5(const char *spec, const char *context, struct ss_raster *r)
 {
 	const char *dataset = h5_dataset(spec);
@@ -165,7 +194,8 @@ static int read_h5(const char *spec, const char *context, struct ss_raster *r)
 	if (!f)
 		return ss_error_input_at(context, "cannot open '%s': %s", path, strerror(errno));
 	fclose(f);
-	int err = ss_snapshot_read_field(path, dataset, -1, &r->nx, &r->ny, &r->values);
+	int err = dataset ? ss_snapshot_read_field(path, dataset, -1, &r->nx, &r->ny, &r->values)
+	                  : read_h5_output(path, r);
 	if (err)
 		return err;
 	const size_t n = (size_t)r->nx * (size_t)r->ny;
@@ -176,19 +206,7 @@ static int read_h5(const char *spec, const char *context, struct ss_raster *r)
 			                         r->values[k], k % (size_t)r->nx + 1,
 			                         k / (size_t)r->nx + 1);
 	}
-	if (dataset)
-		return SS_OK;
-	/* a run's output: its cell size and corner come with it */
-	struct ss_snapshot_summary sum;
-	err = ss_snapshot_read_summary(path, &sum);
-	if (!err) {
-		r->cellsize = sum.dx;
-		r->cellsize_y = sum.dy;
-		r->x0 = sum.origin_x;
-		r->y0 = sum.origin_y;
-	}
-	ss_snapshot_summary_release(&sum);
-	return err;
+	return SS_OK;
 }
 
 static int check_options(const struct ss_dem_read_options *o, enum ss_dem_format format,

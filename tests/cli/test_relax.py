@@ -282,6 +282,12 @@ def test_hdf5_input_relaxes_the_last_snapshot(tmp_path):
     relax(["a.h5", "-o", "b.asc"], tmp_path)
     _, h = read_asc(tmp_path / "b.asc")
     assert h.shape == (12, 20) and face_slopes(h, 0.1) <= TAN35 + 1e-6
+    # a dataset of it: /height (time, y, x) gives its last snapshot, which
+    # is settled; /cell_type (y, x) is flat
+    relax(["a.h5:/height", "-o", "c.asc", "--dx", "0.1"], tmp_path)
+    relax(["a.h5:/cell_type", "-o", "d.asc", "--dx", "0.1"], tmp_path)
+    assert np.array_equal(read_asc(tmp_path / "c.asc")[1], h)
+    assert read_asc(tmp_path / "d.asc")[1].shape == (12, 20)
 
 
 @pytest.mark.parametrize("setup, args, message", [

@@ -4,7 +4,10 @@ tests/fuzz/corpus/<harness>/seed-*: small case files with overrides, ESRI
 ASCII grids, 16-bit PNG heightmaps and PNG masks of many kinds (bit depths,
 colour types, interlaced, tRNS, text chunks before and after the image).
 Standard library only; each seed is under 4 KB (cases/reference.ini
-under 8 KB).
+under 8 KB).  The HDF5 seeds (corpus/h5/seed-*, under 64 KB: the writer's
+B-trees and series chunks take most of it) are small outputs of
+build/sandslide (or $SANDSLIDE) and files made with h5py; they are
+written only when both are at hand.
 
     /usr/bin/python3 tests/fuzz/make_seeds.py      (from the repository root)
 
@@ -12,7 +15,10 @@ The case seeds also include cases/*.ini as they are; the fuzzers add their
 own inputs beside these (libFuzzer -merge=1 keeps the corpus minimal).
 """
 import os
+import shutil
 import struct
+import subprocess
+import tempfile
 import zlib
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -24,7 +30,8 @@ def put(harness, name, data):
     os.makedirs(folder, exist_ok=True)
     if isinstance(data, str):
         data = data.encode()
-    assert len(data) < (8192 if harness == "case" else 4096), (harness, name, len(data))
+    limit = {"case": 8192, "h5": 65536}.get(harness, 4096)
+    assert len(data) < limit, (harness, name, len(data))
     with open(os.path.join(folder, "seed-" + name), "wb") as f:
         f.write(data)
 
@@ -309,8 +316,128 @@ def masks():
     put("mask", "9x6.png", png(9, 6, [[(255,)] * 9] * 6))
 
 
+# ---- HDF5 files -----------------------------------------------------------
+
+H5_CASE = """[grid]
+nx = 5
+ny = 4
+dx = 0.1
+dy = 0.2
+origin = -0.1 2
+
+[model]
+closure = herschel-bulkley
+repose_angle = 33
+nu = 0.05
+gamma = 0.5
+
+[time]
+cfl = 0.5
+output_every = 0.2
+end = 0.4
+
+[boundary]
+south = periodic
+north = periodic
+east = open
+open_level = 0.05
+
+[initial]
+type = flat
+height = 0.3
+
+[wall post]
+rect = 0 2.2 0.1 2.4
+
+[source pour]
+rect = 0.1 2.0 0.2 2.2
+rate = 1e-3
+"""
+
+
+DIAGNOSTICS = ["volume", "inflow", "outflow", "max_height", "max_slope_deg", "steps",
+               "active_fraction", "wall_seconds"]
+
+
+def sandslide_outputs(binary, d):
+    """A run (walls, an open side, a source; deflated heights) and a relax
+    of a 3 x 2 grid: the writer's own files."""
+    with open(os.path.join(d, "c.ini"), "w") as f:
+        f.write(H5_CASE)
+    with open(os.path.join(d, "d.asc"), "w") as f:
+        f.write("ncols 3\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n0 0 0\n0 0 9\n")
+    for args in (["run", "c.ini", "-o", "run.h5", "--deflate", "6", "-q"],
+                 ["relax", "d.asc", "-o", "relax.h5", "-q"]):
+        # argv[0] "sandslide": the history attribute holds no local path
+        subprocess.run(["sandslide"] + args, executable=binary, cwd=d, check=True,
+                       capture_output=True)
+    for name in ("run", "relax"):
+        with open(os.path.join(d, name + ".h5"), "rb") as f:
+            put("h5", "sandslide-" + name, f.read())
+
+
+def h5py_files(h5py, np, d):
+    """Files of other writers: the newest format, variable-length strings,
+    other number types, no snapshot, a plain (y, x) dataset."""
+    path = os.path.join(d, "x.h5")
+    with h5py.File(path, "w", libver="latest") as f:
+        f.attrs["source"] = "sandslide by hand"            # variable length
+        f.attrs["dx"] = np.float32(0.5)
+        f.attrs["dy"] = 2
+        f.attrs["case"] = "[grid]\nnx = 3\nny = 2\ndx = 0.5\n"
+        f.attrs["title"] = "x.ini"
+        f.attrs["case_overrides"] = ""
+        f.attrs["restart_state"] = np.array([4.0, 0, 0, 0, 0])
+        f["height"] = np.arange(12, dtype="<f4").reshape(2, 2, 3)
+        f["time"] = np.array([0, 1], dtype=">f8")
+        f["cell_type"] = np.array([[0, 1, 2], [0, 0, 1]], dtype="<i2")
+        f["x"] = np.array([0.25, 0.75, 1.25])
+        for name in DIAGNOSTICS:
+            f[name] = np.array([1, 2], dtype="<i4")
+    with open(path, "rb") as f:
+        put("h5", "latest-format", f.read())
+    with h5py.File(path, "w") as f:   # all there, but no snapshot yet
+        for name in ("source", "closure", "title"):
+            f.attrs[name] = np.bytes_("sandslide 0.1.0" if name == "source" else name)
+        f.attrs.create("dx", 0.1, dtype=">f8")
+        f.attrs.create("dy", 0.25, dtype="<f4")
+        f.create_dataset("cell_type", data=np.eye(4, 5, dtype="u1") * 2)
+        f["x"], f["y"] = np.arange(5) * 0.1 + 3, np.arange(4) * 0.25 - 1
+        f.create_dataset("height", (0, 4, 5), "f8", maxshape=(None, 4, 5), chunks=(1, 2, 5))
+        for name in ["time"] + DIAGNOSTICS:
+            f.create_dataset(name, (0,), "f8", maxshape=(None,), chunks=(16,))
+    with open(path, "rb") as f:
+        put("h5", "no-snapshot", f.read())
+    with h5py.File(path, "w") as f:
+        f.create_dataset("height", data=np.linspace(0, 1, 12).reshape(3, 4),
+                         compression="gzip", shuffle=True, chunks=(2, 2))
+        f["cell_type"] = np.ones((3, 4), dtype="u1")
+    with open(path, "rb") as f:
+        put("h5", "plain-field", f.read())
+
+
+def h5_seeds():
+    binary = os.environ.get("SANDSLIDE", os.path.join(ROOT, "build", "sandslide"))
+    try:
+        import h5py
+        import numpy as np
+    except ImportError:
+        print("make_seeds: no h5py: HDF5 seeds not written")
+        return
+    if not os.access(binary, os.X_OK):
+        print(f"make_seeds: no {binary} (run make): HDF5 seeds not written")
+        return
+    d = tempfile.mkdtemp(prefix="sandslide-seeds-")
+    try:
+        sandslide_outputs(binary, d)
+        h5py_files(h5py, np, d)
+    finally:
+        shutil.rmtree(d)
+
+
 if __name__ == "__main__":
     cases()
     asc()
     dem_png()
     masks()
+    h5_seeds()

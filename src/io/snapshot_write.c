@@ -1,5 +1,6 @@
 /*
- * snapshot.c - HDF5 + XDMF output (see snapshot.h for the layout).
+ * snapshot_write.c - HDF5 + XDMF output (see snapshot.h for the layout);
+ * the reads are in snapshot_read.c.
  *
  * File types are explicit little-endian IEEE (H5T_IEEE_F64LE, H5T_STD_U8LE),
  * memory types native.  Heights are written straight from the halo layout
@@ -21,38 +22,12 @@
 #include <hdf5_hl.h>
 
 #include "sandslide/error.h"
-
-static const char *const diag_names[] = {
-	"volume", "inflow", "outflow", "max_height", "max_slope_deg", "steps",
-	"active_fraction", "wall_seconds",
-};
-static const char *const diag_units[] = {"m3", "m3", "m3", "m", "degree", "1", "1", "s"};
-static const char *const diag_long_names[] = {
-	"volume of sand on flow cells",
-	"cumulative volume added by sources",
-	"cumulative volume that left through open cells",
-	"highest sand surface on flow cells",
-	"steepest face slope that can carry flux",
-	"cumulative forward-Euler substeps",
-	"fraction of tiles swept since the previous snapshot",
-	"wall-clock time since the run started",
-};
-enum { DIAG_COUNT = 8 };
+#include "io/snapshot_layout.h"
 
 static double diag_get(const struct ss_diagnostics *d, int k)
 {
-	const double v[DIAG_COUNT] = {d->volume, d->inflow, d->outflow, d->max_height,
-	                              d->max_slope_deg, d->steps, d->active_fraction,
-	                              d->wall_seconds};
-	return v[k];
-}
-
-static void diag_set(struct ss_diagnostics *d, int k, double v)
-{
-	double *f[DIAG_COUNT] = {&d->volume, &d->inflow, &d->outflow, &d->max_height,
-	                         &d->max_slope_deg, &d->steps, &d->active_fraction,
-	                         &d->wall_seconds};
-	*f[k] = v;
+	struct ss_diagnostics copy = *d;
+	return *ss_snapshot_diag_field(&copy, k);
 }
 
 struct ss_snapshot {
@@ -60,7 +35,7 @@ struct ss_snapshot {
 	char *partial_path;     /* written here until snapshot 0 is complete */
 	char *xmf_path;
 	hid_t file;
-	hid_t height, time, diag[DIAG_COUNT];
+	hid_t height, time, diag[SS_SNAPSHOT_DIAG_COUNT];
 	struct ss_grid grid;
 	long long count;
 	int failed;             /* a write failed (and said so): the close that
@@ -307,14 +282,15 @@ static int write_static(struct ss_snapshot *s, const uint8_t *cell_types,
 
 	bad = bad || (meta->bedrock && write_bedrock(f, x, y, g, meta->bedrock));
 
-	for (int k = 0; k < DIAG_COUNT && !bad; k++) {
-		s->diag[k] = create_series(f, diag_names[k], diag_units[k], diag_long_names[k]);
+	for (int k = 0; k < SS_SNAPSHOT_DIAG_COUNT && !bad; k++) {
+		s->diag[k] = create_series(f, ss_snapshot_diag_name(k), ss_snapshot_diag_units(k),
+		                          ss_snapshot_diag_long_name(k));
 		bad = s->diag[k] < 0 || H5DSattach_scale(s->diag[k], s->time, 0) < 0;
 	}
 
 	/* global attributes */
 	char source[64];
-	snprintf(source, sizeof source, "sandslide %s", SS_VERSION);
+	snprintf(source, sizeof source, SS_SNAPSHOT_SOURCE " %s", SS_VERSION);
 	bad = bad || attr_string(f, "Conventions", "CF-1.8") ||
 	      attr_string(f, "title", meta->title) || attr_string(f, "history", meta->history) ||
 	      attr_string(f, "source", source) || attr_string(f, "closure", meta->closure) ||
@@ -340,7 +316,7 @@ void ss_snapshot_sidecar_path(const char *path, char *out, size_t size)
 
 static void close_handles(struct ss_snapshot *s)
 {
-	for (int k = 0; k < DIAG_COUNT; k++)
+	for (int k = 0; k < SS_SNAPSHOT_DIAG_COUNT; k++)
 		if (s->diag[k] >= 0)
 			H5Dclose(s->diag[k]);
 	if (s->time >= 0)
@@ -395,7 +371,7 @@ static struct ss_snapshot *snapshot_alloc(const char *path, const struct ss_grid
 	if (!s)
 		return NULL;
 	s->file = s->height = s->time = -1;
-	for (int k = 0; k < DIAG_COUNT; k++)
+	for (int k = 0; k < SS_SNAPSHOT_DIAG_COUNT; k++)
 		s->diag[k] = -1;
 	s->grid = *g;
 	s->path = strdup(path);
@@ -575,7 +551,7 @@ int ss_snapshot_append(struct ss_snapshot *s, double time_s, const double *heigh
 	H5Sclose(fs);
 	if (r < 0 || append_value(s->time, k, time_s))
 		goto fail;
-	for (int m = 0; m < DIAG_COUNT; m++)
+	for (int m = 0; m < SS_SNAPSHOT_DIAG_COUNT; m++)
 		if (append_value(s->diag[m], k, diag_get(d, m)))
 			goto fail;
 	if (state && write_restart_state(s->file, state))
@@ -618,360 +594,32 @@ double ss_snapshot_last_time(const struct ss_snapshot *s)
 	return s->count > 0 ? s->times[s->count - 1] : NAN;
 }
 
-/* ---- reading --------------------------------------------------------- */
-
-static int read_attr_string(hid_t obj, const char *name, char *out, size_t size)
+/* A file to continue must be a sandslide file (ss_snapshot_file_open) of
+ * grid g with at least one snapshot, and every series and cell type in it
+ * must read (the summary): the appends that follow extend them all.  Its
+ * times go into s, for the sidecar. */
+static int check_append(struct ss_snapshot *s, const char *path, const struct ss_grid *g)
 {
-	out[0] = '\0';
-	if (H5Aexists(obj, name) <= 0)
-		return -1;
-	hid_t a = H5Aopen(obj, name, H5P_DEFAULT);
-	hid_t ft = H5Aget_type(a);
-	int r = -1;
-	if (H5Tget_class(ft) == H5T_STRING && !H5Tis_variable_str(ft)) {
-		size_t n = H5Tget_size(ft);
-		char *buf = calloc(1, n + 1);
-		if (buf && H5Aread(a, ft, buf) >= 0) {
-			snprintf(out, size, "%s", buf);
-			r = 0;
-		}
-		free(buf);
-	}
-	H5Tclose(ft);
-	H5Aclose(a);
-	return r;
-}
-
-static double read_attr_double(hid_t obj, const char *name)
-{
-	double v = NAN;
-	if (H5Aexists(obj, name) > 0) {
-		hid_t a = H5Aopen(obj, name, H5P_DEFAULT);
-		if (H5Aread(a, H5T_NATIVE_DOUBLE, &v) < 0)
-			v = NAN;
-		H5Aclose(a);
-	}
-	return v;
-}
-
-static hid_t open_file(const char *path)
-{
-	quiet_hdf5();
-	FILE *f = fopen(path, "rb");
-	if (!f) {
-		ss_error_input("cannot open '%s': %s", path, strerror(errno));
-		return -1;
-	}
-	fclose(f);
-	if (H5Fis_hdf5(path) <= 0) {
-		ss_error_input("'%s' is not an HDF5 file", path);
-		return -1;
-	}
-	hid_t file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
-	if (file < 0)
-		ss_error_input("cannot open HDF5 file '%s'", path);
-	return file;
-}
-
-static int read_series(hid_t file, const char *name, long long count, double *out)
-{
-	hid_t d = H5Dopen2(file, name, H5P_DEFAULT);
-	if (d < 0)
-		return -1;
-	hid_t fs = H5Dget_space(d);
-	hsize_t n = 0;
-	int ok = H5Sget_simple_extent_ndims(fs) == 1 &&
-	         H5Sget_simple_extent_dims(fs, &n, NULL) == 1 && n == (hsize_t)count;
-	herr_t r = ok ? H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, out) : -1;
-	H5Sclose(fs);
-	H5Dclose(d);
-	return r < 0 ? -1 : 0;
-}
-
-int ss_snapshot_read_summary(const char *path, struct ss_snapshot_summary *sum)
-{
-	memset(sum, 0, sizeof *sum);
-	hid_t file = open_file(path);
-	if (file < 0)
-		return SS_ERR_INPUT;
-	int err = SS_OK;
-	if (read_attr_string(file, "source", sum->source, sizeof sum->source) ||
-	    strncmp(sum->source, "sandslide", 9) != 0 || H5Lexists(file, "height", H5P_DEFAULT) <= 0) {
-		err = ss_error_input("'%s' is not a sandslide output file (no 'source = sandslide' "
-		                     "attribute or no /height)", path);
-		goto out;
-	}
-	read_attr_string(file, "closure", sum->closure, sizeof sum->closure);
-	read_attr_string(file, "title", sum->title, sizeof sum->title);
-	sum->repose_angle_deg = read_attr_double(file, "repose_angle_deg");
-	sum->nu = read_attr_double(file, "nu");
-	sum->gamma = read_attr_double(file, "gamma");
-	sum->dx = read_attr_double(file, "dx");
-	sum->dy = read_attr_double(file, "dy");
-
-	hid_t d = H5Dopen2(file, "height", H5P_DEFAULT);
-	hid_t fs = H5Dget_space(d);
-	hsize_t dims[3] = {0, 0, 0};
-	int rank = H5Sget_simple_extent_ndims(fs);
-	if (rank == 3)
-		H5Sget_simple_extent_dims(fs, dims, NULL);
-	H5Sclose(fs);
-	H5Dclose(d);
-	if (rank != 3) {
-		err = ss_error_input("'%s': /height is not a (time, y, x) variable", path);
-		goto out;
-	}
-	sum->count = (long long)dims[0];
-	sum->ny = (int)dims[1];
-	sum->nx = (int)dims[2];
-
-	const long long n = sum->count;
-	sum->time = calloc((size_t)(n ? n : 1), sizeof *sum->time);
-	sum->diag = calloc((size_t)(n ? n : 1), sizeof *sum->diag);
-	double *col = calloc((size_t)(n ? n : 1), sizeof *col);
-	if (!sum->time || !sum->diag || !col) {
-		free(col);
-		err = ss_error_fail("out of memory");
-		goto out;
-	}
-	if (read_series(file, "time", n, sum->time)) {
-		free(col);
-		err = ss_error_input("'%s': cannot read /time", path);
-		goto out;
-	}
-	for (int k = 0; k < DIAG_COUNT; k++) {
-		if (read_series(file, diag_names[k], n, col)) {
-			free(col);
-			err = ss_error_input("'%s': cannot read /%s", path, diag_names[k]);
-			goto out;
-		}
-		for (long long m = 0; m < n; m++)
-			diag_set(&sum->diag[m], k, col[m]);
-	}
-	free(col);
-
-	/* the origin from the first cell centres */
-	double xy[2];
-	hsize_t one = 1, zero = 0;
-	hid_t ms = H5Screate_simple(1, &one, NULL);
-	for (int a = 0; a < 2; a++) {
-		hid_t ds = H5Dopen2(file, a ? "y" : "x", H5P_DEFAULT);
-		hid_t sp = ds >= 0 ? H5Dget_space(ds) : -1;
-		if (sp < 0 || H5Sselect_hyperslab(sp, H5S_SELECT_SET, &zero, NULL, &one, NULL) < 0 ||
-		    H5Dread(ds, H5T_NATIVE_DOUBLE, ms, sp, H5P_DEFAULT, &xy[a]) < 0)
-			xy[a] = NAN;
-		if (sp >= 0)
-			H5Sclose(sp);
-		if (ds >= 0)
-			H5Dclose(ds);
-	}
-	H5Sclose(ms);
-	sum->origin_x = xy[0] - 0.5 * sum->dx;
-	sum->origin_y = xy[1] - 0.5 * sum->dy;
-
-	uint8_t *types = malloc((size_t)sum->nx * (size_t)sum->ny);
-	hid_t ct = H5Dopen2(file, "cell_type", H5P_DEFAULT);
-	if (types && ct >= 0 &&
-	    H5Dread(ct, H5T_NATIVE_UINT8, H5S_ALL, H5S_ALL, H5P_DEFAULT, types) >= 0) {
-		for (size_t k = 0; k < (size_t)sum->nx * (size_t)sum->ny; k++) {
-			sum->flow_cells += types[k] == SS_CELL_FLOW;
-			sum->wall_cells += types[k] == SS_CELL_WALL;
-			sum->open_cells += types[k] == SS_CELL_OPEN;
-		}
-	}
-	if (ct >= 0)
-		H5Dclose(ct);
-	free(types);
-out:
-	H5Fclose(file);
-	if (err)
-		ss_snapshot_summary_release(sum);
-	return err;
-}
-
-void ss_snapshot_summary_release(struct ss_snapshot_summary *sum)
-{
-	free(sum->time);
-	free(sum->diag);
-	sum->time = NULL;
-	sum->diag = NULL;
-}
-
-int ss_snapshot_read_field(const char *path, const char *dataset, long long index,
-                           int *nx, int *ny, double **values)
-{
-	*values = NULL;
-	hid_t file = open_file(path);
-	if (file < 0)
-		return SS_ERR_INPUT;
-	const char *name = dataset && *dataset ? dataset : "/height";
-	int err = SS_OK;
-	hid_t d = H5Lexists(file, name[0] == '/' ? name + 1 : name, H5P_DEFAULT) > 0
-	          ? H5Dopen2(file, name, H5P_DEFAULT) : -1;
-	if (d < 0) {
-		H5Fclose(file);
-		return ss_error_input("'%s' has no dataset '%s'", path, name);
-	}
-	hid_t fs = H5Dget_space(d);
-	int rank = H5Sget_simple_extent_ndims(fs);
-	hsize_t dims[3] = {1, 0, 0};
-	if (rank == 2 || rank == 3)
-		H5Sget_simple_extent_dims(fs, rank == 3 ? dims : dims + 1, NULL);
-	if ((rank != 2 && rank != 3) || dims[1] < 1 || dims[2] < 1 || dims[0] < 1 ||
-	    dims[1] > (1u << 30) || dims[2] > (1u << 30)) {
-		err = ss_error_input("'%s:%s' is not a (y, x) or non-empty (time, y, x) variable",
-		                     path, name);
-		goto out;
-	}
-	long long t = index < 0 ? (long long)dims[0] + index : index;
-	if (t < 0 || t >= (long long)dims[0]) {
-		err = ss_error_input("'%s:%s' has %llu snapshots: index %lld is out of range", path,
-		                     name, (unsigned long long)dims[0], index);
-		goto out;
-	}
-	*ny = (int)dims[1];
-	*nx = (int)dims[2];
-	*values = ss_alloc((size_t)dims[1] * dims[2], sizeof(double), "input heights");
-	if (!*values) {
-		err = SS_ERR_FAIL;
-		goto out;
-	}
-	hsize_t start[3] = {(hsize_t)t, 0, 0}, count[3] = {1, dims[1], dims[2]};
-	if (rank == 3)
-		H5Sselect_hyperslab(fs, H5S_SELECT_SET, start, NULL, count, NULL);
-	hid_t ms = H5Screate_simple(2, dims + 1, NULL);
-	if (H5Dread(d, H5T_NATIVE_DOUBLE, ms, fs, H5P_DEFAULT, *values) < 0) {
-		ss_free(*values);
-		*values = NULL;
-		err = ss_error_input("cannot read '%s:%s' as numbers", path, name);
-	}
-	H5Sclose(ms);
-out:
-	H5Sclose(fs);
-	H5Dclose(d);
-	H5Fclose(file);
-	return err;
-}
-
-/* ---- restarts -------------------------------------------------------- */
-
-/* A string attribute as a new string (NULL if absent or not a string). */
-static char *read_attr_text(hid_t obj, const char *name)
-{
-	if (H5Aexists(obj, name) <= 0)
-		return NULL;
-	hid_t a = H5Aopen(obj, name, H5P_DEFAULT);
-	hid_t ft = a >= 0 ? H5Aget_type(a) : -1;
-	char *buf = NULL;
-	if (ft >= 0 && H5Tget_class(ft) == H5T_STRING && !H5Tis_variable_str(ft)) {
-		buf = calloc(1, H5Tget_size(ft) + 1);
-		if (buf && H5Aread(a, ft, buf) < 0) {
-			free(buf);
-			buf = NULL;
-		}
-	}
-	if (ft >= 0)
-		H5Tclose(ft);
-	if (a >= 0)
-		H5Aclose(a);
-	return buf;
-}
-
-void ss_restart_info_release(struct ss_restart_info *r)
-{
-	free(r->case_text);
-	free(r->case_path);
-	free(r->case_overrides);
-	ss_free(r->height);
-	memset(r, 0, sizeof *r);
-}
-
-/* The restart_state root attribute into *state; -1 if absent or damaged. */
-static int read_restart_state(hid_t file, struct ss_restart_state *state)
-{
-	double v[5] = {NAN, NAN, NAN, NAN, NAN};
-	hid_t a = H5Aexists(file, "restart_state") > 0
-	          ? H5Aopen(file, "restart_state", H5P_DEFAULT) : -1;
-	hid_t as = a >= 0 ? H5Aget_space(a) : -1;
-	const int five = as >= 0 && H5Sget_simple_extent_npoints(as) == 5;
-	if (!(five && H5Aread(a, H5T_NATIVE_DOUBLE, v) >= 0))
-		v[0] = NAN;
-	if (as >= 0)
-		H5Sclose(as);
-	if (a >= 0)
-		H5Aclose(a);
-	if (!(v[0] >= 0.0) || !isfinite(v[1] + v[2] + v[3] + v[4]))
-		return -1;
-	state->steps = (long long)v[0];
-	state->inflow_sum = v[1];
-	state->inflow_carry = v[2];
-	state->outflow_sum = v[3];
-	state->outflow_carry = v[4];
-	return 0;
-}
-
-int ss_snapshot_read_last_state(const char *path, struct ss_restart_info *r)
-{
-	memset(r, 0, sizeof *r);
+	struct ss_snapshot_file f;
 	struct ss_snapshot_summary sum;
-	int err = ss_snapshot_read_summary(path, &sum);
-	if (err)
-		return err;
-	r->count = sum.count;
-	r->nx = sum.nx;
-	r->ny = sum.ny;
-	r->time = sum.count > 0 ? sum.time[sum.count - 1] : NAN;
-	ss_snapshot_summary_release(&sum);
-	if (r->count < 1)
-		return ss_error_input("cannot restart from '%s': it holds no snapshot", path);
-	hid_t file = open_file(path);
-	if (file < 0)
-		return SS_ERR_INPUT;
-	err = read_restart_state(file, &r->state);
-	H5Fclose(file);
-	if (err)
-		return ss_error_input("cannot restart from '%s': its restart state is missing or "
-		                      "damaged (written by an older sandslide?)", path);
-	int nx, ny;
-	err = ss_snapshot_read_field(path, "/height", r->count - 1, &nx, &ny, &r->height);
-	if (err)
-		ss_restart_info_release(r);
-	return err;
-}
-
-int ss_snapshot_read_restart(const char *path, struct ss_restart_info *r)
-{
-	memset(r, 0, sizeof *r);
-	struct ss_snapshot_summary sum;
-	int err = ss_snapshot_read_summary(path, &sum);   /* a sandslide file first */
-	const long long count = sum.count;
-	ss_snapshot_summary_release(&sum);
-	if (err)
-		return err;
-	if (count < 1)
-		return ss_error_input("cannot restart from '%s': it holds no snapshot", path);
-	hid_t file = open_file(path);
-	if (file < 0)
-		return SS_ERR_INPUT;
-	char *text = read_attr_text(file, "case");
-	char *case_path = read_attr_text(file, "title");
-	char *overrides = read_attr_text(file, "case_overrides");
-	H5Fclose(file);
-	if (!text || !case_path || !overrides || !*text)
-		err = ss_error_input("cannot restart from '%s': it does not hold the case it was "
-		                     "run from (written by sandslide run?)", path);
+	memset(&sum, 0, sizeof sum);
+	int err = ss_snapshot_file_open(&f, path);
 	if (!err)
-		err = ss_snapshot_read_last_state(path, r);
-	if (err) {
-		free(text);
-		free(case_path);
-		free(overrides);
-		return err;
+		err = ss_snapshot_file_summary(&f, &sum);
+	if (!err && (f.nx != g->nx || f.ny != g->ny || f.count < 1))
+		err = ss_error_input("cannot open '%s' to continue it: not a sandslide output of "
+		                     "this %d x %d grid", path, g->nx, g->ny);
+	if (!err) {
+		s->count = f.count;
+		s->times_cap = f.count + 64;
+		if (!(s->times = calloc((size_t)s->times_cap, sizeof *s->times)))
+			err = ss_error_fail("out of memory");
+		else
+			memcpy(s->times, f.time, (size_t)f.count * sizeof *s->times);
 	}
-	r->case_text = text;
-	r->case_path = case_path;
-	r->case_overrides = overrides;
-	return SS_OK;
+	ss_snapshot_summary_release(&sum);
+	ss_snapshot_file_close(&f);
+	return err;
 }
 
 int ss_snapshot_open_append(struct ss_snapshot **out, const char *path,
@@ -982,35 +630,28 @@ int ss_snapshot_open_append(struct ss_snapshot **out, const char *path,
 	struct ss_snapshot *s = snapshot_alloc(path, g);
 	if (!s)
 		return ss_error_fail("out of memory");
+	int err = check_append(s, path, g);
+	if (err) {
+		ss_snapshot_destroy(s);
+		return err;
+	}
 	hid_t fapl = writer_access();
+	errno = 0;
 	s->file = H5Fopen(path, H5F_ACC_RDWR, fapl);
 	H5Pclose(fapl);
 	int bad = s->file < 0;
+	const int e = errno;
 	if (!bad) {
 		s->height = H5Dopen2(s->file, "height", H5P_DEFAULT);
 		s->time = H5Dopen2(s->file, "time", H5P_DEFAULT);
 		bad = s->height < 0 || s->time < 0;
-		for (int k = 0; k < DIAG_COUNT && !bad; k++)
-			bad = (s->diag[k] = H5Dopen2(s->file, diag_names[k], H5P_DEFAULT)) < 0;
-	}
-	hsize_t dims[3] = {0, 0, 0};
-	if (!bad) {
-		hid_t fs = H5Dget_space(s->height);
-		bad = H5Sget_simple_extent_ndims(fs) != 3 ||
-		      H5Sget_simple_extent_dims(fs, dims, NULL) != 3 ||
-		      dims[1] != (hsize_t)g->ny || dims[2] != (hsize_t)g->nx || dims[0] < 1;
-		H5Sclose(fs);
-	}
-	if (!bad) {
-		s->count = (long long)dims[0];
-		s->times_cap = s->count + 64;
-		s->times = calloc((size_t)s->times_cap, sizeof *s->times);
-		bad = !s->times || read_series(s->file, "time", s->count, s->times);
+		for (int k = 0; k < SS_SNAPSHOT_DIAG_COUNT && !bad; k++)
+			bad = (s->diag[k] = H5Dopen2(s->file, ss_snapshot_diag_name(k), H5P_DEFAULT)) < 0;
 	}
 	if (bad) {
 		ss_snapshot_destroy(s);
-		return ss_error_input("cannot open '%s' to continue it: not a sandslide output of "
-		                      "this %d x %d grid", path, g->nx, g->ny);
+		return ss_error_input("cannot open '%s' to continue it%s%s", path, e ? ": " : "",
+		                      e ? strerror(e) : "");
 	}
 	*out = s;
 	return SS_OK;

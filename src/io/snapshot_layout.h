@@ -1,0 +1,72 @@
+/*
+ * snapshot_layout.h - what the HDF5 writer (snapshot_write.c) and reader
+ * (snapshot_read.c) share of the file layout of SPEC section 5, without
+ * any HDF5 type: the diagnostic series and the constants of the
+ * definition of a sandslide file.  Not installed; snapshot.h is the
+ * public interface.
+ */
+#ifndef SANDSLIDE_SNAPSHOT_LAYOUT_H
+#define SANDSLIDE_SNAPSHOT_LAYOUT_H
+
+#include "sandslide/diagnostics.h"
+
+/* Root attribute `source` starts with this ("sandslide 0.1.0"). */
+#define SS_SNAPSHOT_SOURCE "sandslide"
+
+/* /height chunks are 1 x 256 x 256 (fewer rows or columns on small grids):
+ * readers take whole chunks of rows at a time. */
+#define SS_SNAPSHOT_CHUNK_SIDE 256
+
+/* A side longer than this is not a grid sandslide writes (int indices). */
+#define SS_SNAPSHOT_MAX_SIDE (1 << 30)
+
+/* Root attribute restart_state: steps, inflow sum and carry, outflow sum
+ * and carry (snapshot.h, struct ss_restart_state). */
+#define SS_SNAPSHOT_RESTART_VALUES 5
+
+/* The float64 (time) series beside /time. */
+enum { SS_SNAPSHOT_DIAG_COUNT = 8 };
+
+static inline const char *ss_snapshot_diag_name(int k)
+{
+	static const char *const names[SS_SNAPSHOT_DIAG_COUNT] = {
+		"volume", "inflow", "outflow", "max_height", "max_slope_deg", "steps",
+		"active_fraction", "wall_seconds",
+	};
+	return names[k];
+}
+
+static inline const char *ss_snapshot_diag_units(int k)
+{
+	static const char *const units[SS_SNAPSHOT_DIAG_COUNT] = {
+		"m3", "m3", "m3", "m", "degree", "1", "1", "s",
+	};
+	return units[k];
+}
+
+static inline const char *ss_snapshot_diag_long_name(int k)
+{
+	static const char *const long_names[SS_SNAPSHOT_DIAG_COUNT] = {
+		"volume of sand on flow cells",
+		"cumulative volume added by sources",
+		"cumulative volume that left through open cells",
+		"highest sand surface on flow cells",
+		"steepest face slope that can carry flux",
+		"cumulative forward-Euler substeps",
+		"fraction of tiles swept since the previous snapshot",
+		"wall-clock time since the run started",
+	};
+	return long_names[k];
+}
+
+/* The field of d that series k holds, in the order of the names. */
+static inline double *ss_snapshot_diag_field(struct ss_diagnostics *d, int k)
+{
+	double *const f[SS_SNAPSHOT_DIAG_COUNT] = {
+		&d->volume, &d->inflow, &d->outflow, &d->max_height, &d->max_slope_deg,
+		&d->steps, &d->active_fraction, &d->wall_seconds,
+	};
+	return f[k];
+}
+
+#endif
