@@ -11,6 +11,7 @@
 #include <string.h>
 #include <sys/file.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "sandslide/error.h"
@@ -88,12 +89,20 @@ static char *lock_path_of(const char *path)
 	return lock;
 }
 
-/* The process that holds the lock file open in fd, as its text says. */
+/* The process that holds the lock file open in fd, as its text says; a run
+ * that has just taken the lock writes it a moment later, so wait up to
+ * 0.2 s for it (0: unknown). */
 static long holder_of(int fd)
 {
-	char text[32] = "";
-	const ssize_t n = pread(fd, text, sizeof text - 1, 0);
-	return n > 0 ? strtol(text, NULL, 10) : 0;
+	for (int tries = 0; tries < 20; tries++) {
+		char text[32] = "";
+		const ssize_t n = pread(fd, text, sizeof text - 1, 0);
+		const long pid = n > 0 ? strtol(text, NULL, 10) : 0;
+		if (pid > 0)
+			return pid;
+		nanosleep(&(struct timespec){0, 10000000}, NULL);
+	}
+	return 0;
 }
 
 /* 1 when fd is still the file at path (a run that ends unlinks its lock
