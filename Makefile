@@ -8,6 +8,7 @@
 #   make SANITIZE=1 AddressSanitizer + UndefinedBehaviorSanitizer, in build-san/
 #                   (`make SANITIZE=1 test` runs every test with them)
 #   make race       data-race check of the OpenMP code: ThreadSanitizer + Archer
+#   make check-layering  the tiers of src/README.md, by their #includes
 #   make V=1        show the full commands
 #
 # User CFLAGS/LDFLAGS are appended last, never overwritten.
@@ -100,7 +101,7 @@ else
   Q := @
 endif
 
-# The library in tiers (src/README.md): base, core, model, io, app; the
+# The library in tiers (src/README.md): base, core, io, model, app; the
 # command line in src/cli/ is the program around it.
 LIB_SRC  := $(filter-out src/cli/%,$(wildcard src/*/*.c))
 CLI_SRC  := $(wildcard src/cli/*.c)
@@ -112,7 +113,7 @@ TEST_SRC := $(wildcard tests/test_*.c)
 TEST_BIN := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
 HEADERS  := $(wildcard include/sandslide/*.h)
 
-.PHONY: all deps test check demo clean headers-check help
+.PHONY: all deps test check demo clean headers-check check-layering help
 all: $(BUILD)/sandslide $(BUILD)/libsandslide.a
 
 # A flags stamp: objects rebuild when the flags change (git's GIT-CFLAGS).
@@ -213,10 +214,10 @@ $(HOOK_BIN): tests/hooks/nan_step.c $(MAIN_OBJ) $(BUILD)/libsandslide.a $(BUILD)
 	$(Q)$(CC) $(filter-out -MMD -MP,$(ALL_CFLAGS)) tests/hooks/nan_step.c $(MAIN_OBJ) \
 	  $(BUILD)/libsandslide.a $(ALL_LDFLAGS) -Wl,--wrap=ss_stepper_advance $(LIBS) -o $@
 
-# The README's test command.  C test programs first (each prints
-# "N passed, M failed"), the fuzz corpora replayed, then the CLI/file tests
-# with pytest.
-test check: all $(TEST_BIN) $(HOOK_BIN) headers-check $(FUZZ_REPLAY)
+# The README's test command.  The layering check, the C test programs
+# (each prints "N passed, M failed"), the fuzz corpora replayed, then the
+# CLI/file tests with pytest.
+test check: all $(TEST_BIN) $(HOOK_BIN) headers-check check-layering $(FUZZ_REPLAY)
 	@fail=0; for t in $(TEST_BIN); do \
 	  echo "== $$t"; OMP_NUM_THREADS=$${OMP_NUM_THREADS:-2} ./$$t || fail=1; \
 	done; \
@@ -225,6 +226,12 @@ test check: all $(TEST_BIN) $(HOOK_BIN) headers-check $(FUZZ_REPLAY)
 	SANDSLIDE=$(abspath $(BUILD)/sandslide) SANDSLIDE_NAN=$(abspath $(HOOK_BIN)) \
 	  $(PYTHON) -m pytest -q tests/cli || fail=1; \
 	exit $$fail
+
+# The tiers of src/README.md, checked by the #includes of each file: the
+# kernel knows nothing of files, printing or the command line, I/O nothing
+# of the stencil, and <hdf5.h> is in two files (tests/check_layering.sh).
+check-layering:
+	@sh tests/check_layering.sh
 
 # ---- data races: make race (ThreadSanitizer + Archer) ----------------------
 # The library, sandslide and the C tests built again with clang
@@ -276,6 +283,6 @@ clean:
 	rm -rf $(BUILD)
 
 help:
-	@sed -n '3,14p' Makefile | sed 's/^# \{0,1\}//'
+	@sed -n '3,15p' Makefile | sed 's/^# \{0,1\}//'
 
 -include $(LIB_OBJ:.o=.d) $(MAIN_OBJ:.o=.d) $(TEST_BIN:=.d)

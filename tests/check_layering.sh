@@ -1,0 +1,57 @@
+#!/bin/sh
+# check_layering.sh - the tiers of src/README.md, checked by the #includes
+# of each file (`make check-layering`, run by `make test`):
+#
+#   src/core    the kernel: no file format, no printing, no upper tier
+#   src/io      file formats: nothing of the stencil
+#   src/model   case and set-up: no app or CLI
+#   render/     pictures from the HDF5 output: not the kernel, not HDF5
+#               itself (it reads through src/io/snapshot_read.c)
+#   library     nothing of src/cli
+#   <hdf5.h>    only src/io/snapshot_write.c and src/io/snapshot_read.c
+#
+# Prints each offending line and exits 1; prints one line and exits 0
+# when every rule holds.  Run from the top of the repository.
+cd "$(dirname "$0")/.." || exit 2
+fail=0
+
+# check WHAT PATTERN FILE...: no FILE may include a header matching PATTERN
+check() {
+	what=$1 pattern=$2
+	shift 2
+	hits=$(grep -nE "^[[:space:]]*#[[:space:]]*include[[:space:]]*[<\"]($pattern)[>\"]" \
+	       "$@" 2>/dev/null)
+	if [ -n "$hits" ]; then
+		echo "check-layering: $what:"
+		echo "$hits" | sed 's/^/    /'
+		fail=1
+	fi
+}
+
+core_headers="include/sandslide/grid.h include/sandslide/boundary.h
+include/sandslide/closure.h include/sandslide/face.h include/sandslide/sweep.h
+include/sandslide/stepper.h include/sandslide/diagnostics.h"
+upper="sandslide/(snapshot|dem|render|run|relax|bench|case|shape|progress)\.h"
+
+# shellcheck disable=SC2086
+check "the kernel (src/core) includes a file format, stdio or an upper tier" \
+	"hdf5\.h|hdf5_hl\.h|png\.h|gdal.*\.h|cpl_.*\.h|ini\.h|stdio\.h|(io|model|app|cli)/.*|$upper" \
+	src/core/* $core_headers
+check "I/O (src/io) includes the stencil or an upper tier" \
+	"sandslide/(sweep|stepper|face)\.h|(model|app|cli)/.*" src/io/*
+check "the model set-up (src/model) includes an upper tier" "(app|cli)/.*" src/model/*
+check "the renderer (render/) includes the kernel, HDF5 or an upper tier" \
+	"hdf5\.h|hdf5_hl\.h|sandslide/(sweep|stepper|face|closure)\.h|(model|app|cli)/.*" render/*
+check "the library includes the command line (src/cli)" "cli/.*" \
+	src/base/* src/core/* src/model/* src/io/* src/app/* render/* include/sandslide/*
+
+hdf5=$(grep -lE '^[[:space:]]*#[[:space:]]*include[[:space:]]*<hdf5' -r src render include \
+       tests/*.c | grep -vE '^src/io/snapshot_(read|write)\.c$')
+if [ -n "$hdf5" ]; then
+	echo "check-layering: <hdf5.h> outside src/io/snapshot_read.c and snapshot_write.c:"
+	echo "$hdf5" | sed 's/^/    /'
+	fail=1
+fi
+
+[ $fail -eq 0 ] && echo "  layering: core, io, model, render and cli include only what they may"
+exit $fail
