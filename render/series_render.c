@@ -235,9 +235,46 @@ static int render_frames(const struct ss_render_plan *p, struct ss_render_source
 	return err;
 }
 
-int ss_render_series(const struct ss_render_series_options *o)
+/* The height scale: the options', else the whole file's lowest and
+ * highest sand. */
+static int series_scale(const struct ss_render_series_options *o, struct ss_render_source *s,
+                        double *zmin, double *zmax)
+{
+	*zmin = o->look.zmin;
+	*zmax = o->look.zmax;
+	if (!isnan(*zmin) && !isnan(*zmax))
+		return SS_OK;
+	double lo, hi;
+	char what[4200];
+	snprintf(what, sizeof what, "'%s'", o->input);
+	const int err = ss_render_source_range(s, 0, s->file.count - 1, &lo, &hi);
+	return err ? err : ss_render_scale_resolve(zmin, zmax, lo, hi, what);
+}
+
+/* What the frames were, for the report. */
+static void report_frames(const struct ss_render_series_options *o,
+                          const struct ss_render_source *s, const struct ss_render_plan *p,
+                          const long long *sel, long long n,
+                          struct ss_render_series_report *r)
+{
+	r->frames = n;
+	r->width = p->image_w;
+	r->height = p->image_h;
+	r->t_first = s->file.time[sel[0]];
+	r->t_last = s->file.time[sel[n - 1]];
+	r->zmin = p->zmin;
+	r->zmax = p->zmax;
+	r->threads = ss_parallel_max_threads();
+	ss_render_frame_path(o->output_dir, n, r->stale, sizeof r->stale);
+	if (access(r->stale, F_OK) != 0)
+		r->stale[0] = '\0';
+}
+
+int ss_render_series(const struct ss_render_series_options *o,
+                     struct ss_render_series_report *report)
 {
 	const double started = ss_parallel_wall_seconds();
+	memset(report, 0, sizeof *report);
 	int err = ss_render_options_check(&o->look);
 	if (err)
 		return err;
@@ -248,25 +285,16 @@ int ss_render_series(const struct ss_render_series_options *o)
 	if ((err = ss_render_source_open(&s, o->input)))
 		return err;
 	long long *sel = NULL, n = 0;
+	double zmin, zmax;
 	if (s.file.count == 0) {
 		err = ss_error_input("'%s' holds no snapshots: nothing to render", o->input);
 		goto out_source;
 	}
-	if ((err = select_frames(o, &s, &sel, &n)))
+	if ((err = select_frames(o, &s, &sel, &n)) ||
+	    (err = ss_render_check_dir(o->output_dir, 0)) ||
+	    (o->video && (err = check_video_path(o->video))) ||
+	    (err = series_scale(o, &s, &zmin, &zmax)))
 		goto out_source;
-	if ((err = ss_render_check_dir(o->output_dir, 0)) ||
-	    (o->video && (err = check_video_path(o->video))))
-		goto out_source;
-
-	double zmin = o->look.zmin, zmax = o->look.zmax;
-	if (isnan(zmin) || isnan(zmax)) {
-		double lo, hi;
-		char what[4200];
-		snprintf(what, sizeof what, "'%s'", o->input);
-		if ((err = ss_render_source_range(&s, 0, s.file.count - 1, &lo, &hi)) ||
-		    (err = ss_render_scale_resolve(&zmin, &zmax, lo, hi, what)))
-			goto out_source;
-	}
 	struct ss_render_plan plan;
 	if ((err = ss_render_plan_init(&plan, &o->look, s.file.nx, s.file.ny, s.file.dx, s.file.dy,
 	                               s.cell_type, s.file.nx, zmin, zmax, 1)))
@@ -277,31 +305,11 @@ int ss_render_series(const struct ss_render_series_options *o)
 	const double t0 = ss_parallel_wall_seconds();
 	if ((err = render_frames(&plan, &s, sel, n, o->output_dir)))
 		goto out_plan;
-	const double seconds = ss_parallel_wall_seconds() - t0;
-
-	if (!o->quiet) {
-		const size_t len = strlen(o->output_dir);
-		printf("wrote %lld frame%s of %d x %d px to %s%s (t = %g .. %g s, %s, heights %g .. "
-		       "%g m) in %.2f s: %.1f frames/s, %.1f Mpixel/s on %d threads\n", n,
-		       n == 1 ? "" : "s", plan.image_w, plan.image_h, o->output_dir,
-		       len && o->output_dir[len - 1] == '/' ? "" : "/", s.file.time[sel[0]],
-		       s.file.time[sel[n - 1]], ss_render_style_name(o->look.style), zmin, zmax,
-		       ss_parallel_wall_seconds() - started, n / fmax(seconds, 1e-9),
-		       (double)n * plan.image_w * plan.image_h / fmax(seconds, 1e-9) * 1e-6,
-		       ss_parallel_max_threads());
-		char stale[4200];
-		ss_render_frame_path(o->output_dir, n, stale, sizeof stale);
-		if (access(stale, F_OK) == 0)
-			printf("note: %s and maybe later frames are left from an earlier render; they "
-			       "are not part of this series\n", stale);
-	}
-	if (o->video) {
-		const int v = ss_render_video(o->output_dir, n, o->fps, o->video);
-		if (v < 0)
-			err = v;
-		else if (v == 0 && !o->quiet)
-			printf("wrote %s: %lld frames at %d frames/s\n", o->video, n, o->fps);
-	}
+	report->render_seconds = ss_parallel_wall_seconds() - t0;
+	report_frames(o, &s, &plan, sel, n, report);
+	report->seconds = ss_parallel_wall_seconds() - started;
+	if (o->video)
+		err = ss_render_video(o->output_dir, n, o->fps, o->video, &report->video);
 
 out_plan:
 	ss_render_plan_release(&plan);

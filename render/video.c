@@ -73,15 +73,13 @@ static int has_mp4_container(const char *video)
 	return !dot || !strcmp(dot, ".mp4") || !strcmp(dot, ".mov") || !strcmp(dot, ".m4v");
 }
 
-int ss_render_video(const char *dir, long long count, int fps, const char *video)
+int ss_render_video(const char *dir, long long count, int fps, const char *video,
+                    enum ss_render_video_made *made)
 {
 	char ffmpeg[4096];
-	if (find_on_path("ffmpeg", ffmpeg, sizeof ffmpeg)) {
-		fflush(stdout);
-		fprintf(stderr, "sandslide: ffmpeg is not on PATH, so no video was made; the %lld "
-		        "frames are kept in '%s' (Debian: apt-get install ffmpeg)\n", count, dir);
-		return 1;
-	}
+	*made = SS_RENDER_VIDEO_NO_FFMPEG;
+	if (find_on_path("ffmpeg", ffmpeg, sizeof ffmpeg))
+		return SS_OK;
 	char pattern[8400], tmp[4200], rate[16], frames[32];
 	frame_pattern(dir, pattern, sizeof pattern);
 	partial_name(video, tmp, sizeof tmp);
@@ -127,5 +125,6 @@ int ss_render_video(const char *dir, long long count, int fps, const char *video
 		remove(tmp);
 		return ss_error_fail("cannot rename '%s' to '%s': %s", tmp, video, strerror(e));
 	}
+	*made = SS_RENDER_VIDEO_MADE;
 	return SS_OK;
 }

@@ -148,19 +148,40 @@ struct ss_render_series_options {
 	double time;                /* s: the snapshot nearest this; NAN: unused */
 	const char *video;          /* FILE.mp4 to assemble with ffmpeg, or NULL */
 	int fps;                    /* frames per second of the video (24) */
-	int quiet;                  /* no summary */
 	struct ss_render_options look;
+};
+
+/* What became of a video that was asked for. */
+enum ss_render_video_made {
+	SS_RENDER_VIDEO_NONE,       /* none was asked for */
+	SS_RENDER_VIDEO_MADE,
+	SS_RENDER_VIDEO_NO_FFMPEG,  /* ffmpeg is not on PATH: the frames are kept */
+};
+
+/* What ss_render_series did, for the caller to print. */
+struct ss_render_series_report {
+	long long frames;           /* written */
+	int width, height;          /* px, with the colour bar */
+	double t_first, t_last;     /* s, of the first and last frame */
+	double zmin, zmax;          /* m, the scale the frames share */
+	double seconds;             /* the frames, from the start of the call, s */
+	double render_seconds;      /* rendering and writing the frames, s */
+	int threads;
+	char stale[4200];           /* the frame file after the last, left by an
+	                             * earlier render; "" if there is none */
+	enum ss_render_video_made video;
 };
 
 /*
  * Render the chosen snapshots of o->input to output_dir/frame_00000.png,
  * frame_00001.png, ... in time order, then the video if asked for (without
- * ffmpeg on PATH: a note, the frames are kept, success).  Everything is
- * checked before the first frame is written.  Returns SS_OK, SS_ERR_INPUT
- * (not a sandslide file, no snapshots, a range outside the series, an
- * unwritable folder, zmin >= zmax) or SS_ERR_FAIL.
+ * ffmpeg on PATH the frames are kept, and that is success).  Everything is
+ * checked before the first frame is written.  Returns SS_OK (*report
+ * filled), SS_ERR_INPUT (not a sandslide file, no snapshots, a range
+ * outside the series, an unwritable folder, zmin >= zmax) or SS_ERR_FAIL.
  */
-int ss_render_series(const struct ss_render_series_options *o);
+int ss_render_series(const struct ss_render_series_options *o,
+                     struct ss_render_series_report *report);
 
 /* Name of frame k in dir: "dir/frame_%05lld.png". */
 void ss_render_frame_path(const char *dir, long long k, char *out, size_t size);
@@ -201,10 +222,12 @@ void ss_render_frames_destroy(struct ss_render_frames *fr);
 /*
  * Assemble dir/frame_00000.png .. frame_<count-1>.png into a video with
  * ffmpeg (H.264, yuv420p, fps frames per second), written to a temporary
- * name and renamed.  Returns SS_OK, SS_ERR_FAIL when ffmpeg fails, or 1
- * (after saying so on stderr) when ffmpeg is not on PATH.
+ * name and renamed.  Returns SS_OK, with *made SS_RENDER_VIDEO_MADE, or
+ * SS_RENDER_VIDEO_NO_FFMPEG when ffmpeg is not on PATH (nothing is done);
+ * SS_ERR_FAIL when ffmpeg fails.
  */
-int ss_render_video(const char *dir, long long count, int fps, const char *video);
+int ss_render_video(const char *dir, long long count, int fps, const char *video,
+                    enum ss_render_video_made *made);
 
 /* What ss_render_bench measured, s. */
 struct ss_render_bench_report {

@@ -435,7 +435,7 @@ static int cmd_relax(int argc, char **argv)
 
 struct render_args {
 	struct ss_render_series_options o;
-	int threads, bench, bench_n;
+	int threads, quiet, bench, bench_n;
 };
 
 #define RENDER(m) offsetof(struct render_args, m)
@@ -455,7 +455,7 @@ static const struct cli_option render_options[] = {
 	{.name = "--fps", .value = "N", .kind = CLI_INT, .offset = RENDER(o.fps), .lo = 1,
 	 .hi = 240, .expected = "1 to 240", .help = "frames per second of the video (default 24)"},
 	THREADS(RENDER(threads)),
-	QUIET(RENDER(o.quiet), "no summary"),
+	QUIET(RENDER(quiet), "no summary"),
 	{.name = "--bench", .value = "[N]", .kind = CLI_OPTIONAL_INT, .offset = RENDER(bench),
 	 .value_offset = RENDER(bench_n), .lo = 16, .hi = 32768,
 	 .help = "time the shaded style on an N x N grid (default 4096)"},
@@ -492,7 +492,11 @@ static int cmd_render(int argc, char **argv)
 	}
 	if (!a.o.input)
 		return cli_usage_error(&cmd, "render needs a sandslide output file");
-	return ss_status_exit_code(ss_render_series(&a.o));
+	struct ss_render_series_report report;
+	const int err = ss_render_series(&a.o, &report);
+	if (!err)
+		cli_print_render_series(&a.o, &report, a.quiet);
+	return ss_status_exit_code(err);
 }
 
 /* ---- bench ---------------------------------------------------------------- */

@@ -208,3 +208,30 @@ void cli_print_render_bench(const struct ss_render_bench_report *r)
 		printf("png encoding, zlib level %d (serial): %.3f s = %.1f Mpixel/s, %.1f MB\n",
 		       r->png_levels[l], r->png[l], mpx / r->png[l], r->png_bytes[l] * 1e-6);
 }
+
+void cli_print_render_series(const struct ss_render_series_options *o,
+                             const struct ss_render_series_report *r, int quiet)
+{
+	const size_t len = strlen(o->output_dir);
+	const double seconds = fmax(r->render_seconds, 1e-9);
+	if (!quiet) {
+		printf("wrote %lld frame%s of %d x %d px to %s%s (t = %g .. %g s, %s, heights %g .. "
+		       "%g m) in %.2f s: %.1f frames/s, %.1f Mpixel/s on %d threads\n", r->frames,
+		       r->frames == 1 ? "" : "s", r->width, r->height, o->output_dir,
+		       len && o->output_dir[len - 1] == '/' ? "" : "/", r->t_first, r->t_last,
+		       ss_render_style_name(o->look.style), r->zmin, r->zmax, r->seconds,
+		       r->frames / seconds, (double)r->frames * r->width * r->height / seconds * 1e-6,
+		       r->threads);
+		if (r->stale[0])
+			printf("note: %s and maybe later frames are left from an earlier render; they "
+			       "are not part of this series\n", r->stale);
+	}
+	if (r->video == SS_RENDER_VIDEO_NO_FFMPEG) {
+		fflush(stdout);
+		fprintf(stderr, "sandslide: ffmpeg is not on PATH, so no video was made; the %lld "
+		        "frames are kept in '%s' (Debian: apt-get install ffmpeg)\n", r->frames,
+		        o->output_dir);
+	} else if (r->video == SS_RENDER_VIDEO_MADE && !quiet) {
+		printf("wrote %s: %lld frames at %d frames/s\n", o->video, r->frames, o->fps);
+	}
+}
