@@ -22,6 +22,15 @@
 static const char *const style_names[] = {"shaded", "gray16", "oblique"};
 static const char *const cmap_names[] = {"dune", "terrain", "gray"};
 
+/* The index of name among the three names, -1 if it is none of them. */
+static int index_of(const char *const names[3], const char *name)
+{
+	for (int k = 0; k < 3; k++)
+		if (!strcmp(name, names[k]))
+			return k;
+	return -1;
+}
+
 const char *ss_render_style_name(enum ss_render_style s)
 {
 	return (unsigned)s < 3 ? style_names[s] : "?";
@@ -29,12 +38,10 @@ const char *ss_render_style_name(enum ss_render_style s)
 
 int ss_render_style_parse(const char *name, enum ss_render_style *s)
 {
-	for (int k = 0; k < 3; k++)
-		if (!strcmp(name, style_names[k])) {
-			*s = (enum ss_render_style)k;
-			return 0;
-		}
-	return -1;
+	const int k = index_of(style_names, name);
+	if (k >= 0)
+		*s = (enum ss_render_style)k;
+	return k >= 0 ? 0 : -1;
 }
 
 const char *ss_render_cmap_name(enum ss_render_cmap c)
@@ -44,12 +51,10 @@ const char *ss_render_cmap_name(enum ss_render_cmap c)
 
 int ss_render_cmap_parse(const char *name, enum ss_render_cmap *c)
 {
-	for (int k = 0; k < 3; k++)
-		if (!strcmp(name, cmap_names[k])) {
-			*c = (enum ss_render_cmap)k;
-			return 0;
-		}
-	return -1;
+	const int k = index_of(cmap_names, name);
+	if (k >= 0)
+		*c = (enum ss_render_cmap)k;
+	return k >= 0 ? 0 : -1;
 }
 
 /* CIELAB (D65) to linear sRGB. */

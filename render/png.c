@@ -83,11 +83,14 @@ static int host_is_little_endian(void)
 
 /* The text chunks: enough to know what a frame shows and, for gray16, to
  * turn its samples back into heights. */
+enum { NUMBER_SIZE = 40 };
+
 struct png_texts {
 	png_text t[12];
 	int n;
-	char software[64], time[40], zmin[40], zmax[40], snapshot[32];
-	char dx[40], dy[40], x0[40], y0[40];
+	char software[64];
+	char number[8][NUMBER_SIZE];   /* the values written as text */
+	int numbers;
 };
 
 static void add_text(struct png_texts *x, const char *key, const char *value)
@@ -100,41 +103,41 @@ static void add_text(struct png_texts *x, const char *key, const char *value)
 	t->text_length = strlen(value);
 }
 
+/* Two numbers that go together ("%.17g": they read back exactly), both or
+ * neither: a known NaN of either leaves both out. */
+static void add_pair(struct png_texts *x, const char *key_a, double a, const char *key_b,
+                     double b)
+{
+	if (isnan(a) || isnan(b))
+		return;
+	char *text_a = x->number[x->numbers++], *text_b = x->number[x->numbers++];
+	snprintf(text_a, NUMBER_SIZE, "%.17g", a);
+	snprintf(text_b, NUMBER_SIZE, "%.17g", b);
+	add_text(x, key_a, text_a);
+	add_text(x, key_b, text_b);
+}
+
 static void fill_texts(struct png_texts *x, const struct ss_render_image *img)
 {
 	x->n = 0;
+	x->numbers = 0;
 	snprintf(x->software, sizeof x->software, "sandslide %s", SS_VERSION);
 	add_text(x, "Software", x->software);
 	if (img->source[0])
 		add_text(x, "Source", img->source);
 	add_text(x, "style", ss_render_style_name(img->style));
 	if (!isnan(img->time)) {
-		snprintf(x->time, sizeof x->time, "%.17g", img->time);
-		add_text(x, "time_s", x->time);
+		snprintf(x->number[x->numbers++], NUMBER_SIZE, "%.17g", img->time);
+		add_text(x, "time_s", x->number[x->numbers - 1]);
 	}
-	if (!isnan(img->zmin) && !isnan(img->zmax)) {
-		snprintf(x->zmin, sizeof x->zmin, "%.17g", img->zmin);
-		snprintf(x->zmax, sizeof x->zmax, "%.17g", img->zmax);
-		add_text(x, "zmin_m", x->zmin);
-		add_text(x, "zmax_m", x->zmax);
-	}
+	add_pair(x, "zmin_m", img->zmin, "zmax_m", img->zmax);
 	if (img->snapshot >= 0) {
-		snprintf(x->snapshot, sizeof x->snapshot, "%lld", img->snapshot);
-		add_text(x, "snapshot", x->snapshot);
+		snprintf(x->number[x->numbers++], NUMBER_SIZE, "%lld", img->snapshot);
+		add_text(x, "snapshot", x->number[x->numbers - 1]);
 	}
 	/* the map's geometry, so that a gray16 frame is a DEM (dem.h) */
-	if (!isnan(img->px_dx) && !isnan(img->px_dy)) {
-		snprintf(x->dx, sizeof x->dx, "%.17g", img->px_dx);
-		snprintf(x->dy, sizeof x->dy, "%.17g", img->px_dy);
-		add_text(x, "dx_m", x->dx);
-		add_text(x, "dy_m", x->dy);
-	}
-	if (!isnan(img->x0) && !isnan(img->y0)) {
-		snprintf(x->x0, sizeof x->x0, "%.17g", img->x0);
-		snprintf(x->y0, sizeof x->y0, "%.17g", img->y0);
-		add_text(x, "x0_m", x->x0);
-		add_text(x, "y0_m", x->y0);
-	}
+	add_pair(x, "dx_m", img->px_dx, "dy_m", img->px_dy);
+	add_pair(x, "x0_m", img->x0, "y0_m", img->y0);
 	if (img->style == SS_RENDER_GRAY16)
 		add_text(x, "height_m", "zmin_m + (value - 1) * (zmax_m - zmin_m) / 65534 for "
 		                        "value >= 1; value 0: wall or no data (transparent)");
