@@ -21,7 +21,7 @@
 #define SS_SNAPSHOT_MAX_SIDE (1 << 30)
 
 /* Root attribute restart_state: steps, inflow sum and carry, outflow sum
- * and carry (snapshot.h, struct ss_restart_state). */
+ * and carry (diagnostics.h, struct ss_restart_state). */
 #define SS_SNAPSHOT_RESTART_VALUES 5
 
 /* The float64 (time) series beside /time. */
