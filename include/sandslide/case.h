@@ -7,7 +7,8 @@
  *               parameters delta, density, gravity, viscosity | consistency;
  *               gamma (herschel-bulkley)
  *   [time]      end (s) | end = steady, output_every (s), cfl, steady_tol,
- *               max_time (s, with end = steady)
+ *               steady_slope_tol, max_time (s, with end = steady),
+ *               integrator = auto|euler|rkl2, rkl2_max_stages, rkl2_max_change
  *   [boundary]  west, east, south, north = wall|open|periodic; open_level (m)
  *   [initial]   type = flat|cone|file; height; center, radius, angle; file
  *   [wall NAME] [open NAME] [source NAME]
@@ -23,6 +24,7 @@
 #include "sandslide/boundary.h"
 #include "sandslide/closure.h"
 #include "sandslide/shape.h"
+#include "sandslide/stepper.h"
 
 
 enum ss_region_role { SS_REGION_WALL, SS_REGION_OPEN, SS_REGION_SOURCE };
@@ -68,7 +70,11 @@ struct ss_case {
 	double output_every;    /* s */
 	double cfl;
 	double steady_tol;      /* m/s */
+	double steady_slope_tol; /* slope excess over tan a_cr (stepper.h) */
 	double max_time;        /* s, INFINITY by default */
+	enum ss_integrator integrator; /* SS_INTEGRATOR_AUTO by default */
+	int rkl2_max_stages;
+	double rkl2_max_change; /* units of tan(a_cr) min(dx, dy) */
 
 	/* [boundary] */
 	struct ss_boundary boundary;

@@ -12,19 +12,22 @@ struct ss_diagnostics {
 	double outflow;         /* cumulative volume that left through open cells, m^3 */
 	double max_height;      /* highest flow cell, m */
 	double max_slope_deg;   /* steepest face that can carry flux, degrees */
-	double steps;           /* cumulative substeps */
+	double steps;           /* cumulative substeps (RKL2: super-steps) */
+	double evaluations;     /* cumulative stencil evaluations */
 	double active_fraction; /* tiles swept / tiles, over the last interval */
 	double wall_seconds;    /* wall time since the run started, s */
 };
 
 /* What a restart needs beyond the heights and the time to continue with the
- * same bits: the step counter and the compensated sums of the inflow and
- * outflow (stepper.h), stored with every snapshot (root attribute
- * restart_state, snapshot.h). */
+ * same bits: the counters, the compensated sums of the inflow and outflow
+ * and RKL2's next super-step limit (stepper.h), stored with every snapshot
+ * (root attribute restart_state, snapshot.h). */
 struct ss_restart_state {
 	long long steps;
 	double inflow_sum, inflow_carry;    /* m^3 */
 	double outflow_sum, outflow_carry;
+	long long evaluations;
+	double rkl2_tau;                    /* s; INFINITY: no limit */
 };
 
 #endif

@@ -25,6 +25,7 @@
 #include "sandslide/dem.h"
 #include "sandslide/progress.h"
 #include "sandslide/shape.h"
+#include "sandslide/stepper.h"
 
 struct ss_relax_options {
 	const char *dem;                  /* input: path or FILE.h5[:/dataset] */
@@ -35,6 +36,11 @@ struct ss_relax_options {
 	double gamma;                     /* herschel-bulkley exponent */
 	double nu;                        /* m^2/s: sets the time scale only */
 	double tol;                       /* m/s: steady when max |dh/dt| < tol */
+	double slope_tol;                 /* and no sand face steeper than the
+	                                     angle by more (stepper.h) */
+	enum ss_integrator integrator;    /* auto: rkl2, euler with a bedrock */
+	int rkl2_max_stages;              /* stepper.h */
+	double rkl2_max_change;
 	double max_time;                  /* s; INFINITY: until steady */
 	double cfl;
 	int threads;                      /* <= 0: all processors */
@@ -69,7 +75,9 @@ struct ss_relax_report {
 	double inflow, outflow;           /* m^3 */
 	double max_slope_before_deg;      /* steepest face that can move sand */
 	double max_slope_after_deg;
-	long long steps;                  /* substeps */
+	long long steps;                  /* substeps (RKL2: super-steps) */
+	long long evaluations;            /* stencil evaluations */
+	const char *integrator;           /* "euler" or "rkl2" */
 	double time;                      /* simulated, s */
 	double wall_seconds;
 	int steady;                       /* reached max |dh/dt| < tol */

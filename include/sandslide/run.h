@@ -69,6 +69,10 @@ struct ss_run_summary {
 	double time;                 /* simulated time reached, s */
 	long long steps;             /* substeps since t = 0 */
 	long long steps_here;        /* substeps this process took */
+	long long evaluations;       /* stencil evaluations since t = 0 */
+	long long evaluations_here;  /* those this process made */
+	const char *integrator;      /* "euler" or "rkl2" */
+	int stages_max;              /* RKL2: the stage cap (rkl2_max_stages) */
 	double cells;                /* of the grid */
 	double wall_seconds;         /* the whole run */
 	double measure_seconds;      /* measuring the largest slope */

@@ -35,6 +35,8 @@ struct ss_snapshot_meta {
 	const char *history;     /* the command line */
 	const char *case_text;   /* the whole case file */
 	const char *closure;     /* closure name */
+	const char *integrator;  /* "euler" or "rkl2" (attribute integrator), or
+	                          * NULL: not written */
 	double repose_angle_deg;
 	double nu;               /* m^2/s */
 	double gamma;

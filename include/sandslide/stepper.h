@@ -17,6 +17,37 @@
  * sliding.  A state with no face above the critical slope and no source
  * does not change, so the stepper jumps straight to the next event.
  *
+ * RKL2 (integrator = SS_INTEGRATOR_RKL2, rkl2.h) advances the same stencil
+ * by super-steps of s stages instead.  Its rules:
+ *
+ *   stability  tau <= dt_all (s^2 + s - 2) / 4 with dt_all forward Euler's
+ *              step above for Lambda(infinity), the bound of every slope
+ *              (for Coulomb max f' = f'(tan a_cr+) = cos a_cr whatever the
+ *              state), so no state a stage can reach is unstable;
+ *   accuracy   s <= rkl2_max_stages, and the largest change of a cell in a
+ *              super-step, max |Y_s - Y_0|, at most rkl2_max_change
+ *              tan(a_cr) min(dx, dy): when a super-step changed a cell by
+ *              more, the next is shortened in proportion (0.9 of it), and
+ *              it grows back by at most 2x a super-step;
+ *   events     super-steps end on target times and source switches, so a
+ *              source is constant over a super-step (its value at every
+ *              stage time), and the source rule above holds for tau;
+ *   ledger     the outflow of each stage is combined with the stage
+ *              weights, as the heights are, so volume balances to
+ *              round-off.
+ *
+ * Bedrock is not supported by RKL2 (its stages have negative weights, so
+ * the per-face limit of face.h cannot keep sand above the rock): a stepper
+ * with a bedrock refuses it at ss_stepper_prepare.
+ *
+ * Steady means: no source to switch on, max |dh/dt| < steady_tol (for RKL2
+ * the mean rate |Y_s - Y_0| / tau of the super-step), and no face in sand
+ * carries more sliding flux than a Coulomb face steeper than the repose
+ * angle by steady_slope_tol would (for Coulomb: no sand face steeper than
+ * tan a_cr + steady_slope_tol).  The rate alone is not enough: a long slope
+ * just above the angle barely changes height, the more so the larger the
+ * cells.
+ *
  * The stepper owns its arrays; it knows nothing of files.
  */
 #ifndef SANDSLIDE_STEPPER_H
@@ -39,6 +70,25 @@ struct ss_source {
 	size_t cell_count;
 };
 
+enum ss_integrator {
+	SS_INTEGRATOR_EULER,    /* forward Euler: the reference */
+	SS_INTEGRATOR_RKL2,     /* RKL2 super-steps (rkl2.h) */
+	SS_INTEGRATOR_AUTO,     /* a choice for the caller to resolve with
+	                         * ss_integrator_resolve; never a stepper's */
+};
+
+#define SS_INTEGRATOR_NAMES "auto, euler or rkl2"
+/* "euler", "rkl2" or "auto". */
+const char *ss_integrator_name(enum ss_integrator integrator);
+/* 0 and *out for one of SS_INTEGRATOR_NAMES, else -1. */
+int ss_integrator_parse(const char *name, enum ss_integrator *out);
+/* The integrator a run uses: the one asked for, and for auto rkl2, or
+ * euler with a bedrock (which rkl2 cannot keep sand above). */
+enum ss_integrator ss_integrator_resolve(enum ss_integrator asked, int has_bedrock);
+
+#define SS_RKL2_MAX_STAGES_DEFAULT 256
+#define SS_RKL2_MAX_CHANGE_DEFAULT 0.3
+
 enum ss_kernel {
 	SS_KERNEL_FAST,         /* in place, active tiles (sweep_fast.c) */
 	SS_KERNEL_REFERENCE,    /* two passes, two flux arrays (sweep.c) */
@@ -50,6 +100,10 @@ struct ss_stepper {
 	struct ss_closure closure;
 	struct ss_face_rule face_rule;
 	enum ss_kernel kernel;        /* set before ss_stepper_prepare */
+	enum ss_integrator integrator; /* set before ss_stepper_prepare */
+	int rkl2_max_stages;          /* s <= it (>= 2) */
+	double rkl2_max_change;       /* max |Y_s - Y_0| per super-step, in units
+	                               * of tan(a_cr) min(dx, dy); INFINITY: none */
 	struct ss_sweep_fast fast;
 	struct ss_cfl_bound cfl_bound;
 	struct ss_boundary boundary;
@@ -67,6 +121,8 @@ struct ss_stepper {
 	                               * (-infinity where no sand lies: walls,
 	                               * open cells, open and wall ghosts) */
 	double *row_scratch;          /* ny per-row partial sums */
+	double *rkl2_y0, *rkl2_prev;  /* RKL2 only: Y_0, Y_{j-2} (m), with halo */
+	double *rkl2_m0;              /*   M(Y_0), m/s */
 
 	struct ss_source *sources;
 	int source_count;
@@ -78,7 +134,12 @@ struct ss_stepper {
 	size_t open_face_count;
 
 	double time;                  /* s */
-	long long steps;              /* substeps taken */
+	long long steps;              /* substeps (RKL2: super-steps) taken */
+	long long evaluations;        /* stencil evaluations: Euler one a step,
+	                               * RKL2 s a super-step */
+	double rkl2_tau;              /* the accuracy rule's longest next
+	                               * super-step, s (INFINITY: no limit) */
+	int last_stages;              /* s of the last super-step */
 	double inflow, outflow;       /* cumulative, m^3 */
 	double inflow_sum, inflow_carry;   /* compensated partial sums of them */
 	double outflow_sum, outflow_carry;
@@ -98,9 +159,9 @@ int ss_stepper_init(struct ss_stepper *st, const struct ss_grid *g,
                     double cfl, int tile_nx, int tile_ny);
 void ss_stepper_release(struct ss_stepper *st);
 
-/* Bytes the stepper allocates for grid g with the fast kernel (for the
- * memory check). */
-double ss_stepper_memory_bytes(const struct ss_grid *g);
+/* Bytes the stepper allocates for grid g with the fast kernel and that
+ * integrator (for the memory check). */
+double ss_stepper_memory_bytes(const struct ss_grid *g, enum ss_integrator integrator);
 
 /* Add a source of rate m/s on the cells where mask (nx * ny, row-major,
  * south row first) is non-zero; call after the cell types are final.
@@ -120,11 +181,10 @@ int ss_stepper_set_bedrock(struct ss_stepper *st, const double *bedrock);
  * non-finite height or the first cell whose bedrock is above the surface. */
 int ss_stepper_prepare(struct ss_stepper *st);
 
-/* How ss_stepper_advance ended.  Steady needs max |dh/dt| < steady_tol and
- * no source still to switch on. */
+/* How ss_stepper_advance ended.  Steady: see the top of this file. */
 enum ss_advance_end {
 	SS_ADVANCE_REACHED,     /* time == t_target */
-	SS_ADVANCE_STEADY,      /* max |dh/dt| < steady_tol (when requested) */
+	SS_ADVANCE_STEADY,      /* steady (when requested) */
 	SS_ADVANCE_NONFINITE,   /* a rate or height became NaN or infinite */
 	SS_ADVANCE_STALLED,     /* dt fell below the resolution of the clock */
 	SS_ADVANCE_STEPS,       /* took max_steps substeps */
@@ -132,7 +192,9 @@ enum ss_advance_end {
 };
 
 struct ss_advance_options {
-	double steady_tol;      /* m/s; stop when max |dh/dt| < it; <= 0: never */
+	double steady_tol;      /* m/s; steady needs max |dh/dt| < it; <= 0: never */
+	double steady_slope_tol; /* and no sand face steeper than the repose
+	                          * angle by more (see above); <= 0: 1e-6 */
 	long long max_steps;    /* > 0: stop after this many substeps */
 	void (*progress)(void *context, const struct ss_stepper *st);
 	void *context;          /* passed to progress, called after each substep */

@@ -106,6 +106,50 @@ double ss_sweep_update(const struct ss_grid *g, const struct ss_tiling *t,
                        double *restrict height);
 
 /*
+ * One stage of an RKL2 super-step (rkl2.h) as both kernels apply it to the
+ * flow cells, in place of pass 2's forward Euler.  With M the rate of pass 2
+ * (flux divergence plus source) at the heights Y_{j-1} of this stage:
+ *
+ *   Y_j = Y_0 + mu (Y_{j-1} - Y_0) + nu (Y_{j-2} - Y_0)
+ *             + tau mu~ M(Y_{j-1}) + tau gamma~ M(Y_0)
+ *
+ * The first stage stores Y_0 and M(Y_0) (mu = nu = gamma~ = 0); every stage
+ * moves Y_{j-1} into prev, which held Y_{j-2}.  Cells that are not flow
+ * cells keep their height.
+ */
+struct ss_sweep_stage {
+	int first;                /* stage 1: y0, prev <- Y_0; m0 <- M(Y_0) */
+	double mu, nu;            /* weights of Y_{j-1} - Y_0, Y_{j-2} - Y_0 */
+	double tau_mu, tau_gamma; /* tau mu~_j, tau gamma~_j, s */
+	double *y0;               /* Y_0, m, by storage index */
+	double *prev;             /* Y_{j-2} in, Y_{j-1} out, m */
+	double *m0;               /* M(Y_0), m/s */
+};
+
+/* Y_j of one cell: the one expression both kernels evaluate, so that they
+ * give the same bits.  A cell with Y_{j-1} = Y_{j-2} = Y_0 and M = M_0 = 0
+ * keeps its height exactly. */
+static inline double ss_sweep_stage_value(const struct ss_sweep_stage *s, double y0,
+                                          double y1, double y2, double m, double m0)
+{
+	return y0 + ((s->mu * (y1 - y0) + s->nu * (y2 - y0)) +
+	             (s->tau_mu * m + s->tau_gamma * m0));
+}
+
+/*
+ * Pass 2 of an RKL2 stage with the fluxes of pass 1 and the source rate
+ * (NULL: none).  Returns max |Y_j - Y_0| over flow cells, m (INFINITY on
+ * NaN).
+ */
+double ss_sweep_stage_update(const struct ss_grid *g, const struct ss_tiling *t,
+                             const struct ss_sweep_stage *stage,
+                             const double *restrict flux_x,
+                             const double *restrict flux_y,
+                             const double *restrict source_rate,
+                             const uint8_t *restrict cell_type,
+                             double *restrict height);
+
+/*
  * The largest slope s over the faces that can carry flux (as pass 1 returns
  * it), without computing fluxes; NaN if a height is NaN.  For diagnostics
  * and to start the fast sweep's running measure.  The fast sweep's
@@ -165,6 +209,10 @@ struct ss_sweep_fast {
 	uint8_t *edges_changed;  /* per tile: SS_EDGE_* bits of the last sweep */
 	uint8_t *plain;          /* per tile: it and its ring are all flow cells */
 	uint8_t *has_source;     /* per tile: a source is on over it */
+	uint8_t *superstep_swept;  /* per tile: swept in an earlier stage of
+	                              this RKL2 super-step */
+	uint8_t *moving_superstep; /* per tile: moved or changed in a stage */
+	uint8_t *edges_superstep;  /* per tile: SS_EDGE_* changed in a stage */
 	int *row_list;           /* tile rows with a tile to sweep */
 	double *ring_south;      /* per tile row: old row j0 - 1, index i + 1 */
 	double *ring_north;      /* per tile row: old row j1 */
@@ -229,6 +277,19 @@ double ss_sweep_fast_step(struct ss_sweep_fast *f, const struct ss_grid *g,
                           const double *restrict bedrock,
                           const uint8_t *restrict cell_types,
                           double *restrict height, double *restrict open_flux);
+
+/* Stage j of an RKL2 super-step (ss_sweep_stage) over the tiles that can
+ * change in it, in place, with the fluxes of the step above (no bedrock:
+ * RKL2 is not used with one).  A tile swept in one stage is swept in every
+ * later stage of the super-step; `last` (j = s) plans the next super-step's
+ * first stage.  Returns max |Y_j - Y_0| over the flow cells swept, m
+ * (INFINITY on NaN); open_flux gets the fluxes of M(Y_{j-1}). */
+double ss_sweep_fast_stage(struct ss_sweep_fast *f, const struct ss_grid *g,
+                           const struct ss_face_rule *rule,
+                           const struct ss_sweep_stage *stage, int last,
+                           const double *restrict source_rate,
+                           const uint8_t *restrict cell_types,
+                           double *restrict height, double *restrict open_flux);
 
 /* Tiles in the grid and tiles the coming step sweeps. */
 double ss_sweep_fast_awake(const struct ss_sweep_fast *f);

@@ -116,7 +116,8 @@ static void report_progress(void *context, const struct ss_stepper *st)
  * it has taken last_step steps. */
 static int replay(const struct ss_drive *d, struct ss_stepper *st, long long last_step)
 {
-	struct ss_advance_options o = {.steady_tol = d->steady_tol};
+	struct ss_advance_options o = {.steady_tol = d->steady_tol,
+	                               .steady_slope_tol = d->steady_slope_tol};
 	long long k = 1;
 	enum ss_advance_end e = SS_ADVANCE_REACHED;
 	while (st->steps < last_step && st->time < d->end &&
@@ -232,12 +233,14 @@ int ss_drive_run(struct ss_drive *d, enum ss_drive_end *end)
 	struct ss_stepper *st = d->stepper;
 	const struct ss_advance_options adv = {
 		.steady_tol = d->steady_tol,
+		.steady_slope_tol = d->steady_slope_tol,
 		.progress = d->progress ? report_progress : NULL,
 		.context = d,
 		.stop = d->stop_signal,
 	};
 	d->time_start = st->time;
 	d->steps_start = st->steps;
+	d->evaluations_start = st->evaluations;
 	*end = SS_DRIVE_END;
 	for (long long k = 1; st->time < d->end;) {
 		const enum ss_advance_end e = ss_stepper_advance(st, next_target(d, st->time, &k), &adv);

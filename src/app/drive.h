@@ -61,6 +61,7 @@ struct ss_drive {
 	double output_every;    /* s between targets; INFINITY: only `end` */
 	double end;             /* s; INFINITY: until steady */
 	double steady_tol;      /* m/s; <= 0: never steady */
+	double steady_slope_tol; /* stepper.h; <= 0: the default 1e-6 */
 	double started;         /* wall clock when the command started, s */
 	const volatile sig_atomic_t *stop_signal; /* NULL, or checked after
 	                           every substep (set by a signal handler) */
@@ -81,6 +82,7 @@ struct ss_drive {
 	double seconds_output;          /* writing snapshots, s */
 	double time_start;              /* of the loop, s */
 	long long steps_start;
+	long long evaluations_start;  /* st->evaluations when ss_drive_run started */
 	struct ss_drive_trouble trouble;
 };
 

@@ -22,7 +22,9 @@ void ss_relax_options_init(struct ss_relax_options *o)
 {
 	*o = (struct ss_relax_options){
 		.closure = SS_CLOSURE_COULOMB, .angle_deg = 35.0, .gamma = 1.0, .nu = 1.0,
-		.tol = 1e-9, .max_time = INFINITY, .cfl = 0.9, .sides = SS_SIDE_WALL,
+		.tol = 1e-9, .slope_tol = 1e-6, .integrator = SS_INTEGRATOR_AUTO,
+		.rkl2_max_stages = SS_RKL2_MAX_STAGES_DEFAULT,
+		.rkl2_max_change = SS_RKL2_MAX_CHANGE_DEFAULT, .max_time = INFINITY, .cfl = 0.9, .sides = SS_SIDE_WALL,
 		.nodata_type = SS_CELL_OPEN, .open_level = NAN, .output_every = NAN,
 	};
 	ss_dem_read_options_init(&o->read);
@@ -75,7 +77,12 @@ static int build_stepper(const struct ss_relax_options *o, const struct ss_raste
 	                       isnan(r->y0) ? 0.0 : r->y0);
 	if (err)
 		return err;
-	const double need = ss_stepper_memory_bytes(&g), have = ss_memory_available_bytes();
+	const enum ss_integrator integrator = ss_integrator_resolve(o->integrator, bedrock != NULL);
+	if (integrator == SS_INTEGRATOR_RKL2 && bedrock)
+		return ss_error_input("--integrator rkl2 cannot be used with --bedrock: its stages "
+		                      "cannot keep the sand above the rock (use euler or auto)");
+	const double need = ss_stepper_memory_bytes(&g, integrator);
+	const double have = ss_memory_available_bytes();
 	if (have > 0.0 && need > have) {
 		char nb[32], hb[32];
 		return ss_error_input("%s: %d x %d cells need %s of memory; this machine has %s "
@@ -100,6 +107,9 @@ static int build_stepper(const struct ss_relax_options *o, const struct ss_raste
 		return err;
 	if ((err = ss_stepper_init(st, &g, &closure, &sides, o->cfl, 0, 0)))
 		return err;
+	st->integrator = integrator;
+	st->rkl2_max_stages = o->rkl2_max_stages;
+	st->rkl2_max_change = o->rkl2_max_change;
 	for (int j = 0; j < g.ny; j++) {
 		for (int i = 0; i < g.nx; i++) {
 			const size_t m = (size_t)j * g.nx + i;
@@ -153,6 +163,8 @@ static int write_report(const char *path, const struct ss_relax_options *o,
 	fprintf(f, "  \"steady\": %s, \"tol\": %.17g,\n", r->steady ? "true" : "false", o->tol);
 	fprintf(f, "  \"steps\": %lld, \"time\": %.17g, \"wall_seconds\": %.6g,\n", r->steps,
 	        r->time, r->wall_seconds);
+	fprintf(f, "  \"integrator\": \"%s\", \"stencil_evaluations\": %lld, "
+	        "\"slope_tol\": %.17g,\n", r->integrator, r->evaluations, o->slope_tol);
 	fprintf(f, "  \"cells_moved\": %lld, \"volume_moved\": %.17g,\n", r->cells_moved,
 	        r->volume_moved);
 	fprintf(f, "  \"volume_before\": %.17g, \"volume_after\": %.17g,\n", r->volume_before,
@@ -247,6 +259,7 @@ static int open_output(struct relax *x, const struct ss_relax_report *rep)
 	const int series = x->format == SS_DEM_H5;
 	d->end = o->max_time;
 	d->steady_tol = o->tol;
+	d->steady_slope_tol = o->slope_tol;
 	d->output_every = !isnan(o->output_every) ? o->output_every
 	                : series && isfinite(o->max_time) ? o->max_time / 20.0 : INFINITY;
 	d->stop_signal = o->stop_signal;
@@ -260,6 +273,7 @@ static int open_output(struct relax *x, const struct ss_relax_report *rep)
 	const struct ss_snapshot_meta meta = {
 		.title = o->dem, .history = o->history ? o->history : "",
 		.case_text = "", .closure = ss_closure_name(o->closure),
+		.integrator = ss_integrator_name(x->st.integrator),
 		.repose_angle_deg = o->angle_deg, .nu = o->nu, .gamma = o->gamma,
 		.bedrock = x->st.bedrock,
 	};
@@ -274,6 +288,8 @@ static void measure_after(struct relax *x, enum ss_drive_end end, struct ss_rela
 	rep->steady = end == SS_DRIVE_STEADY;
 	rep->interrupted = end == SS_DRIVE_INTERRUPTED;
 	rep->steps = st->steps;
+	rep->evaluations = st->evaluations;
+	rep->integrator = ss_integrator_name(st->integrator);
 	rep->time = st->time;
 	rep->inflow = st->inflow;
 	rep->outflow = st->outflow;

@@ -193,6 +193,7 @@ static int open_output(struct run *r)
 	d->output_every = r->c.output_every;
 	d->end = r->c.steady ? r->c.max_time : r->c.end;
 	d->steady_tol = r->c.steady ? r->c.steady_tol : 0.0;
+	d->steady_slope_tol = r->c.steady_slope_tol;
 	d->stop_signal = o->stop_signal;
 	d->progress = o->progress;
 	d->progress_context = o->progress_context;
@@ -211,6 +212,7 @@ static int open_output(struct run *r)
 	const struct ss_snapshot_meta meta = {
 		.title = r->c.path, .history = o->history ? o->history : "",
 		.case_text = r->c.text, .closure = ss_closure_name(r->c.closure),
+		.integrator = ss_integrator_name(r->st.integrator),
 		.repose_angle_deg = r->c.repose_angle_deg, .nu = r->c.nu, .gamma = r->c.gamma,
 		.deflate = o->deflate, .bedrock = r->st.bedrock, .case_overrides = overrides,
 	};
@@ -231,6 +233,10 @@ static void summarise(const struct run *r, enum ss_drive_end end, struct ss_run_
 	s->time = st->time;
 	s->steps = st->steps;
 	s->steps_here = st->steps - r->drive.steps_start;
+	s->evaluations = st->evaluations;
+	s->evaluations_here = st->evaluations - r->drive.evaluations_start;
+	s->integrator = ss_integrator_name(st->integrator);
+	s->stages_max = st->rkl2_max_stages;
 	s->cells = (double)st->grid.nx * st->grid.ny;
 	s->wall_seconds = ss_parallel_wall_seconds() - r->drive.started;
 	s->measure_seconds = st->seconds_measure;

@@ -269,6 +269,11 @@ static int parse_closure(const char *word, void *target)
 	return ss_closure_parse(word, target);
 }
 
+static int parse_integrator(const char *word, void *target)
+{
+	return ss_integrator_parse(word, target);
+}
+
 static int parse_sides(const char *word, void *target)
 {
 	return ss_side_kind_parse(word, target) || *(enum ss_side_kind *)target == SS_SIDE_PERIODIC
@@ -337,6 +342,20 @@ static const struct cli_option relax_options[] = {
 	      "herschel-bulkley exponent (default 1)"),
 	POSITIVE("--nu", "V", o.nu, "m^2/s > 0", "m^2/s (default 1): sets the time scale only"),
 	POSITIVE("--tol", "X", o.tol, "m/s > 0", "steady when max |dh/dt| < X m/s (default 1e-9)"),
+	POSITIVE("--slope-tol", "E", o.slope_tol, "a number > 0",
+	         "and no sand face steeper than tan(angle) + E\n"
+	         "(default 1e-6; other closures: the same flux)"),
+	{.name = "--integrator", .value = "NAME", .kind = CLI_PARSE, .offset = RELAX(o.integrator),
+	 .parse = parse_integrator, .expected = SS_INTEGRATOR_NAMES,
+	 .help = "euler, rkl2 (super-steps) or auto (default: rkl2,\n"
+	         "or euler with --bedrock)"},
+	{.name = "--rkl2-max-stages", .value = "S", .kind = CLI_INT,
+	 .offset = RELAX(o.rkl2_max_stages), .lo = 2, .hi = 100000,
+	 .expected = "an integer >= 2",
+	 .help = "rkl2: at most S stages a super-step (default 256)"},
+	POSITIVE("--rkl2-max-change", "C", o.rkl2_max_change, "a number > 0",
+	         "rkl2: a super-step changes no cell by more than\n"
+	         "C tan(angle) dx (default 0.3)"),
 	POSITIVE("--max-time", "T", o.max_time, "s > 0",
 	         "stop at T s even if not steady (default: none)"),
 	RANGE("--cfl", "C", o.cfl, 1e-9, 1.0, "(0, 1]",

@@ -67,14 +67,15 @@ void cli_print_run_end(const struct ss_run_summary *s, int quiet)
 	}
 	if (quiet)
 		return;
-	printf("wrote %s: %lld snapshots to t = %g s, %lld steps%s\n", s->output, s->snapshots,
-	       s->time, s->steps, s->end == SS_RUN_STEADY ? " (steady)"
+	printf("wrote %s: %lld snapshots to t = %g s, %lld %s%s\n", s->output, s->snapshots,
+	       s->time, s->steps, strcmp(s->integrator, "rkl2") ? "steps (euler)"
+	       : "super-steps (rkl2)", s->end == SS_RUN_STEADY ? " (steady)"
 	       : s->end == SS_RUN_NOT_STEADY ? " (not steady by max_time)" : "");
-	printf("wall %.3f s: slope %.3f s, sweep %.3f s, output %.3f s; "
-	       "%.3g cell-updates/s on %d threads\n", s->wall_seconds, s->measure_seconds,
-	       s->sweep_seconds, s->output_seconds,
-	       (double)s->steps_here * s->cells / fmax(s->measure_seconds + s->sweep_seconds, 1e-9),
-	       s->threads);
+	printf("wall %.3f s: slope %.3f s, sweep %.3f s, output %.3f s; %lld stencil "
+	       "evaluations, %.3g cell-updates/s on %d threads\n", s->wall_seconds,
+	       s->measure_seconds, s->sweep_seconds, s->output_seconds, s->evaluations,
+	       (double)s->evaluations_here * s->cells /
+	       fmax(s->measure_seconds + s->sweep_seconds, 1e-9), s->threads);
 }
 
 void cli_print_relax_end(const struct ss_relax_report *r, double angle_deg, int quiet)
@@ -86,9 +87,11 @@ void cli_print_relax_end(const struct ss_relax_report *r, double angle_deg, int 
 	}
 	if (quiet)
 		return;
-	printf("wrote %s: %d x %d cells, %s after %lld steps (t = %g s)\n", r->output, r->nx,
-	       r->ny, r->steady ? "steady" : r->interrupted ? "NOT steady (interrupted)"
-	       : "NOT steady by --max-time", r->steps, r->time);
+	printf("wrote %s: %d x %d cells, %s after %lld %s (t = %g s, %lld stencil "
+	       "evaluations)\n", r->output, r->nx, r->ny, r->steady ? "steady"
+	       : r->interrupted ? "NOT steady (interrupted)" : "NOT steady by --max-time",
+	       r->steps, strcmp(r->integrator, "rkl2") ? "steps (euler)" : "super-steps (rkl2)",
+	       r->time, r->evaluations);
 	printf("cells moved %lld, volume moved %.6g m^3, steepest sand face %.4f -> "
 	       "%.4f deg (repose %g), wall %.3f s\n", r->cells_moved, r->volume_moved,
 	       r->max_slope_before_deg, r->max_slope_after_deg, angle_deg, r->wall_seconds);

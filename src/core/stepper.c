@@ -9,12 +9,43 @@
 
 #include "sandslide/error.h"
 #include "sandslide/parallel.h"
+#include "sandslide/rkl2.h"
 
-double ss_stepper_memory_bytes(const struct ss_grid *g)
+static const char *const integrator_names[] = {
+	[SS_INTEGRATOR_EULER] = "euler", [SS_INTEGRATOR_RKL2] = "rkl2",
+	[SS_INTEGRATOR_AUTO] = "auto",
+};
+
+const char *ss_integrator_name(enum ss_integrator integrator)
 {
-	/* height and source_rate (doubles) and the packed types; the fast
-	 * sweep's ring rows and buffers are below 2 % of that */
-	return (double)ss_grid_storage_cells(g) * (2.0 * sizeof(double) + 0.25);
+	return integrator_names[integrator];
+}
+
+int ss_integrator_parse(const char *name, enum ss_integrator *out)
+{
+	for (int k = 0; k < 3; k++) {
+		if (strcmp(name, integrator_names[k]) == 0) {
+			*out = (enum ss_integrator)k;
+			return 0;
+		}
+	}
+	return -1;
+}
+
+enum ss_integrator ss_integrator_resolve(enum ss_integrator asked, int has_bedrock)
+{
+	if (asked != SS_INTEGRATOR_AUTO)
+		return asked;
+	return has_bedrock ? SS_INTEGRATOR_EULER : SS_INTEGRATOR_RKL2;
+}
+
+double ss_stepper_memory_bytes(const struct ss_grid *g, enum ss_integrator integrator)
+{
+	/* height and source_rate (doubles) and the packed types, and RKL2's
+	 * Y_0, Y_{j-2} and M(Y_0); the fast sweep's ring rows and buffers
+	 * are below 2 % of that */
+	const double doubles = integrator == SS_INTEGRATOR_RKL2 ? 5.0 : 2.0;
+	return (double)ss_grid_storage_cells(g) * (doubles * sizeof(double) + 0.25);
 }
 
 int ss_stepper_init(struct ss_stepper *st, const struct ss_grid *g,
@@ -32,6 +63,9 @@ int ss_stepper_init(struct ss_stepper *st, const struct ss_grid *g,
 	st->closure = *c;
 	st->boundary = *b;
 	st->cfl = cfl;
+	st->rkl2_max_stages = SS_RKL2_MAX_STAGES_DEFAULT;
+	st->rkl2_max_change = SS_RKL2_MAX_CHANGE_DEFAULT;
+	st->rkl2_tau = INFINITY;
 	ss_cfl_bound_init(&st->cfl_bound, c);
 	ss_face_rule_init(&st->face_rule, c);
 	ss_tiling_init(&st->tiling, g, tile_nx, tile_ny);
@@ -55,6 +89,9 @@ void ss_stepper_release(struct ss_stepper *st)
 	ss_free(st->open_faces);
 	ss_free(st->open_flux);
 	ss_sweep_fast_release(&st->fast);
+	ss_free(st->rkl2_m0);
+	ss_free(st->rkl2_prev);
+	ss_free(st->rkl2_y0);
 	ss_free(st->bedrock);
 	ss_free(st->source_rate);
 	ss_free(st->row_scratch);
@@ -188,6 +225,46 @@ static int open_faces_build(struct ss_stepper *st)
 	return SS_OK;
 }
 
+/* Forward Euler's step for every slope the closure has (stepper.h): the
+ * unit of RKL2's super-steps, s. */
+static double rkl2_dt_all(const struct ss_stepper *st)
+{
+	const struct ss_grid *g = &st->grid;
+	const double inv_d2 = 1.0 / (g->dx * g->dx) + 1.0 / (g->dy * g->dy);
+	return st->cfl / (2.0 * st->closure.nu *
+	                  ss_cfl_bound_lookup(&st->cfl_bound, HUGE_VAL) * inv_d2);
+}
+
+/* The first super-steps are at most RKL2_START_STAGES stages long, and the
+ * limit grows from there by at most 2x a super-step (rkl2_control): a run
+ * starts with no measure of how fast its state changes. */
+#define RKL2_START_STAGES 4
+
+/* RKL2's arrays: Y_0 = Y_{j-2} = the heights and M(Y_0) = 0 everywhere, as
+ * after a super-step in which nothing moved (the fast sweep relies on it
+ * for the tiles it skips). */
+static int rkl2_prepare(struct ss_stepper *st)
+{
+	if (st->bedrock)
+		return ss_error_input("the rkl2 integrator cannot be used with a bedrock: its "
+		                      "stages cannot keep the sand above the rock; use euler");
+	if (st->rkl2_max_stages < 2)
+		return ss_error_input("rkl2_max_stages %d is below 2", st->rkl2_max_stages);
+	if (!(st->rkl2_max_change > 0.0))
+		return ss_error_input("rkl2_max_change %g must be above 0", st->rkl2_max_change);
+	const size_t n = ss_grid_storage_cells(&st->grid);
+	st->rkl2_y0 = ss_alloc(n, sizeof(double), "RKL2 Y_0");
+	st->rkl2_prev = ss_alloc(n, sizeof(double), "RKL2 Y_{j-2}");
+	st->rkl2_m0 = ss_alloc(n, sizeof(double), "RKL2 M(Y_0)");
+	if (!st->rkl2_y0 || !st->rkl2_prev || !st->rkl2_m0)
+		return SS_ERR_FAIL;
+	memcpy(st->rkl2_y0, st->height, n * sizeof(double));
+	memcpy(st->rkl2_prev, st->height, n * sizeof(double));
+	memset(st->rkl2_m0, 0, n * sizeof(double));
+	st->rkl2_tau = rkl2_dt_all(st) * ss_rkl2_stable_ratio(RKL2_START_STAGES);
+	return SS_OK;
+}
+
 int ss_stepper_prepare(struct ss_stepper *st)
 {
 	const struct ss_grid *g = &st->grid;
@@ -226,6 +303,8 @@ int ss_stepper_prepare(struct ss_stepper *st)
 	}
 	int err = open_faces_build(st);
 	if (err)
+		return err;
+	if (st->integrator == SS_INTEGRATOR_RKL2 && (err = rkl2_prepare(st)))
 		return err;
 	if (st->kernel == SS_KERNEL_REFERENCE) {
 		/* the reference sweep reads one type byte per cell */
@@ -343,38 +422,216 @@ static double outflow_rate(const struct ss_stepper *st)
 	return sum_x * st->grid.dy + sum_y * st->grid.dx;
 }
 
+/* What every step starts from: the sources of this time, the next event,
+ * the halo, and the largest face slope S of the state (the fast sweep also
+ * saves its ring rows; the reference sweep computes the fluxes). */
+struct step_start {
+	double next_event;      /* the next target or source switch, s */
+	int may_be_steady;      /* a steady stop is asked for, no source to come */
+	double s_max;           /* NaN if a height is not finite */
+};
+
+static struct step_start step_begin(struct ss_stepper *st, double t_target,
+                                    const struct ss_advance_options *o)
+{
+	const struct ss_grid *g = &st->grid;
+	struct step_start b;
+	sources_update(st);
+	const double next_switch = ss_stepper_next_source_event(st, st->time);
+	/* a state is steady only if no source will switch on later */
+	b.may_be_steady = o->steady_tol > 0.0 && isinf(next_switch);
+	b.next_event = fmin(next_switch, t_target);
+
+	ss_boundary_fill_heights(g, &st->boundary, st->height);
+	const double t0 = ss_parallel_wall_seconds();
+	b.s_max = st->kernel == SS_KERNEL_FAST
+		? ss_sweep_fast_begin(&st->fast, g, st->height, st->cell_types)
+		: ss_sweep_fluxes(g, &st->tiling, &st->face_rule, st->height,
+		                  st->cell_type_bytes, st->flux_x, st->flux_y);
+	st->seconds_measure += ss_parallel_wall_seconds() - t0;
+	return b;
+}
+
+/*
+ * The slope part of the steady test (stepper.h): the steepest face in sand
+ * carries no more sliding flux than a Coulomb face steeper than the repose
+ * angle by slope_tol.  s_max is the state's largest face slope (exact above
+ * the critical slope); with a bedrock, bare rock may stay steep for ever,
+ * so the faces in sand are measured again.
+ */
+static int slopes_settled(struct ss_stepper *st, double s_max, double slope_tol)
+{
+	const struct ss_closure *c = &st->closure;
+	const double t = c->tan_cr + slope_tol;
+	const double flux_tol = slope_tol / sqrt(1.0 + t * t);   /* f_coulomb(t) */
+	if (st->bedrock) {
+		const struct ss_grid *g = &st->grid;
+		/* a film of sand thinner than round-off of the heights is rock */
+		const double bare = 1e-9 * fmax(g->dx, g->dy);
+		s_max = ss_sweep_max_sand_slope(g, st->height, st->cell_types, st->bedrock, bare);
+	}
+	return !(s_max > c->tan_cr) || ss_closure_eval(c, s_max) <= flux_tol;
+}
+
+/* After a step: the totals, the counters, progress, and why to stop (or
+ * -1 to go on).  *steady_candidate: the rate is below steady_tol, so the
+ * next step's start checks the slopes. */
+static int step_end(struct ss_stepper *st, const struct ss_advance_options *o,
+                    const struct step_start *b, int *steady_candidate)
+{
+	st->outflow = st->outflow_sum + st->outflow_carry;
+	st->inflow = st->inflow_sum + st->inflow_carry;
+	st->tile_slots += (double)st->tiling.tiles_x * st->tiling.tiles_y;
+	if (o->progress)
+		o->progress(o->context, st);
+	if (!isfinite(st->rate_max))
+		return SS_ADVANCE_NONFINITE;
+	*steady_candidate = b->may_be_steady && st->rate_max < o->steady_tol;
+	if (o->stop && *o->stop)
+		return SS_ADVANCE_INTERRUPTED;
+	return -1;
+}
+
+/* One forward-Euler substep of dt seconds from the state step_begin
+ * measured. */
+static void euler_step(struct ss_stepper *st, double dt)
+{
+	const struct ss_grid *g = &st->grid;
+	const double t0 = ss_parallel_wall_seconds();
+	if (st->kernel == SS_KERNEL_FAST) {
+		st->tile_sweeps += ss_sweep_fast_awake(&st->fast);
+		st->rate_max = ss_sweep_fast_step(&st->fast, g, &st->face_rule, dt,
+		                                  st->sources_on ? st->source_rate : NULL,
+		                                  st->bedrock, st->cell_types, st->height,
+		                                  st->open_flux);
+	} else {
+		st->tile_sweeps += (double)st->tiling.tiles_x * st->tiling.tiles_y;
+		if (st->bedrock)
+			ss_sweep_limit(g, &st->tiling, dt, st->height, st->bedrock,
+			               st->flux_x, st->flux_y);
+		st->rate_max = ss_sweep_update(g, &st->tiling, dt, st->flux_x, st->flux_y,
+		                               st->sources_on ? st->source_rate : NULL,
+		                               st->cell_type_bytes, st->height);
+	}
+	st->seconds_sweep += ss_parallel_wall_seconds() - t0;
+	add_compensated(&st->outflow_sum, &st->outflow_carry, dt * outflow_rate(st));
+	add_compensated(&st->inflow_sum, &st->inflow_carry, dt * st->source_volume_rate);
+	st->evaluations++;
+}
+
+/*
+ * One RKL2 super-step of tau seconds in s stages (rkl2.h, sweep.h); stage 1
+ * starts from the state step_begin measured.  The outflow of the stages is
+ * combined with the stage weights, O_j = mu O_{j-1} + nu O_{j-2} +
+ * tau (mu~ out(M(Y_{j-1})) + gamma~ out(M(Y_0))), as the heights are, so
+ * that it is the outflow of the super-step's change; the source is
+ * constant over it, so the inflow is tau times its rate.  Returns
+ * max |Y_s - Y_0|, m (INFINITY on NaN).
+ */
+static double rkl2_superstep(struct ss_stepper *st, double tau, int s)
+{
+	const struct ss_grid *g = &st->grid;
+	const double *src = st->sources_on ? st->source_rate : NULL;
+	double out_1 = 0.0, out_2 = 0.0, out_m0 = 0.0, change = 0.0;
+
+	for (int j = 1; j <= s; j++) {
+		double t0 = ss_parallel_wall_seconds();
+		if (j > 1) {
+			ss_boundary_fill_heights(g, &st->boundary, st->height);
+			if (st->kernel == SS_KERNEL_FAST)
+				ss_sweep_fast_begin(&st->fast, g, st->height, st->cell_types);
+			else
+				ss_sweep_fluxes(g, &st->tiling, &st->face_rule, st->height,
+				                st->cell_type_bytes, st->flux_x, st->flux_y);
+		}
+		const double t1 = ss_parallel_wall_seconds();
+		st->seconds_measure += t1 - t0;
+
+		const struct ss_rkl2_stage k = ss_rkl2_stage(s, j);
+		const struct ss_sweep_stage stage = {
+			.first = j == 1, .mu = k.mu, .nu = k.nu,
+			.tau_mu = tau * k.mu_tilde, .tau_gamma = tau * k.gamma_tilde,
+			.y0 = st->rkl2_y0, .prev = st->rkl2_prev, .m0 = st->rkl2_m0,
+		};
+		if (st->kernel == SS_KERNEL_FAST) {
+			st->tile_sweeps += ss_sweep_fast_awake(&st->fast) / s;
+			change = ss_sweep_fast_stage(&st->fast, g, &st->face_rule, &stage, j == s,
+			                             src, st->cell_types, st->height, st->open_flux);
+		} else {
+			st->tile_sweeps += (double)st->tiling.tiles_x * st->tiling.tiles_y / s;
+			change = ss_sweep_stage_update(g, &st->tiling, &stage, st->flux_x,
+			                               st->flux_y, src, st->cell_type_bytes,
+			                               st->height);
+		}
+		st->seconds_sweep += ss_parallel_wall_seconds() - t1;
+		const double out = outflow_rate(st);
+		if (j == 1)
+			out_m0 = out;
+		const double out_j = ss_sweep_stage_value(&stage, 0.0, out_1, out_2, out, out_m0);
+		out_2 = j == 1 ? 0.0 : out_1;
+		out_1 = out_j;
+		st->evaluations++;
+		if (!isfinite(change))
+			return INFINITY;
+	}
+	add_compensated(&st->outflow_sum, &st->outflow_carry, out_1);
+	add_compensated(&st->inflow_sum, &st->inflow_carry, tau * st->source_volume_rate);
+	return change;
+}
+
+/*
+ * The accuracy rule after a super-step of tau that changed a cell by at
+ * most `change` (stepper.h): shorten the next super-step in proportion when
+ * the change was above the cap, let it grow by at most 2x otherwise.  A
+ * super-step cut short by an event, whose change was small, does not lower
+ * the limit.
+ */
+static void rkl2_control(struct ss_stepper *st, double tau, double change,
+                         double change_cap, double tau_stages)
+{
+	const double factor = change > 0.0 ? 0.9 * change_cap / change : INFINITY;
+	if (factor < 1.0)
+		st->rkl2_tau = tau * factor;
+	else if (isfinite(st->rkl2_tau))
+		st->rkl2_tau = fmax(st->rkl2_tau, tau * fmin(factor, 2.0));
+	if (st->rkl2_tau >= tau_stages)
+		st->rkl2_tau = INFINITY;
+}
+
 enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,
                                        const struct ss_advance_options *o)
 {
 	const struct ss_grid *g = &st->grid;
+	const struct ss_closure *c = &st->closure;
 	const double inv_d2 = 1.0 / (g->dx * g->dx) + 1.0 / (g->dy * g->dy);
-	const double tiles = (double)st->tiling.tiles_x * st->tiling.tiles_y;
-	const double source_rise = st->cfl * st->closure.tan_cr * fmin(g->dx, g->dy);
+	const double source_rise = st->cfl * c->tan_cr * fmin(g->dx, g->dy);
+	const double slope_tol = o->steady_slope_tol > 0.0 ? o->steady_slope_tol : 1e-6;
+	const int rkl2 = st->integrator == SS_INTEGRATOR_RKL2;
+	/* RKL2: forward Euler's step for every slope, the longest super-step
+	 * its stage cap allows, and the change cap in m */
+	const double dt_all = rkl2_dt_all(st);
+	const double tau_stages = dt_all * ss_rkl2_stable_ratio(st->rkl2_max_stages);
+	const double change_cap = st->rkl2_max_change * c->tan_cr * fmin(g->dx, g->dy);
 
 	long long steps_left = o->max_steps > 0 ? o->max_steps : -1;
+	int steady_candidate = 0;
 	while (st->time < t_target) {
 		if (steps_left == 0)
 			return SS_ADVANCE_STEPS;
-		sources_update(st);
-		const double next_switch = ss_stepper_next_source_event(st, st->time);
-		/* a state is steady only if no source will switch on later */
-		const int may_be_steady = o->steady_tol > 0.0 && isinf(next_switch);
-		const double next_event = fmin(next_switch, t_target);
-
-		ss_boundary_fill_heights(g, &st->boundary, st->height);
-		double t0 = ss_parallel_wall_seconds();
-		const double s_max = st->kernel == SS_KERNEL_FAST
-			? ss_sweep_fast_begin(&st->fast, g, st->height, st->cell_types)
-			: ss_sweep_fluxes(g, &st->tiling, &st->face_rule, st->height,
-			                  st->cell_type_bytes, st->flux_x, st->flux_y);
-		st->seconds_measure += ss_parallel_wall_seconds() - t0;
-		if (!isfinite(s_max)) {
+		const struct step_start b = step_begin(st, t_target, o);
+		if (!isfinite(b.s_max)) {
 			st->rate_max = NAN;
 			return SS_ADVANCE_NONFINITE;
 		}
+		if (steady_candidate && slopes_settled(st, b.s_max, slope_tol))
+			return SS_ADVANCE_STEADY;
 
-		const double lambda = st->closure.nu * ss_cfl_bound_lookup(&st->cfl_bound, s_max);
+		const double lambda = c->nu * ss_cfl_bound_lookup(&st->cfl_bound, b.s_max);
 		double dt = lambda > 0.0 ? st->cfl / (2.0 * lambda * inv_d2) : INFINITY;
+		/* RKL2: stable for every state its stages can reach, also when
+		 * a source is about to raise a flat state past the onset */
+		if (rkl2 && (lambda > 0.0 || st->sources_on))
+			dt = fmin(tau_stages, st->rkl2_tau);
 		if (st->sources_on && source_rise / st->source_rate_max < dt)
 			dt = source_rise / st->source_rate_max;
 
@@ -382,53 +639,41 @@ enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,
 			/* nothing slides and nothing is poured: the state is
 			 * stationary until the next event */
 			st->rate_max = 0.0;
-			if (may_be_steady)
+			if (b.may_be_steady)
 				return SS_ADVANCE_STEADY;
-			st->time = next_event;
+			st->time = b.next_event;
 			continue;
 		}
 
-		const int lands = st->time + dt >= next_event;
+		const int lands = st->time + dt >= b.next_event;
 		if (lands)
-			dt = next_event - st->time;
+			dt = b.next_event - st->time;
 		else if (st->time + dt == st->time)
 			return SS_ADVANCE_STALLED;
 
-		t0 = ss_parallel_wall_seconds();
-		if (st->kernel == SS_KERNEL_FAST) {
-			st->tile_sweeps += ss_sweep_fast_awake(&st->fast);
-			st->rate_max = ss_sweep_fast_step(&st->fast, g, &st->face_rule, dt,
-			                                  st->sources_on ? st->source_rate : NULL,
-			                                  st->bedrock, st->cell_types, st->height,
-			                                  st->open_flux);
+		if (rkl2) {
+			int s = ss_rkl2_stages_for(dt / dt_all);
+			s = s < st->rkl2_max_stages ? s : st->rkl2_max_stages;
+			const double change = rkl2_superstep(st, dt, s);
+			st->last_stages = s;
+			st->rate_max = change / dt;
+			rkl2_control(st, dt, change, change_cap, tau_stages);
 		} else {
-			st->tile_sweeps += tiles;
-			if (st->bedrock)
-				ss_sweep_limit(g, &st->tiling, dt, st->height, st->bedrock,
-				               st->flux_x, st->flux_y);
-			st->rate_max = ss_sweep_update(g, &st->tiling, dt, st->flux_x, st->flux_y,
-			                               st->sources_on ? st->source_rate : NULL,
-			                               st->cell_type_bytes, st->height);
+			euler_step(st, dt);
 		}
-		st->seconds_sweep += ss_parallel_wall_seconds() - t0;
-		st->tile_slots += tiles;
-		add_compensated(&st->outflow_sum, &st->outflow_carry, dt * outflow_rate(st));
-		add_compensated(&st->inflow_sum, &st->inflow_carry,
-		                dt * st->source_volume_rate);
-		st->outflow = st->outflow_sum + st->outflow_carry;
-		st->inflow = st->inflow_sum + st->inflow_carry;
-		st->time = lands ? next_event : st->time + dt;
+		st->time = lands ? b.next_event : st->time + dt;
 		st->steps++;
 		steps_left--;
-
-		if (o->progress)
-			o->progress(o->context, st);
-		if (!isfinite(st->rate_max))
-			return SS_ADVANCE_NONFINITE;
-		if (may_be_steady && st->rate_max < o->steady_tol)
+		const int end = step_end(st, o, &b, &steady_candidate);
+		if (end >= 0)
+			return (enum ss_advance_end)end;
+	}
+	/* on a target: the slopes are measured here, not by the next step */
+	if (steady_candidate) {
+		ss_boundary_fill_heights(g, &st->boundary, st->height);
+		const double s_max = ss_sweep_max_slope(g, st->height, st->cell_types);
+		if (slopes_settled(st, s_max, slope_tol))
 			return SS_ADVANCE_STEADY;
-		if (o->stop && *o->stop)
-			return SS_ADVANCE_INTERRUPTED;
 	}
 	return SS_ADVANCE_REACHED;
 }
@@ -467,6 +712,7 @@ void ss_stepper_diagnostics(struct ss_stepper *st, struct ss_diagnostics *d)
 	d->max_height = max_height;
 	d->max_slope_deg = atan(s_max) * (180.0 / M_PI);
 	d->steps = (double)st->steps;
+	d->evaluations = (double)st->evaluations;
 	d->active_fraction = st->tile_slots > 0.0 ? st->tile_sweeps / st->tile_slots : 0.0;
 	st->tile_sweeps = st->tile_slots = 0.0;
 }
@@ -478,6 +724,8 @@ void ss_stepper_restart_state(const struct ss_stepper *st, struct ss_restart_sta
 	s->inflow_carry = st->inflow_carry;
 	s->outflow_sum = st->outflow_sum;
 	s->outflow_carry = st->outflow_carry;
+	s->evaluations = st->evaluations;
+	s->rkl2_tau = st->rkl2_tau;
 }
 
 void ss_stepper_restore(struct ss_stepper *st, double t, const double *height,
@@ -493,6 +741,8 @@ void ss_stepper_restore(struct ss_stepper *st, double t, const double *height,
 	st->inflow_carry = s->inflow_carry;
 	st->outflow_sum = s->outflow_sum;
 	st->outflow_carry = s->outflow_carry;
+	st->evaluations = s->evaluations;
+	st->rkl2_tau = s->rkl2_tau;
 	/* the totals as ss_stepper_advance forms them after every substep */
 	st->inflow = st->inflow_sum + st->inflow_carry;
 	st->outflow = st->outflow_sum + st->outflow_carry;

@@ -197,3 +197,48 @@ double ss_sweep_update(const struct ss_grid *g, const struct ss_tiling *t,
 	}
 	return rate_max;
 }
+
+double ss_sweep_stage_update(const struct ss_grid *g, const struct ss_tiling *t,
+                             const struct ss_sweep_stage *stage,
+                             const double *restrict flux_x,
+                             const double *restrict flux_y,
+                             const double *restrict source_rate,
+                             const uint8_t *restrict cell_type,
+                             double *restrict height)
+{
+	const int tiles = t->tiles_x * t->tiles_y;
+	const ptrdiff_t stride = g->stride;
+	const double inv_dx = 1.0 / g->dx, inv_dy = 1.0 / g->dy;
+	double *restrict y0 = stage->y0, *restrict prev = stage->prev;
+	double *restrict m0 = stage->m0;
+	double change_max = 0.0;
+
+	#pragma omp parallel for schedule(static) reduction(max:change_max)
+	for (int tile = 0; tile < tiles; tile++) {
+		const struct ss_tile_span sp = span_of(t, g, tile);
+		for (int j = sp.j0; j < sp.j1; j++) {
+			for (int i = sp.i0; i < sp.i1; i++) {
+				const ptrdiff_t k = ss_grid_index(g, i, j);
+				double rate = (flux_x[k] - flux_x[k + 1]) * inv_dx +
+				              (flux_y[k] - flux_y[k + stride]) * inv_dy;
+				if (source_rate)
+					rate += source_rate[k];
+				const int flows = cell_type[k] == SS_CELL_FLOW;
+				const double y1 = height[k];
+				if (stage->first) {
+					y0[k] = y1;
+					prev[k] = y1;
+					m0[k] = flows ? rate : 0.0;
+				}
+				const double y = ss_sweep_stage_value(stage, y0[k], y1, prev[k],
+				                                      rate, m0[k]);
+				height[k] = flows ? y : y1;
+				prev[k] = y1;
+				const double a = flows ? fabs(y - y0[k]) : 0.0;
+				if (a > change_max || a != a)
+					change_max = a != a ? INFINITY : a;
+			}
+		}
+	}
+	return change_max;
+}

@@ -403,6 +403,9 @@ static int alloc_tables(struct ss_sweep_fast *f, const struct ss_grid *g,
 	f->edges_changed = ss_alloc(tiles, 1, "tile flags");
 	f->plain = ss_alloc(tiles, 1, "tile flags");
 	f->has_source = ss_alloc(tiles, 1, "tile flags");
+	f->superstep_swept = ss_alloc(tiles, 1, "tile flags");
+	f->moving_superstep = ss_alloc(tiles, 1, "tile flags");
+	f->edges_superstep = ss_alloc(tiles, 1, "tile flags");
 	f->row_list = ss_alloc((size_t)t->tiles_y, sizeof *f->row_list, "tile rows");
 	f->ring_south = ss_alloc((size_t)t->tiles_y * g->stride, sizeof(double), "ring rows");
 	f->ring_north = ss_alloc((size_t)t->tiles_y * g->stride, sizeof(double), "ring rows");
@@ -412,7 +415,8 @@ static int alloc_tables(struct ss_sweep_fast *f, const struct ss_grid *g,
 	f->open_slots = ss_alloc(open_face_count ? open_face_count : 1,
 	                         sizeof *f->open_slots, "open faces");
 	if (!f->sweep || !f->sweep_next || !f->moving || !f->edges_changed || !f->plain ||
-	    !f->has_source || !f->row_list || !f->ring_south || !f->ring_north ||
+	    !f->has_source || !f->superstep_swept || !f->moving_superstep ||
+	    !f->edges_superstep || !f->row_list || !f->ring_south || !f->ring_north ||
 	    !f->scratch || !f->open_first || !f->open_slots)
 		return SS_ERR_FAIL;
 	return SS_OK;
@@ -517,6 +521,9 @@ int ss_sweep_fast_init(struct ss_sweep_fast *f, const struct ss_grid *g,
 	}
 	mark_plain_tiles(f, g, cell_types);
 	memset(f->sweep, 1, (size_t)f->tiles);
+	memset(f->superstep_swept, 0, (size_t)f->tiles);
+	memset(f->moving_superstep, 0, (size_t)f->tiles);
+	memset(f->edges_superstep, 0, (size_t)f->tiles);
 	return SS_OK;
 }
 
@@ -528,6 +535,9 @@ void ss_sweep_fast_release(struct ss_sweep_fast *f)
 	ss_free(f->ring_north);
 	ss_free(f->ring_south);
 	ss_free(f->row_list);
+	ss_free(f->edges_superstep);
+	ss_free(f->moving_superstep);
+	ss_free(f->superstep_swept);
 	ss_free(f->has_source);
 	ss_free(f->plain);
 	ss_free(f->edges_changed);
@@ -654,6 +664,7 @@ struct tile_ctx {
 	double *restrict open_flux;    /* m^2/s, by the stepper's open-face list */
 	ptrdiff_t stride;              /* g->stride */
 	double dt;                     /* s */
+	const struct ss_sweep_stage *stage;  /* an RKL2 stage, or NULL: Euler */
 	double inv_dx, inv_dy;         /* 1/dx, 1/dy, 1/m */
 	double inv_2dx, inv_2dy;       /* 1/(2 dx), 1/(2 dy): central differences */
 	double limit_x, limit_y;       /* 0.25 dx/dt, 0.25 dy/dt, m/s (ss_face_limit) */
@@ -960,17 +971,15 @@ static inline int row_fluxes(const struct tile_ctx *c, const struct tile *t,
 	return moving;
 }
 
-/* Forward Euler on the flow cells of row j, in place, as ss_sweep_update;
- * max |dh/dt| into t (INFINITY on NaN); keeps the old east cell for the
- * next tile. */
-static inline void row_update(const struct tile_ctx *c, struct tile *t,
-                              struct row_buffers *w, const struct ring *r, int j)
+/* The rates dh/dt of row j's cells into w->gn + 1 (by x - 1), which the
+ * face loops no longer need; returns that array. */
+static inline double *row_rates(const struct tile_ctx *c, const struct tile *t,
+                                struct row_buffers *w, const struct ring *r, int j)
 {
 	const int W = t->W;
 	const double *fx = w->fx, *fy_south = r->fy_south, *fy_north = r->fy_north;
-	const double *cur = r->cur;
-	const double inv_dx = c->inv_dx, inv_dy = c->inv_dy, dt = c->dt;
-	double *rate = w->gn + 1;             /* free again: rate of cell x */
+	const double inv_dx = c->inv_dx, inv_dy = c->inv_dy;
+	double *rate = w->gn + 1;
 
 	/* dh/dt = -(F_e - F_w)/dx - (F_n - F_s)/dy + q */
 	for (int x = 1; x <= W; x++)
@@ -981,7 +990,65 @@ static inline void row_update(const struct tile_ctx *c, struct tile *t,
 		for (int x = 0; x < W; x++)
 			rate[x] += src_row[x];
 	}
+	return rate;
+}
+
+/* An RKL2 stage (ss_sweep_stage_value) on the flow cells of row j, in
+ * place; max |Y_j - Y_0| into t->rate_max (INFINITY on NaN), and whether a
+ * cell changed into t->moving: a tile that changed in any stage is swept
+ * at the start of the next super-step. */
+static inline void row_stage(const struct tile_ctx *c, struct tile *t,
+                             const double *restrict rate, const struct ring *r, int j)
+{
+	const struct ss_sweep_stage *sg = c->stage;
+	const int W = t->W, first = sg->first, plain = t->plain;
+	const ptrdiff_t k0 = ss_grid_index(c->g, t->i0, j);
+	double *restrict y0 = sg->y0 + k0, *restrict prev = sg->prev + k0;
+	double *restrict m0 = sg->m0 + k0, *restrict hn = c->h + k0;
+	const double *cur = r->cur + 1;
+	const int64_t *tc = r->type_cur + 1;
+	uint64_t row_max = 0;
+	int changed = 0;
+
+	for (int x = 0; x < W; x++) {
+		const int flows = plain || tc[x] == SS_CELL_FLOW;
+		const double y1 = cur[x];
+		if (first) {
+			y0[x] = y1;
+			prev[x] = y1;
+			m0[x] = flows ? rate[x] : 0.0;
+		}
+		const double y = ss_sweep_stage_value(sg, y0[x], y1, prev[x], rate[x], m0[x]);
+		const double h = flows ? y : y1;
+		prev[x] = y1;
+		hn[x] = h;
+		changed |= h != y1;
+		const uint64_t a = flows ? bits_of(fabs(h - y0[x])) : 0;
+		row_max = a > row_max ? a : row_max;
+	}
+	const double row_change_max = double_of(row_max);
+	const int row_nan = row_change_max != row_change_max;
+	t->rate_max = row_nan ? INFINITY : max2(t->rate_max, row_change_max);
+	t->bad |= row_nan;
+	t->moving |= changed;
+}
+
+/* Forward Euler on the flow cells of row j, in place, as ss_sweep_update
+ * (or an RKL2 stage, row_stage); max |dh/dt| into t (INFINITY on NaN);
+ * keeps the old east cell for the next tile. */
+static inline void row_update(const struct tile_ctx *c, struct tile *t,
+                              struct row_buffers *w, const struct ring *r, int j)
+{
+	const int W = t->W;
+	const double *cur = r->cur;
+	const double dt = c->dt;
+	const double *rate = row_rates(c, t, w, r, j);
+
 	w->east_save[j - t->j0] = cur[W];
+	if (c->stage) {
+		row_stage(c, t, rate, r, j);
+		return;
+	}
 	uint64_t row_max = 0;
 	const int64_t *tc = r->type_cur + 1;
 	double *hn = c->h + ss_grid_index(c->g, 0, j) + t->i0;
@@ -1079,6 +1146,23 @@ static inline void row_measure_behind(const struct tile_ctx *c, struct tile *t,
 }
 
 /*
+ * A tile first swept in a later stage of a super-step was not swept before
+ * in it: its heights are Y_0 = Y_1 = ... and M(Y_0) = 0 on it (a tile is
+ * left out of a stage only when it cannot change).  Its stage arrays say so
+ * before the stage reads them.
+ */
+static void stage_tile_start(const struct tile_ctx *c, const struct tile *t)
+{
+	const struct ss_sweep_stage *sg = c->stage;
+	for (int j = t->j0; j < t->j1; j++) {
+		const ptrdiff_t k0 = ss_grid_index(c->g, t->i0, j);
+		memcpy(sg->y0 + k0, c->h + k0, (size_t)t->W * sizeof(double));
+		memcpy(sg->prev + k0, c->h + k0, (size_t)t->W * sizeof(double));
+		memset(sg->m0 + k0, 0, (size_t)t->W * sizeof(double));
+	}
+}
+
+/*
  * Sweep tile (tx, ty) in place: every flow cell advances by one forward
  * Euler step of SPEC section 2,
  *
@@ -1107,6 +1191,9 @@ static inline struct tile_result sweep_tile(const struct tile_ctx *c,
 	struct ring r = w->ring;
 	struct tile t = tile_begin(c, w, &r, tx, ty, west_swept);
 
+	if (c->stage && !c->stage->first && !c->f->superstep_swept[t.index])
+		stage_tile_start(c, &t);
+
 	for (int j = t.j0; j < t.j1; j++) {
 		ring_load_next(c, &t, w, &r, j);
 		t.moving |= row_fluxes(c, &t, w, &r, j);
@@ -1124,7 +1211,8 @@ static inline struct tile_result sweep_tile(const struct tile_ctx *c,
 /* Which tiles the next step sweeps: those that moved, those under a source,
  * and the neighbours that see a changed edge (diagonal ones when both edges
  * at the shared corner changed, which includes every changed corner). */
-static void plan_next(struct ss_sweep_fast *f)
+static void plan_next_from(struct ss_sweep_fast *f, const uint8_t *swept,
+                           const uint8_t *moving, const uint8_t *edges_changed)
 {
 	const int nx = f->tiling.tiles_x, ny = f->tiling.tiles_y;
 	uint8_t *next = f->sweep_next;
@@ -1134,11 +1222,11 @@ static void plan_next(struct ss_sweep_fast *f)
 			const int tile = ty * nx + tx;
 			if (f->has_source[tile])
 				next[tile] = 1;
-			if (!f->sweep[tile])
+			if (!swept[tile])
 				continue;
-			if (f->moving[tile])
+			if (moving[tile])
 				next[tile] = 1;
-			const int e = f->edges_changed[tile];
+			const int e = edges_changed[tile];
 			if (!e)
 				continue;
 			for (int dy = -1; dy <= 1; dy++) {
@@ -1170,24 +1258,45 @@ static void plan_next(struct ss_sweep_fast *f)
 	f->sweep_next = tmp;
 }
 
-double ss_sweep_fast_step(struct ss_sweep_fast *f, const struct ss_grid *g,
-                          const struct ss_face_rule *rule, double dt,
-                          const double *restrict source_rate,
-                          const double *restrict bedrock,
-                          const uint8_t *restrict cell_types,
-                          double *restrict height, double *restrict open_flux)
+static void plan_next(struct ss_sweep_fast *f)
+{
+	plan_next_from(f, f->sweep, f->moving, f->edges_changed);
+}
+
+/*
+ * The tiles of the next stage: those the last one planned, and every tile
+ * swept earlier in the super-step (its stages go on changing it, through
+ * Y_{j-1} - Y_0 and M(Y_0)).  After the last stage, those of the next
+ * super-step: every tile that moved or changed in any stage, and the
+ * neighbours of every edge that changed in any stage.
+ */
+static void plan_next_stage(struct ss_sweep_fast *f, int last)
+{
+	for (int k = 0; k < f->tiles; k++) {
+		if (!f->sweep[k])
+			continue;
+		f->superstep_swept[k] = 1;
+		f->moving_superstep[k] |= f->moving[k];
+		f->edges_superstep[k] |= f->edges_changed[k];
+	}
+	if (!last) {
+		plan_next(f);
+		for (int k = 0; k < f->tiles; k++)
+			f->sweep[k] |= f->superstep_swept[k];
+		return;
+	}
+	plan_next_from(f, f->superstep_swept, f->moving_superstep, f->edges_superstep);
+	memset(f->superstep_swept, 0, (size_t)f->tiles);
+	memset(f->moving_superstep, 0, (size_t)f->tiles);
+	memset(f->edges_superstep, 0, (size_t)f->tiles);
+}
+
+/* The tiles of f->sweep, a tile row per thread at a time; returns the
+ * largest rate (or change) the tiles found, INFINITY on NaN. */
+static double sweep_tiles(struct ss_sweep_fast *f, const struct tile_ctx *c)
 {
 	const struct ss_tiling *t = &f->tiling;
 	const int rows = list_rows(f);
-	const struct tile_ctx ctx = {
-		.f = f, .g = g, .rule = rule,
-		.src = source_rate, .bed = bedrock, .type = cell_types,
-		.h = height, .open_flux = open_flux,
-		.stride = g->stride, .dt = dt,
-		.inv_dx = 1.0 / g->dx, .inv_dy = 1.0 / g->dy,
-		.inv_2dx = 0.5 / g->dx, .inv_2dy = 0.5 / g->dy,
-		.limit_x = 0.25 * g->dx / dt, .limit_y = 0.25 * g->dy / dt,
-	};
 	double rate_max = 0.0, s2_max = 0.0;
 	int bad = 0;
 
@@ -1204,7 +1313,7 @@ double ss_sweep_fast_step(struct ss_sweep_fast *f, const struct ss_grid *g,
 					west_swept = 0;
 					continue;
 				}
-				const struct tile_result res = sweep_tile(&ctx, &w, tx, ty, west_swept);
+				const struct tile_result res = sweep_tile(c, &w, tx, ty, west_swept);
 				rate_max = max2(rate_max, res.rate_max);
 				s2_max = max2(s2_max, res.s2_max);
 				bad |= res.bad;
@@ -1218,6 +1327,52 @@ double ss_sweep_fast_step(struct ss_sweep_fast *f, const struct ss_grid *g,
 	}
 	f->s2_interior = s2_max;
 	f->nonfinite |= bad;
-	plan_next(f);
 	return bad ? INFINITY : rate_max;
+}
+
+static struct tile_ctx context_of(struct ss_sweep_fast *f, const struct ss_grid *g,
+                                  const struct ss_face_rule *rule, double dt,
+                                  const double *restrict source_rate,
+                                  const double *restrict bedrock,
+                                  const uint8_t *restrict cell_types,
+                                  double *restrict height, double *restrict open_flux)
+{
+	return (struct tile_ctx){
+		.f = f, .g = g, .rule = rule,
+		.src = source_rate, .bed = bedrock, .type = cell_types,
+		.h = height, .open_flux = open_flux,
+		.stride = g->stride, .dt = dt,
+		.inv_dx = 1.0 / g->dx, .inv_dy = 1.0 / g->dy,
+		.inv_2dx = 0.5 / g->dx, .inv_2dy = 0.5 / g->dy,
+		.limit_x = 0.25 * g->dx / dt, .limit_y = 0.25 * g->dy / dt,
+	};
+}
+
+double ss_sweep_fast_step(struct ss_sweep_fast *f, const struct ss_grid *g,
+                          const struct ss_face_rule *rule, double dt,
+                          const double *restrict source_rate,
+                          const double *restrict bedrock,
+                          const uint8_t *restrict cell_types,
+                          double *restrict height, double *restrict open_flux)
+{
+	const struct tile_ctx ctx = context_of(f, g, rule, dt, source_rate, bedrock,
+	                                       cell_types, height, open_flux);
+	const double rate_max = sweep_tiles(f, &ctx);
+	plan_next(f);
+	return rate_max;
+}
+
+double ss_sweep_fast_stage(struct ss_sweep_fast *f, const struct ss_grid *g,
+                           const struct ss_face_rule *rule,
+                           const struct ss_sweep_stage *stage, int last,
+                           const double *restrict source_rate,
+                           const uint8_t *restrict cell_types,
+                           double *restrict height, double *restrict open_flux)
+{
+	struct tile_ctx ctx = context_of(f, g, rule, 1.0, source_rate, NULL, cell_types,
+	                                 height, open_flux);
+	ctx.stage = stage;
+	const double change_max = sweep_tiles(f, &ctx);
+	plan_next_stage(f, last);
+	return change_max;
 }

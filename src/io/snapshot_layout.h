@@ -21,17 +21,22 @@
 #define SS_SNAPSHOT_MAX_SIDE (1 << 30)
 
 /* Root attribute restart_state: steps, inflow sum and carry, outflow sum
- * and carry (diagnostics.h, struct ss_restart_state). */
-#define SS_SNAPSHOT_RESTART_VALUES 5
+ * and carry, stencil evaluations, RKL2's next super-step limit (s, or
+ * infinity) (diagnostics.h, struct ss_restart_state).  Files written
+ * before RKL2 have the first 5. */
+#define SS_SNAPSHOT_RESTART_VALUES 7
+#define SS_SNAPSHOT_RESTART_VALUES_OLD 5
 
-/* The float64 (time) series beside /time. */
-enum { SS_SNAPSHOT_DIAG_COUNT = 8 };
+/* The float64 (time) series beside /time; stencil_evaluations
+ * (SS_SNAPSHOT_DIAG_EVALUATIONS) is missing from files written before RKL2,
+ * and read as steps. */
+enum { SS_SNAPSHOT_DIAG_COUNT = 9, SS_SNAPSHOT_DIAG_EVALUATIONS = 8 };
 
 static inline const char *ss_snapshot_diag_name(int k)
 {
 	static const char *const names[SS_SNAPSHOT_DIAG_COUNT] = {
 		"volume", "inflow", "outflow", "max_height", "max_slope_deg", "steps",
-		"active_fraction", "wall_seconds",
+		"active_fraction", "wall_seconds", "stencil_evaluations",
 	};
 	return names[k];
 }
@@ -39,7 +44,7 @@ static inline const char *ss_snapshot_diag_name(int k)
 static inline const char *ss_snapshot_diag_units(int k)
 {
 	static const char *const units[SS_SNAPSHOT_DIAG_COUNT] = {
-		"m3", "m3", "m3", "m", "degree", "1", "1", "s",
+		"m3", "m3", "m3", "m", "degree", "1", "1", "s", "1",
 	};
 	return units[k];
 }
@@ -52,9 +57,10 @@ static inline const char *ss_snapshot_diag_long_name(int k)
 		"cumulative volume that left through open cells",
 		"highest sand surface on flow cells",
 		"steepest face slope that can carry flux",
-		"cumulative forward-Euler substeps",
+		"cumulative substeps (forward Euler) or super-steps (RKL2)",
 		"fraction of tiles swept since the previous snapshot",
 		"wall-clock time since the run started",
+		"cumulative evaluations of the stencil (one per Euler substep, s per RKL2 super-step)",
 	};
 	return long_names[k];
 }
@@ -64,7 +70,7 @@ static inline double *ss_snapshot_diag_field(struct ss_diagnostics *d, int k)
 {
 	double *const f[SS_SNAPSHOT_DIAG_COUNT] = {
 		&d->volume, &d->inflow, &d->outflow, &d->max_height, &d->max_slope_deg,
-		&d->steps, &d->active_fraction, &d->wall_seconds,
+		&d->steps, &d->active_fraction, &d->wall_seconds, &d->evaluations,
 	};
 	return f[k];
 }

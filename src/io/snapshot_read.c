@@ -833,6 +833,15 @@ static int read_diagnostics(struct ss_snapshot_file *f, struct ss_snapshot_summa
 		return ss_error_fail("out of memory");
 	int err = SS_OK;
 	for (int k = 0; k < SS_SNAPSHOT_DIAG_COUNT && !err; k++) {
+		struct var v;
+		const int missing = var_open(&f->h5->in, ss_snapshot_diag_name(k), &v) == VAR_MISSING;
+		var_close(&v);
+		if (k == SS_SNAPSHOT_DIAG_EVALUATIONS && missing) {
+			/* written before RKL2: one evaluation per step */
+			for (long long m = 0; m < n; m++)
+				sum->diag[m].evaluations = sum->diag[m].steps;
+			continue;
+		}
 		err = read_series(&f->h5->in, ss_snapshot_diag_name(k), n, col);
 		for (long long m = 0; m < n && !err; m++)
 			*ss_snapshot_diag_field(&sum->diag[m], k) = col[m];
@@ -936,10 +945,17 @@ static int read_case(struct ss_snapshot_file *f, struct ss_restart_info *r)
 static int read_state(struct ss_snapshot_file *f, struct ss_restart_info *r)
 {
 	const struct h5in *in = &f->h5->in;
-	double v[SS_SNAPSHOT_RESTART_VALUES] = {NAN, NAN, NAN, NAN, NAN};
-	attr_doubles(in->file, "restart_state", SS_SNAPSHOT_RESTART_VALUES, v);
-	/* steps is a count stored as a double: below 2^63 to be one */
-	if (!(v[0] >= 0.0 && v[0] < 0x1p63) || !isfinite(v[1] + v[2] + v[3] + v[4]))
+	double v[SS_SNAPSHOT_RESTART_VALUES] = {NAN, NAN, NAN, NAN, NAN, NAN, NAN};
+	if (attr_doubles(in->file, "restart_state", SS_SNAPSHOT_RESTART_VALUES, v) &&
+	    !attr_doubles(in->file, "restart_state", SS_SNAPSHOT_RESTART_VALUES_OLD, v)) {
+		/* before RKL2: Euler's evaluations are its steps */
+		v[5] = v[0];
+		v[6] = INFINITY;
+	}
+	/* the counts are stored as doubles: below 2^63 to be ones; the
+	 * super-step limit is a positive time or infinity */
+	if (!(v[0] >= 0.0 && v[0] < 0x1p63) || !(v[5] >= 0.0 && v[5] < 0x1p63) ||
+	    !(v[6] > 0.0) || !isfinite(v[1] + v[2] + v[3] + v[4]))
 		return ss_error_input("cannot restart from '%s': its restart state is missing or "
 		                      "damaged (written by an older sandslide?)", f->name);
 	r->state.steps = (long long)v[0];
@@ -947,6 +963,8 @@ static int read_state(struct ss_snapshot_file *f, struct ss_restart_info *r)
 	r->state.inflow_carry = v[2];
 	r->state.outflow_sum = v[3];
 	r->state.outflow_carry = v[4];
+	r->state.evaluations = (long long)v[5];
+	r->state.rkl2_tau = v[6];
 	return SS_OK;
 }
 

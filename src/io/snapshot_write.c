@@ -298,6 +298,7 @@ static int write_static(struct ss_snapshot *s, const uint8_t *cell_types,
 	      attr_doubles(f, "nu", &meta->nu, 1) || attr_doubles(f, "gamma", &meta->gamma, 1) ||
 	      attr_doubles(f, "dx", &g->dx, 1) || attr_doubles(f, "dy", &g->dy, 1) ||
 	      attr_string(f, "case", meta->case_text) ||
+	      (meta->integrator && attr_string(f, "integrator", meta->integrator)) ||
 	      attr_string(f, "case_overrides", meta->case_overrides ? meta->case_overrides : "");
 	if (x >= 0)
 		H5Dclose(x);
@@ -476,8 +477,10 @@ static int write_sidecar(const struct ss_snapshot *s)
  * with the very same bits. */
 static int write_restart_state(hid_t file, const struct ss_restart_state *r)
 {
-	const double v[5] = {(double)r->steps, r->inflow_sum, r->inflow_carry,
-	                     r->outflow_sum, r->outflow_carry};
+	const double v[SS_SNAPSHOT_RESTART_VALUES] = {
+		(double)r->steps, r->inflow_sum, r->inflow_carry, r->outflow_sum,
+		r->outflow_carry, (double)r->evaluations, r->rkl2_tau,
+	};
 	if (H5Aexists(file, "restart_state") > 0) {
 		hid_t a = H5Aopen(file, "restart_state", H5P_DEFAULT);
 		const herr_t w = a >= 0 ? H5Awrite(a, H5T_NATIVE_DOUBLE, v) : -1;
@@ -485,7 +488,7 @@ static int write_restart_state(hid_t file, const struct ss_restart_state *r)
 			H5Aclose(a);
 		return w < 0;
 	}
-	return attr_doubles(file, "restart_state", v, 5);
+	return attr_doubles(file, "restart_state", v, SS_SNAPSHOT_RESTART_VALUES);
 }
 
 /*

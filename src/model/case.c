@@ -38,6 +38,8 @@ enum value_type {
 	V_INITIAL,
 	V_PAIR,       /* two finite numbers */
 	V_PATH,
+	V_INTEGRATOR,
+	V_STAGES,     /* integer >= 2 */
 };
 
 static const char *const accepted[] = {
@@ -53,6 +55,8 @@ static const char *const accepted[] = {
 	[V_INITIAL] = "flat, cone or file",
 	[V_PAIR] = "two finite numbers 'X Y'",
 	[V_PATH] = "a file name",
+	[V_INTEGRATOR] = SS_INTEGRATOR_NAMES,
+	[V_STAGES] = "an integer >= 2",
 };
 
 struct key_spec {
@@ -82,6 +86,10 @@ static const struct key_spec keys[] = {
 	KEY("time", "cfl", V_CFL, cfl),
 	KEY("time", "steady_tol", V_POSITIVE, steady_tol),
 	KEY("time", "max_time", V_POSITIVE, max_time),
+	KEY("time", "steady_slope_tol", V_POSITIVE, steady_slope_tol),
+	KEY("time", "integrator", V_INTEGRATOR, integrator),
+	KEY("time", "rkl2_max_stages", V_STAGES, rkl2_max_stages),
+	KEY("time", "rkl2_max_change", V_POSITIVE, rkl2_max_change),
 	KEY("boundary", "west", V_SIDE, boundary.side[SS_WEST]),
 	KEY("boundary", "east", V_SIDE, boundary.side[SS_EAST]),
 	KEY("boundary", "south", V_SIDE, boundary.side[SS_SOUTH]),
@@ -191,13 +199,15 @@ static int store_value(struct parse *p, const struct key_spec *k, const char *va
 	void *field = (char *)p->c + k->offset;
 	double v[3];
 	switch (k->type) {
-	case V_COUNT: {
+	case V_COUNT:
+	case V_STAGES: {
 		char *end;
 		errno = 0;
 		long n = strtol(value, &end, 10);
 		while (isspace((unsigned char)*end))
 			end++;
-		if (end == value || *end || errno || n < 1 || n > INT_MAX / 4)
+		if (end == value || *end || errno || n < (k->type == V_STAGES ? 2 : 1) ||
+		    n > INT_MAX / 4)
 			goto bad;
 		*(int *)field = (int)n;
 		return SS_OK;
@@ -240,6 +250,10 @@ static int store_value(struct parse *p, const struct key_spec *k, const char *va
 			goto bad;
 		p->c->steady = 0;
 		*(double *)field = v[0];
+		return SS_OK;
+	case V_INTEGRATOR:
+		if (ss_integrator_parse(value, (enum ss_integrator *)field))
+			goto bad;
 		return SS_OK;
 	case V_INITIAL: {
 		static const char *const names[] = {"flat", "cone", "file"};
@@ -811,6 +825,10 @@ static void set_defaults(struct ss_case *c)
 	c->gravity = 9.81;
 	c->cfl = 0.9;
 	c->steady_tol = 1e-9;
+	c->steady_slope_tol = 1e-6;
+	c->integrator = SS_INTEGRATOR_AUTO;
+	c->rkl2_max_stages = SS_RKL2_MAX_STAGES_DEFAULT;
+	c->rkl2_max_change = SS_RKL2_MAX_CHANGE_DEFAULT;
 	c->max_time = INFINITY;
 	c->end = INFINITY;
 	for (int s = 0; s < 4; s++)

@@ -93,7 +93,14 @@ int ss_setup_stepper(const struct ss_case *c, int tile_nx, int tile_ny,
 	struct ss_closure closure;
 	memset(st, 0, sizeof *st);
 	int err = ss_grid_init(&g, c->nx, c->ny, c->dx, c->dy, c->origin_x, c->origin_y);
-	const double need = ss_stepper_memory_bytes(&g), have = ss_memory_available_bytes();
+	const enum ss_integrator integrator =
+		ss_integrator_resolve(c->integrator, c->bedrock_file != NULL);
+	if (integrator == SS_INTEGRATOR_RKL2 && c->bedrock_file)
+		return ss_error_input("%s: [time] integrator = rkl2 cannot be used with a "
+		                      "bedrock: its stages cannot keep the sand above the rock "
+		                      "(use euler or auto)", c->bedrock_where);
+	const double need = ss_stepper_memory_bytes(&g, integrator);
+	const double have = ss_memory_available_bytes();
 	if (!err && have > 0.0 && need > have) {
 		char nb[32], hb[32];
 		return ss_error_input("%s: [grid] nx = %d, ny = %d needs %s of memory; this "
@@ -108,6 +115,9 @@ int ss_setup_stepper(const struct ss_case *c, int tile_nx, int tile_ny,
 	if (err)
 		return err;
 	st->kernel = kernel;
+	st->integrator = integrator;
+	st->rkl2_max_stages = c->rkl2_max_stages;
+	st->rkl2_max_change = c->rkl2_max_change;
 
 	/* a grid-sized mask only when there are regions to rasterise */
 	uint8_t *mask = c->region_count == 0 ? NULL

@@ -10,8 +10,9 @@
 #include "sandslide/stepper.h"
 
 /* Initialise st for case c with tiles of tile_nx x tile_ny cells (<= 0:
- * defaults) and the given kernel.  SS_ERR_INPUT names the key at fault (a region that covers no
- * cell, an initial file of the wrong size, too little memory).  On error st
+ * defaults), the given kernel and the case's integrator.  SS_ERR_INPUT
+ * names the key at fault (a region that covers no cell, an initial file
+ * of the wrong size, too little memory, rkl2 with a bedrock).  On error st
  * is released. */
 int ss_setup_stepper(const struct ss_case *c, int tile_nx, int tile_ny,
                      enum ss_kernel kernel, struct ss_stepper *st);

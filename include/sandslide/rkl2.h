@@ -1,0 +1,51 @@
+/*
+ * rkl2.h - the coefficients of second-order Runge-Kutta-Legendre
+ * super-time-stepping (RKL2; Meyer, Balsara & Aslam, J. Comput. Phys. 257,
+ * 2014, section 3; the recurrence PLUTO, Idefix, Athena++ and SUNDIALS
+ * LSRKStep use).
+ *
+ * An s-stage super-step of length tau for dY/dt = M(Y), in delta form:
+ *
+ *   Y_1 = Y_0 + mu~_1 tau M(Y_0)
+ *   Y_j = Y_0 + mu_j (Y_{j-1} - Y_0) + nu_j (Y_{j-2} - Y_0)
+ *             + tau (mu~_j M(Y_{j-1}) + gamma~_j M(Y_0)),   j = 2 .. s
+ *
+ * with w_1 = 4 / (s^2 + s - 2), b_0 = b_1 = b_2 = 1/3,
+ * b_j = (j^2 + j - 2) / (2 j (j + 1)), a_j = 1 - b_j, mu~_1 = w_1 / 3 and
+ *
+ *   mu_j = (2j - 1)/j  b_j / b_{j-1},     nu_j = -(j - 1)/j  b_j / b_{j-2},
+ *   mu~_j = w_1 mu_j,                      gamma~_j = -a_{j-1} mu~_j.
+ *
+ * The delta form equals the usual mu Y_{j-1} + nu Y_{j-2} + (1 - mu - nu) Y_0
+ * (the weights sum to 1) but a cell whose every M is exactly 0 keeps its
+ * bits, and it rounds increments of size tau M rather than heights.
+ *
+ * Stability: the amplification of a mode with forward-Euler number z =
+ * tau lambda is R_s(z) = a_s + b_s P_s(1 + w_1 z) (P_s Legendre), which
+ * stays in [2 / (s (s + 1)), 1] for tau <= dt_fe (s^2 + s - 2) / 4, dt_fe
+ * the largest stable forward-Euler step: positive, so no mode changes sign
+ * and a slope relaxing towards the repose angle is not pushed through it
+ * at linear order.  The method is second order in tau for any s >= 2.
+ */
+#ifndef SANDSLIDE_RKL2_H
+#define SANDSLIDE_RKL2_H
+
+struct ss_rkl2_stage {
+	double mu;          /* weight of Y_{j-1} - Y_0 (0 for j = 1) */
+	double nu;          /* weight of Y_{j-2} - Y_0 (0 for j = 1) */
+	double mu_tilde;    /* weight of tau M(Y_{j-1}) */
+	double gamma_tilde; /* weight of tau M(Y_0) (0 for j = 1) */
+};
+
+/* The coefficients of stage j (1 .. s) of an s-stage super-step, s >= 2. */
+struct ss_rkl2_stage ss_rkl2_stage(int s, int j);
+
+/* The longest stable super-step of s stages, in units of the largest stable
+ * forward-Euler step: (s^2 + s - 2) / 4. */
+double ss_rkl2_stable_ratio(int s);
+
+/* The fewest stages s >= 2 whose super-step may be `ratio` largest stable
+ * forward-Euler steps long: the smallest s with (s^2 + s - 2)/4 >= ratio. */
+int ss_rkl2_stages_for(double ratio);
+
+#endif
