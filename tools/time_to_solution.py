@@ -83,11 +83,13 @@ def parse_args(argv):
 def variants(args):
     """[(name, integrator, sets)]: the reference (euler) first, then the others."""
     if args.compare_cfl is not None:
-        return [("euler", "euler", []),
-                (f"euler-cfl{args.compare_cfl:g}", "euler", [f"time.cfl={args.compare_cfl!r}"])]
+        return [("euler", "euler", ["time.integrator=euler"]),
+                (f"euler-cfl{args.compare_cfl:g}", "euler",
+                 ["time.integrator=euler", f"time.cfl={args.compare_cfl!r}"])]
     out = []
     for name in args.integrators.split(","):
-        sets = [] if name == "euler" else [f"time.integrator={name}"]
+        # always named: the case's default (auto) is rkl2
+        sets = [f"time.integrator={name}"]
         out.append((name, name, sets + (args.rkl2_set if name == "rkl2" else [])))
     return out
 
