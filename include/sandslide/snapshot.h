@@ -110,6 +110,7 @@ struct ss_snapshot_summary {
 	long long count;         /* snapshots */
 	double dx, dy, origin_x, origin_y;
 	char closure[64], source[64], title[256];
+	char integrator[16];     /* "euler", "rkl2", or "" (written before RKL2) */
 	double repose_angle_deg, nu, gamma;
 	double *time;
 	struct ss_diagnostics *diag;

@@ -238,6 +238,7 @@ static void summarise(const struct run *r, enum ss_drive_end end, struct ss_run_
 	s->integrator = ss_integrator_name(st->integrator);
 	s->stages_max = st->rkl2_max_stages;
 	s->cells = (double)st->grid.nx * st->grid.ny;
+	s->bytes_per_cell = ss_stepper_memory_bytes(&st->grid, st->integrator) / s->cells;
 	s->wall_seconds = ss_parallel_wall_seconds() - r->drive.started;
 	s->measure_seconds = st->seconds_measure;
 	s->sweep_seconds = st->seconds_sweep;

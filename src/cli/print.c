@@ -72,10 +72,11 @@ void cli_print_run_end(const struct ss_run_summary *s, int quiet)
 	       : "super-steps (rkl2)", s->end == SS_RUN_STEADY ? " (steady)"
 	       : s->end == SS_RUN_NOT_STEADY ? " (not steady by max_time)" : "");
 	printf("wall %.3f s: slope %.3f s, sweep %.3f s, output %.3f s; %lld stencil "
-	       "evaluations, %.3g cell-updates/s on %d threads\n", s->wall_seconds,
-	       s->measure_seconds, s->sweep_seconds, s->output_seconds, s->evaluations,
-	       (double)s->evaluations_here * s->cells /
-	       fmax(s->measure_seconds + s->sweep_seconds, 1e-9), s->threads);
+	       "evaluations, %.3g cell-updates/s on %d threads; %.0f B per cell\n",
+	       s->wall_seconds, s->measure_seconds, s->sweep_seconds, s->output_seconds,
+	       s->evaluations, (double)s->evaluations_here * s->cells /
+	       fmax(s->measure_seconds + s->sweep_seconds, 1e-9), s->threads,
+	       s->bytes_per_cell);
 }
 
 void cli_print_relax_end(const struct ss_relax_report *r, double angle_deg, int quiet)
@@ -194,6 +195,10 @@ void cli_print_info(const char *path, const struct ss_snapshot_summary *s)
 	if (!strcmp(s->closure, "herschel-bulkley"))
 		printf(", gamma = %g", s->gamma);
 	printf("\n");
+	if (s->integrator[0] && s->count > 0)
+		printf("integrator %s: %.0f stencil evaluations in %.0f %s to the last snapshot\n",
+		       s->integrator, s->diag[s->count - 1].evaluations, s->diag[s->count - 1].steps,
+		       strcmp(s->integrator, "rkl2") ? "steps" : "super-steps");
 	if (s->count == 0)
 		printf("snapshots  none\n");
 	else

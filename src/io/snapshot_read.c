@@ -864,6 +864,8 @@ int ss_snapshot_file_summary(struct ss_snapshot_file *f, struct ss_snapshot_summ
 	int err;
 	if ((err = attr_string(in, in->file, "source", sum->source, sizeof sum->source)) ||
 	    (err = attr_string(in, in->file, "closure", sum->closure, sizeof sum->closure)) ||
+	    (err = attr_string(in, in->file, "integrator", sum->integrator,
+	                       sizeof sum->integrator)) ||
 	    (err = attr_string(in, in->file, "title", sum->title, sizeof sum->title)))
 		return err;
 	sum->repose_angle_deg = attr_double(in->file, "repose_angle_deg");
