@@ -8,7 +8,7 @@
  *               gamma (herschel-bulkley)
  *   [time]      end (s) | end = steady, output_every (s), cfl, steady_tol,
  *               steady_slope_tol, max_time (s, with end = steady),
- *               integrator = auto|euler|rkl2, rkl2_max_stages, rkl2_max_change
+ *               integrator = auto|euler|rkl2, rkl2_max_stages, rkl2_tol
  *   [boundary]  west, east, south, north = wall|open|periodic; open_level (m)
  *   [initial]   type = flat|cone|file; height; center, radius, angle; file
  *   [wall NAME] [open NAME] [source NAME]
@@ -74,7 +74,7 @@ struct ss_case {
 	double max_time;        /* s, INFINITY by default */
 	enum ss_integrator integrator; /* SS_INTEGRATOR_AUTO by default */
 	int rkl2_max_stages;
-	double rkl2_max_change; /* units of tan(a_cr) min(dx, dy) */
+	double rkl2_tol; /* units of tan(a_cr) min(dx, dy) */
 
 	/* [boundary] */
 	struct ss_boundary boundary;

@@ -40,7 +40,7 @@ struct ss_relax_options {
 	                                     angle by more (stepper.h) */
 	enum ss_integrator integrator;    /* auto: rkl2, euler with a bedrock */
 	int rkl2_max_stages;              /* stepper.h */
-	double rkl2_max_change;
+	double rkl2_tol;
 	double max_time;                  /* s; INFINITY: until steady */
 	double cfl;
 	int threads;                      /* <= 0: all processors */

@@ -24,11 +24,17 @@
  *              step above for Lambda(infinity), the bound of every slope
  *              (for Coulomb max f' = f'(tan a_cr+) = cos a_cr whatever the
  *              state), so no state a stage can reach is unstable;
- *   accuracy   s <= rkl2_max_stages, and the largest change of a cell in a
- *              super-step, max |Y_s - Y_0|, at most rkl2_max_change
- *              tan(a_cr) min(dx, dy): when a super-step changed a cell by
- *              more, the next is shortened in proportion (0.9 of it), and
- *              it grows back by at most 2x a super-step;
+ *   accuracy   s <= rkl2_max_stages, and the embedded error estimate of
+ *              RKC and SUNDIALS (sweep.h, ss_sweep_stage_estimate) at most
+ *              rkl2_tol tan(a_cr) min(dx, dy) in the max norm: the estimate
+ *              of a super-step is made by the next one's first stage, and
+ *              sets the limit of the one after, tau 0.9 sqrt(tol / est),
+ *              growing by at most 2x a super-step, from 4 stages at the
+ *              start.  A limit on the change per super-step was tried
+ *              first: it let super-steps grow without end as a state comes
+ *              to rest, where RKL2 damps the stiff remainder only by its
+ *              a_s ~ 1/2 a super-step (a relaxing cone took 150 times
+ *              Euler's simulated time and 3 times its evaluations);
  *   events     super-steps end on target times and source switches, so a
  *              source is constant over a super-step (its value at every
  *              stage time), and the source rule above holds for tau;
@@ -87,7 +93,7 @@ int ss_integrator_parse(const char *name, enum ss_integrator *out);
 enum ss_integrator ss_integrator_resolve(enum ss_integrator asked, int has_bedrock);
 
 #define SS_RKL2_MAX_STAGES_DEFAULT 256
-#define SS_RKL2_MAX_CHANGE_DEFAULT 0.3
+#define SS_RKL2_TOL_DEFAULT 0.3
 
 enum ss_kernel {
 	SS_KERNEL_FAST,         /* in place, active tiles (sweep_fast.c) */
@@ -102,8 +108,8 @@ struct ss_stepper {
 	enum ss_kernel kernel;        /* set before ss_stepper_prepare */
 	enum ss_integrator integrator; /* set before ss_stepper_prepare */
 	int rkl2_max_stages;          /* s <= it (>= 2) */
-	double rkl2_max_change;       /* max |Y_s - Y_0| per super-step, in units
-	                               * of tan(a_cr) min(dx, dy); INFINITY: none */
+	double rkl2_tol;              /* error estimate per super-step, in units
+	                               * of tan(a_cr) min(dx, dy) */
 	struct ss_sweep_fast fast;
 	struct ss_cfl_bound cfl_bound;
 	struct ss_boundary boundary;

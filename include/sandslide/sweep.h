@@ -115,10 +115,28 @@ double ss_sweep_update(const struct ss_grid *g, const struct ss_tiling *t,
  *
  * The first stage stores Y_0 and M(Y_0) (mu = nu = gamma~ = 0); every stage
  * moves Y_{j-1} into prev, which held Y_{j-2}.  Cells that are not flow
- * cells keep their height.
+ * cells keep their height.  Before the first stage overwrites the previous
+ * super-step's Y and M (its start, Y^n and M(Y^n)), it estimates that
+ * super-step's error, as RKC and SUNDIALS' LSRKStep do for RKL2:
+ *
+ *   est = max |0.8 (Y^n - Y^{n+1}) + 0.4 tau (M(Y^n) + M(Y^{n+1}))|
+ *
+ * (0 for a state the trapezoidal rule would also reach; a stiff mode that
+ * RKL2 damps only by its a_s ~ 1/2 where it should vanish gives ~ tau M).
  */
+/* The error estimate of one cell (the same expression in both kernels). */
+static inline double ss_sweep_stage_estimate(double tau, double y_old, double m_old,
+                                             double y, double m)
+{
+	return fabs(0.8 * (y_old - y) + 0.4 * tau * (m_old + m));
+}
+
 struct ss_sweep_stage {
 	int first;                /* stage 1: y0, prev <- Y_0; m0 <- M(Y_0) */
+	double estimate_tau;      /* stage 1: > 0, the length (s) of the super-step
+	                           * that ended in Y_0, whose error to estimate
+	                           * from the old y0 and m0; 0: none */
+	double *estimate;         /* stage 1: out, the largest estimate, m */
 	double mu, nu;            /* weights of Y_{j-1} - Y_0, Y_{j-2} - Y_0 */
 	double tau_mu, tau_gamma; /* tau mu~_j, tau gamma~_j, s */
 	double *y0;               /* Y_0, m, by storage index */
@@ -213,6 +231,8 @@ struct ss_sweep_fast {
 	                              this RKL2 super-step */
 	uint8_t *moving_superstep; /* per tile: moved or changed in a stage */
 	uint8_t *edges_superstep;  /* per tile: SS_EDGE_* changed in a stage */
+	uint8_t *swept_last;       /* per tile: swept in the last super-step, so
+	                              its y0 and m0 are that super-step's */
 	int *row_list;           /* tile rows with a tile to sweep */
 	double *ring_south;      /* per tile row: old row j0 - 1, index i + 1 */
 	double *ring_north;      /* per tile row: old row j1 */

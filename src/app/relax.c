@@ -24,7 +24,7 @@ void ss_relax_options_init(struct ss_relax_options *o)
 		.closure = SS_CLOSURE_COULOMB, .angle_deg = 35.0, .gamma = 1.0, .nu = 1.0,
 		.tol = 1e-9, .slope_tol = 1e-6, .integrator = SS_INTEGRATOR_AUTO,
 		.rkl2_max_stages = SS_RKL2_MAX_STAGES_DEFAULT,
-		.rkl2_max_change = SS_RKL2_MAX_CHANGE_DEFAULT, .max_time = INFINITY, .cfl = 0.9, .sides = SS_SIDE_WALL,
+		.rkl2_tol = SS_RKL2_TOL_DEFAULT, .max_time = INFINITY, .cfl = 0.9, .sides = SS_SIDE_WALL,
 		.nodata_type = SS_CELL_OPEN, .open_level = NAN, .output_every = NAN,
 	};
 	ss_dem_read_options_init(&o->read);
@@ -109,7 +109,7 @@ static int build_stepper(const struct ss_relax_options *o, const struct ss_raste
 		return err;
 	st->integrator = integrator;
 	st->rkl2_max_stages = o->rkl2_max_stages;
-	st->rkl2_max_change = o->rkl2_max_change;
+	st->rkl2_tol = o->rkl2_tol;
 	for (int j = 0; j < g.ny; j++) {
 		for (int i = 0; i < g.nx; i++) {
 			const size_t m = (size_t)j * g.nx + i;

@@ -353,9 +353,9 @@ static const struct cli_option relax_options[] = {
 	 .offset = RELAX(o.rkl2_max_stages), .lo = 2, .hi = 100000,
 	 .expected = "an integer >= 2",
 	 .help = "rkl2: at most S stages a super-step (default 256)"},
-	POSITIVE("--rkl2-max-change", "C", o.rkl2_max_change, "a number > 0",
-	         "rkl2: a super-step changes no cell by more than\n"
-	         "C tan(angle) dx (default 0.3)"),
+	POSITIVE("--rkl2-tol", "E", o.rkl2_tol, "a number > 0",
+	         "rkl2: error estimate of a super-step at most\n"
+	         "E tan(angle) dx (default 0.3)"),
 	POSITIVE("--max-time", "T", o.max_time, "s > 0",
 	         "stop at T s even if not steady (default: none)"),
 	RANGE("--cfl", "C", o.cfl, 1e-9, 1.0, "(0, 1]",

@@ -64,7 +64,7 @@ int ss_stepper_init(struct ss_stepper *st, const struct ss_grid *g,
 	st->boundary = *b;
 	st->cfl = cfl;
 	st->rkl2_max_stages = SS_RKL2_MAX_STAGES_DEFAULT;
-	st->rkl2_max_change = SS_RKL2_MAX_CHANGE_DEFAULT;
+	st->rkl2_tol = SS_RKL2_TOL_DEFAULT;
 	st->rkl2_tau = INFINITY;
 	ss_cfl_bound_init(&st->cfl_bound, c);
 	ss_face_rule_init(&st->face_rule, c);
@@ -250,8 +250,8 @@ static int rkl2_prepare(struct ss_stepper *st)
 		                      "stages cannot keep the sand above the rock; use euler");
 	if (st->rkl2_max_stages < 2)
 		return ss_error_input("rkl2_max_stages %d is below 2", st->rkl2_max_stages);
-	if (!(st->rkl2_max_change > 0.0))
-		return ss_error_input("rkl2_max_change %g must be above 0", st->rkl2_max_change);
+	if (!(st->rkl2_tol > 0.0))
+		return ss_error_input("rkl2_tol %g must be above 0", st->rkl2_tol);
 	const size_t n = ss_grid_storage_cells(&st->grid);
 	st->rkl2_y0 = ss_alloc(n, sizeof(double), "RKL2 Y_0");
 	st->rkl2_prev = ss_alloc(n, sizeof(double), "RKL2 Y_{j-2}");
@@ -528,7 +528,8 @@ static void euler_step(struct ss_stepper *st, double dt)
  * constant over it, so the inflow is tau times its rate.  Returns
  * max |Y_s - Y_0|, m (INFINITY on NaN).
  */
-static double rkl2_superstep(struct ss_stepper *st, double tau, int s)
+static double rkl2_superstep(struct ss_stepper *st, double tau, int s,
+                             double estimate_tau, double *estimate)
 {
 	const struct ss_grid *g = &st->grid;
 	const double *src = st->sources_on ? st->source_rate : NULL;
@@ -549,7 +550,8 @@ static double rkl2_superstep(struct ss_stepper *st, double tau, int s)
 
 		const struct ss_rkl2_stage k = ss_rkl2_stage(s, j);
 		const struct ss_sweep_stage stage = {
-			.first = j == 1, .mu = k.mu, .nu = k.nu,
+			.first = j == 1, .estimate_tau = estimate_tau, .estimate = estimate,
+			.mu = k.mu, .nu = k.nu,
 			.tau_mu = tau * k.mu_tilde, .tau_gamma = tau * k.gamma_tilde,
 			.y0 = st->rkl2_y0, .prev = st->rkl2_prev, .m0 = st->rkl2_m0,
 		};
@@ -580,20 +582,17 @@ static double rkl2_superstep(struct ss_stepper *st, double tau, int s)
 }
 
 /*
- * The accuracy rule after a super-step of tau that changed a cell by at
- * most `change` (stepper.h): shorten the next super-step in proportion when
- * the change was above the cap, let it grow by at most 2x otherwise.  A
- * super-step cut short by an event, whose change was small, does not lower
- * the limit.
+ * The accuracy rule (stepper.h), once the error estimate of a super-step
+ * of tau is known (at the first stage of the next one): the limit becomes
+ * tau 0.9 sqrt(tol / est), at most twice the limit it had; a limit above
+ * the stage cap is none.
  */
-static void rkl2_control(struct ss_stepper *st, double tau, double change,
-                         double change_cap, double tau_stages)
+static void rkl2_control(struct ss_stepper *st, double tau, double estimate,
+                         double tol, double tau_stages)
 {
-	const double factor = change > 0.0 ? 0.9 * change_cap / change : INFINITY;
-	if (factor < 1.0)
-		st->rkl2_tau = tau * factor;
-	else if (isfinite(st->rkl2_tau))
-		st->rkl2_tau = fmax(st->rkl2_tau, tau * fmin(factor, 2.0));
+	const double factor = estimate > 0.0 ? fmin(0.9 * sqrt(tol / estimate), 2.0) : 2.0;
+	const double limit = isfinite(st->rkl2_tau) ? st->rkl2_tau : tau_stages;
+	st->rkl2_tau = fmin(tau * factor, 2.0 * limit);
 	if (st->rkl2_tau >= tau_stages)
 		st->rkl2_tau = INFINITY;
 }
@@ -611,7 +610,11 @@ enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,
 	 * its stage cap allows, and the change cap in m */
 	const double dt_all = rkl2_dt_all(st);
 	const double tau_stages = dt_all * ss_rkl2_stable_ratio(st->rkl2_max_stages);
-	const double change_cap = st->rkl2_max_change * c->tan_cr * fmin(g->dx, g->dy);
+	const double tol = st->rkl2_tol * c->tan_cr * fmin(g->dx, g->dy);
+	/* the last super-step's length, for its error estimate; none at the
+	 * start of a call, so that a run restarted from a snapshot (whose
+	 * y0 and m0 are not saved) takes the same super-steps */
+	double estimate_tau = 0.0;
 
 	long long steps_left = o->max_steps > 0 ? o->max_steps : -1;
 	int steady_candidate = 0;
@@ -654,10 +657,13 @@ enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,
 		if (rkl2) {
 			int s = ss_rkl2_stages_for(dt / dt_all);
 			s = s < st->rkl2_max_stages ? s : st->rkl2_max_stages;
-			const double change = rkl2_superstep(st, dt, s);
+			double estimate = 0.0;
+			const double change = rkl2_superstep(st, dt, s, estimate_tau, &estimate);
+			if (estimate_tau > 0.0)
+				rkl2_control(st, estimate_tau, estimate, tol, tau_stages);
+			estimate_tau = dt;
 			st->last_stages = s;
 			st->rate_max = change / dt;
-			rkl2_control(st, dt, change, change_cap, tau_stages);
 		} else {
 			euler_step(st, dt);
 		}

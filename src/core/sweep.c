@@ -211,9 +211,9 @@ double ss_sweep_stage_update(const struct ss_grid *g, const struct ss_tiling *t,
 	const double inv_dx = 1.0 / g->dx, inv_dy = 1.0 / g->dy;
 	double *restrict y0 = stage->y0, *restrict prev = stage->prev;
 	double *restrict m0 = stage->m0;
-	double change_max = 0.0;
+	double change_max = 0.0, estimate = 0.0;
 
-	#pragma omp parallel for schedule(static) reduction(max:change_max)
+	#pragma omp parallel for schedule(static) reduction(max:change_max, estimate)
 	for (int tile = 0; tile < tiles; tile++) {
 		const struct ss_tile_span sp = span_of(t, g, tile);
 		for (int j = sp.j0; j < sp.j1; j++) {
@@ -226,6 +226,12 @@ double ss_sweep_stage_update(const struct ss_grid *g, const struct ss_tiling *t,
 				const int flows = cell_type[k] == SS_CELL_FLOW;
 				const double y1 = height[k];
 				if (stage->first) {
+					const double e = stage->estimate_tau > 0.0 && flows
+						? ss_sweep_stage_estimate(stage->estimate_tau, y0[k],
+						                          m0[k], y1, rate)
+						: 0.0;
+					if (e > estimate || e != e)
+						estimate = e != e ? INFINITY : e;
 					y0[k] = y1;
 					prev[k] = y1;
 					m0[k] = flows ? rate : 0.0;
@@ -240,5 +246,7 @@ double ss_sweep_stage_update(const struct ss_grid *g, const struct ss_tiling *t,
 			}
 		}
 	}
+	if (stage->first && stage->estimate)
+		*stage->estimate = estimate;
 	return change_max;
 }

@@ -406,6 +406,7 @@ static int alloc_tables(struct ss_sweep_fast *f, const struct ss_grid *g,
 	f->superstep_swept = ss_alloc(tiles, 1, "tile flags");
 	f->moving_superstep = ss_alloc(tiles, 1, "tile flags");
 	f->edges_superstep = ss_alloc(tiles, 1, "tile flags");
+	f->swept_last = ss_alloc(tiles, 1, "tile flags");
 	f->row_list = ss_alloc((size_t)t->tiles_y, sizeof *f->row_list, "tile rows");
 	f->ring_south = ss_alloc((size_t)t->tiles_y * g->stride, sizeof(double), "ring rows");
 	f->ring_north = ss_alloc((size_t)t->tiles_y * g->stride, sizeof(double), "ring rows");
@@ -416,7 +417,7 @@ static int alloc_tables(struct ss_sweep_fast *f, const struct ss_grid *g,
 	                         sizeof *f->open_slots, "open faces");
 	if (!f->sweep || !f->sweep_next || !f->moving || !f->edges_changed || !f->plain ||
 	    !f->has_source || !f->superstep_swept || !f->moving_superstep ||
-	    !f->edges_superstep || !f->row_list || !f->ring_south || !f->ring_north ||
+	    !f->edges_superstep || !f->swept_last || !f->row_list || !f->ring_south || !f->ring_north ||
 	    !f->scratch || !f->open_first || !f->open_slots)
 		return SS_ERR_FAIL;
 	return SS_OK;
@@ -524,6 +525,7 @@ int ss_sweep_fast_init(struct ss_sweep_fast *f, const struct ss_grid *g,
 	memset(f->superstep_swept, 0, (size_t)f->tiles);
 	memset(f->moving_superstep, 0, (size_t)f->tiles);
 	memset(f->edges_superstep, 0, (size_t)f->tiles);
+	memset(f->swept_last, 0, (size_t)f->tiles);
 	return SS_OK;
 }
 
@@ -535,6 +537,7 @@ void ss_sweep_fast_release(struct ss_sweep_fast *f)
 	ss_free(f->ring_north);
 	ss_free(f->ring_south);
 	ss_free(f->row_list);
+	ss_free(f->swept_last);
 	ss_free(f->edges_superstep);
 	ss_free(f->moving_superstep);
 	ss_free(f->superstep_swept);
@@ -552,6 +555,8 @@ void ss_sweep_fast_wake_all(struct ss_sweep_fast *f, const struct ss_grid *g,
 {
 	int bad = 0;
 	memset(f->sweep, 1, (size_t)f->tiles);
+	if (f->swept_last)
+		memset(f->swept_last, 0, (size_t)f->tiles);
 	f->s2_interior = slope2_all(g, height, cell_types, &bad);
 	f->nonfinite = bad;
 }
@@ -845,10 +850,11 @@ struct tile {
 	int bad;                   /* a NaN slope or rate was seen */
 	double rate_max;           /* max |dh/dt| over its flow cells, m/s */
 	double s2_max;             /* max s^2 over the faces measured behind */
+	double estimate;           /* RKL2 stage 1: the largest error estimate, m */
 };
 
 struct tile_result {
-	double rate_max, s2_max;
+	double rate_max, s2_max, estimate;
 	int bad;
 };
 
@@ -1009,11 +1015,18 @@ static inline void row_stage(const struct tile_ctx *c, struct tile *t,
 	const int64_t *tc = r->type_cur + 1;
 	uint64_t row_max = 0;
 	int changed = 0;
+	/* a tile not swept in the last super-step did not change in it, and
+	 * its M was 0: its y0 and m0 may be older */
+	const double est_tau = first && c->f->swept_last[t->index] ? sg->estimate_tau : 0.0;
+	double est_max = 0.0;
 
 	for (int x = 0; x < W; x++) {
 		const int flows = plain || tc[x] == SS_CELL_FLOW;
 		const double y1 = cur[x];
 		if (first) {
+			const double e = est_tau > 0.0 && flows
+				? ss_sweep_stage_estimate(est_tau, y0[x], m0[x], y1, rate[x]) : 0.0;
+			est_max = e > est_max || e != e ? e : est_max;
 			y0[x] = y1;
 			prev[x] = y1;
 			m0[x] = flows ? rate[x] : 0.0;
@@ -1031,6 +1044,7 @@ static inline void row_stage(const struct tile_ctx *c, struct tile *t,
 	t->rate_max = row_nan ? INFINITY : max2(t->rate_max, row_change_max);
 	t->bad |= row_nan;
 	t->moving |= changed;
+	t->estimate = est_max != est_max ? INFINITY : max2(t->estimate, est_max);
 }
 
 /* Forward Euler on the flow cells of row j, in place, as ss_sweep_update
@@ -1205,7 +1219,7 @@ static inline struct tile_result sweep_tile(const struct tile_ctx *c,
 	}
 	c->f->moving[t.index] = (uint8_t)(t.moving != 0);
 	c->f->edges_changed[t.index] = (uint8_t)t.edges;
-	return (struct tile_result){ t.rate_max, t.s2_max, t.bad };
+	return (struct tile_result){ t.rate_max, t.s2_max, t.estimate, t.bad };
 }
 
 /* Which tiles the next step sweeps: those that moved, those under a source,
@@ -1286,6 +1300,7 @@ static void plan_next_stage(struct ss_sweep_fast *f, int last)
 		return;
 	}
 	plan_next_from(f, f->superstep_swept, f->moving_superstep, f->edges_superstep);
+	memcpy(f->swept_last, f->superstep_swept, (size_t)f->tiles);
 	memset(f->superstep_swept, 0, (size_t)f->tiles);
 	memset(f->moving_superstep, 0, (size_t)f->tiles);
 	memset(f->edges_superstep, 0, (size_t)f->tiles);
@@ -1297,11 +1312,11 @@ static double sweep_tiles(struct ss_sweep_fast *f, const struct tile_ctx *c)
 {
 	const struct ss_tiling *t = &f->tiling;
 	const int rows = list_rows(f);
-	double rate_max = 0.0, s2_max = 0.0;
+	double rate_max = 0.0, s2_max = 0.0, estimate = 0.0;
 	int bad = 0;
 
 	#pragma omp parallel num_threads(f->threads) \
-		reduction(max:rate_max, s2_max) reduction(|:bad) if(rows > 1)
+		reduction(max:rate_max, s2_max, estimate) reduction(|:bad) if(rows > 1)
 	{
 		struct row_buffers w = buffers_of(f, ss_parallel_thread_id());
 		#pragma omp for schedule(dynamic, 1)
@@ -1316,6 +1331,7 @@ static double sweep_tiles(struct ss_sweep_fast *f, const struct tile_ctx *c)
 				const struct tile_result res = sweep_tile(c, &w, tx, ty, west_swept);
 				rate_max = max2(rate_max, res.rate_max);
 				s2_max = max2(s2_max, res.s2_max);
+				estimate = max2(estimate, res.estimate);
 				bad |= res.bad;
 				/* this tile's old east column is the next one's west ring */
 				double *tmp = w.west_old;
@@ -1327,6 +1343,8 @@ static double sweep_tiles(struct ss_sweep_fast *f, const struct tile_ctx *c)
 	}
 	f->s2_interior = s2_max;
 	f->nonfinite |= bad;
+	if (c->stage && c->stage->first && c->stage->estimate)
+		*c->stage->estimate = estimate;
 	return bad ? INFINITY : rate_max;
 }
 

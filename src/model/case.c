@@ -89,7 +89,7 @@ static const struct key_spec keys[] = {
 	KEY("time", "steady_slope_tol", V_POSITIVE, steady_slope_tol),
 	KEY("time", "integrator", V_INTEGRATOR, integrator),
 	KEY("time", "rkl2_max_stages", V_STAGES, rkl2_max_stages),
-	KEY("time", "rkl2_max_change", V_POSITIVE, rkl2_max_change),
+	KEY("time", "rkl2_tol", V_POSITIVE, rkl2_tol),
 	KEY("boundary", "west", V_SIDE, boundary.side[SS_WEST]),
 	KEY("boundary", "east", V_SIDE, boundary.side[SS_EAST]),
 	KEY("boundary", "south", V_SIDE, boundary.side[SS_SOUTH]),
@@ -828,7 +828,7 @@ static void set_defaults(struct ss_case *c)
 	c->steady_slope_tol = 1e-6;
 	c->integrator = SS_INTEGRATOR_AUTO;
 	c->rkl2_max_stages = SS_RKL2_MAX_STAGES_DEFAULT;
-	c->rkl2_max_change = SS_RKL2_MAX_CHANGE_DEFAULT;
+	c->rkl2_tol = SS_RKL2_TOL_DEFAULT;
 	c->max_time = INFINITY;
 	c->end = INFINITY;
 	for (int s = 0; s < 4; s++)

@@ -117,7 +117,7 @@ int ss_setup_stepper(const struct ss_case *c, int tile_nx, int tile_ny,
 	st->kernel = kernel;
 	st->integrator = integrator;
 	st->rkl2_max_stages = c->rkl2_max_stages;
-	st->rkl2_max_change = c->rkl2_max_change;
+	st->rkl2_tol = c->rkl2_tol;
 
 	/* a grid-sized mask only when there are regions to rasterise */
 	uint8_t *mask = c->region_count == 0 ? NULL
