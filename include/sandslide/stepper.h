@@ -93,7 +93,7 @@ int ss_integrator_parse(const char *name, enum ss_integrator *out);
 enum ss_integrator ss_integrator_resolve(enum ss_integrator asked, int has_bedrock);
 
 #define SS_RKL2_MAX_STAGES_DEFAULT 256
-#define SS_RKL2_TOL_DEFAULT 0.3
+#define SS_RKL2_TOL_DEFAULT 0.1
 
 enum ss_kernel {
 	SS_KERNEL_FAST,         /* in place, active tiles (sweep_fast.c) */
@@ -142,7 +142,8 @@ struct ss_stepper {
 	double time;                  /* s */
 	long long steps;              /* substeps (RKL2: super-steps) taken */
 	long long evaluations;        /* stencil evaluations: Euler one a step,
-	                               * RKL2 s a super-step */
+	                               * RKL2 s + 1 a super-step (the stages and
+	                               * the error estimate) */
 	double rkl2_tau;              /* the accuracy rule's longest next
 	                               * super-step, s (INFINITY: no limit) */
 	int last_stages;              /* s of the last super-step */

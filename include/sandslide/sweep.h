@@ -115,9 +115,10 @@ double ss_sweep_update(const struct ss_grid *g, const struct ss_tiling *t,
  *
  * The first stage stores Y_0 and M(Y_0) (mu = nu = gamma~ = 0); every stage
  * moves Y_{j-1} into prev, which held Y_{j-2}.  Cells that are not flow
- * cells keep their height.  Before the first stage overwrites the previous
- * super-step's Y and M (its start, Y^n and M(Y^n)), it estimates that
- * super-step's error, as RKC and SUNDIALS' LSRKStep do for RKL2:
+ * cells keep their height.  After the last stage, one more evaluation
+ * (estimate_only: nothing is written) estimates the super-step's error from
+ * its start Y^n and M(Y^n) (y0, m0) and its end Y^{n+1}, as RKC and
+ * SUNDIALS' LSRKStep do for RKL2:
  *
  *   est = max |0.8 (Y^n - Y^{n+1}) + 0.4 tau (M(Y^n) + M(Y^{n+1}))|
  *
@@ -133,10 +134,9 @@ static inline double ss_sweep_stage_estimate(double tau, double y_old, double m_
 
 struct ss_sweep_stage {
 	int first;                /* stage 1: y0, prev <- Y_0; m0 <- M(Y_0) */
-	double estimate_tau;      /* stage 1: > 0, the length (s) of the super-step
-	                           * that ended in Y_0, whose error to estimate
-	                           * from the old y0 and m0; 0: none */
-	double *estimate;         /* stage 1: out, the largest estimate, m */
+	int estimate_only;        /* after the last stage: est only, no write */
+	double estimate_tau;      /* estimate_only: the super-step's length, s */
+	double *estimate;         /* estimate_only: out, the largest est, m */
 	double mu, nu;            /* weights of Y_{j-1} - Y_0, Y_{j-2} - Y_0 */
 	double tau_mu, tau_gamma; /* tau mu~_j, tau gamma~_j, s */
 	double *y0;               /* Y_0, m, by storage index */

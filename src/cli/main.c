@@ -355,7 +355,7 @@ static const struct cli_option relax_options[] = {
 	 .help = "rkl2: at most S stages a super-step (default 256)"},
 	POSITIVE("--rkl2-tol", "E", o.rkl2_tol, "a number > 0",
 	         "rkl2: error estimate of a super-step at most\n"
-	         "E tan(angle) dx (default 0.3)"),
+	         "E tan(angle) dx (default 0.1)"),
 	POSITIVE("--max-time", "T", o.max_time, "s > 0",
 	         "stop at T s even if not steady (default: none)"),
 	RANGE("--cfl", "C", o.cfl, 1e-9, 1.0, "(0, 1]",

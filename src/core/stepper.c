@@ -519,6 +519,40 @@ static void euler_step(struct ss_stepper *st, double dt)
 	st->evaluations++;
 }
 
+/* One pass of the stencil for an RKL2 stage (or the estimate after the
+ * last), from the halo and the measure (unless `measured`: step_begin did
+ * them for stage 1).  Returns what the sweep returns. */
+static double rkl2_pass(struct ss_stepper *st, const struct ss_sweep_stage *stage, int last,
+                        int measured, double weight)
+{
+	const struct ss_grid *g = &st->grid;
+	const double *src = st->sources_on ? st->source_rate : NULL;
+	const double t0 = ss_parallel_wall_seconds();
+	if (!measured) {
+		ss_boundary_fill_heights(g, &st->boundary, st->height);
+		if (st->kernel == SS_KERNEL_FAST)
+			ss_sweep_fast_begin(&st->fast, g, st->height, st->cell_types);
+		else
+			ss_sweep_fluxes(g, &st->tiling, &st->face_rule, st->height,
+			                st->cell_type_bytes, st->flux_x, st->flux_y);
+	}
+	const double t1 = ss_parallel_wall_seconds();
+	st->seconds_measure += t1 - t0;
+	double change;
+	if (st->kernel == SS_KERNEL_FAST) {
+		st->tile_sweeps += ss_sweep_fast_awake(&st->fast) * weight;
+		change = ss_sweep_fast_stage(&st->fast, g, &st->face_rule, stage, last, src,
+		                             st->cell_types, st->height, st->open_flux);
+	} else {
+		st->tile_sweeps += (double)st->tiling.tiles_x * st->tiling.tiles_y * weight;
+		change = ss_sweep_stage_update(g, &st->tiling, stage, st->flux_x, st->flux_y, src,
+		                               st->cell_type_bytes, st->height);
+	}
+	st->seconds_sweep += ss_parallel_wall_seconds() - t1;
+	st->evaluations++;
+	return change;
+}
+
 /*
  * One RKL2 super-step of tau seconds in s stages (rkl2.h, sweep.h); stage 1
  * starts from the state step_begin measured.  The outflow of the stages is
@@ -526,66 +560,47 @@ static void euler_step(struct ss_stepper *st, double dt)
  * tau (mu~ out(M(Y_{j-1})) + gamma~ out(M(Y_0))), as the heights are, so
  * that it is the outflow of the super-step's change; the source is
  * constant over it, so the inflow is tau times its rate.  Returns
- * max |Y_s - Y_0|, m (INFINITY on NaN).
+ * max |Y_s - Y_0|, m (INFINITY on NaN), and the error estimate (sweep.h)
+ * in *estimate.
  */
-static double rkl2_superstep(struct ss_stepper *st, double tau, int s,
-                             double estimate_tau, double *estimate)
+static double rkl2_superstep(struct ss_stepper *st, double tau, int s, double *estimate)
 {
-	const struct ss_grid *g = &st->grid;
-	const double *src = st->sources_on ? st->source_rate : NULL;
 	double out_1 = 0.0, out_2 = 0.0, out_m0 = 0.0, change = 0.0;
-
 	for (int j = 1; j <= s; j++) {
-		double t0 = ss_parallel_wall_seconds();
-		if (j > 1) {
-			ss_boundary_fill_heights(g, &st->boundary, st->height);
-			if (st->kernel == SS_KERNEL_FAST)
-				ss_sweep_fast_begin(&st->fast, g, st->height, st->cell_types);
-			else
-				ss_sweep_fluxes(g, &st->tiling, &st->face_rule, st->height,
-				                st->cell_type_bytes, st->flux_x, st->flux_y);
-		}
-		const double t1 = ss_parallel_wall_seconds();
-		st->seconds_measure += t1 - t0;
-
 		const struct ss_rkl2_stage k = ss_rkl2_stage(s, j);
 		const struct ss_sweep_stage stage = {
-			.first = j == 1, .estimate_tau = estimate_tau, .estimate = estimate,
-			.mu = k.mu, .nu = k.nu,
+			.first = j == 1, .mu = k.mu, .nu = k.nu,
 			.tau_mu = tau * k.mu_tilde, .tau_gamma = tau * k.gamma_tilde,
 			.y0 = st->rkl2_y0, .prev = st->rkl2_prev, .m0 = st->rkl2_m0,
 		};
-		if (st->kernel == SS_KERNEL_FAST) {
-			st->tile_sweeps += ss_sweep_fast_awake(&st->fast) / s;
-			change = ss_sweep_fast_stage(&st->fast, g, &st->face_rule, &stage, j == s,
-			                             src, st->cell_types, st->height, st->open_flux);
-		} else {
-			st->tile_sweeps += (double)st->tiling.tiles_x * st->tiling.tiles_y / s;
-			change = ss_sweep_stage_update(g, &st->tiling, &stage, st->flux_x,
-			                               st->flux_y, src, st->cell_type_bytes,
-			                               st->height);
-		}
-		st->seconds_sweep += ss_parallel_wall_seconds() - t1;
+		change = rkl2_pass(st, &stage, j == s, j == 1, 1.0 / (s + 1));
 		const double out = outflow_rate(st);
 		if (j == 1)
 			out_m0 = out;
 		const double out_j = ss_sweep_stage_value(&stage, 0.0, out_1, out_2, out, out_m0);
 		out_2 = j == 1 ? 0.0 : out_1;
 		out_1 = out_j;
-		st->evaluations++;
 		if (!isfinite(change))
 			return INFINITY;
 	}
 	add_compensated(&st->outflow_sum, &st->outflow_carry, out_1);
 	add_compensated(&st->inflow_sum, &st->inflow_carry, tau * st->source_volume_rate);
+	/* the error estimate: one more evaluation, at Y_s, that writes nothing;
+	 * the next super-step's first stage evaluates there again, but the
+	 * estimate is then known before the next super-step is sized, and a
+	 * restart from Y_s needs nothing a snapshot does not hold */
+	const struct ss_sweep_stage est = {
+		.estimate_only = 1, .estimate_tau = tau, .estimate = estimate,
+		.y0 = st->rkl2_y0, .prev = st->rkl2_prev, .m0 = st->rkl2_m0,
+	};
+	rkl2_pass(st, &est, 0, 0, 1.0 / (s + 1));
 	return change;
 }
 
 /*
- * The accuracy rule (stepper.h), once the error estimate of a super-step
- * of tau is known (at the first stage of the next one): the limit becomes
- * tau 0.9 sqrt(tol / est), at most twice the limit it had; a limit above
- * the stage cap is none.
+ * The accuracy rule (stepper.h) after a super-step of tau with error
+ * estimate est: the limit becomes tau 0.9 sqrt(tol / est), at most twice
+ * the limit it had; a limit above the stage cap is none.
  */
 static void rkl2_control(struct ss_stepper *st, double tau, double estimate,
                          double tol, double tau_stages)
@@ -611,10 +626,6 @@ enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,
 	const double dt_all = rkl2_dt_all(st);
 	const double tau_stages = dt_all * ss_rkl2_stable_ratio(st->rkl2_max_stages);
 	const double tol = st->rkl2_tol * c->tan_cr * fmin(g->dx, g->dy);
-	/* the last super-step's length, for its error estimate; none at the
-	 * start of a call, so that a run restarted from a snapshot (whose
-	 * y0 and m0 are not saved) takes the same super-steps */
-	double estimate_tau = 0.0;
 
 	long long steps_left = o->max_steps > 0 ? o->max_steps : -1;
 	int steady_candidate = 0;
@@ -658,10 +669,8 @@ enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,
 			int s = ss_rkl2_stages_for(dt / dt_all);
 			s = s < st->rkl2_max_stages ? s : st->rkl2_max_stages;
 			double estimate = 0.0;
-			const double change = rkl2_superstep(st, dt, s, estimate_tau, &estimate);
-			if (estimate_tau > 0.0)
-				rkl2_control(st, estimate_tau, estimate, tol, tau_stages);
-			estimate_tau = dt;
+			const double change = rkl2_superstep(st, dt, s, &estimate);
+			rkl2_control(st, dt, estimate, tol, tau_stages);
 			st->last_stages = s;
 			st->rate_max = change / dt;
 		} else {

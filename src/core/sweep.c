@@ -225,13 +225,16 @@ double ss_sweep_stage_update(const struct ss_grid *g, const struct ss_tiling *t,
 					rate += source_rate[k];
 				const int flows = cell_type[k] == SS_CELL_FLOW;
 				const double y1 = height[k];
-				if (stage->first) {
-					const double e = stage->estimate_tau > 0.0 && flows
+				if (stage->estimate_only) {
+					const double e = flows
 						? ss_sweep_stage_estimate(stage->estimate_tau, y0[k],
 						                          m0[k], y1, rate)
 						: 0.0;
 					if (e > estimate || e != e)
 						estimate = e != e ? INFINITY : e;
+					continue;
+				}
+				if (stage->first) {
 					y0[k] = y1;
 					prev[k] = y1;
 					m0[k] = flows ? rate : 0.0;
@@ -246,7 +249,7 @@ double ss_sweep_stage_update(const struct ss_grid *g, const struct ss_tiling *t,
 			}
 		}
 	}
-	if (stage->first && stage->estimate)
+	if (stage->estimate_only)
 		*stage->estimate = estimate;
 	return change_max;
 }

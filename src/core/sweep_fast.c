@@ -1015,18 +1015,26 @@ static inline void row_stage(const struct tile_ctx *c, struct tile *t,
 	const int64_t *tc = r->type_cur + 1;
 	uint64_t row_max = 0;
 	int changed = 0;
-	/* a tile not swept in the last super-step did not change in it, and
-	 * its M was 0: its y0 and m0 may be older */
-	const double est_tau = first && c->f->swept_last[t->index] ? sg->estimate_tau : 0.0;
-	double est_max = 0.0;
 
+	if (sg->estimate_only) {
+		/* a tile not swept in the super-step did not change in it, and its
+		 * M was 0 at its start: its y0 and m0 may be older */
+		const int swept = c->f->swept_last[t->index];
+		double est_max = 0.0;
+		for (int x = 0; x < W; x++) {
+			const int flows = plain || tc[x] == SS_CELL_FLOW;
+			const double y_old = swept ? y0[x] : cur[x], m_old = swept ? m0[x] : 0.0;
+			const double e = flows ? ss_sweep_stage_estimate(sg->estimate_tau, y_old, m_old,
+			                                                 cur[x], rate[x]) : 0.0;
+			est_max = e > est_max || e != e ? e : est_max;
+		}
+		t->estimate = est_max != est_max ? INFINITY : max2(t->estimate, est_max);
+		return;
+	}
 	for (int x = 0; x < W; x++) {
 		const int flows = plain || tc[x] == SS_CELL_FLOW;
 		const double y1 = cur[x];
 		if (first) {
-			const double e = est_tau > 0.0 && flows
-				? ss_sweep_stage_estimate(est_tau, y0[x], m0[x], y1, rate[x]) : 0.0;
-			est_max = e > est_max || e != e ? e : est_max;
 			y0[x] = y1;
 			prev[x] = y1;
 			m0[x] = flows ? rate[x] : 0.0;
@@ -1044,7 +1052,6 @@ static inline void row_stage(const struct tile_ctx *c, struct tile *t,
 	t->rate_max = row_nan ? INFINITY : max2(t->rate_max, row_change_max);
 	t->bad |= row_nan;
 	t->moving |= changed;
-	t->estimate = est_max != est_max ? INFINITY : max2(t->estimate, est_max);
 }
 
 /* Forward Euler on the flow cells of row j, in place, as ss_sweep_update
@@ -1205,7 +1212,8 @@ static inline struct tile_result sweep_tile(const struct tile_ctx *c,
 	struct ring r = w->ring;
 	struct tile t = tile_begin(c, w, &r, tx, ty, west_swept);
 
-	if (c->stage && !c->stage->first && !c->f->superstep_swept[t.index])
+	if (c->stage && !c->stage->first && !c->stage->estimate_only &&
+	    !c->f->superstep_swept[t.index])
 		stage_tile_start(c, &t);
 
 	for (int j = t.j0; j < t.j1; j++) {
@@ -1343,7 +1351,7 @@ static double sweep_tiles(struct ss_sweep_fast *f, const struct tile_ctx *c)
 	}
 	f->s2_interior = s2_max;
 	f->nonfinite |= bad;
-	if (c->stage && c->stage->first && c->stage->estimate)
+	if (c->stage && c->stage->estimate_only)
 		*c->stage->estimate = estimate;
 	return bad ? INFINITY : rate_max;
 }
@@ -1391,6 +1399,7 @@ double ss_sweep_fast_stage(struct ss_sweep_fast *f, const struct ss_grid *g,
 	                                 height, open_flux);
 	ctx.stage = stage;
 	const double change_max = sweep_tiles(f, &ctx);
-	plan_next_stage(f, last);
+	if (!stage->estimate_only)
+		plan_next_stage(f, last);
 	return change_max;
 }

@@ -60,7 +60,7 @@ static inline const char *ss_snapshot_diag_long_name(int k)
 		"cumulative substeps (forward Euler) or super-steps (RKL2)",
 		"fraction of tiles swept since the previous snapshot",
 		"wall-clock time since the run started",
-		"cumulative evaluations of the stencil (one per Euler substep, s per RKL2 super-step)",
+		"cumulative evaluations of the stencil (one per Euler substep, s + 1 per RKL2 super-step)",
 	};
 	return long_names[k];
 }
