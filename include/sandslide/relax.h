@@ -38,7 +38,7 @@ struct ss_relax_options {
 	double tol;                       /* m/s: steady when max |dh/dt| < tol */
 	double slope_tol;                 /* and no sand face steeper than the
 	                                     angle by more (stepper.h) */
-	enum ss_integrator integrator;    /* auto: rkl2, euler with a bedrock */
+	enum ss_integrator integrator;    /* auto: euler (relax.c says why) */
 	int rkl2_max_stages;              /* stepper.h */
 	double rkl2_tol;
 	double max_time;                  /* s; INFINITY: until steady */

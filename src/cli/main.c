@@ -347,8 +347,9 @@ static const struct cli_option relax_options[] = {
 	         "(default 1e-6; other closures: the same flux)"),
 	{.name = "--integrator", .value = "NAME", .kind = CLI_PARSE, .offset = RELAX(o.integrator),
 	 .parse = parse_integrator, .expected = SS_INTEGRATOR_NAMES,
-	 .help = "euler, rkl2 (super-steps) or auto (default: rkl2,\n"
-	         "or euler with --bedrock)"},
+	 .help = "euler, rkl2 (super-steps) or auto (default: euler,\n"
+	         "which relaxes DEMs faster as measured; rkl2\n"
+	         "cannot be used with --bedrock)"},
 	{.name = "--rkl2-max-stages", .value = "S", .kind = CLI_INT,
 	 .offset = RELAX(o.rkl2_max_stages), .lo = 2, .hi = 100000,
 	 .expected = "an integer >= 2",
