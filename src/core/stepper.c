@@ -622,7 +622,7 @@ enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,
 	const double slope_tol = o->steady_slope_tol > 0.0 ? o->steady_slope_tol : 1e-6;
 	const int rkl2 = st->integrator == SS_INTEGRATOR_RKL2;
 	/* RKL2: forward Euler's step for every slope, the longest super-step
-	 * its stage cap allows, and the change cap in m */
+	 * its stage cap allows, and the error tolerance in m */
 	const double dt_all = rkl2_dt_all(st);
 	const double tau_stages = dt_all * ss_rkl2_stable_ratio(st->rkl2_max_stages);
 	const double tol = st->rkl2_tol * c->tan_cr * fmin(g->dx, g->dy);
