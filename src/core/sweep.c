@@ -164,6 +164,17 @@ void ss_sweep_limit(const struct ss_grid *g, const struct ss_tiling *t, double d
 	}
 }
 
+/* dh/dt of the cell at storage index k from pass 1's fluxes:
+ * -(F_e - F_w)/dx - (F_n - F_s)/dy + q; the one expression of both updates. */
+static inline double rate_at(const double *restrict flux_x, const double *restrict flux_y,
+                             const double *restrict source_rate, ptrdiff_t k,
+                             ptrdiff_t stride, double inv_dx, double inv_dy)
+{
+	const double rate = (flux_x[k] - flux_x[k + 1]) * inv_dx +
+	                    (flux_y[k] - flux_y[k + stride]) * inv_dy;
+	return source_rate ? rate + source_rate[k] : rate;
+}
+
 double ss_sweep_update(const struct ss_grid *g, const struct ss_tiling *t,
                        double dt, const double *restrict flux_x,
                        const double *restrict flux_y,
@@ -182,10 +193,8 @@ double ss_sweep_update(const struct ss_grid *g, const struct ss_tiling *t,
 		for (int j = sp.j0; j < sp.j1; j++) {
 			for (int i = sp.i0; i < sp.i1; i++) {
 				const ptrdiff_t k = ss_grid_index(g, i, j);
-				double rate = (flux_x[k] - flux_x[k + 1]) * inv_dx +
-				              (flux_y[k] - flux_y[k + stride]) * inv_dy;
-				if (source_rate)
-					rate += source_rate[k];
+				const double rate = rate_at(flux_x, flux_y, source_rate, k, stride,
+				                            inv_dx, inv_dy);
 				const int flows = cell_type[k] == SS_CELL_FLOW;
 				height[k] = flows ? height[k] + dt * rate : height[k];
 				const double a = flows ? fabs(rate) : 0.0;
@@ -219,10 +228,8 @@ double ss_sweep_stage_update(const struct ss_grid *g, const struct ss_tiling *t,
 		for (int j = sp.j0; j < sp.j1; j++) {
 			for (int i = sp.i0; i < sp.i1; i++) {
 				const ptrdiff_t k = ss_grid_index(g, i, j);
-				double rate = (flux_x[k] - flux_x[k + 1]) * inv_dx +
-				              (flux_y[k] - flux_y[k + stride]) * inv_dy;
-				if (source_rate)
-					rate += source_rate[k];
+				const double rate = rate_at(flux_x, flux_y, source_rate, k, stride,
+				                            inv_dx, inv_dy);
 				const int flows = cell_type[k] == SS_CELL_FLOW;
 				const double y1 = height[k];
 				if (stage->estimate_only) {

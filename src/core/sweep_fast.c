@@ -1308,7 +1308,9 @@ static void plan_next_stage(struct ss_sweep_fast *f, int last)
 		return;
 	}
 	plan_next_from(f, f->superstep_swept, f->moving_superstep, f->edges_superstep);
-	memcpy(f->swept_last, f->superstep_swept, (size_t)f->tiles);
+	uint8_t *done = f->superstep_swept;      /* it becomes swept_last */
+	f->superstep_swept = f->swept_last;
+	f->swept_last = done;
 	memset(f->superstep_swept, 0, (size_t)f->tiles);
 	memset(f->moving_superstep, 0, (size_t)f->tiles);
 	memset(f->edges_superstep, 0, (size_t)f->tiles);

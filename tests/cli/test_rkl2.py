@@ -14,7 +14,8 @@ import subprocess
 import numpy as np
 import pytest
 
-from conftest import SANDSLIDE_NAN, h5open, run, run_ok, text_attr
+import conftest
+from conftest import SANDSLIDE_NAN, h5open, run, run_ok, same_bits, text_attr
 
 # A small cases/door.ini: sand poured into a walled room leaves through a
 # door; the region beyond has open sides.  30 x 20 cells of 5 cm.
@@ -108,23 +109,8 @@ def write(tmp_path, text, name="case.ini"):
     return name
 
 
-def same_bits(a, b):
-    return a.shape == b.shape and np.array_equal(a.view(np.uint64), b.view(np.uint64))
-
-
 def assert_same_snapshots(cut, whole):
-    """Every snapshot of `whole` is in `cut` at the same time with the same bits."""
-    with h5open(cut) as fa, h5open(whole) as fb:
-        ta, tb = list(fa["time"][:]), list(fb["time"][:])
-        for k, t in enumerate(tb):
-            assert t in ta, f"snapshot at t = {t!r} of the uninterrupted run is missing"
-            i = ta.index(t)
-            ha, hb = fa["height"][i], fb["height"][k]
-            assert same_bits(ha, hb), \
-                f"heights differ at t = {t!r}: max |dh| {np.abs(ha - hb).max()!r}"
-            for name in SERIES:
-                assert fa[name][i] == fb[name][k], \
-                    f"/{name} differs at t = {t!r}: {fa[name][i]!r} vs {fb[name][k]!r}"
+    conftest.assert_same_snapshots(cut, whole, SERIES)
 
 
 # ---- a. the output says which integrator ran and what it cost ---------------------
