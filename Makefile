@@ -8,18 +8,30 @@
 #   make SANITIZE=1 AddressSanitizer + UndefinedBehaviorSanitizer, in build-san/
 #                   (`make SANITIZE=1 test` runs every test with them)
 #   make race       data-race check of the OpenMP code: ThreadSanitizer + Archer
+#   make MPI=1      build-mpi/sandslide with Open MPI and parallel HDF5
+#                   (`make deps MPI=1` installs them; `make MPI=1 test-mpi`
+#                   runs the distributed tests, tests/cli/test_mpi.py)
 #   make check-layering  the tiers of src/README.md, by their #includes
 #   make V=1        show the full commands
 #
 # User CFLAGS/LDFLAGS are appended last, never overwritten.
 
-# A sanitized build has its own folder: build/ is left as it is.
+# A sanitized or MPI build has its own folder: build/ is left as it is.
 ifeq ($(SANITIZE),1)
   BUILD    ?= build-san
+endif
+ifeq ($(MPI),1)
+  BUILD    ?= build-mpi
 endif
 BUILD      ?= build
 PKG_CONFIG ?= pkg-config
 PYTHON     ?= /usr/bin/python3
+MPI        ?= 0
+ifeq ($(MPI),1)
+  # Open MPI, Debian's default MPI, named explicitly: mpicc is an
+  # alternative that another MPI may have taken
+  CC       := mpicc.openmpi
+endif
 CC         ?= cc
 OPENMP     ?= 1
 SANITIZE   ?= 0
@@ -28,12 +40,24 @@ VERSION    := 0.1.0
 .DELETE_ON_ERROR:
 .DEFAULT_GOAL := all
 
-# Debian package that provides each pkg-config module we need.
-DEB_hdf5   := libhdf5-dev
+# Debian package that provides each pkg-config module we need.  HDF5 is
+# named by flavour: installing libhdf5-openmpi-dev turns plain `hdf5` into
+# the parallel one (Debian's alternatives, priority 35 over 20), which a
+# serial build must not pick up.
+DEB_hdf5-serial  := libhdf5-dev
+DEB_hdf5-openmpi := libhdf5-openmpi-dev
 DEB_libpng := libpng-dev
 DEB_inih   := libinih-dev
-PC_MODULES := hdf5 libpng inih
+ifeq ($(MPI),1)
+  PC_HDF5  := hdf5-openmpi
+else
+  PC_HDF5  := hdf5-serial
+endif
+PC_MODULES := $(PC_HDF5) libpng inih
 DEB_BUILD  := pkg-config $(foreach m,$(PC_MODULES),$(DEB_$(m)))
+ifeq ($(MPI),1)
+  DEB_BUILD += openmpi-bin libopenmpi-dev
+endif
 DEB_TEST   := python3-h5py python3-numpy python3-pytest netcdf-bin ffmpeg
 
 # Goals that need no library: do not probe pkg-config for them.
@@ -55,6 +79,10 @@ endif
 # when pkg-config finds it (GDAL=0 builds without); otherwise .tif input
 # and output fail with "unavailable in this build".  `make deps` installs
 # it so the tests cover it (about 100 packages, 54 MB: 34 s on the dev VM).
+# An MPI build leaves GDAL out: GDAL links the serial HDF5.
+ifeq ($(MPI),1)
+  GDAL ?= 0
+endif
 GDAL ?= 1
 DEB_TEST += libgdal-dev
 ifeq ($(GDAL),1)
@@ -90,7 +118,10 @@ ifeq ($(SANITIZE),1)
   export UBSAN_OPTIONS ?= print_stacktrace=1:halt_on_error=1:exitcode=86
   export SANDSLIDE_TEST_SCALE ?= 0.5
 endif
-ALL_CFLAGS  := $(BASE) $(WARN) $(OMPFLAG) $(SANFLAG) -Iinclude -Isrc -DSS_VERSION='"$(VERSION)"' \
+ifeq ($(MPI),1)
+  MPIFLAG := -DSS_HAVE_MPI
+endif
+ALL_CFLAGS  := $(BASE) $(WARN) $(OMPFLAG) $(SANFLAG) $(MPIFLAG) -Iinclude -Isrc -DSS_VERSION='"$(VERSION)"' \
                $(DEP_CFLAGS) -MMD -MP $(CFLAGS)
 ALL_LDFLAGS := $(OMPFLAG) $(SANFLAG) $(LDFLAGS)
 LIBS        := $(DEP_LIBS) -lm

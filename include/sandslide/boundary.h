@@ -46,4 +46,11 @@ void ss_boundary_fill_types(const struct ss_grid *g, const struct ss_boundary *b
 void ss_boundary_fill_heights(const struct ss_grid *g, const struct ss_boundary *b,
                               double *height);
 
+/* For a slab of a distributed grid (grid.h, comm.h) both fills take the
+ * ghost rows that face a neighbour rank from it, whole, after the x sides
+ * (collective: every rank calls them together).  Those neighbours, or -1
+ * where the side's own rule applies (always for a whole grid). */
+void ss_boundary_neighbours(const struct ss_grid *g, const struct ss_boundary *b,
+                            int *south, int *north);
+
 #endif

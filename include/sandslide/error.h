@@ -32,6 +32,15 @@ int ss_error_input_at(const char *where, const char *fmt, ...)
 /* Exit status of the CLI for a status code: 0, 1 or 2. */
 int ss_status_exit_code(int status);
 
+/* Longest message kept, bytes (a longer one is cut). */
+#define SS_ERROR_MESSAGE_MAX 8192
+/* Print "sandslide: <message>" to stderr (stdout flushed first). */
+void ss_error_print(const char *message);
+/* The last message this process reported ("" for none).  In a run of
+ * several ranks only rank 0 prints as it reports; comm.h says how the
+ * message of another rank reaches it. */
+const char *ss_error_last_message(void);
+
 _Noreturn void ss_bug_at(const char *file, int line, const char *fmt, ...)
 	__attribute__((format(printf, 3, 4)));
 #define SS_BUG(...) ss_bug_at(__FILE__, __LINE__, __VA_ARGS__)

@@ -41,6 +41,16 @@ struct ss_grid {
 int ss_grid_init(struct ss_grid *g, int nx, int ny, double dx, double dy,
                  double origin_x, double origin_y);
 
+/* Keep rows first .. first + rows - 1 of the whole grid g (a rank's slab,
+ * stepper.h): ny and offset_j change, the global size does not. */
+void ss_grid_take_rows(struct ss_grid *g, long long first, int rows);
+
+/* Whether this block holds the whole grid (one rank). */
+static inline int ss_grid_is_whole(const struct ss_grid *g)
+{
+	return g->nx == g->global_nx && g->ny == g->global_ny;
+}
+
 /* Elements of one field including the halo: stride * (ny + 2 ghost). */
 size_t ss_grid_storage_cells(const struct ss_grid *g);
 

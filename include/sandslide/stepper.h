@@ -73,7 +73,8 @@ struct ss_source {
 	double rate;            /* m/s of height added on each covered flow cell */
 	double start, stop;     /* active for start <= t < stop, s */
 	ptrdiff_t *cells;       /* storage indices of the flow cells covered */
-	size_t cell_count;
+	size_t cell_count;      /* on this rank */
+	double cell_count_all;  /* on every rank */
 };
 
 enum ss_integrator {
@@ -137,7 +138,16 @@ struct ss_stepper {
 	double source_volume_rate;    /* sum of rate dx dy now, m^3/s */
 
 	struct ss_open_face *open_faces;
-	size_t open_face_count;
+	size_t open_face_count;       /* on this rank */
+	double open_face_count_all;   /* on every rank */
+
+	/* a distributed grid (comm.h): grid is this rank's slab of whole
+	 * tile rows, tiling its tiles */
+	int rank_south, rank_north;   /* ranks beside, -1: none */
+	double tiles_all;             /* tiles of the whole grid */
+	double tiles_awake;           /* tiles the coming pass sweeps, all ranks */
+	uint8_t *edges_in;            /* 2 tiles_x: the changed edges of the
+	                               * tile rows beside (sweep.h) */
 
 	double time;                  /* s */
 	long long steps;              /* substeps (RKL2: super-steps) taken */
@@ -160,7 +170,16 @@ struct ss_stepper {
 
 /* Allocate the arrays for grid g (zero heights, all flow cells).  Returns
  * SS_ERR_INPUT for a bad cfl or boundary, SS_ERR_FAIL when an allocation
- * fails (callers that know the case check ss_stepper_memory_bytes first). */
+ * fails (callers that know the case check ss_stepper_memory_bytes first).
+ *
+ * In a run of several ranks (comm.h) g is the whole grid and st->grid
+ * becomes this rank's slab: the tiling of the whole grid (the tile sizes
+ * given, or the defaults of the whole grid) split into runs of whole tile
+ * rows, one per rank in rank order from the south, so that every rank
+ * count sweeps the same tiles and gives the same bits.  More ranks than
+ * tile rows is SS_ERR_INPUT.  Every function below then works on the slab
+ * (masks, bedrock and heights are the slab's rows) and is collective:
+ * every rank calls it, in the same order. */
 int ss_stepper_init(struct ss_stepper *st, const struct ss_grid *g,
                     const struct ss_closure *c, const struct ss_boundary *b,
                     double cfl, int tile_nx, int tile_ny);
@@ -227,14 +246,14 @@ double ss_stepper_next_source_event(const struct ss_stepper *st, double t);
 void ss_stepper_restart_state(const struct ss_stepper *st, struct ss_restart_state *s);
 
 /* Put a prepared stepper in a saved state: time t (s), the heights of
- * every cell as a snapshot stores them (nx * ny, row-major, south row
- * first) and the counters s that ss_stepper_restart_state gave.  Stepping
+ * every cell of st->grid as a snapshot stores them (nx * ny, row-major,
+ * south row first) and the counters s that ss_stepper_restart_state gave.  Stepping
  * on from it gives the same bits as the run that saved it. */
 void ss_stepper_restore(struct ss_stepper *st, double t, const double *height,
                         const struct ss_restart_state *s);
 
-/* The first cell (in row order) whose height is not finite: 1 and its
- * (i, j), or 0 when every height is finite. */
+/* The first cell (in row order, of every rank) whose height is not
+ * finite: 1 and its global (i, j), or 0 when every height is finite. */
 int ss_stepper_first_nonfinite(const struct ss_stepper *st, int *i, int *j);
 
 #endif

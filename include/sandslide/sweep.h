@@ -239,7 +239,10 @@ struct ss_sweep_fast {
 	double *scratch;         /* per thread: row buffers */
 	size_t scratch_doubles;  /* per thread */
 	int threads;
-	int periodic_x, periodic_y;
+	int periodic_x, periodic_y;   /* periodic_y: within this block (one rank) */
+	uint8_t *edges_out_south;  /* per tile of the first (last) tile row: */
+	uint8_t *edges_out_north;  /*   SS_EDGE_* bits the last plan took from
+	                              it, for the rank beside (0: not swept) */
 	/* faces to open cells, grouped by tile, in row order (see stepper) */
 	struct ss_open_face_slot *open_slots;
 	size_t *open_first;      /* per tile + 1: slots of tile t are
@@ -313,5 +316,20 @@ double ss_sweep_fast_stage(struct ss_sweep_fast *f, const struct ss_grid *g,
 
 /* Tiles in the grid and tiles the coming step sweeps. */
 double ss_sweep_fast_awake(const struct ss_sweep_fast *f);
+
+/*
+ * Tiles across a rank edge (comm.h).  A sweep's plan wakes the neighbours
+ * of every changed tile edge; at a slab's first and last tile rows those
+ * neighbours live on the rank beside.  ss_sweep_fast_step and
+ * ss_sweep_fast_stage (not estimate-only) leave, in f->edges_out_south
+ * and f->edges_out_north (tiles_x bytes each), the changed-edge bits of the
+ * first and last tile rows that their plan used; the stepper sends them to
+ * the ranks beside and hands the rows it receives (the last tile row of the
+ * rank south, the first of the rank north; NULL: none) to
+ * ss_sweep_fast_wake_across, which wakes the tiles here that those edges
+ * face, by the rule of the plan.
+ */
+void ss_sweep_fast_wake_across(struct ss_sweep_fast *f, const uint8_t *from_south,
+                               const uint8_t *from_north);
 
 #endif

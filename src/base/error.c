@@ -4,19 +4,36 @@
  */
 #include "sandslide/error.h"
 
+#include "sandslide/comm.h"
+
 #include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+/* The last message of this process: in a distributed run only rank 0
+ * prints, and ss_comm_agree has it printed there when another rank failed
+ * first (comm.h). */
+static char last_message[SS_ERROR_MESSAGE_MAX];
+
 static int vreport(int status, const char *fmt, va_list ap)
 {
-	fflush(stdout);
-	fputs("sandslide: ", stderr);
-	vfprintf(stderr, fmt, ap);
-	fputc('\n', stderr);
+	vsnprintf(last_message, sizeof last_message, fmt, ap);
+	if (ss_comm_rank() == 0)
+		ss_error_print(last_message);
 	return status;
+}
+
+void ss_error_print(const char *message)
+{
+	fflush(stdout);
+	fprintf(stderr, "sandslide: %s\n", message);
+}
+
+const char *ss_error_last_message(void)
+{
+	return last_message;
 }
 
 int ss_error_input(const char *fmt, ...)

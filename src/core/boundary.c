@@ -2,12 +2,15 @@
  * boundary.c - halo fill for wall, open and periodic sides (see boundary.h).
  *
  * One routine serves both fields: the x sides first (rows 0..ny-1), then the
- * y sides across the full width including the x ghosts.
+ * y sides across the full width including the x ghosts.  A slab of a
+ * distributed grid (comm.h) takes a y ghost row from the neighbour rank
+ * instead, whole: after the x sides, so the corners come along.
  */
 #include "sandslide/boundary.h"
 
 #include <string.h>
 
+#include "sandslide/comm.h"
 #include "sandslide/error.h"
 
 static const char *const side_kind_names[] = {"wall", "open", "periodic"};
@@ -57,10 +60,33 @@ static void fill_type(uint8_t *types, ptrdiff_t ghost, ptrdiff_t wrap,
 	ss_cell_type_set(types, ghost, t);
 }
 
+void ss_boundary_neighbours(const struct ss_grid *g, const struct ss_boundary *b,
+                            int *south, int *north)
+{
+	if (ss_grid_is_whole(g)) {
+		*south = *north = -1;
+		return;
+	}
+	ss_comm_neighbours(b->side[SS_SOUTH] == SS_SIDE_PERIODIC, south, north);
+}
+
+/* The ghost rows -1 and ny from the neighbour ranks: rows 0 and ny - 1 of
+ * this slab go to them, whole (row_bytes from byte offsets first and last
+ * of field). */
+static void exchange_rows(int south, int north, void *field, size_t row_bytes,
+                          size_t ghost_south, size_t first, size_t last, size_t ghost_north)
+{
+	char *f = field;
+	ss_comm_exchange(south, north, f + first, f + ghost_south, f + last, f + ghost_north,
+	                 row_bytes);
+}
+
 void ss_boundary_fill_types(const struct ss_grid *g, const struct ss_boundary *b,
                             uint8_t *cell_types)
 {
 	const int nx = g->nx, ny = g->ny;
+	int south, north;
+	ss_boundary_neighbours(g, b, &south, &north);
 	for (int j = 0; j < ny; j++) {
 		fill_type(cell_types, ss_grid_index(g, -1, j), ss_grid_index(g, nx - 1, j),
 		          b->side[SS_WEST]);
@@ -68,11 +94,18 @@ void ss_boundary_fill_types(const struct ss_grid *g, const struct ss_boundary *b
 		          b->side[SS_EAST]);
 	}
 	for (int i = -1; i <= nx; i++) {
-		fill_type(cell_types, ss_grid_index(g, i, -1), ss_grid_index(g, i, ny - 1),
-		          b->side[SS_SOUTH]);
-		fill_type(cell_types, ss_grid_index(g, i, ny), ss_grid_index(g, i, 0),
-		          b->side[SS_NORTH]);
+		if (south < 0)
+			fill_type(cell_types, ss_grid_index(g, i, -1), ss_grid_index(g, i, ny - 1),
+			          b->side[SS_SOUTH]);
+		if (north < 0)
+			fill_type(cell_types, ss_grid_index(g, i, ny), ss_grid_index(g, i, 0),
+			          b->side[SS_NORTH]);
 	}
+	/* a row of packed types is stride / 4 whole bytes (stride is a
+	 * multiple of 8, grid.h) */
+	const size_t row = (size_t)g->stride / 4;
+	exchange_rows(south, north, cell_types, row, 0, row, (size_t)ny * row,
+	              (size_t)(ny + 1) * row);
 }
 
 void ss_boundary_fill_heights(const struct ss_grid *g, const struct ss_boundary *b,
@@ -80,6 +113,8 @@ void ss_boundary_fill_heights(const struct ss_grid *g, const struct ss_boundary 
 {
 	const int nx = g->nx, ny = g->ny;
 	const double level = b->open_level;
+	int south, north;
+	ss_boundary_neighbours(g, b, &south, &north);
 	for (int j = 0; j < ny; j++) {
 		FILL_SIDE(height, ss_grid_index(g, -1, j), ss_grid_index(g, nx - 1, j),
 		          b->side[SS_WEST], 0.0, level);
@@ -87,9 +122,14 @@ void ss_boundary_fill_heights(const struct ss_grid *g, const struct ss_boundary 
 		          b->side[SS_EAST], 0.0, level);
 	}
 	for (int i = -1; i <= nx; i++) {
-		FILL_SIDE(height, ss_grid_index(g, i, -1), ss_grid_index(g, i, ny - 1),
-		          b->side[SS_SOUTH], 0.0, level);
-		FILL_SIDE(height, ss_grid_index(g, i, ny), ss_grid_index(g, i, 0),
-		          b->side[SS_NORTH], 0.0, level);
+		if (south < 0)
+			FILL_SIDE(height, ss_grid_index(g, i, -1), ss_grid_index(g, i, ny - 1),
+			          b->side[SS_SOUTH], 0.0, level);
+		if (north < 0)
+			FILL_SIDE(height, ss_grid_index(g, i, ny), ss_grid_index(g, i, 0),
+			          b->side[SS_NORTH], 0.0, level);
 	}
+	const size_t row = (size_t)g->stride * sizeof(double);
+	exchange_rows(south, north, height, row, 0, row, (size_t)ny * row,
+	              (size_t)(ny + 1) * row);
 }

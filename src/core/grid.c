@@ -30,6 +30,12 @@ int ss_grid_init(struct ss_grid *g, int nx, int ny, double dx, double dy,
 	return SS_OK;
 }
 
+void ss_grid_take_rows(struct ss_grid *g, long long first, int rows)
+{
+	g->offset_j += first;
+	g->ny = rows;
+}
+
 size_t ss_grid_storage_cells(const struct ss_grid *g)
 {
 	return (size_t)g->stride * (size_t)(g->ny + 2 * SS_GRID_GHOST);

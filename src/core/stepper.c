@@ -7,6 +7,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "sandslide/comm.h"
 #include "sandslide/error.h"
 #include "sandslide/parallel.h"
 #include "sandslide/rkl2.h"
@@ -59,7 +60,25 @@ int ss_stepper_init(struct ss_stepper *st, const struct ss_grid *g,
 	if (err)
 		return err;
 
+	/* the tiling of the whole grid, then this rank's run of tile rows */
+	ss_tiling_init(&st->tiling, g, tile_nx, tile_ny);
+	const long long tile_rows = st->tiling.tiles_y;
+	if (ss_comm_size() > tile_rows)
+		return ss_error_input("%d ranks for a grid of %lld tile rows (ny = %lld cells, "
+		                      "tiles of %d rows): use at most %lld ranks", ss_comm_size(),
+		                      tile_rows, g->global_ny, st->tiling.tile_ny, tile_rows);
+	st->tiles_all = (double)st->tiling.tiles_x * (double)tile_rows;
 	st->grid = *g;
+	if (ss_comm_size() > 1) {
+		long long first, count;
+		ss_comm_split(tile_rows, &first, &count);
+		const long long j0 = first * st->tiling.tile_ny;
+		const long long j1 = (first + count) * st->tiling.tile_ny;
+		ss_grid_take_rows(&st->grid, j0, (int)((j1 < g->ny ? j1 : g->ny) - j0));
+		st->tiling.tiles_y = (int)count;
+	}
+	g = &st->grid;
+	ss_boundary_neighbours(g, b, &st->rank_south, &st->rank_north);
 	st->closure = *c;
 	st->boundary = *b;
 	st->cfl = cfl;
@@ -68,13 +87,13 @@ int ss_stepper_init(struct ss_stepper *st, const struct ss_grid *g,
 	st->rkl2_tau = INFINITY;
 	ss_cfl_bound_init(&st->cfl_bound, c);
 	ss_face_rule_init(&st->face_rule, c);
-	ss_tiling_init(&st->tiling, g, tile_nx, tile_ny);
 
 	const size_t n = ss_grid_storage_cells(g);
 	st->height = ss_alloc(n, sizeof(double), "heights");
 	st->cell_types = ss_alloc(ss_cell_types_bytes(n), 1, "cell types");
 	st->row_scratch = ss_alloc((size_t)g->ny, sizeof(double), "row sums");
-	if (!st->height || !st->cell_types || !st->row_scratch) {
+	st->edges_in = ss_alloc(2 * (size_t)st->tiling.tiles_x, 1, "tile flags");
+	if (!st->height || !st->cell_types || !st->row_scratch || !st->edges_in) {
 		ss_stepper_release(st);
 		return SS_ERR_FAIL;
 	}
@@ -94,6 +113,7 @@ void ss_stepper_release(struct ss_stepper *st)
 	ss_free(st->rkl2_y0);
 	ss_free(st->bedrock);
 	ss_free(st->source_rate);
+	ss_free(st->edges_in);
 	ss_free(st->row_scratch);
 	ss_free(st->flux_y);
 	ss_free(st->flux_x);
@@ -134,6 +154,9 @@ int ss_stepper_add_source(struct ss_stepper *st, const uint8_t *mask,
 		}
 	}
 	s->cell_count = n;
+	double none = 0.0;
+	s->cell_count_all = (double)n;
+	ss_comm_reduce(&none, 0, &s->cell_count_all, 1);
 	s->rate = rate;
 	s->start = start;
 	s->stop = stop;
@@ -181,9 +204,15 @@ static void fill_bedrock_halo(struct ss_stepper *st)
 		r[ss_grid_index(g, nx, j)] = px ? r[ss_grid_index(g, 0, j)] : -INFINITY;
 	}
 	for (int i = -1; i <= nx; i++) {
-		r[ss_grid_index(g, i, -1)] = py ? r[ss_grid_index(g, i, ny - 1)] : -INFINITY;
-		r[ss_grid_index(g, i, ny)] = py ? r[ss_grid_index(g, i, 0)] : -INFINITY;
+		if (st->rank_south < 0)
+			r[ss_grid_index(g, i, -1)] = py ? r[ss_grid_index(g, i, ny - 1)] : -INFINITY;
+		if (st->rank_north < 0)
+			r[ss_grid_index(g, i, ny)] = py ? r[ss_grid_index(g, i, 0)] : -INFINITY;
 	}
+	/* rows from the ranks beside, whole (boundary.c) */
+	const size_t row = (size_t)g->stride;
+	ss_comm_exchange(st->rank_south, st->rank_north, r + row, r, r + ny * row,
+	                 r + (ny + 1) * row, row * sizeof *r);
 }
 
 static int open_faces_build(struct ss_stepper *st)
@@ -265,10 +294,10 @@ static int rkl2_prepare(struct ss_stepper *st)
 	return SS_OK;
 }
 
-int ss_stepper_prepare(struct ss_stepper *st)
+/* The checks of ss_stepper_prepare on this rank's cells. */
+static int check_cells(struct ss_stepper *st)
 {
 	const struct ss_grid *g = &st->grid;
-	ss_boundary_fill_types(g, &st->boundary, st->cell_types);
 	for (int j = 0; j < g->ny; j++) {
 		for (int i = 0; i < g->nx; i++) {
 			const ptrdiff_t k = ss_grid_index(g, i, j);
@@ -292,9 +321,14 @@ int ss_stepper_prepare(struct ss_stepper *st)
 				                      st->bedrock[k], st->height[k]);
 		}
 	}
-	ss_boundary_fill_heights(g, &st->boundary, st->height);
-	if (st->bedrock)
-		fill_bedrock_halo(st);
+	return SS_OK;
+}
+
+/* The parts of prepare that allocate (each rank's own failure; the caller
+ * agrees on it before the next collective call). */
+static int prepare_arrays(struct ss_stepper *st)
+{
+	const struct ss_grid *g = &st->grid;
 	if (st->source_count > 0) {
 		st->source_rate = ss_alloc(ss_grid_storage_cells(g), sizeof(double),
 		                           "source rates");
@@ -321,14 +355,31 @@ int ss_stepper_prepare(struct ss_stepper *st)
 	                         sizeof(double), "open-face fluxes");
 	if (!st->open_flux)
 		return SS_ERR_FAIL;
-	err = ss_sweep_fast_init(&st->fast, g, &st->tiling,
-	                         ss_parallel_max_threads(),
-	                         st->boundary.side[SS_WEST] == SS_SIDE_PERIODIC,
-	                         st->boundary.side[SS_SOUTH] == SS_SIDE_PERIODIC,
-	                         st->cell_types, st->open_faces, st->open_face_count);
+	/* periodic y across ranks is the ranks' business (comm.h) */
+	return ss_sweep_fast_init(&st->fast, g, &st->tiling, ss_parallel_max_threads(),
+	                          st->boundary.side[SS_WEST] == SS_SIDE_PERIODIC,
+	                          st->boundary.side[SS_SOUTH] == SS_SIDE_PERIODIC &&
+	                          ss_grid_is_whole(g),
+	                          st->cell_types, st->open_faces, st->open_face_count);
+}
+
+int ss_stepper_prepare(struct ss_stepper *st)
+{
+	const struct ss_grid *g = &st->grid;
+	ss_boundary_fill_types(g, &st->boundary, st->cell_types);
+	int err = ss_comm_agree(check_cells(st));
 	if (err)
 		return err;
-	ss_sweep_fast_wake_all(&st->fast, g, st->height, st->cell_types);
+	ss_boundary_fill_heights(g, &st->boundary, st->height);
+	if (st->bedrock)
+		fill_bedrock_halo(st);
+	if ((err = ss_comm_agree(prepare_arrays(st))))
+		return err;
+	double none = 0.0;
+	st->open_face_count_all = (double)st->open_face_count;
+	ss_comm_reduce(&none, 0, &st->open_face_count_all, 1);
+	if (st->kernel == SS_KERNEL_FAST)
+		ss_sweep_fast_wake_all(&st->fast, g, st->height, st->cell_types);
 	return SS_OK;
 }
 
@@ -359,7 +410,7 @@ static void sources_update(struct ss_stepper *st)
 	uint64_t on = 0;
 	for (int k = 0; k < st->source_count; k++) {
 		const struct ss_source *s = &st->sources[k];
-		if (s->start <= st->time && st->time < s->stop && s->cell_count > 0)
+		if (s->start <= st->time && st->time < s->stop && s->cell_count_all > 0)
 			on |= UINT64_C(1) << k;
 	}
 	if (on == st->sources_on)
@@ -381,12 +432,17 @@ static void sources_update(struct ss_stepper *st)
 		for (size_t m = 0; m < s->cell_count; m++)
 			st->source_rate[s->cells[m]] += s->rate;
 	}
-	/* the volume rate in storage order, deterministic */
+	/* the volume rate in storage order, deterministic: on several ranks
+	 * one fold carried from rank to rank (the ghost rows between add
+	 * zeros, which change no bit of a sum that starts at +0) */
 	double rate_max = 0.0, volume_rate = 0.0;
+	ss_comm_fold_start(&volume_rate, 1);
 	for (size_t k = 0; k < n; k++) {
 		volume_rate += st->source_rate[k];
 		rate_max = fmax(rate_max, st->source_rate[k]);
 	}
+	ss_comm_fold_finish(&volume_rate, 1);
+	ss_comm_reduce(&rate_max, 1, NULL, 0);
 	st->source_rate_max = rate_max;
 	st->source_volume_rate = volume_rate * st->grid.dx * st->grid.dy;
 	if (st->kernel == SS_KERNEL_FAST)
@@ -406,25 +462,60 @@ static void add_compensated(double *sum, double *carry, double term)
 }
 
 /* Volume leaving through open faces per second with the current fluxes;
- * summed in list order, so the same bits for any thread count and kernel. */
+ * summed in list order, so the same bits for any thread count and kernel
+ * (and rank count: the list of the whole grid is the ranks' lists in rank
+ * order, and the sums are carried from rank to rank). */
 static double outflow_rate(const struct ss_stepper *st)
 {
-	double sum_x = 0.0, sum_y = 0.0;
+	double sum[2] = {0.0, 0.0};   /* x-faces, y-faces */
+	if (st->open_face_count_all == 0.0)
+		return 0.0;
+	ss_comm_fold_start(sum, 2);
 	for (size_t m = 0; m < st->open_face_count; m++) {
 		const struct ss_open_face *f = &st->open_faces[m];
 		const double flux = st->kernel == SS_KERNEL_FAST ? st->open_flux[m]
 		                  : f->axis == 0 ? st->flux_x[f->index] : st->flux_y[f->index];
-		if (f->axis == 0)
-			sum_x += f->sign * flux;
-		else
-			sum_y += f->sign * flux;
+		sum[f->axis] += f->sign * flux;
 	}
-	return sum_x * st->grid.dy + sum_y * st->grid.dx;
+	ss_comm_fold_finish(sum, 2);
+	return sum[0] * st->grid.dy + sum[1] * st->grid.dx;
+}
+
+/* The halo, then the largest face slope S of the state over every rank
+ * (the fast sweep also saves its ring rows; the reference sweep computes
+ * the fluxes), and the tiles the coming pass sweeps into st->tiles_awake. */
+static double measure(struct ss_stepper *st)
+{
+	const struct ss_grid *g = &st->grid;
+	ss_boundary_fill_heights(g, &st->boundary, st->height);
+	const double t0 = ss_parallel_wall_seconds();
+	double s_max = st->kernel == SS_KERNEL_FAST
+		? ss_sweep_fast_begin(&st->fast, g, st->height, st->cell_types)
+		: ss_sweep_fluxes(g, &st->tiling, &st->face_rule, st->height,
+		                  st->cell_type_bytes, st->flux_x, st->flux_y);
+	st->seconds_measure += ss_parallel_wall_seconds() - t0;
+	st->tiles_awake = st->kernel == SS_KERNEL_FAST
+		? ss_sweep_fast_awake(&st->fast) : (double)st->tiling.tiles_x * st->tiling.tiles_y;
+	ss_comm_reduce(&s_max, 1, &st->tiles_awake, 1);
+	return isinf(s_max) ? NAN : s_max;
+}
+
+/* After a pass of the fast sweep that planned the next: the tiles here
+ * that changed edges of the ranks beside wake (sweep.h). */
+static void wake_across(struct ss_stepper *st)
+{
+	if (st->kernel != SS_KERNEL_FAST || ss_grid_is_whole(&st->grid))
+		return;
+	const size_t n = (size_t)st->tiling.tiles_x;
+	uint8_t *from_south = st->edges_in, *from_north = st->edges_in + n;
+	ss_comm_exchange(st->rank_south, st->rank_north, st->fast.edges_out_south, from_south,
+	                 st->fast.edges_out_north, from_north, n);
+	ss_sweep_fast_wake_across(&st->fast, st->rank_south >= 0 ? from_south : NULL,
+	                          st->rank_north >= 0 ? from_north : NULL);
 }
 
 /* What every step starts from: the sources of this time, the next event,
- * the halo, and the largest face slope S of the state (the fast sweep also
- * saves its ring rows; the reference sweep computes the fluxes). */
+ * and the measure. */
 struct step_start {
 	double next_event;      /* the next target or source switch, s */
 	int may_be_steady;      /* a steady stop is asked for, no source to come */
@@ -434,21 +525,13 @@ struct step_start {
 static struct step_start step_begin(struct ss_stepper *st, double t_target,
                                     const struct ss_advance_options *o)
 {
-	const struct ss_grid *g = &st->grid;
 	struct step_start b;
 	sources_update(st);
 	const double next_switch = ss_stepper_next_source_event(st, st->time);
 	/* a state is steady only if no source will switch on later */
 	b.may_be_steady = o->steady_tol > 0.0 && isinf(next_switch);
 	b.next_event = fmin(next_switch, t_target);
-
-	ss_boundary_fill_heights(g, &st->boundary, st->height);
-	const double t0 = ss_parallel_wall_seconds();
-	b.s_max = st->kernel == SS_KERNEL_FAST
-		? ss_sweep_fast_begin(&st->fast, g, st->height, st->cell_types)
-		: ss_sweep_fluxes(g, &st->tiling, &st->face_rule, st->height,
-		                  st->cell_type_bytes, st->flux_x, st->flux_y);
-	st->seconds_measure += ss_parallel_wall_seconds() - t0;
+	b.s_max = measure(st);
 	return b;
 }
 
@@ -469,6 +552,7 @@ static int slopes_settled(struct ss_stepper *st, double s_max, double slope_tol)
 		/* a film of sand thinner than round-off of the heights is rock */
 		const double bare = 1e-9 * fmax(g->dx, g->dy);
 		s_max = ss_sweep_max_sand_slope(g, st->height, st->cell_types, st->bedrock, bare);
+		ss_comm_reduce(&s_max, 1, NULL, 0);
 	}
 	return !(s_max > c->tan_cr) || ss_closure_eval(c, s_max) <= flux_tol;
 }
@@ -481,13 +565,18 @@ static int step_end(struct ss_stepper *st, const struct ss_advance_options *o,
 {
 	st->outflow = st->outflow_sum + st->outflow_carry;
 	st->inflow = st->inflow_sum + st->inflow_carry;
-	st->tile_slots += (double)st->tiling.tiles_x * st->tiling.tiles_y;
+	st->tile_slots += st->tiles_all;
+	/* every rank decides on the same values: a signal reaches the ranks
+	 * at different times */
+	double agree[2] = {st->rate_max, o->stop && *o->stop ? 1.0 : 0.0};
+	ss_comm_reduce(agree, 2, NULL, 0);
+	st->rate_max = agree[0];
 	if (o->progress)
 		o->progress(o->context, st);
 	if (!isfinite(st->rate_max))
 		return SS_ADVANCE_NONFINITE;
 	*steady_candidate = b->may_be_steady && st->rate_max < o->steady_tol;
-	if (o->stop && *o->stop)
+	if (agree[1] != 0.0)
 		return SS_ADVANCE_INTERRUPTED;
 	return -1;
 }
@@ -498,14 +587,14 @@ static void euler_step(struct ss_stepper *st, double dt)
 {
 	const struct ss_grid *g = &st->grid;
 	const double t0 = ss_parallel_wall_seconds();
+	st->tile_sweeps += st->tiles_awake;
 	if (st->kernel == SS_KERNEL_FAST) {
-		st->tile_sweeps += ss_sweep_fast_awake(&st->fast);
 		st->rate_max = ss_sweep_fast_step(&st->fast, g, &st->face_rule, dt,
 		                                  st->sources_on ? st->source_rate : NULL,
 		                                  st->bedrock, st->cell_types, st->height,
 		                                  st->open_flux);
+		wake_across(st);
 	} else {
-		st->tile_sweeps += (double)st->tiling.tiles_x * st->tiling.tiles_y;
 		if (st->bedrock)
 			ss_sweep_limit(g, &st->tiling, dt, st->height, st->bedrock,
 			               st->flux_x, st->flux_y);
@@ -521,36 +610,34 @@ static void euler_step(struct ss_stepper *st, double dt)
 
 /* One pass of the stencil for an RKL2 stage (or the estimate after the
  * last), from the halo and the measure (unless `measured`: step_begin did
- * them for stage 1).  Returns what the sweep returns. */
+ * them for stage 1).  Returns what the sweep returns, the largest of every
+ * rank (and so does the estimate). */
 static double rkl2_pass(struct ss_stepper *st, const struct ss_sweep_stage *stage, int last,
                         int measured, double weight)
 {
 	const struct ss_grid *g = &st->grid;
 	const double *src = st->sources_on ? st->source_rate : NULL;
-	const double t0 = ss_parallel_wall_seconds();
-	if (!measured) {
-		ss_boundary_fill_heights(g, &st->boundary, st->height);
-		if (st->kernel == SS_KERNEL_FAST)
-			ss_sweep_fast_begin(&st->fast, g, st->height, st->cell_types);
-		else
-			ss_sweep_fluxes(g, &st->tiling, &st->face_rule, st->height,
-			                st->cell_type_bytes, st->flux_x, st->flux_y);
-	}
+	if (!measured)
+		measure(st);
 	const double t1 = ss_parallel_wall_seconds();
-	st->seconds_measure += t1 - t0;
 	double change;
+	st->tile_sweeps += st->tiles_awake * weight;
 	if (st->kernel == SS_KERNEL_FAST) {
-		st->tile_sweeps += ss_sweep_fast_awake(&st->fast) * weight;
 		change = ss_sweep_fast_stage(&st->fast, g, &st->face_rule, stage, last, src,
 		                             st->cell_types, st->height, st->open_flux);
+		if (!stage->estimate_only)
+			wake_across(st);
 	} else {
-		st->tile_sweeps += (double)st->tiling.tiles_x * st->tiling.tiles_y * weight;
 		change = ss_sweep_stage_update(g, &st->tiling, stage, st->flux_x, st->flux_y, src,
 		                               st->cell_type_bytes, st->height);
 	}
 	st->seconds_sweep += ss_parallel_wall_seconds() - t1;
 	st->evaluations++;
-	return change;
+	double max[2] = {change, stage->estimate_only ? *stage->estimate : 0.0};
+	ss_comm_reduce(max, 2, NULL, 0);
+	if (stage->estimate_only)
+		*stage->estimate = max[1];
+	return max[0];
 }
 
 /*
@@ -686,7 +773,8 @@ enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,
 	/* on a target: the slopes are measured here, not by the next step */
 	if (steady_candidate) {
 		ss_boundary_fill_heights(g, &st->boundary, st->height);
-		const double s_max = ss_sweep_max_slope(g, st->height, st->cell_types);
+		double s_max = ss_sweep_max_slope(g, st->height, st->cell_types);
+		ss_comm_reduce(&s_max, 1, NULL, 0);
 		if (slopes_settled(st, s_max, slope_tol))
 			return SS_ADVANCE_STEADY;
 	}
@@ -715,12 +803,18 @@ void ss_stepper_diagnostics(struct ss_stepper *st, struct ss_diagnostics *d)
 		if (top > max_height)
 			max_height = top;
 	}
+	/* the row sums in row order, carried from rank to rank */
 	double volume = 0.0;
+	ss_comm_fold_start(&volume, 1);
 	for (int j = 0; j < g->ny; j++)
 		volume += row_volume[j];
+	ss_comm_fold_finish(&volume, 1);
 
 	ss_boundary_fill_heights(g, &st->boundary, st->height);
-	const double s_max = ss_sweep_max_slope(g, st->height, st->cell_types);
+	double max[2] = {ss_sweep_max_slope(g, st->height, st->cell_types), max_height};
+	ss_comm_reduce(max, 2, NULL, 0);
+	const double s_max = max[0];
+	max_height = max[1];
 	d->volume = volume * g->dx * g->dy;
 	d->inflow = st->inflow;
 	d->outflow = st->outflow;
@@ -767,9 +861,19 @@ void ss_stepper_restore(struct ss_stepper *st, double t, const double *height,
 int ss_stepper_first_nonfinite(const struct ss_stepper *st, int *i, int *j)
 {
 	const struct ss_grid *g = &st->grid;
-	for (*j = 0; *j < g->ny; ++*j)
-		for (*i = 0; *i < g->nx; ++*i)
-			if (!isfinite(st->height[ss_grid_index(g, *i, *j)]))
-				return 1;
-	return 0;
+	/* the first in global row order: the largest of minus its index */
+	double first = -INFINITY;
+	for (int jj = 0; jj < g->ny && first == -INFINITY; jj++)
+		for (int ii = 0; ii < g->nx; ii++)
+			if (!isfinite(st->height[ss_grid_index(g, ii, jj)])) {
+				first = -((double)(g->offset_j + jj) * (double)g->global_nx +
+				          (double)(g->offset_i + ii));
+				break;
+			}
+	ss_comm_reduce(&first, 1, NULL, 0);
+	if (first == -INFINITY)
+		return 0;
+	*j = (int)(-first / (double)g->global_nx);
+	*i = (int)(-first - (double)*j * (double)g->global_nx);
+	return 1;
 }

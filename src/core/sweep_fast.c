@@ -407,6 +407,8 @@ static int alloc_tables(struct ss_sweep_fast *f, const struct ss_grid *g,
 	f->moving_superstep = ss_alloc(tiles, 1, "tile flags");
 	f->edges_superstep = ss_alloc(tiles, 1, "tile flags");
 	f->swept_last = ss_alloc(tiles, 1, "tile flags");
+	f->edges_out_south = ss_alloc((size_t)t->tiles_x, 1, "tile flags");
+	f->edges_out_north = ss_alloc((size_t)t->tiles_x, 1, "tile flags");
 	f->row_list = ss_alloc((size_t)t->tiles_y, sizeof *f->row_list, "tile rows");
 	f->ring_south = ss_alloc((size_t)t->tiles_y * g->stride, sizeof(double), "ring rows");
 	f->ring_north = ss_alloc((size_t)t->tiles_y * g->stride, sizeof(double), "ring rows");
@@ -417,7 +419,8 @@ static int alloc_tables(struct ss_sweep_fast *f, const struct ss_grid *g,
 	                         sizeof *f->open_slots, "open faces");
 	if (!f->sweep || !f->sweep_next || !f->moving || !f->edges_changed || !f->plain ||
 	    !f->has_source || !f->superstep_swept || !f->moving_superstep ||
-	    !f->edges_superstep || !f->swept_last || !f->row_list || !f->ring_south || !f->ring_north ||
+	    !f->edges_superstep || !f->swept_last || !f->row_list ||
+	    !f->edges_out_south || !f->edges_out_north || !f->ring_south || !f->ring_north ||
 	    !f->scratch || !f->open_first || !f->open_slots)
 		return SS_ERR_FAIL;
 	return SS_OK;
@@ -537,6 +540,8 @@ void ss_sweep_fast_release(struct ss_sweep_fast *f)
 	ss_free(f->ring_north);
 	ss_free(f->ring_south);
 	ss_free(f->row_list);
+	ss_free(f->edges_out_north);
+	ss_free(f->edges_out_south);
 	ss_free(f->swept_last);
 	ss_free(f->edges_superstep);
 	ss_free(f->moving_superstep);
@@ -1239,6 +1244,12 @@ static void plan_next_from(struct ss_sweep_fast *f, const uint8_t *swept,
 	const int nx = f->tiling.tiles_x, ny = f->tiling.tiles_y;
 	uint8_t *next = f->sweep_next;
 	memset(next, 0, (size_t)f->tiles);
+	/* what the ranks beside see of the first and last tile rows */
+	for (int tx = 0; tx < nx; tx++) {
+		const int first = tx, last = (ny - 1) * nx + tx;
+		f->edges_out_south[tx] = swept[first] ? edges_changed[first] : 0;
+		f->edges_out_north[tx] = swept[last] ? edges_changed[last] : 0;
+	}
 	for (int ty = 0; ty < ny; ty++) {
 		for (int tx = 0; tx < nx; tx++) {
 			const int tile = ty * nx + tx;
@@ -1278,6 +1289,35 @@ static void plan_next_from(struct ss_sweep_fast *f, const uint8_t *swept,
 	uint8_t *tmp = f->sweep;
 	f->sweep = f->sweep_next;
 	f->sweep_next = tmp;
+}
+
+void ss_sweep_fast_wake_across(struct ss_sweep_fast *f, const uint8_t *from_south,
+                               const uint8_t *from_north)
+{
+	const int nx = f->tiling.tiles_x, ny = f->tiling.tiles_y;
+	for (int side = 0; side < 2; side++) {
+		/* the tile row beside: its edge facing us, and our row it wakes */
+		const uint8_t *row = side == 0 ? from_south : from_north;
+		const int facing = side == 0 ? SS_EDGE_NORTH : SS_EDGE_SOUTH;
+		uint8_t *wake = f->sweep + (size_t)(side == 0 ? 0 : ny - 1) * nx;
+		if (!row)
+			continue;
+		for (int tx = 0; tx < nx; tx++) {
+			const int e = row[tx];
+			for (int dx = -1; dx <= 1 && (e & facing); dx++) {
+				const int need = facing | (dx < 0 ? SS_EDGE_WEST : dx > 0 ? SS_EDGE_EAST : 0);
+				if ((e & need) != need)
+					continue;
+				int ux = tx + dx;
+				if (ux < 0 || ux >= nx) {
+					if (!f->periodic_x)
+						continue;
+					ux = (ux + nx) % nx;
+				}
+				wake[ux] = 1;
+			}
+		}
+	}
 }
 
 static void plan_next(struct ss_sweep_fast *f)
