@@ -258,6 +258,25 @@ test check: all $(TEST_BIN) $(HOOK_BIN) headers-check check-layering $(FUZZ_REPL
 	  $(PYTHON) -m pytest -q tests/cli || fail=1; \
 	exit $$fail
 
+# The distributed tests (make MPI=1 test-mpi): the C test of the halo and
+# the ordered sums under mpirun -np 3, then tests/cli/test_mpi.py, which
+# compares every snapshot of build-mpi/sandslide under np = 1..4 with the
+# serial build/sandslide (built first).  Open MPI's settings for a root
+# user, more ranks than cores and a box without RDMA (notes: mpi.md).
+MPI_ENV := OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 \
+           OMPI_MCA_rmaps_base_oversubscribe=1 OMPI_MCA_mpi_yield_when_idle=1 \
+           OMPI_MCA_btl_vader_single_copy_mechanism=none OMPI_MCA_pml=ob1 \
+           OMPI_MCA_btl=self,vader OMPI_MCA_btl_base_warn_component_unused=0 OMP_NUM_THREADS=1
+.PHONY: test-mpi
+test-mpi: all $(BUILD)/tests/test_comm
+	@[ "$(MPI)" = 1 ] || { echo "test-mpi: run it as make MPI=1 test-mpi"; exit 2; }
+	$(MAKE) MPI=0 all
+	@echo "== $(BUILD)/tests/test_comm (mpirun -np 3)"; \
+	  $(MPI_ENV) mpirun.openmpi -np 3 --bind-to none $(BUILD)/tests/test_comm
+	@echo "== tests/cli/test_mpi.py (pytest)"; \
+	  $(MPI_ENV) SANDSLIDE_MPI=$(abspath $(BUILD)/sandslide) SANDSLIDE=$(abspath build/sandslide) \
+	  $(PYTHON) -m pytest -q tests/cli/test_mpi.py
+
 # The tiers of src/README.md, checked by the #includes of each file: the
 # kernel knows nothing of files, printing or the command line, I/O nothing
 # of the stencil, and <hdf5.h> is in two files (tests/check_layering.sh).

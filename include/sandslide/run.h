@@ -34,7 +34,8 @@ struct ss_run_options {
 	const char *output;          /* NULL: out/<case name>.h5 */
 	const char *const *overrides; /* "SECTION.KEY=VALUE" */
 	int override_count;
-	int threads;                 /* <= 0: all processors */
+	int threads;                 /* <= 0: the processors of this
+	                                * node over its ranks (comm.h) */
 	int tile_nx, tile_ny;        /* <= 0: defaults */
 	int reference_kernel;        /* use the reference sweep (sweep.h) */
 	int deflate;                 /* HDF5 deflate level 0..9 */
@@ -79,7 +80,8 @@ struct ss_run_summary {
 	double measure_seconds;      /* measuring the largest slope */
 	double sweep_seconds;        /* sweeping */
 	double output_seconds;       /* writing snapshots */
-	int threads;
+	int threads;                 /* OpenMP threads of each rank */
+	int ranks;                   /* MPI ranks (comm.h) */
 };
 
 /* Returns SS_OK, SS_ERR_INPUT or SS_ERR_FAIL (message already printed);

@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "sandslide/comm.h"
 #include "sandslide/error.h"
 #include "sandslide/parallel.h"
 
@@ -19,6 +20,15 @@ void ss_drive_init(struct ss_drive *d, struct ss_stepper *st, double started)
 	d->started = started;
 	d->trouble.good_step = -1;
 	d->trouble.good_snapshot = -1;
+}
+
+void ss_drive_set_threads(int threads)
+{
+	if (threads <= 0) {
+		threads = ss_parallel_processors() / ss_comm_node_ranks();
+		threads = threads > 0 ? threads : 1;
+	}
+	ss_parallel_set_threads(threads);
 }
 
 int ss_drive_claim(struct ss_drive *d, const char *output, int make_folder, int force,
@@ -145,7 +155,8 @@ static int restart_point(struct ss_drive *d, struct ss_stepper *fresh)
 	struct ss_restart_info r;
 	err = ss_snapshot_read_last_state(d->output, &r);
 	if (!err)
-		ss_stepper_restore(fresh, r.time, r.height, &r.state);
+		ss_stepper_restore(fresh, r.time,   /* this rank's rows */
+		                   r.height + (size_t)fresh->grid.offset_j * fresh->grid.nx, &r.state);
 	ss_restart_info_release(&r);
 	if (!err)
 		err = ss_snapshot_open_append(&d->snapshot, d->output, &fresh->grid);
@@ -164,9 +175,10 @@ static void keep_last_good_state(struct ss_drive *d)
 	struct ss_stepper *st = d->stepper, fresh;
 	int i, j;
 	snprintf(t->cell, sizeof t->cell, "a cell");
-	if (ss_stepper_first_nonfinite(st, &i, &j))
+	const struct ss_grid *g = &st->grid;
+	if (ss_stepper_first_nonfinite(st, &i, &j))   /* global (i, j) */
 		snprintf(t->cell, sizeof t->cell, "cell (%d, %d) at x = %g m, y = %g m", i, j,
-		         ss_grid_x(&st->grid, i), ss_grid_y(&st->grid, j));
+		         g->origin_x + (i + 0.5) * g->dx, g->origin_y + (j + 0.5) * g->dy);
 	t->step = st->steps;
 	t->time = st->time;
 	t->snapshots = ss_drive_snapshots(d);

@@ -88,6 +88,10 @@ struct ss_drive {
 
 void ss_drive_init(struct ss_drive *d, struct ss_stepper *st, double started);
 
+/* Use `threads` OpenMP threads, or for 0 the processors of this node
+ * divided among its ranks (comm.h), at least one. */
+void ss_drive_set_threads(int threads);
+
 /* Claim `output` for this run (unless it already holds the claim): make
  * its folder first when make_folder (a default output's out/), then refuse
  * an output that exists unless force or appending (SS_ERR_INPUT, the

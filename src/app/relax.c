@@ -13,6 +13,7 @@
 
 #include "app/drive.h"
 #include "io/output.h"
+#include "sandslide/comm.h"
 #include "sandslide/error.h"
 #include "sandslide/parallel.h"
 #include "sandslide/snapshot.h"
@@ -55,10 +56,11 @@ static double steepest_sand_face_deg(struct ss_stepper *st)
 {
 	const struct ss_grid *g = &st->grid;
 	ss_boundary_fill_heights(g, &st->boundary, st->height);
-	const double s = st->bedrock
-	               ? ss_sweep_max_sand_slope(g, st->height, st->cell_types, st->bedrock,
-	                                         1e-6 * fmin(g->dx, g->dy))
-	               : ss_sweep_max_slope(g, st->height, st->cell_types);
+	double s = st->bedrock
+	           ? ss_sweep_max_sand_slope(g, st->height, st->cell_types, st->bedrock,
+	                                     1e-6 * fmin(g->dx, g->dy))
+	           : ss_sweep_max_slope(g, st->height, st->cell_types);
+	ss_comm_reduce(&s, 1, NULL, 0);
 	return atan(s) * (180.0 / M_PI);
 }
 
@@ -115,16 +117,19 @@ static int build_stepper(const struct ss_relax_options *o, const struct ss_raste
 	st->integrator = integrator;
 	st->rkl2_max_stages = o->rkl2_max_stages;
 	st->rkl2_tol = o->rkl2_tol;
+	/* every rank read the DEM; from here on g is this rank's slab */
+	g = st->grid;
+	const size_t first = (size_t)g.offset_j * g.nx;
 	for (int j = 0; j < g.ny; j++) {
 		for (int i = 0; i < g.nx; i++) {
-			const size_t m = (size_t)j * g.nx + i;
+			const size_t m = first + (size_t)j * g.nx + i;
 			const ptrdiff_t k = ss_grid_index(&g, i, j);
 			st->height[k] = r->values[m];
 			if (r->nodata && r->nodata[m])
 				ss_cell_type_set(st->cell_types, k, o->nodata_type);
 		}
 	}
-	if (bedrock && (err = ss_stepper_set_bedrock(st, bedrock->values)))
+	if (bedrock && (err = ss_stepper_set_bedrock(st, bedrock->values + first)))
 		return err;
 	if (o->add_sand) {
 		uint8_t *mask = ss_alloc((size_t)g.nx * g.ny, 1, "sand source mask");
@@ -132,10 +137,12 @@ static int build_stepper(const struct ss_relax_options *o, const struct ss_raste
 		if (!mask)
 			return SS_ERR_FAIL;
 		err = ss_shape_rasterize(&o->sand_shape, &g, mask, &covered);
-		if (!err && covered == 0)
+		double covered_all = (double)covered, none = 0.0;
+		ss_comm_reduce(&none, 0, &covered_all, 1);
+		if (!err && covered_all == 0)
 			err = ss_error_input("--add-sand covers no cell centre of the DEM (x %g .. %g "
-			                     "m, y %g .. %g m)", g.origin_x, g.origin_x + g.nx * dx,
-			                     g.origin_y, g.origin_y + g.ny * dy);
+			                     "m, y %g .. %g m)", g.origin_x, g.origin_x + r->nx * dx,
+			                     g.origin_y, g.origin_y + r->ny * dy);
 		if (!err)
 			err = ss_stepper_add_source(st, mask, o->sand_rate, 0.0, o->sand_duration);
 		ss_free(mask);
@@ -185,14 +192,19 @@ static int write_report(const char *path, const struct ss_relax_options *o,
 	return SS_OK;
 }
 
-/* The relaxed heights into r's values (nodata cells keep theirs). */
+/* The relaxed heights into r's values (nodata cells keep theirs): each
+ * rank's rows, gathered on rank 0. */
 static void heights_to_raster(const struct ss_stepper *st, struct ss_raster *r)
 {
 	const struct ss_grid *g = &st->grid;
+	double *rows = r->values + (size_t)g->offset_j * g->nx;
+	const uint8_t *nodata = r->nodata ? r->nodata + (size_t)g->offset_j * g->nx : NULL;
 	for (int j = 0; j < g->ny; j++)
 		for (int i = 0; i < g->nx; i++)
-			if (!r->nodata || !r->nodata[(size_t)j * g->nx + i])
-				r->values[(size_t)j * g->nx + i] = st->height[ss_grid_index(g, i, j)];
+			if (!nodata || !nodata[(size_t)j * g->nx + i])
+				rows[(size_t)j * g->nx + i] = st->height[ss_grid_index(g, i, j)];
+	if (!ss_grid_is_whole(g))
+		ss_comm_gather_rows(rows, (size_t)g->ny * g->nx * sizeof *rows, r->values);
 }
 
 /* Everything one relaxation holds, released by ss_relax_run. */
@@ -247,8 +259,8 @@ static int measure_before(struct relax *x, struct ss_relax_report *rep)
 	if (!(x->h0 = ss_alloc(cells, sizeof *x->h0, "initial heights")))
 		return SS_ERR_FAIL;
 	memcpy(x->h0, x->st.height, cells * sizeof *x->h0);
-	rep->nx = g->nx;
-	rep->ny = g->ny;
+	rep->nx = (int)g->global_nx;
+	rep->ny = (int)g->global_ny;
 	rep->dx = g->dx;
 	rep->dy = g->dy;
 	rep->volume_before = flow_volume(&x->st);
@@ -300,17 +312,22 @@ static void measure_after(struct relax *x, enum ss_drive_end end, struct ss_rela
 	rep->outflow = st->outflow;
 	rep->volume_after = flow_volume(st);
 	rep->max_slope_after_deg = steepest_sand_face_deg(st);
-	double moved = 0.0;
+	/* in row order, carried from rank to rank (comm.h) */
+	double moved = 0.0, cells_moved = 0.0, none = 0.0;
+	ss_comm_fold_start(&moved, 1);
 	for (int j = 0; j < g->ny; j++) {
 		for (int i = 0; i < g->nx; i++) {
 			const ptrdiff_t k = ss_grid_index(g, i, j);
 			if (ss_cell_type_get(st->cell_types, k) != SS_CELL_FLOW ||
 			    st->height[k] == x->h0[k])
 				continue;
-			rep->cells_moved++;
+			cells_moved++;
 			moved += fabs(st->height[k] - x->h0[k]);
 		}
 	}
+	ss_comm_fold_finish(&moved, 1);
+	ss_comm_reduce(&none, 0, &cells_moved, 1);
+	rep->cells_moved = (long long)cells_moved;
 	rep->volume_moved = 0.5 * moved * g->dx * g->dy;
 }
 
@@ -321,7 +338,8 @@ static int write_raster(struct relax *x, const char *path)
 	if (x->format == SS_DEM_H5)
 		return SS_OK;
 	heights_to_raster(&x->st, &x->dem);
-	return ss_dem_write(path, x->format, &x->dem);
+	return ss_comm_agree(ss_comm_rank() == 0 ? ss_dem_write(path, x->format, &x->dem)
+	                                         : SS_OK);
 }
 
 /* The guard fired: the last good state goes to a raster output too. */
@@ -342,7 +360,7 @@ int ss_relax_run(const struct ss_relax_options *o, struct ss_relax_report *rep)
 	memset(rep, 0, sizeof *rep);
 	x.o = o;
 	ss_drive_init(&x.drive, &x.st, started);
-	ss_parallel_set_threads(o->threads > 0 ? o->threads : ss_parallel_processors());
+	ss_drive_set_threads(o->threads);
 
 	enum ss_drive_end end = SS_DRIVE_END;
 	int err = read_inputs(&x, rep);
@@ -362,7 +380,7 @@ int ss_relax_run(const struct ss_relax_options *o, struct ss_relax_report *rep)
 	}
 	rep->wall_seconds = ss_parallel_wall_seconds() - started;
 	if (!err && o->report)
-		err = write_report(o->report, o, rep);
+		err = ss_comm_agree(ss_comm_rank() == 0 ? write_report(o->report, o, rep) : SS_OK);
 	err = ss_drive_finish(&x.drive, err);
 	ss_free(x.h0);
 	ss_stepper_release(&x.st);

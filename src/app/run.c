@@ -15,6 +15,7 @@
 #include "io/output.h"
 #include "model/setup.h"
 #include "sandslide/case.h"
+#include "sandslide/comm.h"
 #include "sandslide/error.h"
 #include "sandslide/parallel.h"
 #include "sandslide/snapshot.h"
@@ -147,11 +148,14 @@ static int start_stepper(struct run *r)
 	int err = r->o->restart ? restart_files_reachable(r) : SS_OK;
 	if (err || (err = rebuild(r, &r->st)) || !r->o->restart)
 		return err;
-	if (rs->nx != r->st.grid.nx || rs->ny != r->st.grid.ny)
+	const struct ss_grid *g = &r->st.grid;
+	if (rs->nx != g->global_nx || rs->ny != g->global_ny)
 		return ss_error_input("--restart %s: its snapshots are %d x %d cells, its case "
-		                      "gives %d x %d", r->o->restart, rs->nx, rs->ny, r->st.grid.nx,
-		                      r->st.grid.ny);
-	ss_stepper_restore(&r->st, rs->time, rs->height, &rs->state);
+		                      "gives %lld x %lld", r->o->restart, rs->nx, rs->ny,
+		                      g->global_nx, g->global_ny);
+	/* every rank read the snapshot; each keeps its rows */
+	ss_stepper_restore(&r->st, rs->time, rs->height + (size_t)g->offset_j * g->nx,
+	                   &rs->state);
 	return SS_OK;
 }
 
@@ -237,8 +241,10 @@ static void summarise(const struct run *r, enum ss_drive_end end, struct ss_run_
 	s->evaluations_here = st->evaluations - r->drive.evaluations_start;
 	s->integrator = ss_integrator_name(st->integrator);
 	s->stages_max = st->rkl2_max_stages;
-	s->cells = (double)st->grid.nx * st->grid.ny;
-	s->bytes_per_cell = ss_stepper_memory_bytes(&st->grid, st->integrator) / s->cells;
+	s->cells = (double)st->grid.global_nx * st->grid.global_ny;
+	s->bytes_per_cell = ss_stepper_memory_bytes(&st->grid, st->integrator) /
+	                    ((double)st->grid.nx * st->grid.ny);
+	s->ranks = ss_comm_size();
 	s->wall_seconds = ss_parallel_wall_seconds() - r->drive.started;
 	s->measure_seconds = st->seconds_measure;
 	s->sweep_seconds = st->seconds_sweep;
@@ -253,7 +259,7 @@ int ss_run_case(const struct ss_run_options *o, struct ss_run_summary *summary)
 	memset(&r, 0, sizeof r);
 	r.o = o;
 	ss_drive_init(&r.drive, &r.st, started);
-	ss_parallel_set_threads(o->threads > 0 ? o->threads : ss_parallel_processors());
+	ss_drive_set_threads(o->threads);
 
 	/* a restart reads the file it will write: claimed first, as a live run
 	 * may be writing it (a missing file is left to the reading to report) */

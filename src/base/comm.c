@@ -177,7 +177,8 @@ void ss_comm_gather_rows(const void *mine, size_t bytes, void *all)
 		return;
 	}
 	char *out = all;
-	memcpy(out, mine, bytes);
+	if (out != mine)
+		memmove(out, mine, bytes);
 	out += bytes;
 	for (int r = 1; r < comm_size; r++) {
 		/* the sender's size first is not known: probe each piece */
@@ -305,7 +306,8 @@ void ss_comm_fold_finish(double *running, int n)
 
 void ss_comm_gather_rows(const void *mine, size_t bytes, void *all)
 {
-	memcpy(all, mine, bytes);
+	if (all != mine)
+		memmove(all, mine, bytes);
 }
 
 void ss_comm_broadcast(void *buf, size_t bytes, int root)

@@ -19,6 +19,7 @@
 #include "cli/print.h"
 #include "sandslide/bench.h"
 #include "sandslide/dem.h"
+#include "sandslide/comm.h"
 #include "sandslide/error.h"
 #include "sandslide/parallel.h"
 #include "sandslide/relax.h"
@@ -70,7 +71,8 @@ static ss_progress_fn *watch(int quiet, const volatile sig_atomic_t **stop)
 	 * report it) rather than the process die silently */
 	signal(SIGXFSZ, SIG_IGN);
 	*stop = &stop_signal;
-	return !quiet && isatty(fileno(stderr)) ? cli_print_progress : NULL;
+	return !quiet && ss_comm_rank() == 0 && isatty(fileno(stderr)) ? cli_print_progress
+	                                                               : NULL;
 }
 
 /* The exit status of a command that a signal may have stopped. */
@@ -681,6 +683,8 @@ static int cmd_info(int argc, char **argv)
 
 static int main_usage_error(const char *fmt, const char *arg)
 {
+	if (ss_comm_rank() != 0)
+		return 2;
 	fflush(stdout);
 	fputs("sandslide: ", stderr);
 	fprintf(stderr, fmt, arg);
@@ -688,7 +692,10 @@ static int main_usage_error(const char *fmt, const char *arg)
 	return 2;
 }
 
-int main(int argc, char **argv)
+/* The command, run by every rank of a distributed run (comm.h); only
+ * rank 0 prints (the others' stdout goes nowhere, and their error messages
+ * reach rank 0 through ss_comm_agree). */
+static int command(int argc, char **argv)
 {
 	static const struct {
 		const char *name;
@@ -706,18 +713,33 @@ int main(int argc, char **argv)
 		return 0;
 	}
 	if (!strcmp(cmd, "--version") || !strcmp(cmd, "version")) {
-		printf("sandslide %s (OpenMP: %s, %d processors; GDAL: %s)\n", SS_VERSION,
+		printf("sandslide %s (OpenMP: %s, %d processors; GDAL: %s; MPI: %s)\n", SS_VERSION,
 #ifdef _OPENMP
 		       "on",
 #else
 		       "off",
 #endif
-		       ss_parallel_processors(), ss_dem_gdal_available() ? "on" : "off");
+		       ss_parallel_processors(), ss_dem_gdal_available() ? "on" : "off",
+		       ss_comm_library() ? ss_comm_library() : "off");
 		return 0;
 	}
+	/* the distributed commands: the others work on one block */
+	if (ss_comm_size() > 1 && strcmp(cmd, "run") != 0 && strcmp(cmd, "relax") != 0)
+		return main_usage_error("'%s' runs on one rank: only run and relax are distributed "
+		                        "(start it without mpirun)", cmd);
 	for (int k = 0; k < COUNT(commands); k++)
 		if (!strcmp(cmd, commands[k].name))
 			return commands[k].run(argc, argv);
 	return main_usage_error("unknown command '%s': expected run, relax, info, render or bench",
 	                        cmd);
+}
+
+int main(int argc, char **argv)
+{
+	ss_comm_init(&argc, &argv);
+	if (ss_comm_rank() != 0 && !freopen("/dev/null", "w", stdout))
+		ss_comm_abort(1);
+	const int code = command(argc, argv);
+	ss_comm_finalize();
+	return code;
 }

@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "sandslide/comm.h"
 #include "sandslide/error.h"
 
 /* The help's second column: options on the left, their text from here. */
@@ -94,6 +95,8 @@ void cli_help(const struct cli_command *c, FILE *f)
 
 int cli_usage_error(const struct cli_command *c, const char *fmt, ...)
 {
+	if (ss_comm_rank() != 0)
+		return 2;
 	va_list ap;
 	fflush(stdout);
 	fputs("sandslide: ", stderr);

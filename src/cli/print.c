@@ -7,6 +7,8 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "sandslide/comm.h"
+
 static void format_duration(double s, char *buf, size_t size)
 {
 	if (!isfinite(s) || s < 0)
@@ -58,6 +60,8 @@ void cli_progress_done(void)
 
 void cli_print_run_end(const struct ss_run_summary *s, int quiet)
 {
+	if (ss_comm_rank() != 0)
+		return;
 	if (s->end == SS_RUN_INTERRUPTED) {
 		fflush(stdout);
 		fprintf(stderr, "sandslide: interrupted at t = %g s (step %lld): snapshot %lld is "
@@ -71,16 +75,21 @@ void cli_print_run_end(const struct ss_run_summary *s, int quiet)
 	       s->time, s->steps, strcmp(s->integrator, "rkl2") ? "steps (euler)"
 	       : "super-steps (rkl2)", s->end == SS_RUN_STEADY ? " (steady)"
 	       : s->end == SS_RUN_NOT_STEADY ? " (not steady by max_time)" : "");
+	char ranks[48] = "";
+	if (s->ranks > 1)
+		snprintf(ranks, sizeof ranks, "%d ranks x ", s->ranks);
 	printf("wall %.3f s: slope %.3f s, sweep %.3f s, output %.3f s; %lld stencil "
-	       "evaluations, %.3g cell-updates/s on %d threads; %.0f B per cell\n",
+	       "evaluations, %.3g cell-updates/s on %s%d threads; %.0f B per cell\n",
 	       s->wall_seconds, s->measure_seconds, s->sweep_seconds, s->output_seconds,
 	       s->evaluations, (double)s->evaluations_here * s->cells /
-	       fmax(s->measure_seconds + s->sweep_seconds, 1e-9), s->threads,
+	       fmax(s->measure_seconds + s->sweep_seconds, 1e-9), ranks, s->threads,
 	       s->bytes_per_cell);
 }
 
 void cli_print_relax_end(const struct ss_relax_report *r, double angle_deg, int quiet)
 {
+	if (ss_comm_rank() != 0)
+		return;
 	if (r->interrupted) {
 		fflush(stdout);
 		fprintf(stderr, "sandslide: interrupted at t = %g s (step %lld): '%s' holds the "

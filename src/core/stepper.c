@@ -141,6 +141,9 @@ int ss_stepper_add_source(struct ss_stepper *st, const uint8_t *mask,
 			         ss_cell_type_get(st->cell_types, ss_grid_index(g, i, j)) ==
 			         SS_CELL_FLOW;
 	struct ss_source *s = &st->sources[st->source_count];
+	double none = 0.0;
+	s->cell_count_all = (double)count;
+	ss_comm_reduce(&none, 0, &s->cell_count_all, 1);
 	s->cells = ss_alloc(count ? count : 1, sizeof *s->cells, "source cells");
 	if (!s->cells)
 		return SS_ERR_FAIL;
@@ -154,9 +157,6 @@ int ss_stepper_add_source(struct ss_stepper *st, const uint8_t *mask,
 		}
 	}
 	s->cell_count = n;
-	double none = 0.0;
-	s->cell_count_all = (double)n;
-	ss_comm_reduce(&none, 0, &s->cell_count_all, 1);
 	s->rate = rate;
 	s->start = start;
 	s->stop = stop;

@@ -14,6 +14,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "sandslide/comm.h"
 #include "sandslide/error.h"
 
 /* The folder of path: "." for a bare name, "/" for a file in the root. */
@@ -46,7 +47,7 @@ int ss_output_check_folder(const char *path, int default_folder)
 	return SS_OK;
 }
 
-int ss_output_make_folder(const char *path)
+static int rank0_make_folder(const char *path)
 {
 	char dir[4096];
 	folder_of(path, dir, sizeof dir);
@@ -55,7 +56,7 @@ int ss_output_make_folder(const char *path)
 	return SS_OK;
 }
 
-int ss_output_check_absent(const char *path, int force, const char *hint)
+static int rank0_check_absent(const char *path, int force, const char *hint)
 {
 	struct stat sb;
 	if (!force && stat(path, &sb) == 0)
@@ -133,7 +134,7 @@ static int refuse_held(const char *path, const char *lock, long holder)
 	                      lock);
 }
 
-int ss_output_claim(struct ss_output_claim **out, const char *path)
+static int rank0_claim(struct ss_output_claim **out, const char *path)
 {
 	*out = NULL;
 	struct ss_output_claim *c = calloc(1, sizeof *c);
@@ -183,4 +184,22 @@ void ss_output_release(struct ss_output_claim *c)
 	close(c->fd);
 	free(c->lock_path);
 	free(c);
+}
+
+/* In a run of several ranks (comm.h) rank 0 alone makes the folder, checks
+ * and claims the output, and every rank learns the outcome. */
+int ss_output_make_folder(const char *path)
+{
+	return ss_comm_agree(ss_comm_rank() == 0 ? rank0_make_folder(path) : SS_OK);
+}
+
+int ss_output_check_absent(const char *path, int force, const char *hint)
+{
+	return ss_comm_agree(ss_comm_rank() == 0 ? rank0_check_absent(path, force, hint) : SS_OK);
+}
+
+int ss_output_claim(struct ss_output_claim **out, const char *path)
+{
+	*out = NULL;
+	return ss_comm_agree(ss_comm_rank() == 0 ? rank0_claim(out, path) : SS_OK);
 }

@@ -3,7 +3,15 @@
  * the reads are in snapshot_read.c.
  *
  * File types are explicit little-endian IEEE (H5T_IEEE_F64LE, H5T_STD_U8LE),
- * memory types native.  Heights are written straight from the halo layout
+ * memory types native.
+ *
+ * In a run of several ranks (make MPI=1, comm.h) every rank opens the one
+ * file through MPI-IO and makes every metadata call (create, extend,
+ * attributes, dimension scales) with the same arguments, as parallel HDF5
+ * requires; each writes its own rows of the grid variables (/height
+ * collectively: a filtered dataset must be), rank 0 the coordinates and the
+ * series.  Rank 0 alone checks the space, renames the file and writes the
+ * sidecar; the outcome is agreed.  Heights are written straight from the halo layout
  * through a memory hyperslab, so no copy of the grid is made.  HDF5's own
  * error stack printing is off: each failure prints one sandslide message.
  */
@@ -21,6 +29,8 @@
 #include <hdf5.h>
 #include <hdf5_hl.h>
 
+#include "base/comm_mpi.h"
+#include "sandslide/comm.h"
 #include "sandslide/error.h"
 #include "io/snapshot_layout.h"
 
@@ -93,6 +103,24 @@ static int attr_units(hid_t obj, const char *units, const char *long_name)
 	return attr_string(obj, "units", units) || attr_string(obj, "long_name", long_name);
 }
 
+/* ---- ranks ----------------------------------------------------------- */
+
+static int is_root(void)
+{
+	return ss_comm_rank() == 0;
+}
+
+/* Raw-data transfer: collective in a parallel file (every rank calls the
+ * write, with its own selection, maybe none); the default otherwise. */
+static hid_t transfer(void)
+{
+	hid_t dxpl = H5Pcreate(H5P_DATASET_XFER);
+#ifdef SS_HAVE_MPI
+	H5Pset_dxpl_mpio(dxpl, H5FD_MPIO_COLLECTIVE);
+#endif
+	return dxpl;
+}
+
 /* ---- creation -------------------------------------------------------- */
 
 /* An extendible 1-D float64 variable along time. */
@@ -125,7 +153,9 @@ static hid_t create_coordinate(hid_t file, const char *name, int n, double origi
 	hid_t space = H5Screate_simple(1, &dim, NULL);
 	hid_t d = H5Dcreate2(file, name, H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT,
 	                     H5P_DEFAULT);
-	int bad = d < 0 || H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v) < 0 ||
+	/* rank 0 writes the values (independently); every rank the attributes */
+	int bad = d < 0 ||
+	          (is_root() && H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v) < 0) ||
 	          attr_units(d, "m", long_name) || attr_string(d, "axis", axis);
 	ss_free(v);
 	H5Sclose(space);
@@ -147,8 +177,9 @@ static hid_t interior_space(const struct ss_grid *g)
 	return m;
 }
 
-/* Rows j0 .. j0 + n - 1 of a (y, x) dataset of nx columns from block, in
- * memory type mem_type; nonzero on failure. */
+/* Rows j0 .. j0 + n - 1 (of the whole grid) of a (y, x) dataset of nx
+ * columns from block, in memory type mem_type; nonzero on failure.  An
+ * independent write of an unfiltered dataset: each rank its own rows. */
 static int write_rows(hid_t dataset, hid_t file_space, int j0, int n, int nx, hid_t mem_type,
                       const void *block)
 {
@@ -177,7 +208,8 @@ static int write_cell_types(hid_t dataset, hid_t file_space, const struct ss_gri
 		for (int j = 0; j < n; j++)
 			ss_cell_types_unpack(cell_types, ss_grid_index(g, 0, j0 + j), (size_t)g->nx,
 			                     block + (size_t)j * g->nx);
-		bad = write_rows(dataset, file_space, j0, n, g->nx, H5T_NATIVE_UINT8, block);
+		bad = write_rows(dataset, file_space, (int)g->offset_j + j0, n, g->nx,
+		                 H5T_NATIVE_UINT8, block);
 	}
 	ss_free(block);
 	return bad;
@@ -188,7 +220,7 @@ static int write_cell_types(hid_t dataset, hid_t file_space, const struct ss_gri
 static int write_bedrock(hid_t file, hid_t x, hid_t y, const struct ss_grid *g,
                          const double *bedrock)
 {
-	hsize_t dims[2] = {(hsize_t)g->ny, (hsize_t)g->nx};
+	hsize_t dims[2] = {(hsize_t)g->global_ny, (hsize_t)g->nx};
 	hid_t space = H5Screate_simple(2, dims, NULL);
 	hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
 	const double fill = NAN;
@@ -206,7 +238,7 @@ static int write_bedrock(hid_t file, hid_t x, hid_t y, const struct ss_grid *g,
 			for (int i = 0; i < g->nx; i++)
 				block[(size_t)j * g->nx + i] = isinf(row[i]) ? NAN : row[i];
 		}
-		bad = write_rows(d, space, j0, n, g->nx, H5T_NATIVE_DOUBLE, block);
+		bad = write_rows(d, space, (int)g->offset_j + j0, n, g->nx, H5T_NATIVE_DOUBLE, block);
 	}
 	ss_free(block);
 	bad = bad || attr_units(d, "m", "non-erodible bedrock under the sand") ||
@@ -226,7 +258,7 @@ static int write_static(struct ss_snapshot *s, const uint8_t *cell_types,
 
 	hid_t x = create_coordinate(f, "x", g->nx, g->origin_x, g->dx,
 	                            "x coordinate of cell centre (west to east)", "X");
-	hid_t y = create_coordinate(f, "y", g->ny, g->origin_y, g->dy,
+	hid_t y = create_coordinate(f, "y", (int)g->global_ny, g->origin_y, g->dy,
 	                            "y coordinate of cell centre (south to north)", "Y");
 	s->time = create_series(f, "time", "s", "simulated time");
 	if (x < 0 || y < 0 || s->time < 0)
@@ -236,10 +268,10 @@ static int write_static(struct ss_snapshot *s, const uint8_t *cell_types,
 	      H5DSset_scale(s->time, "time") < 0;
 
 	/* height (time, y, x) */
-	hsize_t dims[3] = {0, (hsize_t)g->ny, (hsize_t)g->nx};
-	hsize_t maxdims[3] = {H5S_UNLIMITED, (hsize_t)g->ny, (hsize_t)g->nx};
-	hsize_t chunk[3] = {1, (hsize_t)(g->ny < 256 ? g->ny : 256),
-	                    (hsize_t)(g->nx < 256 ? g->nx : 256)};
+	const hsize_t ny = (hsize_t)g->global_ny;
+	hsize_t dims[3] = {0, ny, (hsize_t)g->nx};
+	hsize_t maxdims[3] = {H5S_UNLIMITED, ny, (hsize_t)g->nx};
+	hsize_t chunk[3] = {1, ny < 256 ? ny : 256, (hsize_t)(g->nx < 256 ? g->nx : 256)};
 	hid_t space = H5Screate_simple(3, dims, maxdims);
 	hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
 	H5Pset_chunk(dcpl, 3, chunk);
@@ -258,7 +290,7 @@ static int write_static(struct ss_snapshot *s, const uint8_t *cell_types,
 	      H5DSattach_scale(s->height, y, 1) < 0 || H5DSattach_scale(s->height, x, 2) < 0;
 
 	/* cell_type (y, x) */
-	hsize_t dims2[2] = {(hsize_t)g->ny, (hsize_t)g->nx};
+	hsize_t dims2[2] = {ny, (hsize_t)g->nx};
 	space = H5Screate_simple(2, dims2, NULL);
 	hid_t ct = bad ? -1 : H5Dcreate2(f, "cell_type", H5T_STD_U8LE, space, H5P_DEFAULT,
 	                                 H5P_DEFAULT, H5P_DEFAULT);
@@ -267,6 +299,7 @@ static int write_static(struct ss_snapshot *s, const uint8_t *cell_types,
 	      attr_string(ct, "flag_meanings", "flow wall open") ||
 	      H5DSattach_scale(ct, y, 0) < 0 || H5DSattach_scale(ct, x, 1) < 0;
 	if (!bad) {
+		/* an attribute: every rank writes the same values */
 		const uint8_t flags[3] = {SS_CELL_FLOW, SS_CELL_WALL, SS_CELL_OPEN};
 		hsize_t n = 3;
 		hid_t as = H5Screate_simple(1, &n, NULL);
@@ -334,7 +367,7 @@ int ss_snapshot_destroy(struct ss_snapshot *s)
 	close_handles(s);
 	if (s->file >= 0 && H5Fclose(s->file) < 0)
 		err = s->failed ? SS_ERR_FAIL : ss_error_fail("cannot close '%s'", s->path);
-	if (s->count == 0 && s->partial_path)
+	if (s->count == 0 && s->partial_path && is_root())
 		remove(s->partial_path);   /* never complete: leave nothing */
 	free(s->times);
 	free(s->xmf_path);
@@ -363,6 +396,13 @@ static hid_t writer_access(void)
 		mdc.decr_mode = H5C_decr__off;
 		H5Pset_mdc_config(fapl, &mdc);
 	}
+#ifdef SS_HAVE_MPI
+	/* every rank through MPI-IO; metadata read by one and broadcast, and
+	 * written collectively */
+	H5Pset_fapl_mpio(fapl, ss_comm_mpi(), MPI_INFO_NULL);
+	H5Pset_all_coll_metadata_ops(fapl, 1);
+	H5Pset_coll_metadata_write(fapl, 1);
+#endif
 	return fapl;
 }
 
@@ -422,7 +462,13 @@ static int append_value(hid_t d, long long index, double v)
 	hid_t fs = H5Dget_space(d);
 	hid_t ms = H5Screate_simple(1, &one, NULL);
 	H5Sselect_hyperslab(fs, H5S_SELECT_SET, &start, NULL, &one, NULL);
-	herr_t r = H5Dwrite(d, H5T_NATIVE_DOUBLE, ms, fs, H5P_DEFAULT, &v);
+	if (!is_root()) {   /* rank 0's value (wall_seconds differs) */
+		H5Sselect_none(fs);
+		H5Sselect_none(ms);
+	}
+	hid_t dxpl = transfer();
+	herr_t r = H5Dwrite(d, H5T_NATIVE_DOUBLE, ms, fs, dxpl, &v);
+	H5Pclose(dxpl);
 	H5Sclose(ms);
 	H5Sclose(fs);
 	return r < 0 ? -1 : 0;
@@ -431,6 +477,7 @@ static int append_value(hid_t d, long long index, double v)
 static int write_sidecar(const struct ss_snapshot *s)
 {
 	const struct ss_grid *g = &s->grid;
+	const int ny = (int)g->global_ny;   /* the whole grid's */
 	char tmp[4200];
 	snprintf(tmp, sizeof tmp, "%s.tmp", s->xmf_path);
 	FILE *f = fopen(tmp, "w");
@@ -458,9 +505,9 @@ static int write_sidecar(const struct ss_snapshot *s)
 		           "     <DataItem Format=\"HDF\" NumberType=\"UChar\" Precision=\"1\" "
 		           "Dimensions=\"%d %d\">%s:/cell_type</DataItem>\n"
 		           "    </Attribute>\n   </Grid>\n",
-		        k, s->times[k], g->ny + 1, g->nx + 1, g->origin_y, g->origin_x, g->dy, g->dx,
-		        g->ny, g->nx, k, g->ny, g->nx, s->count, g->ny, g->nx, base,
-		        g->ny, g->nx, base);
+		        k, s->times[k], ny + 1, g->nx + 1, g->origin_y, g->origin_x, g->dy, g->dx,
+		        ny, g->nx, k, ny, g->nx, s->count, ny, g->nx, base,
+		        ny, g->nx, base);
 	}
 	fprintf(f, "  </Grid>\n </Domain>\n</Xdmf>\n");
 	int bad = ferror(f);
@@ -500,31 +547,36 @@ static int write_restart_state(hid_t file, const struct ss_restart_state *r)
  * /height plus room for the metadata.  (Space taken by another process
  * between this check and the flush is not covered.)
  */
-static int check_snapshot_space(struct ss_snapshot *s)
+static int space_verdict(struct ss_snapshot *s)
 {
 	const struct ss_grid *g = &s->grid;
-	void *handle = NULL;
 	struct stat sb;
 	struct statvfs fs;
 	struct rlimit limit;
-	if (H5Fget_vfd_handle(s->file, H5P_DEFAULT, &handle) < 0 || !handle)
-		return 0;                               /* not a plain file: go on */
-	const int fd = *(const int *)handle;
-	if (fstat(fd, &sb) != 0)
+	/* by path: under MPI-IO the file's handle is not a descriptor; until
+	 * snapshot 0 is complete the file is the .partial one */
+	const char *path = s->count == 0 ? s->partial_path : s->path;
+	if (stat(path, &sb) != 0)
 		return 0;
-	const double cy = g->ny < 256 ? g->ny : 256, cx = g->nx < 256 ? g->nx : 256;
-	const double chunks = ceil(g->ny / cy) * ceil(g->nx / cx);
+	const double ny = (double)g->global_ny;
+	const double cy = ny < 256 ? ny : 256, cx = g->nx < 256 ? g->nx : 256;
+	const double chunks = ceil(ny / cy) * ceil(g->nx / cx);
 	const double bytes = chunks * cy * cx * sizeof(double) + (256 << 10);
 	if (getrlimit(RLIMIT_FSIZE, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY &&
-	    (double)sb.st_size + bytes > (double)limit.rlim_cur) {
-		errno = EFBIG;
-		return -1;
-	}
-	if (fstatvfs(fd, &fs) == 0 && (double)fs.f_bavail * (double)fs.f_frsize < bytes) {
-		errno = ENOSPC;
-		return -1;
-	}
+	    (double)sb.st_size + bytes > (double)limit.rlim_cur)
+		return EFBIG;
+	if (statvfs(path, &fs) == 0 && (double)fs.f_bavail * (double)fs.f_frsize < bytes)
+		return ENOSPC;
 	return 0;
+}
+
+/* The verdict of rank 0, for every rank: they skip or write together. */
+static int check_snapshot_space(struct ss_snapshot *s)
+{
+	int verdict = is_root() ? space_verdict(s) : 0;
+	ss_comm_broadcast(&verdict, sizeof verdict, 0);
+	errno = verdict;
+	return verdict ? -1 : 0;
 }
 
 int ss_snapshot_append(struct ss_snapshot *s, double time_s, const double *height,
@@ -540,16 +592,19 @@ int ss_snapshot_append(struct ss_snapshot *s, double time_s, const double *heigh
 		                     "snapshots before it are complete", k, time_s, s->path,
 		                     strerror(e), k);
 	}
-	hsize_t dims[3] = {(hsize_t)k + 1, (hsize_t)g->ny, (hsize_t)g->nx};
-	hsize_t start[3] = {(hsize_t)k, 0, 0};
+	hsize_t dims[3] = {(hsize_t)k + 1, (hsize_t)g->global_ny, (hsize_t)g->nx};
+	hsize_t start[3] = {(hsize_t)k, (hsize_t)g->offset_j, 0};
 	hsize_t count[3] = {1, (hsize_t)g->ny, (hsize_t)g->nx};
 
 	if (H5Dset_extent(s->height, dims) < 0)
 		goto fail;
+	/* this rank's rows, all ranks in one collective write */
 	hid_t fs = H5Dget_space(s->height);
 	H5Sselect_hyperslab(fs, H5S_SELECT_SET, start, NULL, count, NULL);
 	hid_t ms = interior_space(g);
-	herr_t r = H5Dwrite(s->height, H5T_NATIVE_DOUBLE, ms, fs, H5P_DEFAULT, height);
+	hid_t dxpl = transfer();
+	herr_t r = H5Dwrite(s->height, H5T_NATIVE_DOUBLE, ms, fs, dxpl, height);
+	H5Pclose(dxpl);
 	H5Sclose(ms);
 	H5Sclose(fs);
 	if (r < 0 || append_value(s->time, k, time_s))
@@ -564,8 +619,12 @@ int ss_snapshot_append(struct ss_snapshot *s, double time_s, const double *heigh
 	/* the file takes its name only once it holds a complete snapshot, so
 	 * a run killed while it starts leaves no half-written file (and an
 	 * existing file of that name intact) */
-	if (k == 0 && rename(s->partial_path, s->path) != 0)
+	int renamed = k > 0 || !is_root() || rename(s->partial_path, s->path) == 0 ? 0 : errno;
+	ss_comm_broadcast(&renamed, sizeof renamed, 0);
+	if (renamed) {
+		errno = renamed;
 		goto fail;
+	}
 
 	if (k + 1 > s->times_cap) {
 		long long cap = s->times_cap ? 2 * s->times_cap : 64;
@@ -577,7 +636,7 @@ int ss_snapshot_append(struct ss_snapshot *s, double time_s, const double *heigh
 	}
 	s->times[k] = time_s;
 	s->count = k + 1;
-	if (write_sidecar(s))
+	if (is_root() && write_sidecar(s))
 		return ss_error_fail("cannot write the XDMF sidecar '%s': %s", s->xmf_path,
 		                     strerror(errno));
 	return SS_OK;
@@ -609,9 +668,9 @@ static int check_append(struct ss_snapshot *s, const char *path, const struct ss
 	int err = ss_snapshot_file_open(&f, path);
 	if (!err)
 		err = ss_snapshot_file_summary(&f, &sum);
-	if (!err && (f.nx != g->nx || f.ny != g->ny || f.count < 1))
+	if (!err && (f.nx != g->global_nx || f.ny != g->global_ny || f.count < 1))
 		err = ss_error_input("cannot open '%s' to continue it: not a sandslide output of "
-		                     "this %d x %d grid", path, g->nx, g->ny);
+		                     "this %lld x %lld grid", path, g->global_nx, g->global_ny);
 	if (!err) {
 		s->count = f.count;
 		s->times_cap = f.count + 64;

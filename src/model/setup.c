@@ -6,6 +6,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "sandslide/comm.h"
 #include "sandslide/dem.h"
 #include "sandslide/error.h"
 #include "sandslide/shape.h"
@@ -18,10 +19,10 @@ static int initial_heights(const struct ss_case *c, struct ss_stepper *st)
 	if (c->initial == SS_INITIAL_FILE) {
 		struct ss_raster r;
 		int err = ss_dem_read(c->initial_file, c->initial_where, NULL, &r);
-		if (!err && (r.nx != g->nx || r.ny != g->ny))
+		if (!err && (r.nx != g->global_nx || r.ny != g->global_ny))
 			err = ss_error_input("%s: initial file '%s' is %d x %d cells: expected the "
-			                     "grid's %d x %d (nx x ny)", c->initial_where,
-			                     c->initial_file, r.nx, r.ny, g->nx, g->ny);
+			                     "grid's %lld x %lld (nx x ny)", c->initial_where,
+			                     c->initial_file, r.nx, r.ny, g->global_nx, g->global_ny);
 		if (!err && !isnan(r.cellsize) &&
 		    (fabs(r.cellsize - g->dx) > 1e-9 * g->dx || fabs(r.cellsize - g->dy) > 1e-9 * g->dy))
 			err = ss_error_input("%s: initial file '%s' has cellsize %g m: expected the "
@@ -31,9 +32,10 @@ static int initial_heights(const struct ss_case *c, struct ss_stepper *st)
 			ss_raster_release(&r);
 			return err;
 		}
+		/* every rank reads the file and keeps its rows */
 		for (int j = 0; j < g->ny; j++) {
 			for (int i = 0; i < g->nx; i++) {
-				const size_t m = (size_t)j * g->nx + i;
+				const size_t m = (size_t)(g->offset_j + j) * g->nx + i;
 				const ptrdiff_t k = ss_grid_index(g, i, j);
 				st->height[k] = r.values[m];
 				if (r.nodata && r.nodata[m] &&
@@ -70,18 +72,18 @@ static int load_bedrock(const struct ss_case *c, struct ss_stepper *st)
 	const struct ss_grid *g = &st->grid;
 	struct ss_raster r;
 	int err = ss_dem_read(c->bedrock_file, c->bedrock_where, NULL, &r);
-	if (!err && (r.nx != g->nx || r.ny != g->ny))
+	if (!err && (r.nx != g->global_nx || r.ny != g->global_ny))
 		err = ss_error_input("%s: bedrock '%s' is %d x %d cells: expected the grid's "
-		                     "%d x %d (nx x ny)", c->bedrock_where, c->bedrock_file,
-		                     r.nx, r.ny, g->nx, g->ny);
+		                     "%lld x %lld (nx x ny)", c->bedrock_where, c->bedrock_file,
+		                     r.nx, r.ny, g->global_nx, g->global_ny);
 	for (size_t m = 0; !err && r.nodata && m < (size_t)r.nx * r.ny; m++)
 		if (r.nodata[m])
 			err = ss_error_input("%s: bedrock '%s' has no data at cell (%d, %d): the "
 			                     "bedrock needs a value in every cell", c->bedrock_where,
 			                     c->bedrock_file, (int)(m % (size_t)r.nx),
 			                     (int)(m / (size_t)r.nx));
-	if (!err)
-		err = ss_stepper_set_bedrock(st, r.values);
+	if (!err)   /* this rank's rows */
+		err = ss_stepper_set_bedrock(st, r.values + (size_t)g->offset_j * g->nx);
 	ss_raster_release(&r);
 	return err;
 }
@@ -99,7 +101,9 @@ int ss_setup_stepper(const struct ss_case *c, int tile_nx, int tile_ny,
 		return ss_error_input("%s: [time] integrator = rkl2 cannot be used with a "
 		                      "bedrock: its stages cannot keep the sand above the rock "
 		                      "(use euler or auto)", c->bedrock_where);
-	const double need = ss_stepper_memory_bytes(&g, integrator);
+	/* the memory of one rank's slab, times the ranks on this node */
+	const double need = ss_stepper_memory_bytes(&g, integrator) / ss_comm_size() *
+	                    ss_comm_node_ranks();
 	const double have = ss_memory_available_bytes();
 	if (!err && have > 0.0 && need > have) {
 		char nb[32], hb[32];
@@ -112,9 +116,11 @@ int ss_setup_stepper(const struct ss_case *c, int tile_nx, int tile_ny,
 		err = ss_closure_init(&closure, c->closure, c->repose_angle_deg, c->gamma, c->nu);
 	if (!err)
 		err = ss_stepper_init(st, &g, &closure, &c->boundary, c->cfl, tile_nx, tile_ny);
-	if (err)
+	if ((err = ss_comm_agree(err)))
 		return err;
 	st->kernel = kernel;
+	/* from here on the grid is this rank's slab (stepper.h) */
+	g = st->grid;
 	st->integrator = integrator;
 	st->rkl2_max_stages = c->rkl2_max_stages;
 	st->rkl2_tol = c->rkl2_tol;
@@ -135,7 +141,9 @@ int ss_setup_stepper(const struct ss_case *c, int tile_nx, int tile_ny,
 			long long covered = 0;
 			memset(mask, 0, (size_t)g.nx * (size_t)g.ny);
 			err = ss_shape_rasterize(&r->shape, &g, mask, &covered);
-			if (!err && covered == 0)
+			double covered_all = (double)covered, none = 0.0;
+			ss_comm_reduce(&none, 0, &covered_all, 1);
+			if (!err && covered_all == 0)
 				err = ss_error_input("%s: [%s %s] covers no cell centre: enlarge it or "
 				                     "refine the grid (dx = %g m, dy = %g m)",
 				                     r->shape.where, role_names[r->role], r->name,
@@ -160,6 +168,9 @@ int ss_setup_stepper(const struct ss_case *c, int tile_nx, int tile_ny,
 			err = load_bedrock(c, st);
 	}
 	ss_free(mask);
+	/* failures of one rank (a file, an allocation) before the collective
+	 * calls of prepare */
+	err = ss_comm_agree(err);
 	if (!err)
 		err = ss_stepper_prepare(st);
 	if (err)

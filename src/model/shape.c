@@ -51,11 +51,12 @@ static int read_mask(const struct ss_shape *s, const struct ss_grid *g, uint8_t 
 	if (!png_image_begin_read_from_file(&image, s->mask_path))
 		return ss_error_input("%s: mask '%s' is not a readable PNG: %s", s->where,
 		                      s->mask_path, image.message);
-	if (image.width != (png_uint_32)g->nx || image.height != (png_uint_32)g->ny) {
+	if (image.width != (png_uint_32)g->global_nx || image.height != (png_uint_32)g->global_ny) {
 		png_image_free(&image);
 		return ss_error_input("%s: mask '%s' is %u x %u pixels: expected the grid's "
-		                      "%d x %d (nx x ny)", s->where, s->mask_path,
-		                      (unsigned)image.width, (unsigned)image.height, g->nx, g->ny);
+		                      "%lld x %lld (nx x ny)", s->where, s->mask_path,
+		                      (unsigned)image.width, (unsigned)image.height,
+		                      g->global_nx, g->global_ny);
 	}
 	image.format = PNG_FORMAT_GRAY;
 	uint8_t *pixels = ss_alloc(PNG_IMAGE_SIZE(image), 1, "mask pixels");
@@ -68,8 +69,10 @@ static int read_mask(const struct ss_shape *s, const struct ss_grid *g, uint8_t 
 		return ss_error_input("%s: cannot decode mask '%s': %s", s->where,
 		                      s->mask_path, image.message);
 	}
+	/* the image's top row is the grid's north row; a block (a rank's
+	 * slab, grid.h) takes its own rows */
 	for (int j = 0; j < g->ny; j++) {
-		const uint8_t *row = pixels + (size_t)(g->ny - 1 - j) * g->nx;
+		const uint8_t *row = pixels + (size_t)(g->global_ny - 1 - (g->offset_j + j)) * g->nx;
 		for (int i = 0; i < g->nx; i++) {
 			if (row[i]) {
 				mask[(size_t)j * g->nx + i] = 1;
