@@ -36,8 +36,8 @@ int ss_drive_claim(struct ss_drive *d, const char *output, int make_folder, int 
 {
 	snprintf(d->output, sizeof d->output, "%s", output);
 	int err = make_folder ? ss_output_make_folder(output) : SS_OK;
-	if (!err && !d->claim)
-		err = ss_output_claim(&d->claim, output);
+	if (!err && !d->claimed)
+		d->claimed = (err = ss_output_claim(&d->claim, output)) == SS_OK;
 	if (!err && !appending)
 		err = ss_output_check_absent(output, force, hint);
 	return err;
@@ -281,5 +281,6 @@ int ss_drive_finish(struct ss_drive *d, int err)
 	d->snapshot = NULL;
 	ss_output_release(d->claim);
 	d->claim = NULL;
+	d->claimed = 0;
 	return err;
 }

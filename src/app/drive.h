@@ -77,7 +77,8 @@ struct ss_drive {
 
 	/* the driver's own */
 	char output[4096];
-	struct ss_output_claim *claim;
+	struct ss_output_claim *claim;  /* rank 0's (comm.h) */
+	int claimed;                    /* the claim is held, on every rank */
 	struct ss_snapshot *snapshot;   /* the series; NULL: none */
 	double seconds_output;          /* writing snapshots, s */
 	double time_start;              /* of the loop, s */

@@ -264,8 +264,9 @@ int ss_run_case(const struct ss_run_options *o, struct ss_run_summary *summary)
 	/* a restart reads the file it will write: claimed first, as a live run
 	 * may be writing it (a missing file is left to the reading to report) */
 	enum ss_drive_end end = SS_DRIVE_END;
-	int err = o->restart && access(o->restart, F_OK) == 0
-	          ? ss_output_claim(&r.drive.claim, o->restart) : SS_OK;
+	const int exists = o->restart && access(o->restart, F_OK) == 0;
+	int err = exists ? ss_output_claim(&r.drive.claim, o->restart) : SS_OK;
+	r.drive.claimed = exists && !err;
 	if (!err)
 		err = resolve(&r);
 	if (!err)
