@@ -86,6 +86,10 @@ void ss_comm_fold_finish(double *running, int n);
  * `bytes` from each rank (which may differ); `all` may be NULL elsewhere. */
 void ss_comm_gather_rows(const void *mine, size_t bytes, void *all);
 
+/* Seconds this rank has spent in the calls above (waiting for the other
+ * ranks included): the communication share of a run. */
+double ss_comm_seconds(void);
+
 /* bytes of buf from rank `root` to every rank. */
 void ss_comm_broadcast(void *buf, size_t bytes, int root);
 void ss_comm_barrier(void);

@@ -80,6 +80,7 @@ struct ss_run_summary {
 	double measure_seconds;      /* measuring the largest slope */
 	double sweep_seconds;        /* sweeping */
 	double output_seconds;       /* writing snapshots */
+	double comm_seconds;         /* in MPI calls, rank 0 (comm.h) */
 	int threads;                 /* OpenMP threads of each rank */
 	int ranks;                   /* MPI ranks (comm.h) */
 };

@@ -249,6 +249,7 @@ static void summarise(const struct run *r, enum ss_drive_end end, struct ss_run_
 	s->measure_seconds = st->seconds_measure;
 	s->sweep_seconds = st->seconds_sweep;
 	s->output_seconds = r->drive.seconds_output;
+	s->comm_seconds = ss_comm_seconds();
 	s->threads = ss_parallel_max_threads();
 }
 

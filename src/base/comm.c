@@ -12,6 +12,15 @@
 #include <string.h>
 
 #include "sandslide/error.h"
+#include "sandslide/parallel.h"
+
+/* Seconds spent in MPI calls (waiting for other ranks included). */
+static double comm_seconds;
+
+double ss_comm_seconds(void)
+{
+	return comm_seconds;
+}
 
 #ifdef SS_HAVE_MPI
 #include <mpi.h>
@@ -105,8 +114,8 @@ const char *ss_comm_library(void)
 	return library[0] ? library : "MPI";
 }
 
-void ss_comm_exchange(int south, int north, const void *send_south, void *recv_south,
-                      const void *send_north, void *recv_north, size_t bytes)
+static void exchange(int south, int north, const void *send_south, void *recv_south,
+                     const void *send_north, void *recv_north, size_t bytes)
 {
 	if (comm_size == 1)
 		return;
@@ -128,7 +137,7 @@ void ss_comm_exchange(int south, int north, const void *send_south, void *recv_s
 	MPI_Waitall(r, req, MPI_STATUSES_IGNORE);
 }
 
-void ss_comm_reduce(double *max, int n_max, double *sum, int n_sum)
+static void reduce(double *max, int n_max, double *sum, int n_sum)
 {
 	if (n_max > SS_COMM_REDUCE_MAX || n_sum > SS_COMM_REDUCE_MAX)
 		SS_BUG("ss_comm_reduce of %d maxima and %d sums", n_max, n_sum);
@@ -147,14 +156,14 @@ void ss_comm_reduce(double *max, int n_max, double *sum, int n_sum)
 	memcpy(sum, b.sum, (size_t)n_sum * sizeof *sum);
 }
 
-void ss_comm_fold_start(double *running, int n)
+static void fold_start(double *running, int n)
 {
 	if (comm_size > 1 && comm_rank > 0)
 		MPI_Recv(running, n, MPI_DOUBLE, comm_rank - 1, 3, MPI_COMM_WORLD,
 		         MPI_STATUS_IGNORE);
 }
 
-void ss_comm_fold_finish(double *running, int n)
+static void fold_finish(double *running, int n)
 {
 	if (comm_size == 1)
 		return;
@@ -163,7 +172,7 @@ void ss_comm_fold_finish(double *running, int n)
 	MPI_Bcast(running, n, MPI_DOUBLE, comm_size - 1, MPI_COMM_WORLD);
 }
 
-void ss_comm_gather_rows(const void *mine, size_t bytes, void *all)
+static void gather_rows(const void *mine, size_t bytes, void *all)
 {
 	/* in pieces of at most 1 GiB: an MPI count is an int */
 	const size_t piece = (size_t)1 << 30;
@@ -199,7 +208,7 @@ void ss_comm_gather_rows(const void *mine, size_t bytes, void *all)
 	}
 }
 
-void ss_comm_broadcast(void *buf, size_t bytes, int root)
+static void broadcast(void *buf, size_t bytes, int root)
 {
 	if (comm_size == 1)
 		return;
@@ -216,7 +225,7 @@ void ss_comm_barrier(void)
 		MPI_Barrier(MPI_COMM_WORLD);
 }
 
-int ss_comm_agree(int status)
+static int agree(int status)
 {
 	if (comm_size == 1)
 		return status;
@@ -239,6 +248,52 @@ int ss_comm_agree(int status)
 				ss_error_print(message);
 		}
 	}
+	return agreed;
+}
+
+/* The calls above, timed (ss_comm_seconds). */
+#define TIMED(call)                                                   \
+	do {                                                          \
+		const double t0_ = ss_parallel_wall_seconds();        \
+		call;                                                 \
+		comm_seconds += ss_parallel_wall_seconds() - t0_;     \
+	} while (0)
+
+void ss_comm_exchange(int south, int north, const void *send_south, void *recv_south,
+                      const void *send_north, void *recv_north, size_t bytes)
+{
+	TIMED(exchange(south, north, send_south, recv_south, send_north, recv_north, bytes));
+}
+
+void ss_comm_reduce(double *max, int n_max, double *sum, int n_sum)
+{
+	TIMED(reduce(max, n_max, sum, n_sum));
+}
+
+void ss_comm_fold_start(double *running, int n)
+{
+	TIMED(fold_start(running, n));
+}
+
+void ss_comm_fold_finish(double *running, int n)
+{
+	TIMED(fold_finish(running, n));
+}
+
+void ss_comm_gather_rows(const void *mine, size_t bytes, void *all)
+{
+	TIMED(gather_rows(mine, bytes, all));
+}
+
+void ss_comm_broadcast(void *buf, size_t bytes, int root)
+{
+	TIMED(broadcast(buf, bytes, root));
+}
+
+int ss_comm_agree(int status)
+{
+	int agreed;
+	TIMED(agreed = agree(status));
 	return agreed;
 }
 

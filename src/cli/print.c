@@ -75,12 +75,15 @@ void cli_print_run_end(const struct ss_run_summary *s, int quiet)
 	       s->time, s->steps, strcmp(s->integrator, "rkl2") ? "steps (euler)"
 	       : "super-steps (rkl2)", s->end == SS_RUN_STEADY ? " (steady)"
 	       : s->end == SS_RUN_NOT_STEADY ? " (not steady by max_time)" : "");
-	char ranks[48] = "";
-	if (s->ranks > 1)
+	/* with ranks: rank 0's phases, and its time in MPI calls */
+	char ranks[48] = "", mpi[48] = "";
+	if (s->ranks > 1) {
 		snprintf(ranks, sizeof ranks, "%d ranks x ", s->ranks);
-	printf("wall %.3f s: slope %.3f s, sweep %.3f s, output %.3f s; %lld stencil "
+		snprintf(mpi, sizeof mpi, ", mpi %.3f s", s->comm_seconds);
+	}
+	printf("wall %.3f s: slope %.3f s, sweep %.3f s, output %.3f s%s; %lld stencil "
 	       "evaluations, %.3g cell-updates/s on %s%d threads; %.0f B per cell\n",
-	       s->wall_seconds, s->measure_seconds, s->sweep_seconds, s->output_seconds,
+	       s->wall_seconds, s->measure_seconds, s->sweep_seconds, s->output_seconds, mpi,
 	       s->evaluations, (double)s->evaluations_here * s->cells /
 	       fmax(s->measure_seconds + s->sweep_seconds, 1e-9), ranks, s->threads,
 	       s->bytes_per_cell);

@@ -593,7 +593,6 @@ static void euler_step(struct ss_stepper *st, double dt)
 		                                  st->sources_on ? st->source_rate : NULL,
 		                                  st->bedrock, st->cell_types, st->height,
 		                                  st->open_flux);
-		wake_across(st);
 	} else {
 		if (st->bedrock)
 			ss_sweep_limit(g, &st->tiling, dt, st->height, st->bedrock,
@@ -603,6 +602,7 @@ static void euler_step(struct ss_stepper *st, double dt)
 		                               st->cell_type_bytes, st->height);
 	}
 	st->seconds_sweep += ss_parallel_wall_seconds() - t0;
+	wake_across(st);
 	add_compensated(&st->outflow_sum, &st->outflow_carry, dt * outflow_rate(st));
 	add_compensated(&st->inflow_sum, &st->inflow_carry, dt * st->source_volume_rate);
 	st->evaluations++;
@@ -625,13 +625,13 @@ static double rkl2_pass(struct ss_stepper *st, const struct ss_sweep_stage *stag
 	if (st->kernel == SS_KERNEL_FAST) {
 		change = ss_sweep_fast_stage(&st->fast, g, &st->face_rule, stage, last, src,
 		                             st->cell_types, st->height, st->open_flux);
-		if (!stage->estimate_only)
-			wake_across(st);
 	} else {
 		change = ss_sweep_stage_update(g, &st->tiling, stage, st->flux_x, st->flux_y, src,
 		                               st->cell_type_bytes, st->height);
 	}
 	st->seconds_sweep += ss_parallel_wall_seconds() - t1;
+	if (!stage->estimate_only)
+		wake_across(st);
 	st->evaluations++;
 	double max[2] = {change, stage->estimate_only ? *stage->estimate : 0.0};
 	ss_comm_reduce(max, 2, NULL, 0);
