@@ -1,0 +1,803 @@
+"""Distributed runs (issue 14): `mpirun -np N build-mpi/sandslide` against the
+serial build/sandslide, bit for bit.
+
+Skipped unless the MPI build exists: SANDSLIDE_MPI (default
+build-mpi/sandslide of this checkout, `make MPI=1`; set but empty: skipped)
+and Open MPI's mpirun (MPIRUN, default mpirun.openmpi).  The serial binary
+is conftest's SANDSLIDE.
+
+  bit identity     six small cases (64 x 45..48 cells, tiles 16 x 8: six tile
+                   rows, the last one short when ny is 45 or 47) covering wall,
+                   open and periodic sides (periodic y across ranks, periodic
+                   in both axes), interior walls and an open drain, two
+                   sources switching on and off, a bedrock (Euler), both
+                   integrators; under np = 1, 2, 3, 4 and the MPI binary
+                   without mpirun against the serial build; the reference
+                   kernel under np = 2 and 4.  Compared: every dataset
+                   (/height, /time, x, y, cell_type, bedrock when present, every
+                   diagnostic series with active_fraction, but not
+                   wall_seconds), shapes and types, the attributes of every
+                   dataset (the dimension-scale references left out), every
+                   root attribute but history (restart_state included), and
+                   the XDMF sidecar
+  relax            np = 3 equal to serial: .asc in and .asc out (the bytes,
+                   and the --report but wall_seconds), .asc in and .h5 out
+  restart          np = 2 cut by a file-size limit (exit 1, one message, the
+                   snapshots before it complete), continued by run --restart
+                   under np = 3 to the end: every snapshot and the final
+                   restart_state are those of the serial run never cut
+  SIGTERM          to mpirun -np 3 mid-run: one message from rank 0, a
+                   readable file (h5py, ncdump) ending with a complete
+                   snapshot; run --restart under np = 2 from it, interrupted
+                   again: every snapshot on the output times has the serial
+                   run's bits
+  killed job       SIGKILL to every process of the job (mpirun puts each rank
+                   in its own process group, so the test kills the session)
+                   leaves a file that h5py and ncdump -h read, with every
+                   snapshot seen before the kill present and equal to the
+                   serial run
+  ncdump           reads the header and the data of an np = 3 file; its
+                   summary is printed once
+  refusals         more ranks than tile rows: exit 2, one message naming both
+                   numbers, no output file
+  version          --version of the MPI binary names MPI, printed once under
+                   mpirun -np 2
+
+Every run gets --threads 1 and --bind-to none, and the Open MPI settings of
+../shared/notes/mpi.md section 2 (root, oversubscription of 2 cores,
+yielding when idle, shared memory only).  A run that hangs (a deadlock) is
+killed, all its processes (and what they leave in /dev/shm and mpirun's
+session folder), after 60 s and fails the test.  About 60 mpirun starts:
+31 s on 2 busy cores.
+"""
+import glob
+import json
+import os
+import re
+import shutil
+import signal
+import subprocess
+import tempfile
+import time
+
+import numpy as np
+import pytest
+
+import conftest
+from conftest import ROOT, SANDSLIDE, h5open, same_bits, wait_for
+
+SANDSLIDE_MPI = os.environ.get("SANDSLIDE_MPI", os.path.join(ROOT, "build-mpi", "sandslide"))
+MPIRUN = os.environ.get("MPIRUN") or shutil.which("mpirun.openmpi") or shutil.which("mpirun")
+
+pytestmark = [
+    # SANDSLIDE_MPI= (empty): not here; `make MPI=1 test-mpi` runs these
+    pytest.mark.skipif(SANDSLIDE_MPI == "", reason="SANDSLIDE_MPI is empty: the distributed "
+                       "tests are make MPI=1 test-mpi"),
+    pytest.mark.skipif(not (os.path.isfile(SANDSLIDE_MPI) and os.access(SANDSLIDE_MPI, os.X_OK)),
+                       reason=f"no MPI build at {SANDSLIDE_MPI} "
+                              "(make MPI=1, or set SANDSLIDE_MPI)"),
+    pytest.mark.skipif(MPIRUN is None, reason="mpirun not found (Debian package openmpi-bin)"),
+]
+
+# Open MPI as root on a small machine (notes/mpi.md section 2)
+MPI_ENV = dict(
+    os.environ,
+    OMPI_ALLOW_RUN_AS_ROOT="1",
+    OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+    OMPI_MCA_rmaps_base_oversubscribe="1",
+    OMPI_MCA_mpi_yield_when_idle="1",
+    OMPI_MCA_btl_vader_single_copy_mechanism="none",
+    OMPI_MCA_pml="ob1",
+    OMPI_MCA_btl="self,vader",
+    OMPI_MCA_btl_base_warn_component_unused="0",
+    OMP_NUM_THREADS="1",
+)
+
+TILE = "16x8"        # 64 x 48 cells: 4 x 6 tiles
+TILE_ROWS = 6        # for every case below (ny = 45 .. 48)
+PHYSICAL = ["volume", "inflow", "outflow", "max_height", "max_slope_deg", "steps",
+            "stencil_evaluations"]
+
+
+# ---- running ----------------------------------------------------------------------
+
+
+def session_processes(sid):
+    """Pids of the processes of session sid (mpirun's, as it was started with
+    start_new_session): mpirun and every rank, whatever their process group."""
+    pids = []
+    for d in os.listdir("/proc"):
+        if not d.isdigit():
+            continue
+        try:
+            with open(f"/proc/{d}/stat") as f:
+                stat = f.read()
+        except OSError:
+            continue
+        fields = stat[stat.rindex(")") + 2:].split()
+        if int(fields[3]) == sid and fields[0] != "Z":   # a zombie is gone, but unreaped
+            pids.append(int(d))
+    return pids
+
+
+def shared_memory_of(sid):
+    """The /dev/shm files (Open MPI's vader segments) that the processes of
+    session sid map."""
+    files = set()
+    for pid in session_processes(sid):
+        try:
+            with open(f"/proc/{pid}/maps") as f:
+                for line in f:
+                    fields = line.split(maxsplit=5)
+                    if len(fields) == 6 and fields[5].startswith("/dev/shm/"):
+                        files.add(fields[5].strip().replace(" (deleted)", ""))
+        except OSError:
+            pass
+    return files
+
+
+def remove_leftovers(mpirun_pid, files):
+    """What a job that did not end on its own leaves: its shared-memory
+    segments (4 MiB a rank) and mpirun's session folder."""
+    for path in files:
+        try:
+            os.unlink(path)
+        except OSError:
+            pass
+    for d in glob.glob(os.path.join(tempfile.gettempdir(), "ompi.*", f"pid.{mpirun_pid}")):
+        shutil.rmtree(d, ignore_errors=True)
+
+
+def kill_session(sid):
+    """SIGKILL every process of session sid, until none is left, then remove
+    what they leave behind."""
+    files = shared_memory_of(sid)
+    deadline = time.monotonic() + 10
+    while time.monotonic() < deadline:
+        pids = session_processes(sid)
+        if not pids:
+            remove_leftovers(sid, files)
+            return
+        for pid in pids:
+            try:
+                os.kill(pid, signal.SIGKILL)
+            except ProcessLookupError:
+                pass
+        time.sleep(0.02)
+    raise AssertionError(f"processes {session_processes(sid)} of the killed job survive")
+
+
+def with_threads(args):
+    args = [str(a) for a in args]
+    return args + ["--threads", "1"] if args and args[0] in ("run", "relax") else args
+
+
+def mpi_command(np_, args):
+    """mpirun -np np_ ... sandslide args; np_ None: the MPI binary alone."""
+    if np_ is None:
+        return [SANDSLIDE_MPI] + with_threads(args)
+    return [MPIRUN, "-np", str(np_), "--bind-to", "none", SANDSLIDE_MPI] + with_threads(args)
+
+
+def start_mpi(np_, args, cwd):
+    """Start a distributed run in its own session (see kill_session)."""
+    return subprocess.Popen(mpi_command(np_, args), cwd=cwd, env=MPI_ENV, text=True,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            stdin=subprocess.DEVNULL, start_new_session=True)
+
+
+def finish(p, what, timeout):
+    """Wait for p; a run still going after timeout seconds is killed, all its
+    processes, and fails the test (a deadlock, most likely)."""
+    try:
+        out, err = p.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        kill_session(p.pid)
+        out, err = p.communicate()
+        raise AssertionError(f"{what} still running after {timeout} s (a deadlock?), killed\n"
+                             f"stdout:\n{out}\nstderr:\n{err}")
+    finally:
+        kill_session(p.pid)   # nothing of the job may outlive it
+    return subprocess.CompletedProcess(p.args, p.returncode, out, err)
+
+
+def mpi_run(np_, args, cwd, timeout=60):
+    what = " ".join(mpi_command(np_, args))
+    return finish(start_mpi(np_, args, cwd), what, timeout)
+
+
+def mpi_run_ok(np_, args, cwd, timeout=60):
+    r = mpi_run(np_, args, cwd, timeout)
+    assert r.returncode == 0, (f"{' '.join(r.args)} exited {r.returncode}\n"
+                               f"stdout:\n{r.stdout}\nstderr:\n{r.stderr}")
+    return r
+
+
+def serial_run_ok(args, cwd):
+    return conftest.run_ok(with_threads(args), cwd=cwd)
+
+
+def np_label(np_):
+    return "the MPI binary without mpirun" if np_ is None else f"mpirun -np {np_}"
+
+
+# ---- cases --------------------------------------------------------------------------
+
+CONE = "type = cone\ncenter = 1.2 1.2\nradius = 0.35\nangle = 50\nheight = 0\n"
+ON_BEDROCK = "type = file\nfile = start.asc\nbedrock = rock.asc\n"
+
+
+def case_text(ny=48, integrator="euler", sides=("wall", "open", "open", "wall"), end=4.0,
+              every=0.25, initial=CONE):
+    """64 x ny cells of 5 cm: a cone of sand on rows 17 .. 30 (np = 2 splits
+    it at row 24), a wall pillar, a wall bar on rows 31 and 32 (np = 3 and 4
+    split it), an open drain in the cone on rows 22 .. 24, a source in the
+    south-west corner (on until end / 2: it wraps round periodic sides) and
+    one near the north-east corner on rows 40 .. 43 (np = 4 splits it; from
+    end / 4 to 3 end / 4).  Sides west, east, south, north."""
+    w, e, s, n = sides
+    return f"""\
+# tests/cli/test_mpi.py
+[grid]
+nx = 64
+ny = {ny}
+dx = 0.05
+origin = 0 0
+
+[model]
+closure = coulomb
+repose_angle = 35
+nu = 0.05
+
+[time]
+integrator = {integrator}
+end = {end!r}
+output_every = {every!r}
+
+[boundary]
+west = {w}
+east = {e}
+south = {s}
+north = {n}
+open_level = 0
+
+[initial]
+{initial}
+[wall pillar]
+disk = 2.2 0.9 0.15
+
+[wall bar]
+rect = 1.9 1.55 2.6 1.65
+
+[open drain]
+rect = 1.5 1.1 1.65 1.25
+
+[source corner]
+rect = 0 0 0.3 0.3
+rate = 0.05
+start = 0
+stop = {end / 2!r}
+
+[source north]
+disk = 3.05 2.1 0.1
+rate = 0.1
+start = {end / 4!r}
+stop = {3 * end / 4!r}
+"""
+
+
+CASES = {
+    # sides: west, east, south, north
+    "mixed-euler": dict(integrator="euler"),
+    "mixed-rkl2": dict(integrator="rkl2"),
+    "periodic-y-rkl2": dict(integrator="rkl2", ny=45,
+                            sides=("wall", "open", "periodic", "periodic")),
+    "periodic-x-euler": dict(ny=47, sides=("periodic", "periodic", "open", "wall")),
+    "periodic-xy-euler": dict(sides=("periodic",) * 4),
+    "bedrock-euler": dict(ny=47, sides=("open", "wall", "wall", "open"), initial=ON_BEDROCK),
+    # cut by a file-size limit: about 4800 steps, 301 snapshots of 24 kB
+    "long-euler": dict(end=60.0, every=0.2),
+    # interrupted and killed: about 48000 steps, several seconds under mpirun
+    # (mpirun passes SIGTERM on to the ranks only after 1 s); a snapshot
+    # every 160 steps
+    "signal-euler": dict(end=600.0, every=2.0),
+}
+BIT_CASES = [c for c in CASES if c not in ("long-euler", "signal-euler")]
+
+
+def asc_text(h, dx=0.05):
+    ny, nx = h.shape
+    rows = "\n".join(" ".join(repr(float(v)) for v in h[j]) for j in range(ny - 1, -1, -1))
+    return f"ncols {nx}\nnrows {ny}\nxllcorner 0\nyllcorner 0\ncellsize {dx!r}\n{rows}\n"
+
+
+def write_case(d, name):
+    """case.ini of CASES[name] in folder d, with its rasters."""
+    spec = CASES[name]
+    (d / "case.ini").write_text(case_text(**spec))
+    if spec.get("initial") == ON_BEDROCK:
+        ny = spec["ny"]
+        x = (np.arange(64) + 0.5) * 0.05
+        y = (np.arange(ny) + 0.5) * 0.05
+        X, Y = np.meshgrid(x, y)
+        # a rock ridge along y = 1.2 m and a slope down to the west, under a
+        # steep pile of sand that slides over it
+        rock = 0.25 * np.exp(-((Y - 1.2) / 0.3) ** 2) + 0.05 * X / 3.2
+        sand = np.maximum(0.0, 0.45 - 1.2 * np.hypot(X - 1.6, Y - 1.0))
+        (d / "rock.asc").write_text(asc_text(rock))
+        (d / "start.asc").write_text(asc_text(rock + sand))
+
+
+@pytest.fixture(scope="module")
+def serial(tmp_path_factory):
+    """The serial build's output of a case (with extra flags), run once for
+    the module: serial(name, *flags) -> path of serial.h5."""
+    cache = {}
+
+    def get(name, *flags):
+        key = (name,) + flags
+        if key not in cache:
+            d = tmp_path_factory.mktemp("serial-" + name)
+            write_case(d, name)
+            serial_run_ok(["run", "case.ini", "-o", "serial.h5", "-q", "--tile", TILE, *flags], d)
+            cache[key] = d / "serial.h5"
+        return cache[key]
+
+    return get
+
+
+# ---- comparing outputs --------------------------------------------------------------------
+
+SCALE_REFERENCES = ("DIMENSION_LIST", "REFERENCE_LIST")   # object references: addresses
+
+
+def attr_value(v):
+    if isinstance(v, np.ndarray) and v.shape == ():
+        v = v[()]
+    return v
+
+
+def same_attr(a, b):
+    a, b = attr_value(a), attr_value(b)
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        a, b = np.asarray(a), np.asarray(b)
+        if a.dtype.kind == "f" and b.dtype.kind == "f":
+            return same_bits(a, b)
+        return a.shape == b.shape and a.dtype == b.dtype and np.array_equal(a, b)
+    if isinstance(a, float) and isinstance(b, float):
+        return same_bits(np.array(a), np.array(b))
+    return type(a) == type(b) and a == b
+
+
+def first_difference(a, b):
+    """Where two arrays of the same shape differ first (index tuple)."""
+    if a.dtype.kind == "f":
+        diff = a.view(np.uint64) != b.view(np.uint64)
+    else:
+        diff = a != b
+    return tuple(int(k) for k in np.argwhere(diff)[0])
+
+
+def describe_height_difference(a, b, t):
+    k, j, i = first_difference(a, b)
+    bad = [int(s) for s in range(a.shape[0]) if not same_bits(a[s], b[s])]
+    diff = a[k].view(np.uint64) != b[k].view(np.uint64)
+    rows = sorted({int(r) for r in np.argwhere(diff)[:, 0]})
+    return (f"snapshots {bad} (times {[float(t[s]) for s in bad][:5]}) differ; in snapshot "
+            f"{k} first at cell (i, j) = ({i}, {j}): {b[k, j, i]!r}, serial {a[k, j, i]!r}; "
+            f"rows {rows[:12]}{' ...' if len(rows) > 12 else ''}, "
+            f"max |dh| {np.abs(a[k] - b[k]).max()!r}")
+
+
+def assert_same_output(ref, got, what):
+    """The file got has the serial file ref's datasets, attributes and bits
+    (wall_seconds and history aside)."""
+    with h5open(ref) as a, h5open(got) as b:
+        assert sorted(a) == sorted(b), \
+            f"{what}: the file holds {sorted(b)}, the serial build's {sorted(a)}"
+        assert "active_fraction" in a and "restart_state" in a.attrs, \
+            "test set-up: the serial file lacks active_fraction or restart_state"
+        t = a["time"][()]
+        # /height first: the most telling difference
+        for name in sorted(a, key=lambda n: (n != "height", n != "time", n)):
+            da, db = a[name], b[name]
+            assert da.shape == db.shape and da.dtype == db.dtype, \
+                f"{what}: /{name} is {db.dtype} {db.shape}, serial {da.dtype} {da.shape}"
+            for k in sorted(set(da.attrs) | set(db.attrs)):
+                if k in SCALE_REFERENCES:
+                    assert (k in da.attrs) == (k in db.attrs), \
+                        f"{what}: attribute {k} of /{name} in one file only"
+                    continue
+                assert k in da.attrs and k in db.attrs and same_attr(da.attrs[k], db.attrs[k]), \
+                    (f"{what}: attribute {k} of /{name} is {db.attrs.get(k)!r}, "
+                     f"serial {da.attrs.get(k)!r}")
+            if name == "wall_seconds":
+                continue
+            va, vb = da[()], db[()]
+            equal = same_bits(va, vb) if va.dtype.kind == "f" else np.array_equal(va, vb)
+            if equal:
+                continue
+            if name == "height":
+                raise AssertionError(f"{what}: /height differs from the serial build: "
+                                     + describe_height_difference(va, vb, t))
+            where = first_difference(va, vb)
+            raise AssertionError(f"{what}: /{name} differs from the serial build first at "
+                                 f"{where}: {vb[where]!r} vs serial {va[where]!r}"
+                                 + (f" (t = {t[where[0]]!r})" if va.shape == t.shape else ""))
+        keys_a, keys_b = set(a.attrs) - {"history"}, set(b.attrs) - {"history"}
+        assert keys_a == keys_b, \
+            f"{what}: root attributes {sorted(keys_b)}, serial {sorted(keys_a)}"
+        for k in sorted(keys_a):
+            assert same_attr(a.attrs[k], b.attrs[k]), \
+                f"{what}: root attribute {k} is {b.attrs[k]!r}, serial {a.attrs[k]!r}"
+
+
+def assert_same_sidecar(ref, got, what):
+    """The XDMF sidecars say the same but for the file name."""
+    ta = ref.with_suffix(".xmf").read_text().replace(ref.name + ":", "OUT.h5:")
+    tb = got.with_suffix(".xmf").read_text().replace(got.name + ":", "OUT.h5:")
+    assert ta == tb, \
+        f"{what}: the sidecar {got.with_suffix('.xmf').name} differs from the serial one"
+
+
+# ---- a. the same bits as the serial build ---------------------------------------------------
+
+
+def test_cases_exercise_what_they_claim(serial):
+    """Set-up: every case takes a hundred steps or more, moves sand out through
+    an open side or the drain, and lets tiles sleep (so the wake flags that
+    cross rank edges matter); sand crosses the periodic sides."""
+    for name in BIT_CASES:
+        with h5open(serial(name)) as f:
+            ev, af = f["stencil_evaluations"][-1], f["active_fraction"][()]
+            h = f["height"]
+            assert 100 <= ev <= 1500, f"{name}: {ev} stencil evaluations"
+            assert f["outflow"][-1] > 0, f"{name}: nothing flows out"
+            assert 0 < af[1:].min() and af[1:].min() < 1, f"{name}: active_fraction {af}"
+            assert f["inflow"][-1] > 0
+            d = h[-1] - h[0]
+            if "periodic-y" in name or "periodic-xy" in name:
+                assert d[-1, :6].min() > 0, f"{name}: the corner source's sand did not wrap north"
+            if "periodic-x" in name or "periodic-xy" in name:
+                assert d[:6, -1].min() > 0, f"{name}: the corner source's sand did not wrap east"
+            if name == "bedrock-euler":
+                assert "bedrock" in f, "bedrock-euler: no /bedrock"
+
+
+@pytest.mark.parametrize("np_", [1, 2, 3, 4, None],
+                         ids=["np1", "np2", "np3", "np4", "no-mpirun"])
+@pytest.mark.parametrize("case", BIT_CASES)
+def test_every_snapshot_has_the_serial_bits(tmp_path, serial, case, np_):
+    write_case(tmp_path, case)
+    out = tmp_path / "mpi.h5"
+    r = mpi_run_ok(np_, ["run", "case.ini", "-o", out.name, "-q", "--tile", TILE], tmp_path)
+    what = f"{case} under {np_label(np_)}"
+    assert r.stdout == "" and "sandslide:" not in r.stderr, \
+        f"{what}: -q, yet it printed\nstdout:\n{r.stdout}\nstderr:\n{r.stderr}"
+    assert_same_output(serial(case), out, what)
+    assert_same_sidecar(serial(case), out, what)
+
+
+@pytest.mark.parametrize("np_", [2, 4], ids=["np2", "np4"])
+@pytest.mark.parametrize("case", BIT_CASES)
+def test_reference_kernel_has_the_serial_bits(tmp_path, serial, case, np_):
+    write_case(tmp_path, case)
+    out = tmp_path / "mpi.h5"
+    mpi_run_ok(np_, ["run", "case.ini", "-o", out.name, "-q", "--tile", TILE,
+                     "--reference-kernel"], tmp_path)
+    assert_same_output(serial(case, "--reference-kernel"), out,
+                       f"{case}, reference kernel, under {np_label(np_)}")
+
+
+# ---- b. relax ------------------------------------------------------------------------------
+
+
+def write_cliff(path):
+    """A 0.2 m plateau over a third of a rough 32 x 26 floor of 10 cm cells:
+    26 rows, four tile rows of 8, 8, 8 and 2 by default."""
+    rng = np.random.default_rng(11)
+    h = 0.02 * rng.random((26, 32))
+    h[:, :10] += 0.2
+    path.write_text(asc_text(h, dx=0.1))
+
+
+def read_asc(path):
+    """The values of an ESRI ASCII grid, row 0 south."""
+    tokens = path.read_text().split()
+    head = dict(zip(tokens[0:10:2], tokens[1:10:2]))
+    nx, ny = int(head["ncols"]), int(head["nrows"])
+    return np.array([float(v) for v in tokens[10:10 + nx * ny]]).reshape(ny, nx)[::-1]
+
+
+# --tol and --slope-tol looser than the defaults: steady after about 1500 steps
+RELAX_FAST = ["--tol", "1e-6", "--slope-tol", "1e-3"]
+
+
+@pytest.fixture(scope="module")
+def serial_relax(tmp_path_factory):
+    d = tmp_path_factory.mktemp("serial-relax")
+    write_cliff(d / "cliff.asc")
+    serial_run_ok(["relax", "cliff.asc", "-o", "relaxed.asc", "-q", "--report", "report.json",
+                   *RELAX_FAST], d)
+    serial_run_ok(["relax", "cliff.asc", "-o", "relaxed.h5", "-q", "--sides", "open",
+                   "--integrator", "rkl2", "--output-every", "1", *RELAX_FAST], d)
+    return d
+
+
+def test_relax_asc_under_3_ranks_is_the_serial_raster(tmp_path, serial_relax):
+    write_cliff(tmp_path / "cliff.asc")
+    mpi_run_ok(3, ["relax", "cliff.asc", "-o", "relaxed.asc", "-q", "--report", "report.json",
+                   *RELAX_FAST], tmp_path)
+    want = (serial_relax / "relaxed.asc").read_bytes()
+    got = (tmp_path / "relaxed.asc").read_bytes()
+    if got != want:
+        a, b = read_asc(serial_relax / "relaxed.asc"), read_asc(tmp_path / "relaxed.asc")
+        where = ""
+        if a.shape == b.shape:
+            j, i = np.unravel_index(np.abs(a - b).argmax(), a.shape)
+            where = f": max |dh| {np.abs(a - b).max()!r} at cell (i, j) = ({i}, {j})"
+        raise AssertionError(f"relax under np = 3: the .asc output differs from the serial "
+                             f"one ({b.shape} cells, serial {a.shape}){where}")
+    ra = json.loads((serial_relax / "report.json").read_text())
+    rb = json.loads((tmp_path / "report.json").read_text())
+    assert ra["steady"] is True, f"test set-up: the serial relax did not settle: {ra}"
+    for k in sorted(set(ra) | set(rb)):
+        if k != "wall_seconds":
+            assert ra.get(k) == rb.get(k), \
+                f"relax under np = 3: report {k} is {rb.get(k)!r}, serial {ra.get(k)!r}"
+
+
+def test_relax_h5_under_3_ranks_is_the_serial_series(tmp_path, serial_relax):
+    write_cliff(tmp_path / "cliff.asc")
+    mpi_run_ok(3, ["relax", "cliff.asc", "-o", "relaxed.h5", "-q", "--sides", "open",
+                   "--integrator", "rkl2", "--output-every", "1", *RELAX_FAST], tmp_path)
+    assert_same_output(serial_relax / "relaxed.h5", tmp_path / "relaxed.h5",
+                       "relax (.h5, open sides, rkl2) under np = 3")
+
+
+# ---- c. cut, restarted under another rank count, interrupted, killed ------------------------
+
+
+def snapshot_count(path):
+    try:
+        with h5open(path) as f:
+            return f["time"].shape[0]
+    except Exception:   # not yet there, or being written
+        return 0
+
+
+def assert_consistent(path, what, min_count, every):
+    """Readable, every series as long as /height, the first min_count
+    snapshots every `every` s from 0, finite heights; returns the count."""
+    with h5open(path) as f:
+        nt = f["height"].shape[0]
+        assert nt >= min_count, f"{what}: {nt} snapshots, {min_count} had been seen written"
+        for name in PHYSICAL + ["time", "active_fraction", "wall_seconds"]:
+            assert f[name].shape == (nt,), f"{what}: /{name} has {f[name].shape}, /height {nt}"
+        t = f["time"][()]
+        assert np.all(np.diff(t) > 0), f"{what}: times not increasing: {t}"
+        np.testing.assert_allclose(t[:min_count], every * np.arange(min_count), rtol=1e-12,
+                                   atol=0, err_msg=f"{what}: snapshot times")
+        assert np.isfinite(f["height"][()]).all(), f"{what}: non-finite heights"
+    return nt
+
+
+def assert_snapshots_are_serial(path, whole, what, count=None):
+    """The first `count` snapshots of path (all by default) that fall on the
+    serial run's output times have its bits: heights and PHYSICAL series."""
+    with h5open(path) as f, h5open(whole) as w:
+        tw = list(w["time"][()])
+        n = f["time"].shape[0] if count is None else count
+        matched = 0
+        for k in range(n):
+            t = f["time"][k]
+            if t not in tw:
+                continue   # an interrupt's snapshot
+            i = tw.index(t)
+            matched += 1
+            assert same_bits(f["height"][k], w["height"][i]), \
+                f"{what}: snapshot {k} (t = {t!r}) differs from the serial run: " \
+                f"max |dh| {np.abs(f['height'][k] - w['height'][i]).max()!r}"
+            for name in PHYSICAL:
+                assert same_bits(np.array(f[name][k]), np.array(w[name][i])), \
+                    f"{what}: /{name} at t = {t!r} is {f[name][k]!r}, serial {w[name][i]!r}"
+    return matched
+
+
+def ncdump_header(path):
+    r = subprocess.run(["ncdump", "-h", str(path)], capture_output=True, text=True, timeout=60)
+    assert r.returncode == 0, f"ncdump -h cannot read {path.name}: {r.stderr}"
+    return r.stdout
+
+
+def test_cut_under_2_ranks_continued_under_3_is_the_uninterrupted_run(tmp_path, serial):
+    """mpirun -np 2 stops at a file-size limit of 6 MiB (about 250 of the 301
+    snapshots: a cut that does not depend on timing) with exit 1, one message
+    and the snapshots before it complete; run --restart under np = 3, without
+    the limit, continues it to the end: every snapshot and the final
+    restart_state are those of the serial run never cut.  The limit is set on
+    the ranks alone (prlimit): Open MPI's own files are larger than 4 MiB."""
+    write_case(tmp_path, "long-euler")
+    limit = 6 << 20
+    cmd = [MPIRUN, "-np", "2", "--bind-to", "none", "prlimit", f"--fsize={limit}:{limit}",
+           SANDSLIDE_MPI] + with_threads(["run", "case.ini", "-o", "cut.h5", "-q",
+                                          "--tile", TILE])
+    p = subprocess.Popen(cmd, cwd=tmp_path, env=MPI_ENV, text=True, stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, stdin=subprocess.DEVNULL,
+                         start_new_session=True)
+    r = finish(p, "mpirun -np 2 under a file-size limit", 60)
+    assert r.returncode == 1, \
+        f"np = 2 with a 6 MiB file-size limit: exit {r.returncode}, not 1\n{r.stderr}"
+    ours = [line for line in r.stderr.splitlines() if line.startswith("sandslide:")]
+    assert len(ours) == 1 and "cut.h5" in ours[0] and "large" in ours[0].lower(), \
+        f"np = 2 with a file-size limit: one message naming the file expected:\n{r.stderr}"
+    nt = assert_consistent(tmp_path / "cut.h5", "cut by the file-size limit", 2,
+                           CASES["long-euler"]["every"])
+    with h5open(tmp_path / "cut.h5") as f:
+        t_cut = float(f["time"][-1])
+    assert t_cut < 60.0, f"test set-up: the limit did not cut the run (last snapshot t = {t_cut})"
+
+    mpi_run_ok(3, ["run", "--restart", "cut.h5", "-q"], tmp_path)
+    whole = serial("long-euler")
+    conftest.assert_same_snapshots(tmp_path / "cut.h5", whole, PHYSICAL)
+    with h5open(tmp_path / "cut.h5") as f, h5open(whole) as w:
+        assert list(f["time"][()]) == list(w["time"][()]), \
+            f"cut after snapshot {nt - 1} (t = {t_cut}), continued: times {f['time'][()]}"
+        for k in sorted(set(w.attrs) - {"history"}):
+            assert k in f.attrs and same_attr(f.attrs[k], w.attrs[k]), \
+                (f"cut under np = 2, continued under np = 3: root attribute {k} is "
+                 f"{f.attrs.get(k)!r}, uninterrupted serial {w.attrs[k]!r}")
+
+
+def interrupt(p, out, what, count, end):
+    """SIGTERM to mpirun once out holds `count` snapshots.  mpirun passes it
+    on to the ranks after odls_base_sigkill_timeout (1 s) and SIGKILLs them
+    1 s later: a run that reaches its end within that second is skipped.
+    Returns the snapshots seen before the signal."""
+    try:
+        ok = wait_for(lambda: snapshot_count(out) >= count or p.poll() is not None, 60)
+        assert p.poll() is None, f"{what} ended before the signal: {p.communicate()}"
+        assert ok, f"{what} wrote no {count} snapshots within 60 s"
+        seen = max(count, snapshot_count(out))
+        files = shared_memory_of(p.pid)
+        p.send_signal(signal.SIGTERM)
+        sent = time.monotonic()
+        r = finish(p, f"{what}, interrupted", 60)
+        took = time.monotonic() - sent
+        remove_leftovers(p.pid, files)   # mpirun ends the ranks with SIGKILL
+    finally:
+        kill_session(p.pid)
+    with h5open(out) as f:
+        t_last = float(f["time"][-1])
+    if t_last == end:
+        if took < 1.0:
+            pytest.skip(f"{what} reached its end {took:.2f} s after SIGTERM, before mpirun "
+                        f"passed it on (machine too fast)")
+        raise AssertionError(f"{what} ran on to its end (t = {end}) {took:.2f} s after SIGTERM: "
+                             f"the ranks did not stop\nstderr:\n{r.stderr}")
+    assert r.returncode != 0, f"{what}, interrupted, exited 0\nstderr:\n{r.stderr}"
+    ours = [line for line in r.stderr.splitlines() if line.startswith("sandslide:")]
+    assert len(ours) == 1 and "interrupted" in ours[0], \
+        f"{what}: one message from rank 0 expected:\n{r.stderr}"
+    assert f"sandslide run --restart {out.name}" in r.stderr, \
+        f"{what}: the message does not say how to continue:\n{r.stderr}"
+    return seen
+
+
+def test_sigterm_leaves_a_complete_last_snapshot_that_continues_bit_for_bit(tmp_path, serial):
+    """SIGTERM to mpirun -np 3 after 3 snapshots: within Open MPI's grace
+    period every rank stops at the same substep and the file ends with a
+    complete snapshot (readable by h5py and ncdump).  run --restart under
+    np = 2 continues from it and is interrupted again 2 snapshots later:
+    every snapshot on the output times, before and after the first cut, has
+    the bits of the serial run (so the interrupt's snapshot, restart_state
+    and all, was the state of the run)."""
+    write_case(tmp_path, "signal-euler")
+    out = tmp_path / "cut.h5"
+    every = CASES["signal-euler"]["every"]
+    p = start_mpi(3, ["run", "case.ini", "-o", out.name, "-q", "--tile", TILE], tmp_path)
+    end = CASES["signal-euler"]["end"]
+    seen = interrupt(p, out, "mpirun -np 3", 3, end)
+    nt = assert_consistent(out, "after SIGTERM", seen, every)
+    with h5open(out) as f:
+        t_cut = float(f["time"][-1])
+    ncdump_header(out)
+    whole = serial("signal-euler")
+    assert assert_snapshots_are_serial(out, whole, "cut under np = 3") >= seen
+
+    p = start_mpi(2, ["run", "--restart", out.name, "-q"], tmp_path)
+    interrupt(p, out, "run --restart under mpirun -np 2", nt + 2, end)
+    matched = assert_snapshots_are_serial(out, whole, "cut under np = 3, continued under np = 2")
+    with h5open(out) as f:
+        assert f["time"][-1] > t_cut and matched >= nt + 1, \
+            f"continued from t = {t_cut}: times {f['time'][()]}"
+
+
+def test_killed_job_leaves_a_readable_file_with_every_snapshot_seen(tmp_path, serial):
+    """SIGKILL to mpirun's process group and to the ranks (each in a process
+    group of its own: the test kills the session) while it writes a snapshot
+    every 160 steps: h5py and ncdump -h read the file, every snapshot seen
+    before the kill is in it, with the serial run's bits."""
+    write_case(tmp_path, "signal-euler")
+    out = tmp_path / "killed.h5"
+    every = CASES["signal-euler"]["every"]
+    p = start_mpi(3, ["run", "case.ini", "-o", out.name, "-q", "--tile", TILE], tmp_path)
+    try:
+        ok = wait_for(lambda: snapshot_count(out) >= 3 or p.poll() is not None, 60)
+        assert p.poll() is None, f"the run ended before it was killed: {p.communicate()}"
+        assert ok, "mpirun -np 3 wrote no 3 snapshots within 60 s"
+        time.sleep(0.1)   # in the middle of later snapshots
+        seen = max(3, snapshot_count(out))
+        alive = p.poll() is None
+        files = shared_memory_of(p.pid)
+        try:
+            os.killpg(p.pid, signal.SIGKILL)   # mpirun's group ...
+        except ProcessLookupError:
+            pass
+    finally:
+        kill_session(p.pid)                    # ... and the ranks, each in its own group
+        p.communicate()
+    remove_leftovers(p.pid, files)
+    assert alive, "the run ended before it was killed"
+    nt = assert_consistent(out, "killed job", seen, every)
+    header = ncdump_header(out)
+    m = re.search(r"time = UNLIMITED ; // \((\d+) currently\)", header)
+    assert m and int(m.group(1)) == nt, f"ncdump sees other snapshots than h5py ({nt}):\n{header}"
+    assert assert_snapshots_are_serial(out, serial("signal-euler"), "killed job", seen) == seen
+
+
+def test_ncdump_reads_a_file_of_3_ranks(tmp_path):
+    write_case(tmp_path, "mixed-euler")
+    r = mpi_run_ok(3, ["run", "case.ini", "-o", "np3.h5", "--tile", TILE], tmp_path)
+    assert r.stdout.count("wrote np3.h5:") == 1 and "sandslide:" not in r.stderr, \
+        f"the summary of 3 ranks is not printed once (by rank 0):\n{r.stdout}\n{r.stderr}"
+    header = ncdump_header(tmp_path / "np3.h5")
+    assert re.search(r"time = UNLIMITED ; // \(17 currently\)", header), header
+    assert re.search(r"\bx = 64 ;", header) and re.search(r"\by = 48 ;", header), header
+    for decl in ["double height(time, y, x)", "ubyte cell_type(y, x)", "double time(time)",
+                 "double x(x)", "double y(y)", "double volume(time)",
+                 "double active_fraction(time)"]:
+        assert decl in header, f"ncdump does not show '{decl}' in a file of 3 ranks:\n{header}"
+    r = subprocess.run(["ncdump", "-v", "height", str(tmp_path / "np3.h5")], capture_output=True,
+                       text=True, timeout=60)
+    assert r.returncode == 0, f"ncdump cannot read /height of a file of 3 ranks: {r.stderr}"
+    with h5open(tmp_path / "np3.h5") as f:
+        heights = f["height"][()]
+    data = r.stdout.split("\ndata:\n", 1)[-1]
+    values = data.split(" height =", 1)[-1].split(";", 1)[0]
+    numbers = [float(v) for v in re.findall(r"-?\d+(?:\.\d*)?(?:e[-+]?\d+)?", values)]
+    assert len(numbers) == 17 * 48 * 64, f"ncdump printed {len(numbers)} heights, not 17 x 48 x 64"
+    np.testing.assert_allclose(np.array(numbers).reshape(heights.shape), heights, rtol=1e-5,
+                               atol=1e-12, err_msg="ncdump's heights are not h5py's")
+
+
+# ---- d. refusals and the version ---------------------------------------------------------
+
+
+def test_more_ranks_than_tile_rows_are_refused(tmp_path):
+    write_case(tmp_path, "mixed-euler")
+    n = TILE_ROWS + 1
+    r = mpi_run(n, ["run", "case.ini", "-o", "o.h5", "-q", "--tile", TILE], tmp_path)
+    assert r.returncode == 2, \
+        f"{n} ranks for {TILE_ROWS} tile rows: exit {r.returncode}, not 2\n{r.stderr}"
+    ours = [line for line in r.stderr.splitlines() if line.startswith("sandslide:")]
+    assert len(ours) == 1, f"one message expected, printed once:\n{r.stderr}"
+    msg = ours[0]
+    assert re.search(rf"\b{n}\b", msg) and re.search(rf"\b{TILE_ROWS}\b", msg), \
+        f"the message does not name the {n} ranks and the {TILE_ROWS} tile rows: {msg}"
+    assert "rank" in msg and "tile row" in msg, msg
+    assert not (tmp_path / "o.h5").exists(), "a refused run left an output file"
+
+
+def test_version_names_mpi(tmp_path):
+    r = mpi_run(None, ["--version"], tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert "MPI" in r.stdout and "Open MPI" in r.stdout, \
+        f"--version of the MPI build does not name its MPI: {r.stdout!r}"
+    first = r.stdout.splitlines()[0]
+    r = mpi_run(2, ["--version"], tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.count(first) == 1, f"under mpirun -np 2 --version is printed " \
+        f"{r.stdout.count(first)} times:\n{r.stdout}"
+    serial = subprocess.run([SANDSLIDE, "--version"], capture_output=True, text=True, timeout=60)
+    assert "Open MPI" not in serial.stdout, f"the serial build claims MPI: {serial.stdout!r}"
