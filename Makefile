@@ -254,12 +254,13 @@ test check: all $(TEST_BIN) $(HOOK_BIN) headers-check check-layering $(FUZZ_REPL
 	done; \
 	echo "== tests/fuzz (corpora and regressions replayed)"; ( $(FUZZ_REPLAY_RUN) ) || fail=1; \
 	echo "== tests/cli (pytest)"; \
-	SANDSLIDE=$(abspath $(BUILD)/sandslide) SANDSLIDE_NAN=$(abspath $(HOOK_BIN)) \
+	SANDSLIDE_MPI= SANDSLIDE=$(abspath $(BUILD)/sandslide) SANDSLIDE_NAN=$(abspath $(HOOK_BIN)) \
 	  $(PYTHON) -m pytest -q tests/cli || fail=1; \
 	exit $$fail
 
 # The distributed tests (make MPI=1 test-mpi): the C test of the halo and
-# the ordered sums under mpirun -np 3, then tests/cli/test_mpi.py, which
+# the ordered sums alone and under mpirun -np 1 .. 4, then
+# tests/cli/test_mpi.py (which `make test` skips), which
 # compares every snapshot of build-mpi/sandslide under np = 1..4 with the
 # serial build/sandslide (built first).  Open MPI's settings for a root
 # user, more ranks than cores and a box without RDMA (notes: mpi.md).
@@ -271,8 +272,11 @@ MPI_ENV := OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 \
 test-mpi: all $(BUILD)/tests/test_comm
 	@[ "$(MPI)" = 1 ] || { echo "test-mpi: run it as make MPI=1 test-mpi"; exit 2; }
 	$(MAKE) MPI=0 all
-	@echo "== $(BUILD)/tests/test_comm (mpirun -np 3)"; \
-	  $(MPI_ENV) mpirun.openmpi -np 3 --bind-to none $(BUILD)/tests/test_comm
+	@echo "== $(BUILD)/tests/test_comm (alone, then mpirun -np 1 .. 4)"; \
+	  $(MPI_ENV) timeout 120 $(BUILD)/tests/test_comm || exit 1; \
+	  for n in 1 2 3 4; do \
+	    $(MPI_ENV) timeout 120 mpirun.openmpi -np $$n --bind-to none $(BUILD)/tests/test_comm || exit 1; \
+	  done
 	@echo "== tests/cli/test_mpi.py (pytest)"; \
 	  $(MPI_ENV) SANDSLIDE_MPI=$(abspath $(BUILD)/sandslide) SANDSLIDE=$(abspath build/sandslide) \
 	  $(PYTHON) -m pytest -q tests/cli/test_mpi.py
