@@ -584,8 +584,8 @@ static int check_snapshot_space(struct ss_snapshot *s)
 	return verdict ? -1 : 0;
 }
 
-int ss_snapshot_append(struct ss_snapshot *s, double time_s, const double *height,
-                       const struct ss_diagnostics *d, const struct ss_restart_state *state)
+static int append(struct ss_snapshot *s, double time_s, const double *height,
+                  const struct ss_diagnostics *d, const struct ss_restart_state *state)
 {
 	const struct ss_grid *g = &s->grid;
 	const long long k = s->count;
@@ -649,6 +649,17 @@ fail:
 	s->failed = 1;
 	return ss_error_fail("cannot write snapshot %lld (t = %g s) to '%s'%s%s", k, time_s,
 	                     s->path, errno ? ": " : "", errno ? strerror(errno) : "");
+}
+
+/* A failure of one rank's write is every rank's, before the next
+ * collective call (comm.h). */
+int ss_snapshot_append(struct ss_snapshot *s, double time_s, const double *height,
+                       const struct ss_diagnostics *d, const struct ss_restart_state *state)
+{
+	const int err = ss_comm_agree(append(s, time_s, height, d, state));
+	if (err)
+		s->failed = 1;
+	return err;
 }
 
 long long ss_snapshot_count(const struct ss_snapshot *s)
