@@ -116,7 +116,7 @@ static void report_progress(void *context, const struct ss_stepper *st)
 		.time = st->time, .time_start = d->time_start, .end = d->end,
 		.steady_tol = d->steady_tol, .steps = st->steps,
 		.steps_here = st->steps - d->steps_start, .rate_max = st->rate_max,
-		.cells = (double)st->grid.nx * st->grid.ny,
+		.cells = (double)st->grid.global_nx * st->grid.global_ny,
 		.wall_seconds = ss_parallel_wall_seconds() - d->started,
 	};
 	d->progress(d->progress_context, &p);

@@ -88,7 +88,9 @@ static int build_stepper(const struct ss_relax_options *o, const struct ss_raste
 	if (integrator == SS_INTEGRATOR_RKL2 && bedrock)
 		return ss_error_input("--integrator rkl2 cannot be used with --bedrock: its stages "
 		                      "cannot keep the sand above the rock (use euler or auto)");
-	const double need = ss_stepper_memory_bytes(&g, integrator);
+	/* the memory of one rank's slab, times the ranks on this node */
+	const double need = ss_stepper_memory_bytes(&g, integrator) / ss_comm_size() *
+	                    ss_comm_node_ranks();
 	const double have = ss_memory_available_bytes();
 	if (have > 0.0 && need > have) {
 		char nb[32], hb[32];

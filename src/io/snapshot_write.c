@@ -3,7 +3,9 @@
  * the reads are in snapshot_read.c.
  *
  * File types are explicit little-endian IEEE (H5T_IEEE_F64LE, H5T_STD_U8LE),
- * memory types native.
+ * memory types native.  Heights are written straight from the halo layout
+ * through a memory hyperslab, so no copy of the grid is made.  HDF5's own
+ * error stack printing is off: each failure prints one sandslide message.
  *
  * In a run of several ranks (make MPI=1, comm.h) every rank opens the one
  * file through MPI-IO and makes every metadata call (create, extend,
@@ -11,9 +13,7 @@
  * requires; each writes its own rows of the grid variables (/height
  * collectively: a filtered dataset must be), rank 0 the coordinates and the
  * series.  Rank 0 alone checks the space, renames the file and writes the
- * sidecar; the outcome is agreed.  Heights are written straight from the halo layout
- * through a memory hyperslab, so no copy of the grid is made.  HDF5's own
- * error stack printing is off: each failure prints one sandslide message.
+ * sidecar; the outcome is agreed.
  */
 #include "sandslide/snapshot.h"
 
