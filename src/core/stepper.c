@@ -471,12 +471,19 @@ static double outflow_rate(const struct ss_stepper *st)
 	if (st->open_face_count_all == 0.0)
 		return 0.0;
 	ss_comm_fold_start(sum, 2);
+	/* two sums in registers: sum[f->axis] would go through memory */
+	double sum_x = sum[0], sum_y = sum[1];
 	for (size_t m = 0; m < st->open_face_count; m++) {
 		const struct ss_open_face *f = &st->open_faces[m];
 		const double flux = st->kernel == SS_KERNEL_FAST ? st->open_flux[m]
 		                  : f->axis == 0 ? st->flux_x[f->index] : st->flux_y[f->index];
-		sum[f->axis] += f->sign * flux;
+		if (f->axis == 0)
+			sum_x += f->sign * flux;
+		else
+			sum_y += f->sign * flux;
 	}
+	sum[0] = sum_x;
+	sum[1] = sum_y;
 	ss_comm_fold_finish(sum, 2);
 	return sum[0] * st->grid.dy + sum[1] * st->grid.dx;
 }
