@@ -74,7 +74,10 @@ struct ss_restart_info {
 	int nx, ny;
 	long long count;         /* snapshots in the file */
 	double time;             /* of the last one, s */
-	double *height;          /* nx * ny, south row first (ss_free) */
+	double *height;          /* nx * rows, south row first (ss_free); NULL
+	                          * when no row was asked for */
+	long long first_row;     /* the rows height holds: first_row .. */
+	int rows;                /*   first_row + rows - 1 of the grid */
 	struct ss_restart_state state;
 	char *case_text;         /* the case file's text */
 	char *case_path;         /* where it was read from */
@@ -90,6 +93,13 @@ int ss_snapshot_read_restart(const char *path, struct ss_restart_info *r);
  * state, as the guard of a run needs them to take its steps again. */
 int ss_snapshot_read_last_state(const char *path, struct ss_restart_info *r);
 void ss_restart_info_release(struct ss_restart_info *r);
+
+/* A rank's part of them (comm.h): the case and the restart state without
+ * any height, and the last snapshot's rows first_row .. first_row + rows - 1
+ * with its restart state, so that no rank holds the whole grid. */
+int ss_snapshot_read_restart_case(const char *path, struct ss_restart_info *r);
+int ss_snapshot_read_last_rows(const char *path, long long first_row, int rows,
+                               struct ss_restart_info *r);
 
 /* Snapshots written so far. */
 long long ss_snapshot_count(const struct ss_snapshot *s);

@@ -153,10 +153,10 @@ static int restart_point(struct ss_drive *d, struct ss_stepper *fresh)
 	if (closed)
 		return closed;
 	struct ss_restart_info r;
-	err = ss_snapshot_read_last_state(d->output, &r);
+	err = ss_comm_agree(ss_snapshot_read_last_rows(d->output, fresh->grid.offset_j,
+	                                               fresh->grid.ny, &r));
 	if (!err)
-		ss_stepper_restore(fresh, r.time,   /* this rank's rows */
-		                   r.height + (size_t)fresh->grid.offset_j * fresh->grid.nx, &r.state);
+		ss_stepper_restore(fresh, r.time, r.height, &r.state);   /* this rank's rows */
 	ss_restart_info_release(&r);
 	if (!err)
 		err = ss_snapshot_open_append(&d->snapshot, d->output, &fresh->grid);

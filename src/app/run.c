@@ -97,7 +97,8 @@ static int resolve(struct run *r)
 			default_output(o->case_path, r->output, sizeof r->output);
 		return ss_output_check_folder(r->output, o->output == NULL);
 	}
-	if ((err = ss_snapshot_read_restart(o->restart, &r->restart)) ||
+	/* the heights later, each rank its rows (start_stepper) */
+	if ((err = ss_snapshot_read_restart_case(o->restart, &r->restart)) ||
 	    (err = restart_case(o, &r->restart, &r->c)))
 		return err;
 	if (o->output && strcmp(o->output, o->restart) != 0)
@@ -153,10 +154,18 @@ static int start_stepper(struct run *r)
 		return ss_error_input("--restart %s: its snapshots are %d x %d cells, its case "
 		                      "gives %lld x %lld", r->o->restart, rs->nx, rs->ny,
 		                      g->global_nx, g->global_ny);
-	/* every rank read the snapshot; each keeps its rows */
-	ss_stepper_restore(&r->st, rs->time, rs->height + (size_t)g->offset_j * g->nx,
-	                   &rs->state);
-	return SS_OK;
+	/* this rank's rows of the last snapshot, read now that the slab is known */
+	struct ss_restart_info rows;
+	if ((err = ss_comm_agree(ss_snapshot_read_last_rows(r->o->restart, g->offset_j, g->ny,
+	                                                    &rows))))
+		return err;
+	if (rows.time != rs->time || rows.count != rs->count)
+		err = ss_error_input("--restart %s: the file changed while it was read",
+		                     r->o->restart);
+	else
+		ss_stepper_restore(&r->st, rows.time, rows.height, &rows.state);
+	ss_restart_info_release(&rows);
+	return err;
 }
 
 /* The most the sources can add to one cell by time `stop`: each source's

@@ -970,14 +970,40 @@ static int read_state(struct ss_snapshot_file *f, struct ss_restart_info *r)
 	return SS_OK;
 }
 
-/* The last snapshot with its restart state, and with the case when
- * with_case. */
-static int read_last(struct ss_snapshot_file *f, struct ss_restart_info *r, int with_case)
+/* Rows first_row .. first_row + rows - 1 of snapshot t as a new array
+ * (south row first; ss_free); rows < 0: every row, 0: none. */
+static int read_snapshot_rows(struct ss_snapshot_file *f, long long t, long long first_row,
+                              int rows, double **out)
+{
+	if (rows < 0)
+		return read_snapshot(f, t, out);
+	if (rows == 0)
+		return SS_OK;
+	if (first_row < 0 || first_row + rows > f->ny)
+		return ss_error_input("cannot restart from '%s': its snapshots have %d rows, not "
+		                      "the %lld this grid needs", f->name, f->ny, first_row + rows);
+	*out = ss_alloc((size_t)f->nx * (size_t)rows, sizeof **out, "snapshot heights");
+	if (!*out)
+		return SS_ERR_FAIL;
+	const int err = ss_snapshot_file_read_rows(f, t, (int)first_row, rows, *out);
+	if (err) {
+		ss_free(*out);
+		*out = NULL;
+	}
+	return err;
+}
+
+/* The last snapshot (its rows first_row .. + rows - 1, all for rows < 0)
+ * with its restart state, and with the case when with_case. */
+static int read_last(struct ss_snapshot_file *f, struct ss_restart_info *r, int with_case,
+                     long long first_row, int rows)
 {
 	memset(r, 0, sizeof *r);
 	r->count = f->count;
 	r->nx = f->nx;
 	r->ny = f->ny;
+	r->first_row = rows < 0 ? 0 : first_row;
+	r->rows = rows < 0 ? f->ny : rows;
 	if (f->count < 1)
 		return ss_error_input("cannot restart from '%s': it holds no snapshot", f->name);
 	r->time = f->time[f->count - 1];
@@ -985,7 +1011,7 @@ static int read_last(struct ss_snapshot_file *f, struct ss_restart_info *r, int 
 	if (!err)
 		err = read_state(f, r);
 	if (!err)
-		err = read_snapshot(f, f->count - 1, &r->height);
+		err = read_snapshot_rows(f, f->count - 1, first_row, rows, &r->height);
 	if (err)
 		ss_restart_info_release(r);
 	return err;
@@ -993,23 +1019,41 @@ static int read_last(struct ss_snapshot_file *f, struct ss_restart_info *r, int 
 
 int ss_snapshot_file_restart(struct ss_snapshot_file *f, struct ss_restart_info *r)
 {
-	return read_last(f, r, 1);
+	return read_last(f, r, 1, 0, -1);
 }
 
-int ss_snapshot_read_last_state(const char *path, struct ss_restart_info *r)
+/* Open path, read_last, close. */
+static int read_last_of(const char *path, struct ss_restart_info *r, int with_case,
+                        long long first_row, int rows)
 {
 	struct ss_snapshot_file f;
 	memset(r, 0, sizeof *r);
 	int err = ss_snapshot_file_open(&f, path);
 	if (!err)
-		err = read_last(&f, r, 0);
+		err = read_last(&f, r, with_case, first_row, rows);
 	ss_snapshot_file_close(&f);
 	return err;
+}
+
+int ss_snapshot_read_last_state(const char *path, struct ss_restart_info *r)
+{
+	return read_last_of(path, r, 0, 0, -1);
+}
+
+int ss_snapshot_read_last_rows(const char *path, long long first_row, int rows,
+                               struct ss_restart_info *r)
+{
+	return read_last_of(path, r, 0, first_row, rows);
 }
 
 int ss_snapshot_read_restart(const char *path, struct ss_restart_info *r)
 {
 	return read_path(path, NULL, r);
+}
+
+int ss_snapshot_read_restart_case(const char *path, struct ss_restart_info *r)
+{
+	return read_last_of(path, r, 1, 0, 0);
 }
 
 /* ---- a 2-D field of any file ----------------------------------------- */
