@@ -131,7 +131,9 @@ static int build_stepper(const struct ss_relax_options *o, const struct ss_raste
 				ss_cell_type_set(st->cell_types, k, o->nodata_type);
 		}
 	}
-	if (bedrock && (err = ss_stepper_set_bedrock(st, bedrock->values + first)))
+	/* agreed: the collective calls of prepare follow */
+	if ((err = ss_comm_agree(bedrock ? ss_stepper_set_bedrock(st, bedrock->values + first)
+	                                 : SS_OK)))
 		return err;
 	if (o->add_sand) {
 		uint8_t *mask = ss_alloc((size_t)g.nx * g.ny, 1, "sand source mask");
@@ -148,7 +150,7 @@ static int build_stepper(const struct ss_relax_options *o, const struct ss_raste
 		if (!err)
 			err = ss_stepper_add_source(st, mask, o->sand_rate, 0.0, o->sand_duration);
 		ss_free(mask);
-		if (err)
+		if ((err = ss_comm_agree(err)))
 			return err;
 	}
 	return ss_stepper_prepare(st);

@@ -179,9 +179,9 @@ int ss_stepper_set_bedrock(struct ss_stepper *st, const double *bedrock)
 			const double b = bedrock[(size_t)j * g->nx + i];
 			const ptrdiff_t k = ss_grid_index(g, i, j);
 			if (!isfinite(b))
-				return ss_error_input("bedrock of cell (%d, %d) at x = %g m, y = %g m "
-				                      "is %g: it must be finite", i, j,
-				                      ss_grid_x(g, i), ss_grid_y(g, j), b);
+				return ss_error_input("bedrock of cell (%lld, %lld) at x = %g m, y = %g m "
+				                      "is %g: it must be finite", g->offset_i + i,
+				                      g->offset_j + j, ss_grid_x(g, i), ss_grid_y(g, j), b);
 			if (ss_cell_type_get(st->cell_types, k) == SS_CELL_FLOW)
 				st->bedrock[k] = b;
 		}
@@ -294,7 +294,8 @@ static int rkl2_prepare(struct ss_stepper *st)
 	return SS_OK;
 }
 
-/* The checks of ss_stepper_prepare on this rank's cells. */
+/* The checks of ss_stepper_prepare on this rank's cells (the messages name
+ * a cell by its index in the whole grid). */
 static int check_cells(struct ss_stepper *st)
 {
 	const struct ss_grid *g = &st->grid;
@@ -309,16 +310,16 @@ static int check_cells(struct ss_stepper *st)
 			else if (st->height[k] == 0.0)
 				st->height[k] = 0.0;   /* no -0: h + 0 then keeps every bit */
 			if (!isfinite(st->height[k]))
-				return ss_error_input("initial height of cell (%d, %d) at x = %g m, "
+				return ss_error_input("initial height of cell (%lld, %lld) at x = %g m, "
 				                      "y = %g m is %g: heights must be finite",
-				                      i, j, ss_grid_x(g, i), ss_grid_y(g, j),
-				                      st->height[k]);
+				                      g->offset_i + i, g->offset_j + j, ss_grid_x(g, i),
+				                      ss_grid_y(g, j), st->height[k]);
 			if (st->bedrock && type == SS_CELL_FLOW && st->bedrock[k] > st->height[k])
-				return ss_error_input("bedrock of cell (%d, %d) at x = %g m, y = %g m "
+				return ss_error_input("bedrock of cell (%lld, %lld) at x = %g m, y = %g m "
 				                      "is %.17g m, above the surface %.17g m: the "
 				                      "surface must be at or above the bedrock",
-				                      i, j, ss_grid_x(g, i), ss_grid_y(g, j),
-				                      st->bedrock[k], st->height[k]);
+				                      g->offset_i + i, g->offset_j + j, ss_grid_x(g, i),
+				                      ss_grid_y(g, j), st->bedrock[k], st->height[k]);
 		}
 	}
 	return SS_OK;

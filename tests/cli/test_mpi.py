@@ -802,3 +802,33 @@ def test_version_names_mpi(tmp_path):
         f"{r.stdout.count(first)} times:\n{r.stdout}"
     serial = subprocess.run([SANDSLIDE, "--version"], capture_output=True, text=True, timeout=60)
     assert "Open MPI" not in serial.stdout, f"the serial build claims MPI: {serial.stdout!r}"
+
+
+def test_an_error_of_one_rank_is_printed_once_by_rank_0(tmp_path):
+    """A bedrock above the surface in one cell of the north rows: only the
+    last rank's slab holds it, so only that rank finds it.  Every rank must
+    stop before the next collective call (no deadlock), with exit 2, and
+    rank 0 prints the message once: the serial build's, naming the cell by
+    its index in the whole grid.  relax with such a bedrock likewise."""
+    write_case(tmp_path, "bedrock-euler")
+    rock = read_asc(tmp_path / "rock.asc")
+    start = read_asc(tmp_path / "start.asc")
+    ny = rock.shape[0]
+    j, i = ny - 3, 10   # row ny - 3 from the south: the last rank's for np = 3
+    rock[j, i] = start[j, i] + 0.5
+    (tmp_path / "rock.asc").write_text(asc_text(rock))
+    want = conftest.run(["run", "case.ini", "-o", "s.h5", "-q", "--tile", TILE, "--threads", "1"],
+                        cwd=tmp_path)
+    assert want.returncode == 2 and f"cell ({i}, {j})" in want.stderr, \
+        f"the serial build should refuse cell ({i}, {j}): {want.returncode}\n{want.stderr}"
+    for args in (["run", "case.ini", "-o", "m.h5", "-q", "--tile", TILE],
+                 ["relax", "start.asc", "--bedrock", "rock.asc", "-o", "m.asc", "-q"]):
+        r = mpi_run(3, args, tmp_path)
+        ours = [line for line in r.stderr.splitlines() if line.startswith("sandslide:")]
+        assert r.returncode == 2, f"{args[0]} under np = 3: exit {r.returncode}, not 2\n{r.stderr}"
+        assert len(ours) == 1 and f"cell ({i}, {j})" in ours[0], \
+            f"{args[0]} under np = 3: one message naming cell ({i}, {j}) expected:\n{r.stderr}"
+        if args[0] == "run":
+            assert ours[0] == want.stderr.strip(), \
+                f"the message differs from the serial build's:\n{ours[0]}\n{want.stderr}"
+        assert not (tmp_path / args[4]).exists(), f"{args[0]} refused but left {args[4]}"
