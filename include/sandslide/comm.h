@@ -28,7 +28,8 @@
 #include <stddef.h>
 
 /* Start MPI (threads funnelled to the main thread) or nothing; call once,
- * first thing in main.  Without mpirun an MPI build runs as one rank. */
+ * first thing in main.  Started without a launcher (mpirun, srun) an MPI
+ * build runs as one rank and does not initialise MPI at all. */
 void ss_comm_init(int *argc, char ***argv);
 /* Leave MPI (after every HDF5 file is closed). */
 void ss_comm_finalize(void);

@@ -57,8 +57,29 @@ MPI_Comm ss_comm_mpi(void)
 	return MPI_COMM_WORLD;
 }
 
+/* Whether a launcher (mpirun, srun) started this process: Open MPI's
+ * mpirun sets OMPI_COMM_WORLD_SIZE, PMIx launchers PMIX_RANK, PMI-1/2 ones
+ * (MPICH's hydra, Slurm's srun --mpi=pmi2) PMI_RANK. */
+static int launched(void)
+{
+	static const char *const vars[] = {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK"};
+	for (size_t k = 0; k < sizeof vars / sizeof *vars; k++)
+		if (getenv(vars[k]))
+			return 1;
+	return 0;
+}
+
 void ss_comm_init(int *argc, char ***argv)
 {
+	int len = 0;
+	MPI_Get_library_version(library, &len);   /* allowed before MPI_Init */
+	library[strcspn(library, "\n,")] = '\0';
+	/* Started without a launcher: one rank, and no MPI_Init, which as a
+	 * singleton would start Open MPI's orted from PATH and write its
+	 * shared-memory files (failing under a small ulimit -f); the
+	 * one-rank paths never call MPI. */
+	if (!launched())
+		return;
 	int provided;
 	MPI_Init_thread(argc, argv, MPI_THREAD_FUNNELED, &provided);
 	started = 1;
@@ -69,9 +90,6 @@ void ss_comm_init(int *argc, char ***argv)
 	                    &node);
 	MPI_Comm_size(node, &node_ranks);
 	MPI_Comm_free(&node);
-	int len = 0;
-	MPI_Get_library_version(library, &len);
-	library[strcspn(library, "\n,")] = '\0';
 	MPI_Type_contiguous(2 * SS_COMM_REDUCE_MAX, MPI_DOUBLE, &reduce_type);
 	MPI_Type_commit(&reduce_type);
 	MPI_Op_create(reduce_blocks, 1, &reduce_op);
