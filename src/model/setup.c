@@ -116,8 +116,10 @@ int ss_setup_stepper(const struct ss_case *c, int tile_nx, int tile_ny,
 		err = ss_closure_init(&closure, c->closure, c->repose_angle_deg, c->gamma, c->nu);
 	if (!err)
 		err = ss_stepper_init(st, &g, &closure, &c->boundary, c->cfl, tile_nx, tile_ny);
-	if ((err = ss_comm_agree(err)))
+	if ((err = ss_comm_agree(err))) {
+		ss_stepper_release(st);   /* another rank's failure: ours is whole */
 		return err;
+	}
 	st->kernel = kernel;
 	/* from here on the grid is this rank's slab (stepper.h) */
 	g = st->grid;
