@@ -42,9 +42,16 @@ int ss_boundary_check(const struct ss_boundary *b);
 void ss_boundary_fill_types(const struct ss_grid *g, const struct ss_boundary *b,
                             uint8_t *cell_types);
 
-/* Ghost heights, in the same order. */
+/* Ghost heights, in the same order: 0 behind a wall, open_level beyond an
+ * open side. */
 void ss_boundary_fill_heights(const struct ss_grid *g, const struct ss_boundary *b,
                               double *height);
+
+/* The same for any field with the values it takes behind a wall and
+ * beyond an open side (the bedrock: -infinity for both, no sand lies
+ * outside the grid). */
+void ss_boundary_fill_field(const struct ss_grid *g, const struct ss_boundary *b,
+                            double *field, double wall_value, double open_value);
 
 /* For a slab of a distributed grid (grid.h, comm.h) both fills take the
  * ghost rows that face a neighbour rank from it, whole, after the x sides

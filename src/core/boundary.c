@@ -111,25 +111,30 @@ void ss_boundary_fill_types(const struct ss_grid *g, const struct ss_boundary *b
 void ss_boundary_fill_heights(const struct ss_grid *g, const struct ss_boundary *b,
                               double *height)
 {
+	ss_boundary_fill_field(g, b, height, 0.0, b->open_level);
+}
+
+void ss_boundary_fill_field(const struct ss_grid *g, const struct ss_boundary *b,
+                            double *field, double wall_value, double open_value)
+{
 	const int nx = g->nx, ny = g->ny;
-	const double level = b->open_level;
 	int south, north;
 	ss_boundary_neighbours(g, b, &south, &north);
 	for (int j = 0; j < ny; j++) {
-		FILL_SIDE(height, ss_grid_index(g, -1, j), ss_grid_index(g, nx - 1, j),
-		          b->side[SS_WEST], 0.0, level);
-		FILL_SIDE(height, ss_grid_index(g, nx, j), ss_grid_index(g, 0, j),
-		          b->side[SS_EAST], 0.0, level);
+		FILL_SIDE(field, ss_grid_index(g, -1, j), ss_grid_index(g, nx - 1, j),
+		          b->side[SS_WEST], wall_value, open_value);
+		FILL_SIDE(field, ss_grid_index(g, nx, j), ss_grid_index(g, 0, j),
+		          b->side[SS_EAST], wall_value, open_value);
 	}
 	for (int i = -1; i <= nx; i++) {
 		if (south < 0)
-			FILL_SIDE(height, ss_grid_index(g, i, -1), ss_grid_index(g, i, ny - 1),
-			          b->side[SS_SOUTH], 0.0, level);
+			FILL_SIDE(field, ss_grid_index(g, i, -1), ss_grid_index(g, i, ny - 1),
+			          b->side[SS_SOUTH], wall_value, open_value);
 		if (north < 0)
-			FILL_SIDE(height, ss_grid_index(g, i, ny), ss_grid_index(g, i, 0),
-			          b->side[SS_NORTH], 0.0, level);
+			FILL_SIDE(field, ss_grid_index(g, i, ny), ss_grid_index(g, i, 0),
+			          b->side[SS_NORTH], wall_value, open_value);
 	}
 	const size_t row = (size_t)g->stride * sizeof(double);
-	exchange_rows(south, north, height, row, 0, row, (size_t)ny * row,
+	exchange_rows(south, north, field, row, 0, row, (size_t)ny * row,
 	              (size_t)(ny + 1) * row);
 }

@@ -189,32 +189,6 @@ int ss_stepper_set_bedrock(struct ss_stepper *st, const double *bedrock)
 	return SS_OK;
 }
 
-/* Bedrock ghosts: a periodic side copies the cell it wraps to; elsewhere no
- * sand lies outside the grid (-infinity: no limit). */
-static void fill_bedrock_halo(struct ss_stepper *st)
-{
-	const struct ss_grid *g = &st->grid;
-	const struct ss_boundary *b = &st->boundary;
-	double *r = st->bedrock;
-	const int nx = g->nx, ny = g->ny;
-	const int px = b->side[SS_WEST] == SS_SIDE_PERIODIC;
-	const int py = b->side[SS_SOUTH] == SS_SIDE_PERIODIC;
-	for (int j = 0; j < ny; j++) {
-		r[ss_grid_index(g, -1, j)] = px ? r[ss_grid_index(g, nx - 1, j)] : -INFINITY;
-		r[ss_grid_index(g, nx, j)] = px ? r[ss_grid_index(g, 0, j)] : -INFINITY;
-	}
-	for (int i = -1; i <= nx; i++) {
-		if (st->rank_south < 0)
-			r[ss_grid_index(g, i, -1)] = py ? r[ss_grid_index(g, i, ny - 1)] : -INFINITY;
-		if (st->rank_north < 0)
-			r[ss_grid_index(g, i, ny)] = py ? r[ss_grid_index(g, i, 0)] : -INFINITY;
-	}
-	/* rows from the ranks beside, whole (boundary.c) */
-	const size_t row = (size_t)g->stride;
-	ss_comm_exchange(st->rank_south, st->rank_north, r + row, r, r + ny * row,
-	                 r + (ny + 1) * row, row * sizeof *r);
-}
-
 static int open_faces_build(struct ss_stepper *st)
 {
 	const struct ss_grid *g = &st->grid;
@@ -373,7 +347,9 @@ int ss_stepper_prepare(struct ss_stepper *st)
 		return err;
 	ss_boundary_fill_heights(g, &st->boundary, st->height);
 	if (st->bedrock)
-		fill_bedrock_halo(st);
+		/* bedrock ghosts: a periodic side copies the cell it wraps to;
+		 * elsewhere no sand lies outside the grid (-infinity: no limit) */
+		ss_boundary_fill_field(g, &st->boundary, st->bedrock, -INFINITY, -INFINITY);
 	if ((err = ss_comm_agree(prepare_arrays(st))))
 		return err;
 	double none = 0.0;
