@@ -1,8 +1,13 @@
 # sandslide - plain GNU Makefile.
 #
-#   make            build build/sandslide and build/libsandslide.a
-#   make deps       install the missing Debian packages (apt-get)
+#   make            build build/sandslide, build/libsandslide.a and .so
+#   make deps       install the Debian packages building and running need
+#   make deps-test  add those the test suite needs (pytest, GDAL's tools,
+#                   xarray, CDO, ParaView, clang for the race check)
 #   make test       build and run every test (C programs, then CLI tests)
+#   make install    bin, lib (.so and .a), headers, sandslide.pc, the man
+#                   page, the example cases and the Python module under
+#                   PREFIX (/usr/local), staged in DESTDIR; make uninstall
 #   make demo       run the default case (cases/door.ini -> out/door.h5)
 #   make OPENMP=0   build without OpenMP (pragmas must still compile)
 #   make SANITIZE=1 AddressSanitizer + UndefinedBehaviorSanitizer, in build-san/
@@ -36,6 +41,9 @@ CC         ?= cc
 OPENMP     ?= 1
 SANITIZE   ?= 0
 VERSION    := 0.1.0
+# The shared library's ABI version: the soname is libsandslide.so.$(SOVERSION).
+# 0 while the public headers may still change from one release to the next.
+SOVERSION  := 0
 
 .DELETE_ON_ERROR:
 .DEFAULT_GOAL := all
@@ -58,10 +66,18 @@ DEB_BUILD  := pkg-config $(foreach m,$(PC_MODULES),$(DEB_$(m)))
 ifeq ($(MPI),1)
   DEB_BUILD += openmpi-bin libopenmpi-dev
 endif
-DEB_TEST   := python3-h5py python3-numpy python3-pytest netcdf-bin ffmpeg
+# Run time: ffmpeg for render --video, numpy for the Python module.
+DEB_RUN    := ffmpeg python3-numpy
+# The test suite's tools: the CLI tests (pytest, h5py), and the programs
+# that check the outputs open as they are (ncdump, gdalinfo and GDAL's
+# Python bindings, xarray with netCDF4, CDO, ParaView's pvbatch).  Debian's
+# python3-vtk9 conflicts with python3-paraview, so VTK's readers are
+# tested inside pvbatch.
+DEB_TEST   := python3-h5py python3-pytest netcdf-bin gdal-bin python3-gdal \
+              python3-xarray python3-netcdf4 cdo paraview python3-paraview man-db groff-base
 
 # Goals that need no library: do not probe pkg-config for them.
-NO_PROBE_GOALS := deps clean help
+NO_PROBE_GOALS := deps deps-test clean help uninstall
 ifeq ($(filter-out $(NO_PROBE_GOALS),$(or $(MAKECMDGOALS),all)),)
 else
   ifeq ($(shell command -v $(PKG_CONFIG) 2>/dev/null),)
@@ -78,13 +94,13 @@ endif
 # Optional GDAL: GeoTIFF and other GDAL rasters in src/io/dem_gdal.c.  Used
 # when pkg-config finds it (GDAL=0 builds without); otherwise .tif input
 # and output fail with "unavailable in this build".  `make deps` installs
-# it so the tests cover it (about 100 packages, 54 MB: 34 s on the dev VM).
+# it: DEMs come as GeoTIFFs (about 100 packages, 54 MB: 34 s on the dev VM).
 # An MPI build leaves GDAL out: GDAL links the serial HDF5.
 ifeq ($(MPI),1)
   GDAL ?= 0
 endif
 GDAL ?= 1
-DEB_TEST += libgdal-dev
+DEB_BUILD += libgdal-dev
 ifeq ($(GDAL),1)
   ifneq ($(filter-out $(NO_PROBE_GOALS),$(or $(MAKECMDGOALS),all)),)
     ifeq ($(shell $(PKG_CONFIG) --exists gdal 2>/dev/null && echo y),y)
@@ -121,7 +137,10 @@ endif
 ifeq ($(MPI),1)
   MPIFLAG := -DSS_HAVE_MPI
 endif
-ALL_CFLAGS  := $(BASE) $(WARN) $(OMPFLAG) $(SANFLAG) $(MPIFLAG) -Iinclude -Isrc -DSS_VERSION='"$(VERSION)"' \
+# -fPIC: the same objects make the static and the shared library (on
+# x86-64 the kernel's loops make no calls through the PLT or GOT, so the
+# sweep runs as fast: README, Performance).
+ALL_CFLAGS  := $(BASE) -fPIC $(WARN) $(OMPFLAG) $(SANFLAG) $(MPIFLAG) -Iinclude -Isrc -DSS_VERSION='"$(VERSION)"' \
                $(DEP_CFLAGS) -MMD -MP $(CFLAGS)
 ALL_LDFLAGS := $(OMPFLAG) $(SANFLAG) $(LDFLAGS)
 LIBS        := $(DEP_LIBS) -lm
@@ -144,8 +163,11 @@ TEST_SRC := $(wildcard tests/test_*.c)
 TEST_BIN := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
 HEADERS  := $(wildcard include/sandslide/*.h)
 
-.PHONY: all deps test check demo clean headers-check check-layering help
-all: $(BUILD)/sandslide $(BUILD)/libsandslide.a
+.PHONY: all deps deps-test test check demo clean headers-check check-layering help \
+        install uninstall
+SONAME   := libsandslide.so.$(SOVERSION)
+SHLIB    := libsandslide.so.$(VERSION)
+all: $(BUILD)/sandslide $(BUILD)/libsandslide.a $(BUILD)/libsandslide.so
 
 # A flags stamp: objects rebuild when the flags change (git's GIT-CFLAGS).
 $(BUILD)/.flags: FORCE
@@ -166,6 +188,20 @@ $(BUILD)/obj/render/%.o: render/%.c $(BUILD)/.flags
 $(BUILD)/libsandslide.a: $(LIB_OBJ)
 	@$(if $(Q),echo '  AR      $@')
 	$(Q)rm -f $@ && ar rcs $@ $^
+
+# The shared library (for C programs through pkg-config, and the Python
+# module), with its soname and the two links a build tree needs:
+# libsandslide.so for -lsandslide, libsandslide.so.0 for the loader.  Every
+# library it uses is linked in (--no-undefined; not under the sanitizers,
+# whose run-time symbols the program provides).
+ifneq ($(SANITIZE),1)
+  SHLIB_CHECK := -Wl,--no-undefined
+endif
+$(BUILD)/$(SHLIB): $(LIB_OBJ)
+	@$(if $(Q),echo '  LINK    $@')
+	$(Q)$(CC) -shared -Wl,-soname,$(SONAME) $(SHLIB_CHECK) $(ALL_LDFLAGS) $^ $(LIBS) -o $@
+$(BUILD)/libsandslide.so: $(BUILD)/$(SHLIB)
+	$(Q)ln -sf $(SHLIB) $(BUILD)/$(SONAME) && ln -sf $(SONAME) $@
 
 $(BUILD)/sandslide: $(MAIN_OBJ) $(BUILD)/libsandslide.a
 	@$(if $(Q),echo '  LINK    $@')
@@ -255,6 +291,8 @@ test check: all $(TEST_BIN) $(HOOK_BIN) headers-check check-layering $(FUZZ_REPL
 	echo "== tests/fuzz (corpora and regressions replayed)"; ( $(FUZZ_REPLAY_RUN) ) || fail=1; \
 	echo "== tests/cli (pytest)"; \
 	SANDSLIDE_MPI= SANDSLIDE=$(abspath $(BUILD)/sandslide) SANDSLIDE_NAN=$(abspath $(HOOK_BIN)) \
+	  SANDSLIDE_MAKEFLAGS="BUILD=$(BUILD) SANITIZE=$(SANITIZE) MPI=$(MPI) OPENMP=$(OPENMP) GDAL=$(GDAL)" \
+	  SANDSLIDE_CC="$(CC)" SANDSLIDE_LDFLAGS="$(ALL_LDFLAGS)" \
 	  $(PYTHON) -m pytest -q tests/cli || fail=1; \
 	exit $$fail
 
@@ -317,21 +355,80 @@ race:
 	  TSAN_OPTIONS="$${TSAN_OPTIONS:-exitcode=66 suppressions=$(abspath tests/tsan.supp)}" \
 	  sh tests/race.sh $(RACE_BUILD)
 
+# ---- make install / make uninstall -----------------------------------------
+# The usual GNU variables: PREFIX (default /usr/local) and the folders under
+# it, DESTDIR to stage the tree elsewhere (a package build, the install
+# test).  The Python module goes where PREFIX's python3 looks: the entry of
+# its sys.path under PREFIX/lib (Debian: /usr/local/lib/python3.X/
+# dist-packages), else PREFIX/lib/python3.X/site-packages (then set
+# PYTHONPATH); it is told where the installed library is (_library.py).
+PREFIX      ?= /usr/local
+BINDIR      ?= $(PREFIX)/bin
+LIBDIR      ?= $(PREFIX)/lib
+INCLUDEDIR  ?= $(PREFIX)/include
+DATADIR     ?= $(PREFIX)/share
+MANDIR      ?= $(DATADIR)/man
+PKGCONFIGDIR ?= $(LIBDIR)/pkgconfig
+PYTHONDIR   ?= $(shell $(PYTHON) -c 'import sys, sysconfig; p = "$(PREFIX)"; \
+  c = [d for d in sys.path if d.startswith(p + "/lib/") and d.endswith("-packages")]; \
+  print(c[0] if c else sysconfig.get_path("purelib", "posix_prefix", {"base": p, "platbase": p}))')
+INSTALL     ?= install
+INSTALL_HEADERS := $(HEADERS)
+PY_SRC      := $(wildcard python/sandslide/*.py)
+PC_REQUIRES := $(PC_MODULES)$(if $(findstring SS_HAVE_GDAL,$(DEP_CFLAGS)), gdal)
+
+install: all
+	$(INSTALL) -d $(DESTDIR)$(BINDIR) $(DESTDIR)$(LIBDIR) $(DESTDIR)$(INCLUDEDIR)/sandslide \
+	  $(DESTDIR)$(PKGCONFIGDIR) $(DESTDIR)$(MANDIR)/man1 $(DESTDIR)$(DATADIR)/sandslide/cases/dem \
+	  $(DESTDIR)$(PYTHONDIR)/sandslide
+	$(INSTALL) -m 755 $(BUILD)/sandslide $(DESTDIR)$(BINDIR)/sandslide
+	$(INSTALL) -m 755 $(BUILD)/$(SHLIB) $(DESTDIR)$(LIBDIR)/$(SHLIB)
+	ln -sf $(SHLIB) $(DESTDIR)$(LIBDIR)/$(SONAME)
+	ln -sf $(SONAME) $(DESTDIR)$(LIBDIR)/libsandslide.so
+	$(INSTALL) -m 644 $(BUILD)/libsandslide.a $(DESTDIR)$(LIBDIR)/libsandslide.a
+	$(INSTALL) -m 644 $(INSTALL_HEADERS) $(DESTDIR)$(INCLUDEDIR)/sandslide/
+	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@LIBDIR@|$(patsubst $(PREFIX)/%,$${prefix}/%,$(LIBDIR))|' -e 's|@INCLUDEDIR@|$(patsubst $(PREFIX)/%,$${prefix}/%,$(INCLUDEDIR))|' \
+	  -e 's|@VERSION@|$(VERSION)|' \
+	  -e 's|@REQUIRES@|$(PC_REQUIRES)|' -e 's|@OPENMP@|$(filter -fopenmp,$(OMPFLAG))|' \
+	  sandslide.pc.in > $(DESTDIR)$(PKGCONFIGDIR)/sandslide.pc
+	$(INSTALL) -m 644 doc/sandslide.1 $(DESTDIR)$(MANDIR)/man1/sandslide.1
+	$(INSTALL) -m 644 $(wildcard cases/*.ini cases/*.py) $(DESTDIR)$(DATADIR)/sandslide/cases/
+	$(INSTALL) -m 644 $(wildcard cases/dem/*) $(DESTDIR)$(DATADIR)/sandslide/cases/dem/
+	$(INSTALL) -m 644 $(PY_SRC) $(DESTDIR)$(PYTHONDIR)/sandslide/
+	printf '# written by make install: the library this module loads\nPATH = "%s"\n' \
+	  '$(LIBDIR)/$(SONAME)' > $(DESTDIR)$(PYTHONDIR)/sandslide/_library.py
+	@echo "installed sandslide $(VERSION) under $(DESTDIR)$(PREFIX) (Python module in $(DESTDIR)$(PYTHONDIR))"
+
+uninstall:
+	rm -f $(DESTDIR)$(BINDIR)/sandslide $(DESTDIR)$(LIBDIR)/$(SHLIB) $(DESTDIR)$(LIBDIR)/$(SONAME) \
+	  $(DESTDIR)$(LIBDIR)/libsandslide.so $(DESTDIR)$(LIBDIR)/libsandslide.a \
+	  $(DESTDIR)$(PKGCONFIGDIR)/sandslide.pc $(DESTDIR)$(MANDIR)/man1/sandslide.1 \
+	  $(HEADERS:include/sandslide/%=$(DESTDIR)$(INCLUDEDIR)/sandslide/%)
+	rm -rf $(DESTDIR)$(DATADIR)/sandslide $(DESTDIR)$(PYTHONDIR)/sandslide
+	-rmdir $(DESTDIR)$(INCLUDEDIR)/sandslide 2>/dev/null
+
 demo: all
 	@mkdir -p out
 	./$(BUILD)/sandslide run cases/door.ini -o out/door.h5
 
-deps:
-	@missing=""; for p in $(DEB_BUILD) $(DEB_TEST); do \
+# `make deps`: what building and running need (DEB_BUILD, DEB_RUN, and
+# with MPI=1 Open MPI); `make deps-test`: what the test suite adds
+# (DEB_TEST: pytest, the readers the output is checked with, ParaView,
+# clang).  apt-get only for what is missing.
+DEPS_INSTALL = missing=""; for p in $(1); do \
 	  dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q 'ok installed' || missing="$$missing $$p"; \
 	done; \
-	if [ -z "$$missing" ]; then echo "deps: all Debian packages present ($(DEB_BUILD) $(DEB_TEST))"; \
+	if [ -z "$$missing" ]; then echo "$@: all Debian packages present ($(strip $(1)))"; \
 	else \
-	  echo "deps: installing missing Debian packages:$$missing"; \
+	  echo "$@: installing missing Debian packages:$$missing"; \
 	  SUDO=""; [ "$$(id -u)" = 0 ] || SUDO=sudo; \
 	  $$SUDO apt-get update -qq && \
 	  DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq --no-install-recommends $$missing; \
 	fi
+deps:
+	@$(call DEPS_INSTALL,$(DEB_BUILD) $(DEB_RUN))
+deps-test: deps
+	@$(call DEPS_INSTALL,$(DEB_TEST))
 
 clean:
 	rm -rf $(BUILD)

@@ -40,6 +40,10 @@ void ss_error_print(const char *message);
  * several ranks only rank 0 prints as it reports; comm.h says how the
  * message of another rank reaches it. */
 const char *ss_error_last_message(void);
+/* on != 0: report without printing, for a program that shows
+ * ss_error_last_message() its own way (the Python module raises it as an
+ * exception).  Off by default. */
+void ss_error_set_quiet(int on);
 
 _Noreturn void ss_bug_at(const char *file, int line, const char *fmt, ...)
 	__attribute__((format(printf, 3, 4)));

@@ -16,11 +16,18 @@
  * prints, and ss_comm_agree has it printed there when another rank failed
  * first (comm.h). */
 static char last_message[SS_ERROR_MESSAGE_MAX];
+/* Set by a program that shows the messages itself (the Python module). */
+static int quiet;
+
+void ss_error_set_quiet(int on)
+{
+	quiet = on != 0;
+}
 
 static int vreport(int status, const char *fmt, va_list ap)
 {
 	vsnprintf(last_message, sizeof last_message, fmt, ap);
-	if (ss_comm_rank() == 0)
+	if (ss_comm_rank() == 0 && !quiet)
 		ss_error_print(last_message);
 	return status;
 }

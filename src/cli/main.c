@@ -26,6 +26,7 @@
 #include "sandslide/render.h"
 #include "sandslide/run.h"
 #include "sandslide/snapshot.h"
+#include "sandslide/version.h"
 
 #define COUNT(a) ((int)(sizeof(a) / sizeof((a)[0])))
 
@@ -713,7 +714,7 @@ static int command(int argc, char **argv)
 		return 0;
 	}
 	if (!strcmp(cmd, "--version") || !strcmp(cmd, "version")) {
-		printf("sandslide %s (OpenMP: %s, %d processors; GDAL: %s; MPI: %s)\n", SS_VERSION,
+		printf("sandslide %s (OpenMP: %s, %d processors; GDAL: %s; MPI: %s)\n", ss_version(),
 #ifdef _OPENMP
 		       "on",
 #else

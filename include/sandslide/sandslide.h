@@ -1,0 +1,42 @@
+/*
+ * sandslide.h - the whole public interface in one include, for programs
+ * that link the library (pkg-config --cflags --libs sandslide):
+ *
+ *     #include <sandslide/sandslide.h>
+ *
+ * Each header says what its part does; the tiers they belong to are in
+ * src/README.md.  The commands as functions (run.h, relax.h, render.h,
+ * bench.h) are the usual entry points; the kernel (grid.h, stepper.h,
+ * sweep.h) is for programs that drive the time loop themselves.  Every
+ * function returns a status (error.h) and prints only error messages, which
+ * ss_error_set_quiet() turns off in favour of ss_error_last_message().
+ */
+#ifndef SANDSLIDE_SANDSLIDE_H
+#define SANDSLIDE_SANDSLIDE_H
+
+#include "sandslide/version.h"
+#include "sandslide/error.h"
+#include "sandslide/parallel.h"
+#include "sandslide/comm.h"
+
+#include "sandslide/grid.h"
+#include "sandslide/boundary.h"
+#include "sandslide/closure.h"
+#include "sandslide/face.h"
+#include "sandslide/diagnostics.h"
+#include "sandslide/sweep.h"
+#include "sandslide/rkl2.h"
+#include "sandslide/stepper.h"
+
+#include "sandslide/dem.h"
+#include "sandslide/snapshot.h"
+#include "sandslide/shape.h"
+#include "sandslide/case.h"
+#include "sandslide/progress.h"
+
+#include "sandslide/run.h"
+#include "sandslide/relax.h"
+#include "sandslide/bench.h"
+#include "sandslide/render.h"
+
+#endif
