@@ -394,7 +394,7 @@ install: all
 	$(INSTALL) -m 644 doc/sandslide.1 $(DESTDIR)$(MANDIR)/man1/sandslide.1
 	$(INSTALL) -m 644 $(wildcard cases/*.ini cases/*.py) $(DESTDIR)$(DATADIR)/sandslide/cases/
 	$(INSTALL) -m 644 $(wildcard cases/dem/*) $(DESTDIR)$(DATADIR)/sandslide/cases/dem/
-	$(INSTALL) -m 644 $(PY_SRC) $(DESTDIR)$(PYTHONDIR)/sandslide/
+	$(if $(PY_SRC),$(INSTALL) -m 644 $(PY_SRC) $(DESTDIR)$(PYTHONDIR)/sandslide/)
 	printf '# written by make install: the library this module loads\nPATH = "%s"\n' \
 	  '$(LIBDIR)/$(SONAME)' > $(DESTDIR)$(PYTHONDIR)/sandslide/_library.py
 	@echo "installed sandslide $(VERSION) under $(DESTDIR)$(PREFIX) (Python module in $(DESTDIR)$(PYTHONDIR))"

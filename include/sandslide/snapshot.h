@@ -43,6 +43,9 @@ struct ss_snapshot_meta {
 	int deflate;             /* 0 (none) .. 9 */
 	const double *bedrock;   /* m, the grid's halo layout, or NULL */
 	const char *case_overrides; /* the --set values, one per line, or NULL */
+	const char *crs_wkt;     /* coordinate reference system of x and y (WKT,
+	                          * from the input DEM), or NULL: written as the
+	                          * CF grid mapping variable /crs */
 };
 
 /* Call first in a program: HDF5 quiet (errors are reported by the callers)
@@ -57,11 +60,13 @@ int ss_snapshot_create(struct ss_snapshot **out, const char *path,
                        const struct ss_grid *g, const uint8_t *cell_types,
                        const struct ss_snapshot_meta *meta);
 
-/* Append one snapshot (height with the grid's halo layout) and, when state
- * is not NULL, the restart state (root attribute restart_state), flush the
- * file and rewrite the XDMF sidecar. */
+/* Append one snapshot (height with the grid's halo layout; walls are
+ * written as NaN, the _FillValue, so cell_types in the same layout) and,
+ * when state is not NULL, the restart state (root attribute
+ * restart_state), flush the file and rewrite the XDMF sidecar. */
 int ss_snapshot_append(struct ss_snapshot *s, double time_s, const double *height,
-                       const struct ss_diagnostics *d, const struct ss_restart_state *state);
+                       const uint8_t *cell_types, const struct ss_diagnostics *d,
+                       const struct ss_restart_state *state);
 
 /* Reopen an output of grid g to append snapshots to it (a restart).
  * SS_ERR_INPUT if it is not a sandslide output (ss_snapshot_file_open) of
@@ -110,6 +115,12 @@ double ss_snapshot_last_time(const struct ss_snapshot *s);
 /* Close the file; returns SS_ERR_FAIL if the final close fails.
  * ss_snapshot_destroy(NULL) is a no-op. */
 int ss_snapshot_destroy(struct ss_snapshot *s);
+
+/* 1 when path ends in .nc or .nc4: the same HDF5 file, under a name that
+ * makes GDAL (and QGIS) open it with its netCDF driver, which reads the
+ * coordinates and CRS itself and shows the grid north up; no .aux.xml is
+ * written for it. */
+int ss_snapshot_named_netcdf(const char *path);
 
 /* Path of the XDMF sidecar for an output path: "run.h5" -> "run.xmf". */
 void ss_snapshot_sidecar_path(const char *path, char *out, size_t size);
@@ -173,6 +184,7 @@ struct ss_snapshot_file {
 	double dx, dy;              /* cell size, m */
 	double origin_x, origin_y;  /* lower-left corner, m (NAN without /x, /y) */
 	double *time;               /* count entries, s */
+	char *crs_wkt;              /* the CRS of x and y (/crs), NULL if none */
 	struct ss_snapshot_file_h5 *h5;
 };
 

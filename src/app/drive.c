@@ -67,7 +67,8 @@ static int keep_state(struct ss_drive *d)
 	if (!d->snapshot)
 		return SS_OK;
 	ss_stepper_restart_state(st, &state);
-	const int err = ss_snapshot_append(d->snapshot, st->time, st->height, &diag, &state);
+	const int err = ss_snapshot_append(d->snapshot, st->time, st->height, st->cell_types,
+	                                   &diag, &state);
 	d->seconds_output += ss_parallel_wall_seconds() - t0;
 	return err;
 }

@@ -124,7 +124,8 @@ static enum ss_dem_format format_of(const char *path)
 		return SS_DEM_PNG;
 	if (has_suffix(path, ".tif") || has_suffix(path, ".tiff"))
 		return SS_DEM_GDAL;
-	if (has_suffix(path, ".h5") || h5_dataset(path))
+	if (has_suffix(path, ".h5") || has_suffix(path, ".nc") || has_suffix(path, ".nc4") ||
+	    h5_dataset(path))
 		return SS_DEM_H5;
 	return SS_DEM_AUTO;
 }
@@ -168,7 +169,10 @@ static int read_h5_output(const char *path, struct ss_raster *r)
 		r->cellsize_y = f.dy;
 		r->x0 = f.origin_x;
 		r->y0 = f.origin_y;
-	} else {
+		if (f.crs_wkt && !(r->crs_wkt = ss_dem_strdup(f.crs_wkt)))
+			err = SS_ERR_FAIL;
+	}
+	if (err) {
 		ss_free(r->values);
 		r->values = NULL;
 	}

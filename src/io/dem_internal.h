@@ -12,7 +12,7 @@
 
 /* What the extension-less error messages list as accepted. */
 #define SS_DEM_ACCEPTED_READ                                                    \
-	"an ESRI ASCII grid (.asc), a sandslide HDF5 file (.h5 or .h5:/dataset), " \
+	"an ESRI ASCII grid (.asc), a sandslide HDF5 file (.h5, .nc or .h5:/dataset), " \
 	"a 16-bit greyscale PNG (.png) or a GeoTIFF (.tif, .tiff)"
 
 /* Readers: r is zeroed with unknown geometry on entry; r->source is set. */

@@ -680,7 +680,15 @@ static int check_definition(struct ss_snapshot_file *f)
 	f->origin_y = y0 - 0.5 * f->dy;
 	f->origin_x = isfinite(f->origin_x) ? f->origin_x : NAN;
 	f->origin_y = isfinite(f->origin_y) ? f->origin_y : NAN;
-	return SS_OK;
+	/* the optional CF grid mapping variable /crs of a georeferenced run */
+	if (H5Lexists(in->file, "crs", H5P_DEFAULT) > 0) {
+		hid_t crs = H5Oopen(in->file, "crs", H5P_DEFAULT);
+		if (crs >= 0) {
+			err = attr_text(in, crs, "crs_wkt", &f->crs_wkt);
+			H5Oclose(crs);
+		}
+	}
+	return err;
 }
 
 void ss_snapshot_file_close(struct ss_snapshot_file *f)
@@ -693,6 +701,7 @@ void ss_snapshot_file_close(struct ss_snapshot_file *f)
 	}
 	free(f->time);
 	free(f->name);
+	free(f->crs_wkt);
 	memset(f, 0, sizeof *f);
 }
 
@@ -743,6 +752,29 @@ static void check_rows(const struct ss_snapshot_file *f, int j0, int rows)
 		SS_BUG("rows %d .. %d of a grid of %d rows", j0, j0 + rows - 1, f->ny);
 }
 
+/* Walls are stored as NaN (the _FillValue, snapshot_write.c) and held at
+ * 0 m by the stepper: give them 0 m again, so that a restart, a frame or a
+ * DEM read from the file sees what the run had.  A NaN anywhere else is
+ * left for the caller's checks to find. */
+static int walls_to_zero(struct ss_snapshot_file *f, int j0, int rows, double *out)
+{
+	const size_t n = (size_t)rows * (size_t)f->nx;
+	size_t k = 0;
+	while (k < n && !isnan(out[k]))
+		k++;
+	if (k == n)
+		return SS_OK;
+	uint8_t *types = ss_alloc(n, 1, "cell type rows");
+	if (!types)
+		return SS_ERR_FAIL;
+	const int err = ss_snapshot_file_read_cell_types(f, j0, rows, types);
+	for (; k < n && !err; k++)
+		if (types[k] == SS_CELL_WALL && isnan(out[k]))
+			out[k] = 0.0;
+	ss_free(types);
+	return err;
+}
+
 int ss_snapshot_file_read_rows(struct ss_snapshot_file *f, long long t, int j0, int rows,
                                double *out)
 {
@@ -761,7 +793,7 @@ int ss_snapshot_file_read_rows(struct ss_snapshot_file *f, long long t, int j0, 
 		err = var_read(&f->h5->in, &f->h5->height, start, count, H5T_NATIVE_DOUBLE, out,
 		               what);
 	}
-	return err;
+	return err ? err : walls_to_zero(f, j0, rows, out);
 }
 
 int ss_snapshot_file_read_cell_types(struct ss_snapshot_file *f, int j0, int rows,
@@ -834,9 +866,13 @@ static int read_diagnostics(struct ss_snapshot_file *f, struct ss_snapshot_summa
 	int err = SS_OK;
 	for (int k = 0; k < SS_SNAPSHOT_DIAG_COUNT && !err; k++) {
 		struct var v;
-		const int missing = var_open(&f->h5->in, ss_snapshot_diag_name(k), &v) == VAR_MISSING;
+		const int opened = var_open(&f->h5->in, ss_snapshot_diag_name(k), &v);
 		var_close(&v);
-		if (k == SS_SNAPSHOT_DIAG_EVALUATIONS && missing) {
+		if (opened < 0) {   /* damaged: said so already (read_series would again) */
+			err = opened;
+			break;
+		}
+		if (k == SS_SNAPSHOT_DIAG_EVALUATIONS && opened == VAR_MISSING) {
 			/* written before RKL2: one evaluation per step */
 			for (long long m = 0; m < n; m++)
 				sum->diag[m].evaluations = sum->diag[m].steps;

@@ -2,10 +2,16 @@
  * snapshot_write.c - HDF5 + XDMF output (see snapshot.h for the layout);
  * the reads are in snapshot_read.c.
  *
- * File types are explicit little-endian IEEE (H5T_IEEE_F64LE, H5T_STD_U8LE),
- * memory types native.  Heights are written straight from the halo layout
- * through a memory hyperslab, so no copy of the grid is made.  HDF5's own
- * error stack printing is off: each failure prints one sandslide message.
+ * File types are explicit little-endian IEEE (H5T_IEEE_F64LE, H5T_STD_I8LE),
+ * memory types native.  Heights are copied a band of chunk rows at a time,
+ * with NaN (the CF _FillValue) at walls, so that netCDF readers, GDAL and
+ * ParaView show walls as missing rather than as floor at 0 m; the reader
+ * (snapshot_read.c) gives walls 0 m again.  HDF5's own error stack
+ * printing is off: each failure prints one sandslide message.
+ *
+ * Beside the file: the XDMF sidecar (run.xmf, for ParaView) and GDAL's
+ * .aux.xml (run.h5.aux.xml), which gives GDAL's HDF5 driver the
+ * georeferencing it cannot find itself (it reads no dimension scales).
  *
  * In a run of several ranks (make MPI=1, comm.h) every rank opens the one
  * file through MPI-IO and makes every metadata call (create, extend,
@@ -22,6 +28,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/statvfs.h>
@@ -52,6 +59,11 @@ struct ss_snapshot {
 	                           follows will fail too, silently */
 	double *times;          /* for the sidecar */
 	long long times_cap;
+	double *band;           /* band_rows x nx heights being written */
+	uint8_t *band_types;    /* a row of unpacked cell types */
+	int band_rows;          /* rows of a chunk of /height */
+	char *crs_wkt;          /* for the .aux.xml; NULL: none */
+	int has_bedrock;        /* /bedrock written */
 };
 
 static void quiet_hdf5(void)
@@ -143,7 +155,8 @@ static hid_t create_series(hid_t file, const char *name, const char *units,
 }
 
 static hid_t create_coordinate(hid_t file, const char *name, int n, double origin,
-                               double spacing, const char *long_name, const char *axis)
+                               double spacing, const char *long_name, const char *axis,
+                               const char *standard_name)
 {
 	hsize_t dim = (hsize_t)n;
 	double *v = ss_alloc((size_t)n, sizeof *v, "coordinates");
@@ -157,7 +170,8 @@ static hid_t create_coordinate(hid_t file, const char *name, int n, double origi
 	/* rank 0 writes the values (independently); every rank the attributes */
 	int bad = d < 0 ||
 	          (is_root() && H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v) < 0) ||
-	          attr_units(d, "m", long_name) || attr_string(d, "axis", axis);
+	          attr_units(d, "m", long_name) || attr_string(d, "axis", axis) ||
+	          (standard_name && attr_string(d, "standard_name", standard_name));
 	ss_free(v);
 	H5Sclose(space);
 	if (bad && d >= 0) {
@@ -167,15 +181,19 @@ static hid_t create_coordinate(hid_t file, const char *name, int n, double origi
 	return d;
 }
 
-/* The memory space of a halo-layout field with the interior selected. */
-static hid_t interior_space(const struct ss_grid *g)
+/* A scalar float64 attribute NaN named _FillValue: the CF and netCDF
+ * name of the value that marks a missing cell (walls in /height, cells
+ * without rock in /bedrock), matching the dataset's fill value. */
+static int attr_fill_nan(hid_t d)
 {
-	hsize_t dims[2] = {(hsize_t)g->ny + 2 * SS_GRID_GHOST, (hsize_t)g->stride};
-	hsize_t start[2] = {SS_GRID_GHOST, SS_GRID_GHOST};
-	hsize_t count[2] = {(hsize_t)g->ny, (hsize_t)g->nx};
-	hid_t m = H5Screate_simple(2, dims, NULL);
-	H5Sselect_hyperslab(m, H5S_SELECT_SET, start, NULL, count, NULL);
-	return m;
+	const double fill = NAN;
+	return attr_doubles(d, "_FillValue", &fill, 1);
+}
+
+/* Rows of /height per chunk: a chunk is 1 x rows x min(nx, 256). */
+static int chunk_rows(long long ny)
+{
+	return ny < 256 ? (int)ny : 256;
 }
 
 /* Rows j0 .. j0 + n - 1 (of the whole grid) of a (y, x) dataset of nx
@@ -210,7 +228,7 @@ static int write_cell_types(hid_t dataset, hid_t file_space, const struct ss_gri
 			ss_cell_types_unpack(cell_types, ss_grid_index(g, 0, j0 + j), (size_t)g->nx,
 			                     block + (size_t)j * g->nx);
 		bad = write_rows(dataset, file_space, (int)g->offset_j + j0, n, g->nx,
-		                 H5T_NATIVE_UINT8, block);
+		                 H5T_NATIVE_UINT8, block);   /* converted to int8 */
 	}
 	ss_free(block);
 	return bad;
@@ -219,7 +237,7 @@ static int write_cell_types(hid_t dataset, hid_t file_space, const struct ss_gri
 /* bedrock (y, x), m: NaN (the _FillValue) where no sand can lie (walls,
  * open cells), written a block of rows at a time. */
 static int write_bedrock(hid_t file, hid_t x, hid_t y, const struct ss_grid *g,
-                         const double *bedrock)
+                         const double *bedrock, int crs)
 {
 	hsize_t dims[2] = {(hsize_t)g->global_ny, (hsize_t)g->nx};
 	hid_t space = H5Screate_simple(2, dims, NULL);
@@ -243,7 +261,29 @@ static int write_bedrock(hid_t file, hid_t x, hid_t y, const struct ss_grid *g,
 	}
 	ss_free(block);
 	bad = bad || attr_units(d, "m", "non-erodible bedrock under the sand") ||
+	      attr_fill_nan(d) || (crs && attr_string(d, "grid_mapping", "crs")) ||
 	      H5DSattach_scale(d, y, 0) < 0 || H5DSattach_scale(d, x, 1) < 0;
+	if (d >= 0)
+		H5Dclose(d);
+	H5Sclose(space);
+	return bad;
+}
+
+/* The CF grid mapping variable of a georeferenced grid: a scalar "crs"
+ * with the input DEM's coordinate reference system as WKT, under the CF
+ * name (crs_wkt, CF 1.7 section 5.6) and GDAL's (spatial_ref), which
+ * gdalinfo, QGIS and xarray's rioxarray read.  A WKT does not give CF's
+ * grid_mapping_name without a projection library; readers use the WKT. */
+static int write_crs(hid_t file, const char *wkt)
+{
+	hid_t space = H5Screate(H5S_SCALAR);
+	hid_t d = H5Dcreate2(file, "crs", H5T_STD_I32LE, space, H5P_DEFAULT, H5P_DEFAULT,
+	                     H5P_DEFAULT);
+	const int zero = 0;
+	const int bad = d < 0 ||
+	      (is_root() && H5Dwrite(d, H5T_NATIVE_INT, H5S_ALL, H5S_ALL, H5P_DEFAULT, &zero) < 0) ||
+	      attr_string(d, "crs_wkt", wkt) || attr_string(d, "spatial_ref", wkt) ||
+	      attr_string(d, "long_name", "coordinate reference system of x and y");
 	if (d >= 0)
 		H5Dclose(d);
 	H5Sclose(space);
@@ -256,23 +296,32 @@ static int write_static(struct ss_snapshot *s, const uint8_t *cell_types,
 	const struct ss_grid *g = &s->grid;
 	hid_t f = s->file;
 	int bad = 0;
+	const int crs = meta->crs_wkt && *meta->crs_wkt;
 
 	hid_t x = create_coordinate(f, "x", g->nx, g->origin_x, g->dx,
-	                            "x coordinate of cell centre (west to east)", "X");
+	                            "x coordinate of cell centre (west to east)", "X",
+	                            crs ? "projection_x_coordinate" : NULL);
 	hid_t y = create_coordinate(f, "y", (int)g->global_ny, g->origin_y, g->dy,
-	                            "y coordinate of cell centre (south to north)", "Y");
-	s->time = create_series(f, "time", "s", "simulated time");
+	                            "y coordinate of cell centre (south to north)", "Y",
+	                            crs ? "projection_y_coordinate" : NULL);
+	/* "seconds", a duration without a reference date: xarray decodes it as
+	 * elapsed time (timedelta64) and CDO counts from 0000-00-00, where
+	 * "seconds since <date>" would make both invent calendar dates for a
+	 * simulation that has none; "s" was read by neither as time */
+	s->time = create_series(f, "time", "seconds", "simulated time since the start");
 	if (x < 0 || y < 0 || s->time < 0)
 		bad = 1;
 	bad = bad || attr_string(s->time, "axis", "T");
 	bad = bad || H5DSset_scale(x, "x") < 0 || H5DSset_scale(y, "y") < 0 ||
 	      H5DSset_scale(s->time, "time") < 0;
+	bad = bad || (crs && write_crs(f, meta->crs_wkt));
 
 	/* height (time, y, x) */
 	const hsize_t ny = (hsize_t)g->global_ny;
 	hsize_t dims[3] = {0, ny, (hsize_t)g->nx};
 	hsize_t maxdims[3] = {H5S_UNLIMITED, ny, (hsize_t)g->nx};
-	hsize_t chunk[3] = {1, ny < 256 ? ny : 256, (hsize_t)(g->nx < 256 ? g->nx : 256)};
+	hsize_t chunk[3] = {1, (hsize_t)chunk_rows(g->global_ny),
+	                    (hsize_t)(g->nx < 256 ? g->nx : 256)};
 	hid_t space = H5Screate_simple(3, dims, maxdims);
 	hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
 	H5Pset_chunk(dcpl, 3, chunk);
@@ -281,31 +330,36 @@ static int write_static(struct ss_snapshot *s, const uint8_t *cell_types,
 		H5Pset_deflate(dcpl, (unsigned)meta->deflate);
 	}
 	H5Pset_fletcher32(dcpl);
+	const double fill = NAN;
+	H5Pset_fill_value(dcpl, H5T_NATIVE_DOUBLE, &fill);
 	s->height = bad ? -1 : H5Dcreate2(f, "height", H5T_IEEE_F64LE, space, H5P_DEFAULT,
 	                                  dcpl, H5P_DEFAULT);
 	H5Pclose(dcpl);
 	H5Sclose(space);
 	bad = bad || s->height < 0 || attr_units(s->height, "m", "height of the sand surface") ||
 	      attr_string(s->height, "standard_name", "surface_altitude") ||
+	      attr_fill_nan(s->height) || (crs && attr_string(s->height, "grid_mapping", "crs")) ||
 	      H5DSattach_scale(s->height, s->time, 0) < 0 ||
 	      H5DSattach_scale(s->height, y, 1) < 0 || H5DSattach_scale(s->height, x, 2) < 0;
 
-	/* cell_type (y, x) */
+	/* cell_type (y, x): signed bytes, NC_BYTE to netCDF, which every netCDF
+	 * reader takes (VTK's netCDF-CF reader, ParaView's, rejects NC_UBYTE) */
 	hsize_t dims2[2] = {ny, (hsize_t)g->nx};
 	space = H5Screate_simple(2, dims2, NULL);
-	hid_t ct = bad ? -1 : H5Dcreate2(f, "cell_type", H5T_STD_U8LE, space, H5P_DEFAULT,
+	hid_t ct = bad ? -1 : H5Dcreate2(f, "cell_type", H5T_STD_I8LE, space, H5P_DEFAULT,
 	                                 H5P_DEFAULT, H5P_DEFAULT);
 	bad = bad || ct < 0 || write_cell_types(ct, space, g, cell_types) ||
 	      attr_units(ct, "1", "cell type") ||
 	      attr_string(ct, "flag_meanings", "flow wall open") ||
+	      (crs && attr_string(ct, "grid_mapping", "crs")) ||
 	      H5DSattach_scale(ct, y, 0) < 0 || H5DSattach_scale(ct, x, 1) < 0;
 	if (!bad) {
 		/* an attribute: every rank writes the same values */
-		const uint8_t flags[3] = {SS_CELL_FLOW, SS_CELL_WALL, SS_CELL_OPEN};
+		const int8_t flags[3] = {SS_CELL_FLOW, SS_CELL_WALL, SS_CELL_OPEN};
 		hsize_t n = 3;
 		hid_t as = H5Screate_simple(1, &n, NULL);
-		hid_t a = H5Acreate2(ct, "flag_values", H5T_STD_U8LE, as, H5P_DEFAULT, H5P_DEFAULT);
-		bad = a < 0 || H5Awrite(a, H5T_NATIVE_UINT8, flags) < 0;
+		hid_t a = H5Acreate2(ct, "flag_values", H5T_STD_I8LE, as, H5P_DEFAULT, H5P_DEFAULT);
+		bad = a < 0 || H5Awrite(a, H5T_NATIVE_INT8, flags) < 0;
 		if (a >= 0)
 			H5Aclose(a);
 		H5Sclose(as);
@@ -314,7 +368,7 @@ static int write_static(struct ss_snapshot *s, const uint8_t *cell_types,
 	if (ct >= 0)
 		H5Dclose(ct);
 
-	bad = bad || (meta->bedrock && write_bedrock(f, x, y, g, meta->bedrock));
+	bad = bad || (meta->bedrock && write_bedrock(f, x, y, g, meta->bedrock, crs));
 
 	for (int k = 0; k < SS_SNAPSHOT_DIAG_COUNT && !bad; k++) {
 		s->diag[k] = create_series(f, ss_snapshot_diag_name(k), ss_snapshot_diag_units(k),
@@ -339,6 +393,13 @@ static int write_static(struct ss_snapshot *s, const uint8_t *cell_types,
 	if (y >= 0)
 		H5Dclose(y);
 	return bad ? -1 : 0;
+}
+
+int ss_snapshot_named_netcdf(const char *path)
+{
+	const size_t n = strlen(path);
+	return (n > 3 && !strcasecmp(path + n - 3, ".nc")) ||
+	       (n > 4 && !strcasecmp(path + n - 4, ".nc4"));
 }
 
 void ss_snapshot_sidecar_path(const char *path, char *out, size_t size)
@@ -371,6 +432,9 @@ int ss_snapshot_destroy(struct ss_snapshot *s)
 	if (s->count == 0 && s->partial_path && is_root())
 		remove(s->partial_path);   /* never complete: leave nothing */
 	free(s->times);
+	ss_free(s->band);
+	ss_free(s->band_types);
+	free(s->crs_wkt);
 	free(s->xmf_path);
 	free(s->partial_path);
 	free(s->path);
@@ -423,7 +487,11 @@ static struct ss_snapshot *snapshot_alloc(const char *path, const struct ss_grid
 	s->path = strdup(path);
 	s->xmf_path = malloc(strlen(path) + 8);
 	s->partial_path = malloc(strlen(path) + 16);
-	if (!s->path || !s->xmf_path || !s->partial_path) {
+	s->band_rows = chunk_rows(g->global_ny);
+	s->band = ss_alloc((size_t)s->band_rows * (size_t)g->nx, sizeof *s->band,
+	                   "a band of heights to write");
+	s->band_types = ss_alloc((size_t)g->nx, 1, "a row of cell types");
+	if (!s->path || !s->xmf_path || !s->partial_path || !s->band || !s->band_types) {
 		ss_snapshot_destroy(s);
 		return NULL;
 	}
@@ -451,6 +519,11 @@ int ss_snapshot_create(struct ss_snapshot **out, const char *path,
 		return ss_error_fail("cannot create '%s'%s%s", path, e ? ": " : "",
 		                     e ? strerror(e) : "");
 	}
+	if (meta->crs_wkt && *meta->crs_wkt && !(s->crs_wkt = strdup(meta->crs_wkt))) {
+		ss_snapshot_destroy(s);
+		return ss_error_fail("out of memory");
+	}
+	s->has_bedrock = meta->bedrock != NULL;
 	if (write_static(s, cell_types, meta) || H5Fflush(s->file, H5F_SCOPE_GLOBAL) < 0) {
 		ss_snapshot_destroy(s);
 		return ss_error_fail("cannot write the static variables of '%s'", path);
@@ -524,6 +597,66 @@ static int write_sidecar(const struct ss_snapshot *s)
 	return 0;
 }
 
+/* text with XML's five special characters escaped (a WKT has quotes) */
+static void xml_text(FILE *f, const char *text)
+{
+	for (const char *c = text; *c; c++) {
+		switch (*c) {
+		case '&': fputs("&amp;", f); break;
+		case '<': fputs("&lt;", f); break;
+		case '>': fputs("&gt;", f); break;
+		case '"': fputs("&quot;", f); break;
+		case '\'': fputs("&apos;", f); break;
+		default: fputc(*c, f);
+		}
+	}
+}
+
+/*
+ * GDAL's PAM sidecar, path.aux.xml: `gdalinfo run.h5` picks GDAL's HDF5
+ * driver (its netCDF driver takes HDF5 files only named .nc, .nc4, .cdf),
+ * which reads no dimension scales and so finds no georeferencing.  The
+ * sidecar gives each grid variable its geotransform (x = x0 + column dx,
+ * y = y0 + row dy: row 0 is the south row, so the pixel height is
+ * positive and GDAL, QGIS and gdalwarp place the image right way up), the
+ * CRS of the input DEM and NaN as no data.  Written once, with the first
+ * snapshot; a file named .nc needs none.
+ */
+static int write_gdal_sidecar(const struct ss_snapshot *s, int has_bedrock)
+{
+	const struct ss_grid *g = &s->grid;
+	char path[4200], tmp[4210];
+	snprintf(path, sizeof path, "%s.aux.xml", s->path);
+	snprintf(tmp, sizeof tmp, "%s.tmp", path);
+	FILE *f = fopen(tmp, "w");
+	if (!f)
+		return -1;
+	static const char *const names[] = {"height", "cell_type", "bedrock"};
+	fprintf(f, "<PAMDataset>\n");
+	for (int v = 0; v < (has_bedrock ? 3 : 2); v++) {
+		fprintf(f, "  <Subdataset name=\"//%s\">\n    <PAMDataset>\n", names[v]);
+		if (s->crs_wkt) {
+			fprintf(f, "      <SRS dataAxisToSRSAxisMapping=\"1,2\">");
+			xml_text(f, s->crs_wkt);
+			fprintf(f, "</SRS>\n");
+		}
+		fprintf(f, "      <GeoTransform>%.17g, %.17g, 0, %.17g, 0, %.17g</GeoTransform>\n",
+		        g->origin_x, g->dx, g->origin_y, g->dy);
+		if (v != 1)
+			fprintf(f, "      <PAMRasterBand band=\"1\"><NoDataValue>nan</NoDataValue>"
+			           "</PAMRasterBand>\n");
+		fprintf(f, "    </PAMDataset>\n  </Subdataset>\n");
+	}
+	fprintf(f, "</PAMDataset>\n");
+	int bad = ferror(f);
+	bad |= fclose(f) != 0;
+	if (bad || rename(tmp, path) != 0) {
+		remove(tmp);
+		return -1;
+	}
+	return 0;
+}
+
 /* Root attribute restart_state = steps, inflow sum and carry, outflow sum
  * and carry of the last snapshot: a restart continues the compensated sums
  * with the very same bits. */
@@ -584,8 +717,58 @@ static int check_snapshot_space(struct ss_snapshot *s)
 	return verdict ? -1 : 0;
 }
 
+/*
+ * Snapshot k of /height: this rank's rows of height (halo layout), NaN at
+ * walls, one band of chunk rows of the whole grid at a time.  Every rank
+ * makes the same writes, one per band, selecting its rows of the band
+ * (maybe none): a write per band keeps the copy small (band_rows x nx),
+ * and each chunk of the filtered dataset is written once, by one
+ * collective write, as parallel HDF5 requires of filtered data.
+ */
+static int write_heights(struct ss_snapshot *s, long long k, const double *height,
+                         const uint8_t *cell_types)
+{
+	const struct ss_grid *g = &s->grid;
+	const long long first = g->offset_j, end = g->offset_j + g->ny;
+	hid_t fs = H5Dget_space(s->height);
+	hid_t dxpl = transfer();
+	int bad = fs < 0 || dxpl < 0;
+	for (long long b0 = 0; b0 < g->global_ny && !bad; b0 += s->band_rows) {
+		const long long lo = b0 > first ? b0 : first;
+		const long long b1 = b0 + s->band_rows < g->global_ny ? b0 + s->band_rows
+		                                                      : g->global_ny;
+		const long long hi = b1 < end ? b1 : end;
+		const hsize_t n = hi > lo ? (hsize_t)(hi - lo) * (hsize_t)g->nx : 1;
+		hid_t ms = H5Screate_simple(1, &n, NULL);
+		if (hi > lo) {
+			for (long long j = lo; j < hi; j++) {
+				const ptrdiff_t row = ss_grid_index(g, 0, (int)(j - first));
+				double *out = s->band + (size_t)(j - lo) * (size_t)g->nx;
+				ss_cell_types_unpack(cell_types, row, (size_t)g->nx, s->band_types);
+				for (int i = 0; i < g->nx; i++)
+					out[i] = s->band_types[i] == SS_CELL_WALL ? NAN : height[row + i];
+			}
+			const hsize_t start[3] = {(hsize_t)k, (hsize_t)lo, 0};
+			const hsize_t count[3] = {1, (hsize_t)(hi - lo), (hsize_t)g->nx};
+			bad = H5Sselect_hyperslab(fs, H5S_SELECT_SET, start, NULL, count, NULL) < 0;
+		} else {
+			bad = H5Sselect_none(fs) < 0 || H5Sselect_none(ms) < 0;
+		}
+		bad = bad || ms < 0 ||
+		      H5Dwrite(s->height, H5T_NATIVE_DOUBLE, ms, fs, dxpl, s->band) < 0;
+		if (ms >= 0)
+			H5Sclose(ms);
+	}
+	if (dxpl >= 0)
+		H5Pclose(dxpl);
+	if (fs >= 0)
+		H5Sclose(fs);
+	return bad;
+}
+
 static int append(struct ss_snapshot *s, double time_s, const double *height,
-                  const struct ss_diagnostics *d, const struct ss_restart_state *state)
+                  const uint8_t *cell_types, const struct ss_diagnostics *d,
+                  const struct ss_restart_state *state)
 {
 	const struct ss_grid *g = &s->grid;
 	const long long k = s->count;
@@ -598,21 +781,8 @@ static int append(struct ss_snapshot *s, double time_s, const double *height,
 		                     strerror(e), k);
 	}
 	hsize_t dims[3] = {(hsize_t)k + 1, (hsize_t)g->global_ny, (hsize_t)g->nx};
-	hsize_t start[3] = {(hsize_t)k, (hsize_t)g->offset_j, 0};
-	hsize_t count[3] = {1, (hsize_t)g->ny, (hsize_t)g->nx};
-
-	if (H5Dset_extent(s->height, dims) < 0)
-		goto fail;
-	/* this rank's rows, all ranks in one collective write */
-	hid_t fs = H5Dget_space(s->height);
-	H5Sselect_hyperslab(fs, H5S_SELECT_SET, start, NULL, count, NULL);
-	hid_t ms = interior_space(g);
-	hid_t dxpl = transfer();
-	herr_t r = H5Dwrite(s->height, H5T_NATIVE_DOUBLE, ms, fs, dxpl, height);
-	H5Pclose(dxpl);
-	H5Sclose(ms);
-	H5Sclose(fs);
-	if (r < 0 || append_value(s->time, k, time_s))
+	if (H5Dset_extent(s->height, dims) < 0 || write_heights(s, k, height, cell_types) ||
+	    append_value(s->time, k, time_s))
 		goto fail;
 	for (int m = 0; m < SS_SNAPSHOT_DIAG_COUNT; m++)
 		if (append_value(s->diag[m], k, diag_get(d, m)))
@@ -641,6 +811,10 @@ static int append(struct ss_snapshot *s, double time_s, const double *height,
 	}
 	s->times[k] = time_s;
 	s->count = k + 1;
+	if (k == 0 && is_root() && !ss_snapshot_named_netcdf(s->path) &&
+	    write_gdal_sidecar(s, s->has_bedrock))
+		return ss_error_fail("cannot write GDAL's sidecar '%s.aux.xml': %s", s->path,
+		                     strerror(errno));
 	if (is_root() && write_sidecar(s))
 		return ss_error_fail("cannot write the XDMF sidecar '%s': %s", s->xmf_path,
 		                     strerror(errno));
@@ -654,9 +828,10 @@ fail:
 /* A failure of one rank's write is every rank's, before the next
  * collective call (comm.h). */
 int ss_snapshot_append(struct ss_snapshot *s, double time_s, const double *height,
-                       const struct ss_diagnostics *d, const struct ss_restart_state *state)
+                       const uint8_t *cell_types, const struct ss_diagnostics *d,
+                       const struct ss_restart_state *state)
 {
-	const int err = ss_comm_agree(append(s, time_s, height, d, state));
+	const int err = ss_comm_agree(append(s, time_s, height, cell_types, d, state));
 	if (err)
 		s->failed = 1;
 	return err;

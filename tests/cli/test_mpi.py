@@ -755,7 +755,7 @@ def test_ncdump_reads_a_file_of_3_ranks(tmp_path):
     header = ncdump_header(tmp_path / "np3.h5")
     assert re.search(r"time = UNLIMITED ; // \(17 currently\)", header), header
     assert re.search(r"\bx = 64 ;", header) and re.search(r"\by = 48 ;", header), header
-    for decl in ["double height(time, y, x)", "ubyte cell_type(y, x)", "double time(time)",
+    for decl in ["double height(time, y, x)", "byte cell_type(y, x)", "double time(time)",
                  "double x(x)", "double y(y)", "double volume(time)",
                  "double active_fraction(time)"]:
         assert decl in header, f"ncdump does not show '{decl}' in a file of 3 ranks:\n{header}"

@@ -22,7 +22,7 @@ def test_ncdump_reads_dimensions_and_variables(tmp_path, base_case):
     header = r.stdout
     assert re.search(r"time = UNLIMITED ; // \(3 currently\)", header), header
     assert re.search(r"\bx = 20 ;", header) and re.search(r"\by = 16 ;", header), header
-    for decl in ["double height(time, y, x)", "ubyte cell_type(y, x)", "double time(time)",
+    for decl in ["double height(time, y, x)", "byte cell_type(y, x)", "double time(time)",
                  "double x(x)", "double y(y)", "double volume(time)",
                  "double max_slope_deg(time)", "double active_fraction(time)"]:
         assert decl in header, f"ncdump does not show '{decl}':\n{header}"

@@ -93,7 +93,13 @@ def test_height_dataset(output):
         assert h.shape == (len(TIMES), NY, NX), h.shape
         assert h.chunks is not None, "height must be chunked"
         assert h.maxshape == (None, NY, NX), h.maxshape
-        assert np.all(np.isfinite(h[...]))
+        assert np.isnan(h.attrs["_FillValue"]) and np.isnan(h.fillvalue), \
+            "height's _FillValue (and HDF5 fill value) must be NaN"
+        walls = f["cell_type"][...] == 1
+        assert walls.any(), "test bug: the case has no wall cells"
+        hh = h[...]
+        assert np.all(np.isnan(hh[:, walls])), "walls must be stored as NaN (missing)"
+        assert np.all(np.isfinite(hh[:, ~walls])), "every other cell must be finite"
 
 
 def test_time_values_exact(output):
@@ -101,7 +107,8 @@ def test_time_values_exact(output):
     with h5open(path) as f:
         t = f["time"]
         assert t.dtype == np.float64 and t.shape == (len(TIMES),), (t.dtype, t.shape)
-        assert text_attr(t, "units") == "s"
+        # "seconds": elapsed time to xarray (timedelta64) and CDO, no calendar
+        assert text_attr(t, "units") == "seconds"
         assert list(t[...]) == TIMES, f"times {list(t[...])} != {TIMES}"
 
 
@@ -123,8 +130,10 @@ def test_cell_type(output):
     _, path, _ = output
     with h5open(path) as f:
         ct = f["cell_type"]
-        assert ct.dtype == np.uint8 and ct.shape == (NY, NX), (ct.dtype, ct.shape)
-        assert list(np.asarray(ct.attrs["flag_values"]).ravel()) == [0, 1, 2]
+        # int8 (netCDF's byte): VTK's netCDF-CF reader rejects ubyte
+        assert ct.dtype == np.int8 and ct.shape == (NY, NX), (ct.dtype, ct.shape)
+        flags = np.asarray(ct.attrs["flag_values"])
+        assert flags.dtype == np.int8 and list(flags.ravel()) == [0, 1, 2], flags
         assert text_attr(ct, "flag_meanings") == "flow wall open"
         got = ct[...]
     want = expected_cell_type()
