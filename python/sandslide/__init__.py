@@ -57,8 +57,8 @@ def _word(value):
 
 
 def _grid(name, values):
-    """values as a float64 array [row, column] with row 0 the SOUTH edge,
-    C-contiguous (a copy: the library's order); InputError if it is not a
+    """values as a new float64 array [row, column] with row 0 the SOUTH
+    edge, C-contiguous (the library's order); InputError if it is not a
     2-D array of real numbers."""
     try:
         if isinstance(values, np.ma.MaskedArray):   # rasterio's masked=True
@@ -82,7 +82,9 @@ def _grid(name, values):
         r, c = np.argwhere(inf)[0]
         raise InputError(f"{name}[{r}, {c}] is {a[r, c]}: expected a finite height, or NaN "
                          f"for no data")
-    return np.ascontiguousarray(a[::-1], dtype=np.float64)
+    # a copy always: relax writes its result over it (a one-row view is
+    # contiguous, and ascontiguousarray would hand back the caller's memory)
+    return np.array(a[::-1], dtype=np.float64, order="C", copy=True)
 
 
 def relax(heights, dx, dy=None, angle=35.0, closure="coulomb", nu=None, sides="wall",

@@ -255,6 +255,11 @@ def test_other_inputs_are_converted():
         "a masked cell must be no data (NaN) in the result"
     f32, _ = sandslide.relax(h0.astype(np.float32), 1.0, threads=1)
     assert f32.dtype == np.float64
+    row = np.array([[0.0, 0.0, 9.0, 0.0, 0.0]])
+    kept = row.copy()
+    got, _ = sandslide.relax(row, 1.0, threads=1)
+    assert same_bits(row, kept) and not same_bits(got, kept), \
+        "a one-row DEM must relax into a new array, its input untouched"
 
 
 # ---- run and open ----------------------------------------------------------
