@@ -26,8 +26,8 @@ import numpy as np
 from ._native import Error, InputError, RunError  # noqa: F401  (the API)
 from . import _native
 
-__all__ = ["relax", "run", "open", "version", "Error", "InputError", "RunError",
-           "__version__"]
+# open is left out: `from sandslide import *` must not hide the built-in
+__all__ = ["relax", "run", "version", "Error", "InputError", "RunError", "__version__"]
 
 
 def version():

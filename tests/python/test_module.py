@@ -361,7 +361,8 @@ def package_copy(tmp_path):
     return dest.parent
 
 
-BUILD_LIB = os.path.join(ROOT, "build", "libsandslide.so.0")
+BUILD_LIB = os.environ.get("SANDSLIDE_LIBRARY") or os.path.join(ROOT, "build",
+                                                                 "libsandslide.so.0")
 
 
 def test_missing_library_says_what_was_tried(tmp_path):
