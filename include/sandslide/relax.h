@@ -19,6 +19,7 @@
 #define SANDSLIDE_RELAX_H
 
 #include <signal.h>
+#include <stddef.h>
 
 #include "sandslide/boundary.h"
 #include "sandslide/closure.h"
@@ -63,9 +64,40 @@ struct ss_relax_options {
 	                                     substep and write what there is */
 	ss_progress_fn *progress;         /* after every substep (NULL: none) */
 	void *progress_context;
+	/* In memory, for a program that holds its rasters (the Python module).
+	 * Each, when set, replaces a file: input_raster is relaxed instead of
+	 * reading dem and bedrock_raster is the base instead of reading
+	 * bedrock (dem and bedrock then only name them in messages and the
+	 * report, and must be set), and the relaxed heights go to the values
+	 * of output_raster, which must have the input's size, instead of a
+	 * file (0 where the input has no data, as rasters store it): nothing
+	 * is claimed or written, output and force are unused.  The caller owns
+	 * all three. */
+	const struct ss_raster *input_raster;
+	const struct ss_raster *bedrock_raster;
+	struct ss_raster *output_raster;
 };
 
 void ss_relax_options_init(struct ss_relax_options *o);
+
+/* For callers that cannot lay the struct out (a foreign-function
+ * interface such as Python's ctypes; its fields change between
+ * versions): heap options set by name.  create returns options
+ * ss_relax_options_init'ed, or NULL (message printed) when out of memory;
+ * destroy(NULL) does nothing. */
+struct ss_relax_options *ss_relax_options_create(void);
+void ss_relax_options_destroy(struct ss_relax_options *o);
+
+/* Set option `key` of options from ss_relax_options_create to `value`,
+ * parsed and checked as the command line does: keys are relax's option
+ * names without the dashes ("angle", "closure", "nu", "tol", "max-time";
+ * '_' may stand for '-') and value is the word the command line would
+ * take ("35", "coulomb", "1" or "0" for a flag).  Text values (dem,
+ * output, report, bedrock) are copied.  SS_ERR_INPUT names the key and
+ * what it accepts ("angle '95': expected degrees in (0, 90)"), options
+ * unchanged.  Keys other than the text ones work on any options.
+ * --add-sand has no key: use the struct. */
+int ss_relax_options_set(struct ss_relax_options *o, const char *key, const char *value);
 
 struct ss_relax_report {
 	int nx, ny;
@@ -91,5 +123,26 @@ struct ss_relax_report {
  * *report is filled when SS_OK.  Prints nothing else: the caller shows the
  * progress and the report. */
 int ss_relax_run(const struct ss_relax_options *o, struct ss_relax_report *report);
+
+/* The JSON of `sandslide relax --report` for a relaxation (o, r) into buf
+ * (size bytes, NUL-terminated); SS_ERR_INPUT when it does not fit (the
+ * message says how many bytes it needs). */
+int ss_relax_report_json(const struct ss_relax_options *o, const struct ss_relax_report *r,
+                         char *buf, size_t size);
+
+/* ss_relax_run on arrays, a flat entry point for foreign callers: nx x ny
+ * heights (m), row-major, row j the j-th from the SOUTH, NaN where there is
+ * no data; cells dx by dy m; bedrock the same layout, or NULL (its NaNs
+ * are allowed only where heights is NaN too).  The relaxed surface goes
+ * to `relaxed` (nx * ny, NaN where heights is; it may be heights itself)
+ * and the report's JSON (ss_relax_report_json) to report_json
+ * (report_size bytes), or nowhere when report_json is NULL.  The options'
+ * dem and bedrock name the arrays in messages ("(array)" when NULL); their
+ * output, force, dx and in-memory fields are not used, and report is
+ * written when set.  An infinite height is refused.  Returns as
+ * ss_relax_run; relaxed is written only when SS_OK. */
+int ss_relax_heights(const struct ss_relax_options *o, int nx, int ny, double dx, double dy,
+                     const double *heights, const double *bedrock, double *relaxed,
+                     char *report_json, size_t report_size);
 
 #endif

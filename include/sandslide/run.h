@@ -13,6 +13,7 @@
 #define SANDSLIDE_RUN_H
 
 #include <signal.h>
+#include <stddef.h>
 
 #include "sandslide/progress.h"
 
@@ -88,5 +89,34 @@ struct ss_run_summary {
 /* Returns SS_OK, SS_ERR_INPUT or SS_ERR_FAIL (message already printed);
  * *summary is filled when SS_OK. */
 int ss_run_case(const struct ss_run_options *o, struct ss_run_summary *summary);
+
+/* For callers that cannot lay the structs out (a foreign-function
+ * interface such as Python's ctypes; their fields change between
+ * versions): heap options set by name.  create returns the command line's
+ * defaults, or NULL (message printed) when out of memory; destroy(NULL)
+ * does nothing. */
+struct ss_run_options *ss_run_options_create(void);
+void ss_run_options_destroy(struct ss_run_options *o);
+
+/* Set option `key` of options from ss_run_options_create to `value`,
+ * checked as the command line does: keys are run's option names without
+ * the dashes ('_' may stand for '-'): "output", "restart", "threads",
+ * "force" and "reference-kernel" ("1" or "0"), "deflate", "tile" ("NXxNY"),
+ * "set" (one SECTION.KEY=VALUE override, added after those set before, as
+ * --set is; the case parser checks it), and "case" (CASE.ini) and
+ * "history" (the file's history attribute).  Text values are copied.
+ * SS_ERR_INPUT names the key and what it accepts, options unchanged. */
+int ss_run_options_set(struct ss_run_options *o, const char *key, const char *value);
+
+/* The summary as JSON into buf (size bytes, NUL-terminated): "output",
+ * "end" ("done", "steady", "not steady", "interrupted"), "snapshots",
+ * "time", "steps", "evaluations", "integrator", the threads, ranks and
+ * timings; SS_ERR_INPUT when it does not fit (the message says how many
+ * bytes it needs). */
+int ss_run_summary_json(const struct ss_run_summary *s, char *buf, size_t size);
+
+/* ss_run_case with the summary as JSON (ss_run_summary_json): a flat
+ * entry point for foreign callers. */
+int ss_run_case_json(const struct ss_run_options *o, char *summary_json, size_t size);
 
 #endif

@@ -163,37 +163,32 @@ static double flow_volume(struct ss_stepper *st)
 	return d.volume;
 }
 
+/* The report (ss_relax_report_json, the one formatter) to path, whole or
+ * not at all. */
 static int write_report(const char *path, const struct ss_relax_options *o,
                         const struct ss_relax_report *r)
 {
+	/* the numbers, and both paths with every byte escaped (\u00XX) */
+	const size_t size = 2048 + 6 * (strlen(o->dem) + strlen(r->output));
+	char *json = ss_alloc(size, 1, "the report");
+	if (!json)
+		return SS_ERR_FAIL;
+	int err = ss_relax_report_json(o, r, json, size);
 	char tmp[4200];
 	snprintf(tmp, sizeof tmp, "%s.partial", path);
-	FILE *f = fopen(tmp, "w");
-	if (!f)
-		return ss_error_input("--report: cannot write '%s': %s", path, strerror(errno));
-	fprintf(f, "{\n  \"input\": \"%s\",\n  \"output\": \"%s\",\n", o->dem, r->output);
-	fprintf(f, "  \"nx\": %d, \"ny\": %d, \"dx\": %.17g, \"dy\": %.17g,\n", r->nx, r->ny,
-	        r->dx, r->dy);
-	fprintf(f, "  \"closure\": \"%s\", \"repose_angle_deg\": %.17g, \"nu\": %.17g,\n",
-	        ss_closure_name(o->closure), o->angle_deg, o->nu);
-	fprintf(f, "  \"steady\": %s, \"tol\": %.17g,\n", r->steady ? "true" : "false", o->tol);
-	fprintf(f, "  \"steps\": %lld, \"time\": %.17g, \"wall_seconds\": %.6g,\n", r->steps,
-	        r->time, r->wall_seconds);
-	fprintf(f, "  \"integrator\": \"%s\", \"stencil_evaluations\": %lld, "
-	        "\"slope_tol\": %.17g,\n", r->integrator, r->evaluations, o->slope_tol);
-	fprintf(f, "  \"cells_moved\": %lld, \"volume_moved\": %.17g,\n", r->cells_moved,
-	        r->volume_moved);
-	fprintf(f, "  \"volume_before\": %.17g, \"volume_after\": %.17g,\n", r->volume_before,
-	        r->volume_after);
-	fprintf(f, "  \"inflow\": %.17g, \"outflow\": %.17g,\n", r->inflow, r->outflow);
-	fprintf(f, "  \"max_slope_before_deg\": %.17g, \"max_slope_after_deg\": %.17g\n}\n",
-	        r->max_slope_before_deg, r->max_slope_after_deg);
-	const int bad = ferror(f) | (fclose(f) != 0);
-	if (bad || rename(tmp, path) != 0) {
-		remove(tmp);
-		return ss_error_fail("--report: writing '%s' failed", path);
+	FILE *f = err ? NULL : fopen(tmp, "w");
+	if (!err && !f)
+		err = ss_error_input("--report: cannot write '%s': %s", path, strerror(errno));
+	if (f) {
+		fputs(json, f);
+		const int bad = ferror(f) | (fclose(f) != 0);
+		if (bad || rename(tmp, path) != 0) {
+			remove(tmp);
+			err = ss_error_fail("--report: writing '%s' failed", path);
+		}
 	}
-	return SS_OK;
+	ss_free(json);
+	return err;
 }
 
 /* The relaxed heights into r's values (nodata cells keep theirs): each
@@ -228,26 +223,57 @@ static int rebuild(void *context, struct ss_stepper *st)
 	return build_stepper(x->o, &x->dem, x->o->bedrock ? &x->bedrock : NULL, st);
 }
 
+/* A copy of a caller's raster (values, nodata and geometry: the writers'
+ * metadata is not needed in memory) into r. */
+static int raster_copy(const struct ss_raster *from, struct ss_raster *r)
+{
+	const size_t cells = (size_t)from->nx * (size_t)from->ny;
+	int err = ss_raster_init(r, from->nx, from->ny);
+	if (!err && from->nodata && !(r->nodata = ss_alloc(cells, 1, "nodata flags")))
+		err = SS_ERR_FAIL;
+	if (err)
+		return err;
+	memcpy(r->values, from->values, cells * sizeof *r->values);
+	if (from->nodata)
+		memcpy(r->nodata, from->nodata, cells);
+	r->cellsize = from->cellsize;
+	r->cellsize_y = from->cellsize_y;
+	r->x0 = from->x0;
+	r->y0 = from->y0;
+	return SS_OK;
+}
+
 /* The inputs and the output's name and format, all checked. */
 static int read_inputs(struct relax *x, struct ss_relax_report *rep)
 {
 	const struct ss_relax_options *o = x->o;
-	if (o->output)
+	if ((o->input_raster && !o->dem) || (o->bedrock_raster && !o->bedrock))
+		SS_BUG("ss_relax_run: an input raster without its name (dem, bedrock)");
+	if (o->output_raster)
+		snprintf(rep->output, sizeof rep->output, "(array)");
+	else if (o->output)
 		snprintf(rep->output, sizeof rep->output, "%s", o->output);
 	else
 		default_output(o->dem, rep->output, sizeof rep->output);
-	int err = ss_dem_read(o->dem, NULL, &o->read, &x->dem);
-	if (!err)
+	int err = o->input_raster ? raster_copy(o->input_raster, &x->dem)
+	                          : ss_dem_read(o->dem, NULL, &o->read, &x->dem);
+	if (!err && o->output_raster && (o->output_raster->nx != x->dem.nx ||
+	                                 o->output_raster->ny != x->dem.ny))
+		err = ss_error_input("the output raster is %d x %d cells: expected the DEM's "
+		                     "%d x %d", o->output_raster->nx, o->output_raster->ny,
+		                     x->dem.nx, x->dem.ny);
+	if (!err && !o->output_raster)
 		err = ss_dem_format_from_path(rep->output, "-o", &x->format);
 	if (!err && x->format == SS_DEM_GDAL && !ss_dem_gdal_available())
 		err = ss_error_input("-o %s: GeoTIFF output needs a build with GDAL (libgdal-dev); "
 		                     "write .asc, .png or .h5", rep->output);
-	if (!err)
+	if (!err && !o->output_raster)
 		err = ss_output_check_folder(rep->output, o->output == NULL);
 	if (err || !o->bedrock)
 		return err;
 	struct ss_dem_read_options bo = o->read;
-	if ((err = ss_dem_read(o->bedrock, "--bedrock", &bo, &x->bedrock)))
+	if ((err = o->bedrock_raster ? raster_copy(o->bedrock_raster, &x->bedrock)
+	                             : ss_dem_read(o->bedrock, "--bedrock", &bo, &x->bedrock)))
 		return err;
 	if (x->bedrock.nx != x->dem.nx || x->bedrock.ny != x->dem.ny)
 		return ss_error_input("--bedrock %s is %d x %d cells: expected the DEM's %d x %d",
@@ -288,6 +314,8 @@ static int open_output(struct relax *x, const struct ss_relax_report *rep)
 	d->progress_context = o->progress_context;
 	d->rebuild = rebuild;
 	d->rebuild_context = x;
+	if (o->output_raster)
+		return SS_OK;   /* nothing to claim: the caller's memory */
 	int err = ss_drive_claim(d, rep->output, o->output == NULL, o->force, 0, NULL);
 	if (err || !series)
 		return err;
@@ -342,6 +370,11 @@ static int write_raster(struct relax *x, const char *path)
 	if (x->format == SS_DEM_H5)
 		return SS_OK;
 	heights_to_raster(&x->st, &x->dem);
+	if (x->o->output_raster) {
+		memcpy(x->o->output_raster->values, x->dem.values,
+		       (size_t)x->dem.nx * x->dem.ny * sizeof *x->dem.values);
+		return SS_OK;
+	}
 	return ss_comm_agree(ss_comm_rank() == 0 ? ss_dem_write(path, x->format, &x->dem)
 	                                         : SS_OK);
 }

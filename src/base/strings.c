@@ -3,6 +3,9 @@
  */
 #include "base/strings.h"
 
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -30,4 +33,37 @@ char *ss_strings_join(const char *const *v, int n, const char *separator, int te
 	}
 	*end = '\0';
 	return s;
+}
+
+void ss_strbuf_printf(struct ss_strbuf *b, const char *fmt, ...)
+{
+	const size_t room = b->len < b->size ? b->size - b->len : 0;
+	va_list ap;
+	va_start(ap, fmt);
+	const int n = vsnprintf(room ? b->buf + b->len : NULL, room, fmt, ap);
+	va_end(ap);
+	if (n > 0)
+		b->len += (size_t)n;
+}
+
+void ss_strbuf_json_string(struct ss_strbuf *b, const char *s)
+{
+	ss_strbuf_printf(b, "\"");
+	for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
+		if (*p == '"' || *p == '\\')
+			ss_strbuf_printf(b, "\\%c", *p);
+		else if (*p < 0x20)
+			ss_strbuf_printf(b, "\\u%04x", *p);
+		else
+			ss_strbuf_printf(b, "%c", *p);
+	}
+	ss_strbuf_printf(b, "\"");
+}
+
+void ss_strbuf_json_number(struct ss_strbuf *b, double x, int digits)
+{
+	if (isfinite(x))
+		ss_strbuf_printf(b, "%.*g", digits, x);
+	else
+		ss_strbuf_printf(b, "null");
 }

@@ -1,0 +1,310 @@
+/*
+ * relax_api.c - `relax` for callers that cannot lay out its structs (see
+ * relax.h): options created on the heap and set by name, the report as
+ * JSON in a buffer, and a flat entry point on arrays.  Python's ctypes
+ * module (python/sandslide) is the caller this is written for: the struct
+ * layouts change between versions, names and strings do not.
+ *
+ * The option names, ranges and messages are those of relax's table in
+ * src/cli/main.c, so that a bad value reads the same from Python as on the
+ * command line (tests/python/test_module.py compares them).
+ */
+#include "sandslide/relax.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "base/strings.h"
+#include "sandslide/error.h"
+
+/* The text values an options object owns (its copies of the caller's). */
+enum { TEXT_DEM, TEXT_OUTPUT, TEXT_REPORT, TEXT_BEDROCK, TEXT_COUNT };
+
+struct owned_options {
+	struct ss_relax_options o;   /* first: the caller's pointer is to it */
+	char *text[TEXT_COUNT];      /* NULL, or the value of o's text field */
+};
+
+enum key_kind { REAL, INT, FLAG, TEXT, CLOSURE, INTEGRATOR, SIDES, NODATA };
+
+struct key {
+	const char *name;            /* relax's option without "--" */
+	enum key_kind kind;
+	size_t offset;               /* of the field in struct ss_relax_options */
+	double lo, hi;               /* REAL, INT */
+	const char *expected;        /* for the message, as the CLI says it */
+	int text;                    /* TEXT: its slot in owned_options */
+};
+
+#define AT(m) offsetof(struct ss_relax_options, m)
+#define RANGE(n, m, l, h, e) {n, REAL, AT(m), l, h, e, 0}
+#define POSITIVE(n, m, e) RANGE(n, m, 1e-300, 1e300, e)
+
+static const struct key keys[] = {
+	RANGE("angle", angle_deg, 1e-9, 90.0 - 1e-9, "degrees in (0, 90)"),
+	{"closure", CLOSURE, AT(closure), 0, 0, SS_CLOSURE_NAMES, 0},
+	RANGE("gamma", gamma, 1e-6, 1e6, "a number > 0"),
+	POSITIVE("nu", nu, "m^2/s > 0"),
+	POSITIVE("tol", tol, "m/s > 0"),
+	POSITIVE("slope-tol", slope_tol, "a number > 0"),
+	{"integrator", INTEGRATOR, AT(integrator), 0, 0, SS_INTEGRATOR_NAMES, 0},
+	{"rkl2-max-stages", INT, AT(rkl2_max_stages), 2, 100000, "an integer >= 2", 0},
+	POSITIVE("rkl2-tol", rkl2_tol, "a number > 0"),
+	POSITIVE("max-time", max_time, "s > 0"),
+	RANGE("cfl", cfl, 1e-9, 1.0, "(0, 1]"),
+	{"threads", INT, AT(threads), 1, 4096, "an integer from 1 to 4096", 0},
+	{"sides", SIDES, AT(sides), 0, 0, "wall or open", 0},
+	{"nodata", NODATA, AT(nodata_type), 0, 0, "wall or open", 0},
+	RANGE("open-level", open_level, -1e300, 1e300, "a height in m"),
+	POSITIVE("dx", read.cellsize, "m > 0"),
+	POSITIVE("zscale", read.zscale, "m per grey level > 0"),
+	RANGE("zoffset", read.zoffset, -1e300, 1e300, "m"),
+	POSITIVE("output-every", output_every, "s > 0"),
+	{"force", FLAG, AT(force), 0, 0, "1 or 0", 0},
+	{"dem", TEXT, AT(dem), 0, 0, "a path", TEXT_DEM},
+	{"output", TEXT, AT(output), 0, 0, "a path", TEXT_OUTPUT},
+	{"report", TEXT, AT(report), 0, 0, "a path", TEXT_REPORT},
+	{"bedrock", TEXT, AT(bedrock), 0, 0, "a path", TEXT_BEDROCK},
+};
+
+struct ss_relax_options *ss_relax_options_create(void)
+{
+	struct owned_options *w = ss_alloc(1, sizeof *w, "relax options");
+	if (!w)
+		return NULL;
+	ss_relax_options_init(&w->o);
+	return &w->o;
+}
+
+void ss_relax_options_destroy(struct ss_relax_options *o)
+{
+	if (!o)
+		return;
+	struct owned_options *w = (struct owned_options *)o;
+	for (int k = 0; k < TEXT_COUNT; k++)
+		ss_free(w->text[k]);
+	ss_free(w);
+}
+
+/* key names option name, '_' standing for '-' ("max_time" is "max-time"). */
+static int same_key(const char *key, const char *name)
+{
+	for (; *key && *name; key++, name++)
+		if (*key != *name && !(*key == '_' && *name == '-'))
+			return 0;
+	return *key == *name;
+}
+
+/* "unknown relax option 'KEY': expected angle, closure, ..." */
+static int unknown_key(const char *key)
+{
+	char names[512];
+	struct ss_strbuf b = {names, sizeof names, 0};
+	for (size_t k = 0; k < sizeof keys / sizeof *keys; k++)
+		ss_strbuf_printf(&b, "%s%s", k ? ", " : "", keys[k].name);
+	return ss_error_input("unknown relax option '%s': expected one of %s", key, names);
+}
+
+/* value parsed for k into target; 0, or -1 when it is not what k takes */
+static int parse(const struct key *k, const char *value, void *target)
+{
+	char *end;
+	errno = 0;
+	switch (k->kind) {
+	case REAL: {
+		const double v = strtod(value, &end);
+		if (end == value || *end || errno || !isfinite(v) || !(v >= k->lo && v <= k->hi))
+			return -1;
+		*(double *)target = v;
+		return 0;
+	}
+	case INT: {
+		const long v = strtol(value, &end, 10);
+		if (end == value || *end || errno || v < (long)k->lo || v > (long)k->hi)
+			return -1;
+		*(int *)target = (int)v;
+		return 0;
+	}
+	case FLAG:
+		if (strcmp(value, "0") && strcmp(value, "1"))
+			return -1;
+		*(int *)target = value[0] == '1';
+		return 0;
+	case CLOSURE:
+		return ss_closure_parse(value, target);
+	case INTEGRATOR:
+		return ss_integrator_parse(value, target);
+	case SIDES: {
+		/* periodic sides make no sense for a DEM: the CLI refuses them */
+		enum ss_side_kind side;
+		if (ss_side_kind_parse(value, &side) || side == SS_SIDE_PERIODIC)
+			return -1;
+		*(enum ss_side_kind *)target = side;
+		return 0;
+	}
+	case NODATA:
+		if (strcmp(value, "wall") && strcmp(value, "open"))
+			return -1;
+		*(enum ss_cell_type *)target = !strcmp(value, "wall") ? SS_CELL_WALL : SS_CELL_OPEN;
+		return 0;
+	case TEXT:
+		break;
+	}
+	return -1;
+}
+
+int ss_relax_options_set(struct ss_relax_options *o, const char *key, const char *value)
+{
+	const struct key *k = NULL;
+	for (size_t n = 0; n < sizeof keys / sizeof *keys && !k; n++)
+		if (same_key(key, keys[n].name))
+			k = &keys[n];
+	if (!k)
+		return unknown_key(key);
+	if (!value || !*value)
+		return ss_error_input("%s needs a value: %s", key, k->expected);
+	void *target = (char *)o + k->offset;
+	if (k->kind != TEXT) {
+		if (parse(k, value, target))
+			return ss_error_input("%s '%s': expected %s", key, value, k->expected);
+		return SS_OK;
+	}
+	struct owned_options *w = (struct owned_options *)o;
+	const size_t n = strlen(value) + 1;
+	char *copy = ss_alloc(n, 1, "an option's text");
+	if (!copy)
+		return SS_ERR_FAIL;
+	memcpy(copy, value, n);
+	ss_free(w->text[k->text]);
+	w->text[k->text] = copy;
+	*(const char **)target = copy;
+	return SS_OK;
+}
+
+int ss_relax_report_json(const struct ss_relax_options *o, const struct ss_relax_report *r,
+                         char *buf, size_t size)
+{
+	struct ss_strbuf b = {buf, size, 0};
+	ss_strbuf_printf(&b, "{\n  \"input\": ");
+	ss_strbuf_json_string(&b, o->dem ? o->dem : "");
+	ss_strbuf_printf(&b, ",\n  \"output\": ");
+	ss_strbuf_json_string(&b, r->output);
+	ss_strbuf_printf(&b, ",\n  \"nx\": %d, \"ny\": %d, \"dx\": ", r->nx, r->ny);
+	ss_strbuf_json_number(&b, r->dx, 17);
+	ss_strbuf_printf(&b, ", \"dy\": ");
+	ss_strbuf_json_number(&b, r->dy, 17);
+	ss_strbuf_printf(&b, ",\n  \"closure\": \"%s\", \"repose_angle_deg\": ",
+	                 ss_closure_name(o->closure));
+	ss_strbuf_json_number(&b, o->angle_deg, 17);
+	ss_strbuf_printf(&b, ", \"nu\": ");
+	ss_strbuf_json_number(&b, o->nu, 17);
+	ss_strbuf_printf(&b, ",\n  \"steady\": %s, \"tol\": ", r->steady ? "true" : "false");
+	ss_strbuf_json_number(&b, o->tol, 17);
+	ss_strbuf_printf(&b, ",\n  \"steps\": %lld, \"time\": ", r->steps);
+	ss_strbuf_json_number(&b, r->time, 17);
+	ss_strbuf_printf(&b, ", \"wall_seconds\": ");
+	ss_strbuf_json_number(&b, r->wall_seconds, 6);
+	ss_strbuf_printf(&b, ",\n  \"integrator\": \"%s\", \"stencil_evaluations\": %lld, "
+	                 "\"slope_tol\": ", r->integrator ? r->integrator : "", r->evaluations);
+	ss_strbuf_json_number(&b, o->slope_tol, 17);
+	ss_strbuf_printf(&b, ",\n  \"cells_moved\": %lld, \"volume_moved\": ", r->cells_moved);
+	ss_strbuf_json_number(&b, r->volume_moved, 17);
+	ss_strbuf_printf(&b, ",\n  \"volume_before\": ");
+	ss_strbuf_json_number(&b, r->volume_before, 17);
+	ss_strbuf_printf(&b, ", \"volume_after\": ");
+	ss_strbuf_json_number(&b, r->volume_after, 17);
+	ss_strbuf_printf(&b, ",\n  \"inflow\": ");
+	ss_strbuf_json_number(&b, r->inflow, 17);
+	ss_strbuf_printf(&b, ", \"outflow\": ");
+	ss_strbuf_json_number(&b, r->outflow, 17);
+	ss_strbuf_printf(&b, ",\n  \"max_slope_before_deg\": ");
+	ss_strbuf_json_number(&b, r->max_slope_before_deg, 17);
+	ss_strbuf_printf(&b, ", \"max_slope_after_deg\": ");
+	ss_strbuf_json_number(&b, r->max_slope_after_deg, 17);
+	ss_strbuf_printf(&b, "\n}\n");
+	if (b.len >= size)
+		return ss_error_input("the relax report needs %zu bytes: the buffer has %zu",
+		                      b.len + 1, size);
+	return SS_OK;
+}
+
+/* nx x ny values into r (initialised here): NaN is no data (flagged, 0 as
+ * rasters store it), an infinite value refused naming `what` and the cell. */
+static int raster_from(const char *what, int nx, int ny, double dx, double dy,
+                       const double *values, struct ss_raster *r)
+{
+	const size_t cells = (size_t)nx * (size_t)ny;
+	int err = ss_raster_init(r, nx, ny);
+	if (err)
+		return err;
+	r->cellsize = dx;
+	r->cellsize_y = dy;
+	for (size_t m = 0; m < cells; m++) {
+		if (isinf(values[m]))
+			return ss_error_input("%s: cell (%zu, %zu) (column from the west, row from the "
+			                      "south) is %g: expected a finite height, or NaN for no "
+			                      "data", what, m % (size_t)nx, m / (size_t)nx, values[m]);
+		if (!isnan(values[m])) {
+			r->values[m] = values[m];
+			continue;
+		}
+		if (!r->nodata && !(r->nodata = ss_alloc(cells, 1, "nodata flags")))
+			return SS_ERR_FAIL;
+		r->nodata[m] = 1;
+	}
+	return SS_OK;
+}
+
+int ss_relax_heights(const struct ss_relax_options *o, int nx, int ny, double dx, double dy,
+                     const double *heights, const double *bedrock, double *relaxed,
+                     char *report_json, size_t report_size)
+{
+	struct ss_relax_options local = *o;
+	if (!local.dem)
+		local.dem = "(array)";
+	if (bedrock && !local.bedrock)
+		local.bedrock = "(array)";
+	if (!bedrock)
+		local.bedrock = NULL;   /* a path would be read: arrays in, arrays out */
+	local.read.cellsize = NAN;   /* it would override dx */
+	if (nx < 1 || ny < 1)
+		return ss_error_input("%s: %d x %d cells: expected at least one of each", local.dem,
+		                      nx, ny);
+	if (!(dx > 0.0 && isfinite(dx)))
+		return ss_error_input("dx '%g': expected m > 0", dx);
+	if (!(dy > 0.0 && isfinite(dy)))
+		return ss_error_input("dy '%g': expected m > 0", dy);
+
+	struct ss_raster in, rock, out;
+	memset(&rock, 0, sizeof rock);
+	memset(&out, 0, sizeof out);
+	int err = raster_from(local.dem, nx, ny, dx, dy, heights, &in);
+	if (!err && bedrock) {
+		err = raster_from(local.bedrock, nx, ny, dx, dy, bedrock, &rock);
+		/* no bedrock under no data is fine (nothing moves there); under
+		 * sand, NaN goes on to the stepper, which refuses it naming the cell */
+		for (size_t m = 0; !err && m < (size_t)nx * ny; m++)
+			if (rock.nodata && rock.nodata[m] && !(in.nodata && in.nodata[m]))
+				rock.values[m] = NAN;
+	}
+	if (!err)
+		err = ss_raster_init(&out, nx, ny);
+	if (!err) {
+		local.input_raster = &in;
+		local.bedrock_raster = bedrock ? &rock : NULL;
+		local.output_raster = &out;
+		struct ss_relax_report rep;
+		err = ss_relax_run(&local, &rep);
+		if (!err && report_json)
+			err = ss_relax_report_json(&local, &rep, report_json, report_size);
+	}
+	if (!err)
+		for (size_t m = 0; m < (size_t)nx * ny; m++)
+			relaxed[m] = in.nodata && in.nodata[m] ? NAN : out.values[m];
+	ss_raster_release(&out);
+	ss_raster_release(&rock);
+	ss_raster_release(&in);
+	return err;
+}

@@ -1,0 +1,389 @@
+"""The Python module `sandslide` (python/sandslide) over libsandslide.so.0.
+
+Run from the top of the repository after `make`:
+
+    PYTHONPATH=python /usr/bin/python3 -m pytest -q tests/python
+
+It compares the module with the program build/sandslide (SANDSLIDE names
+another): relax gives the CLI's bits on the same DEM, read back both
+through .asc (%.17g-exact) and through the .h5 series (rows south first),
+on DEMs that are not symmetric north-south so that a flipped row order
+fails; then physics (steady, the repose angle, volume, nodata, bedrock),
+errors with the library's messages (the CLI's for the same bad value),
+run with --set overrides, open with xarray, and finding the library.
+"""
+import json
+import math
+import os
+import shutil
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+try:
+    import sandslide
+except ImportError:   # not on PYTHONPATH: this checkout's
+    sys.path.insert(0, os.path.join(ROOT, "python"))
+    import sandslide
+SANDSLIDE = os.environ.get("SANDSLIDE", os.path.join(ROOT, "build", "sandslide"))
+TAN35 = math.tan(math.radians(35.0))
+SLOPE_TOL = 1e-6          # relax's default --slope-tol
+
+
+def cli(args, cwd, expect=0):
+    r = subprocess.run([SANDSLIDE] + [str(a) for a in args], cwd=cwd, capture_output=True,
+                       text=True, timeout=60)
+    assert r.returncode == expect, \
+        f"sandslide {' '.join(map(str, args))} exited {r.returncode}, expected {expect}\n" \
+        f"{r.stdout}\n{r.stderr}"
+    return r
+
+
+def write_asc(path, h, dx=1.0, dy=None, nodata=None):
+    """h [row, column] with row 0 north, as the file lists it; %.17g."""
+    ny, nx = h.shape
+    head = f"ncols {nx}\nnrows {ny}\nxllcorner 0\nyllcorner 0\n"
+    head += f"cellsize {dx:.17g}\n" if dy is None else f"dx {dx:.17g}\ndy {dy:.17g}\n"
+    if nodata is not None:
+        head += f"NODATA_value {nodata:.17g}\n"
+    with open(path, "w") as f:
+        f.write(head + "\n".join(" ".join(f"{v:.17g}" for v in row) for row in h) + "\n")
+
+
+def read_asc(path):
+    """(header, values [row, column] row 0 north) of an .asc file."""
+    with open(path) as f:
+        words = f.read().split()
+    head = {}
+    k = 0
+    while words[k][0].isalpha():
+        head[words[k].lower()] = words[k + 1]
+        k += 2
+    nx, ny = int(head["ncols"]), int(head["nrows"])
+    return head, np.array([float(w) for w in words[k:k + nx * ny]]).reshape(ny, nx)
+
+
+def same_bits(a, b):
+    return a.shape == b.shape and np.array_equal(a.view(np.uint64), b.view(np.uint64))
+
+
+def pile_on_ramp(ny=36, nx=44, dx=1.0, dy=1.0):
+    """A 60 deg pile north of the centre on a ramp rising to the north
+    (row 0 the north edge): nothing about it is symmetric north-south."""
+    r, c = np.mgrid[0:ny, 0:nx]
+    ramp = 0.15 * (ny - 1 - r) * dy
+    d = np.hypot((c - 0.6 * nx) * dx, (r - 0.3 * ny) * dy)
+    return ramp + np.maximum(0.0, 12.0 - math.tan(math.radians(60)) * d)
+
+
+def steepest_normal_gradient(h, dx, dy):
+    """The largest |dh| / spacing across any face with data on both sides:
+    a lower bound of the face slope of SPEC section 2 (which adds the
+    tangential part), so it too must not exceed tan(angle)."""
+    gx = np.abs(np.diff(h, axis=1)) / dx
+    gy = np.abs(np.diff(h, axis=0)) / dy
+    return max(np.nanmax(gx), np.nanmax(gy))
+
+
+# ---- the CLI's bits --------------------------------------------------------
+
+@pytest.mark.parametrize("dx, dy, bedrock", [(1.0, None, False), (0.5, 0.8, False),
+                                             (1.0, None, True)],
+                         ids=["square", "rectangular", "bedrock"])
+def test_relax_gives_the_cli_bits(tmp_path, dx, dy, bedrock):
+    h0 = pile_on_ramp(dx=dx, dy=dy or dx)
+    write_asc(tmp_path / "dem.asc", h0, dx, dy)
+    args = ["relax", "dem.asc", "--threads", "1", "-q", "--report", "r.json"]
+    rock = None
+    if bedrock:
+        rock = h0 - 3.0 + 0.02 * np.arange(h0.shape[1])   # under all of it
+        rock[:, :10] = h0[:, :10]                          # bare in the west
+        write_asc(tmp_path / "rock.asc", rock, dx, dy)
+        args += ["--bedrock", "rock.asc"]
+    cli(args + ["-o", "out.asc"], tmp_path)
+    cli(args + ["-o", "out.h5"], tmp_path)
+    _, want = read_asc(tmp_path / "out.asc")
+    import h5py
+    with h5py.File(tmp_path / "out.h5", "r") as f:
+        series = f["height"][-1][::-1]                     # stored south row first
+    want_report = json.loads((tmp_path / "r.json").read_text())
+
+    got, report = sandslide.relax(h0, dx, dy, bedrock=rock, threads=1)
+
+    assert not same_bits(want, want[::-1]), \
+        "the relaxed DEM is symmetric north-south: the test could not see flipped rows"
+    assert same_bits(got, want), \
+        f"relax differs from `sandslide relax` (out.asc) in {np.sum(got != want)} cells " \
+        f"of {got.size}; flipped rows would match: {same_bits(got[::-1], want)}"
+    assert same_bits(got, series), "relax differs from the last snapshot of `relax -o out.h5`"
+    assert set(report) == set(want_report), \
+        f"report keys {sorted(set(report) ^ set(want_report))} differ from --report's"
+    for key in set(want_report) - {"input", "output", "wall_seconds"}:
+        assert report[key] == want_report[key], \
+            f"report[{key!r}] = {report[key]!r}, --report says {want_report[key]!r}"
+    assert report["input"] == "heights" and report["output"] == "(array)", report
+
+
+def test_threads_give_the_same_bits():
+    h0 = pile_on_ramp(20, 24)
+    one, _ = sandslide.relax(h0, 1.0, threads=1)
+    two, _ = sandslide.relax(h0, 1.0, threads=2)
+    assert same_bits(one, two), "2 threads differ from 1 (README: same bits for any count)"
+
+
+# ---- physics ---------------------------------------------------------------
+
+def test_relaxed_surface_is_steady_at_the_repose_angle_with_volume_conserved():
+    h0 = pile_on_ramp(dx=0.5, dy=0.8)
+    before = h0.copy()
+    h, rep = sandslide.relax(h0, 0.5, 0.8, threads=1)
+    assert same_bits(h0, before), "relax modified its input"
+    assert h.shape == h0.shape and h.dtype == np.float64, (h.shape, h.dtype)
+    assert rep["steady"] is True, f"not steady: {rep}"
+    assert rep["max_slope_before_deg"] > 55, f"the DEM should start at 60 deg: {rep}"
+    assert math.tan(math.radians(rep["max_slope_after_deg"])) <= TAN35 + SLOPE_TOL, \
+        f"steepest face {rep['max_slope_after_deg']!r} deg after, above 35 deg"
+    g = steepest_normal_gradient(h, 0.5, 0.8)
+    assert g <= TAN35 + SLOPE_TOL, f"a face of slope {g!r} > tan 35 deg = {TAN35!r} remains"
+    v0, v1 = h0.sum(), h.sum()
+    assert abs(v1 - v0) <= 1e-12 * v0, f"volume {v0!r} -> {v1!r} with wall sides"
+    assert rep["volume_before"] == pytest.approx(v0 * 0.4, rel=1e-12), rep
+    assert abs(rep["volume_after"] - rep["volume_before"]) <= 1e-12 * rep["volume_before"], \
+        f"report's volume not conserved: {rep}"
+    assert rep["outflow"] == 0 and rep["inflow"] == 0, rep
+
+
+def test_nodata_cells_stay_nan():
+    h0 = pile_on_ramp()
+    h0[20:24, 5:9] = np.nan          # a hole south-west of the pile
+    h0[0, :] = np.nan                # and the north row
+    for nodata in ("open", "wall"):
+        h, rep = sandslide.relax(h0, 1.0, nodata=nodata, threads=1)
+        assert np.array_equal(np.isnan(h), np.isnan(h0)), \
+            f"nodata={nodata}: NaN cells moved: {np.argwhere(np.isnan(h) != np.isnan(h0))}"
+        assert rep["steady"], rep
+        if nodata == "wall":
+            v0, v1 = np.nansum(h0), np.nansum(h)
+            assert abs(v1 - v0) <= 1e-12 * v0, f"walls: volume {v0!r} -> {v1!r}"
+        else:
+            assert rep["outflow"] >= 0, rep
+
+
+def test_bedrock_is_respected():
+    ny, nx = 30, 40
+    r, c = np.mgrid[0:ny, 0:nx]
+    rock = 0.2 * c + 0.1 * (ny - r)                        # tilted, steeper than nothing
+    rock[:, 30:] += 8.0                                    # and a rock cliff
+    h0 = rock + np.where(np.hypot(c - 12, r - 9) < 6, 5.0, 0.0)   # a block of sand
+    h, rep = sandslide.relax(h0, 1.0, bedrock=rock, sides="open", threads=1)
+    assert rep["steady"], rep
+    below = rock - h
+    assert below.max() <= 1e-12 * np.abs(rock).max(), \
+        f"sand went {below.max()!r} m below the bedrock at {np.unravel_index(below.argmax(), h.shape)}"
+    assert np.array_equal(h[:, 31:], rock[:, 31:]) or np.all(h[:, 31:] >= rock[:, 31:]), \
+        "the bare rock cliff changed"
+
+
+# ---- errors ----------------------------------------------------------------
+
+@pytest.mark.parametrize("option, value", [("angle", 95), ("closure", "bogus"),
+                                           ("sides", "periodic"), ("tol", -1),
+                                           ("threads", 0), ("max_time", "soon")])
+def test_bad_option_raises_the_cli_message(tmp_path, option, value):
+    h0 = pile_on_ramp(8, 8)
+    write_asc(tmp_path / "dem.asc", h0)
+    r = cli(["relax", "dem.asc", "--" + option.replace("_", "-"), str(value)], tmp_path,
+            expect=2)
+    said = r.stderr.splitlines()[0]
+    with pytest.raises(sandslide.InputError) as e:
+        sandslide.relax(h0, 1.0, **{option: value})
+    assert isinstance(e.value, ValueError) and isinstance(e.value, sandslide.Error)
+    assert said == "sandslide: --" + str(e.value).replace(option, option.replace("_", "-"), 1), \
+        f"{option}={value!r}: Python says {str(e.value)!r}, the CLI {said!r}"
+
+
+@pytest.mark.parametrize("heights, words", [
+    (np.zeros(5), "2-D array"),
+    (np.zeros((2, 3, 4)), "2-D array"),
+    (np.zeros((0, 4)), "at least one row"),
+    (np.array([["a", "b"], ["c", "d"]]), "real numbers"),
+    (np.ones((3, 3), dtype=complex), "real numbers"),
+    ([[1.0, np.inf], [0.0, 0.0]], "heights[0, 1] is inf"),
+])
+def test_bad_arrays_raise_input_errors(heights, words):
+    with pytest.raises(sandslide.InputError, match=words.replace("[", r"\[")):
+        sandslide.relax(heights, 1.0)
+
+
+def test_bad_cell_size_and_bedrock_raise_input_errors():
+    h0 = pile_on_ramp(8, 8)
+    with pytest.raises(sandslide.InputError, match=r"dx '-1': expected m > 0"):
+        sandslide.relax(h0, -1.0)
+    with pytest.raises(sandslide.InputError, match="shape"):
+        sandslide.relax(h0, 1.0, bedrock=np.zeros((8, 7)))
+    rock = h0 - 1.0
+    rock[2, 3] = np.nan
+    with pytest.raises(sandslide.InputError, match=r"bedrock\[2, 3\] is NaN"):
+        sandslide.relax(h0, 1.0, bedrock=rock)
+    rock = h0 - 1.0
+    rock[1, 6] += 2.0
+    with pytest.raises(sandslide.InputError, match=r"bedrock\[1, 6\] = .* is above heights"):
+        sandslide.relax(h0, 1.0, bedrock=rock)
+    with pytest.raises(sandslide.InputError, match="heights: every cell is nodata"):
+        sandslide.relax(np.full((3, 4), np.nan), 1.0)
+
+
+def test_error_classes():
+    assert issubclass(sandslide.InputError, (sandslide.Error, ValueError))
+    assert issubclass(sandslide.RunError, sandslide.Error)
+    assert issubclass(sandslide.RunError, RuntimeError)
+
+
+def test_other_inputs_are_converted():
+    h0 = pile_on_ramp(12, 14)
+    want, _ = sandslide.relax(h0, 1.0, threads=1)
+    got, _ = sandslide.relax(h0.tolist(), 1.0, threads=1)
+    assert same_bits(got, want), "a list of lists must relax as its array"
+    masked = np.ma.masked_array(h0, mask=np.zeros_like(h0, dtype=bool))
+    masked.mask[3, 4] = True
+    got, _ = sandslide.relax(masked, 1.0, threads=1)
+    assert np.isnan(got[3, 4]) and np.isfinite(np.delete(got.ravel(), 3 * 14 + 4)).all(), \
+        "a masked cell must be no data (NaN) in the result"
+    f32, _ = sandslide.relax(h0.astype(np.float32), 1.0, threads=1)
+    assert f32.dtype == np.float64
+    row = np.array([[0.0, 0.0, 9.0, 0.0, 0.0]])
+    kept = row.copy()
+    got, _ = sandslide.relax(row, 1.0, threads=1)
+    assert same_bits(row, kept) and not same_bits(got, kept), \
+        "a one-row DEM must relax into a new array, its input untouched"
+
+
+# ---- run and open ----------------------------------------------------------
+
+CASE = """\
+[grid]
+nx = 20
+ny = 16
+dx = 0.1
+origin = 0 0
+
+[model]
+closure = coulomb
+repose_angle = 35
+nu = 0.1
+
+[time]
+end = 1
+output_every = 0.5
+
+[boundary]
+west = wall
+east = open
+south = wall
+north = wall
+
+[initial]
+type = flat
+height = 0.2
+"""
+
+
+@pytest.fixture
+def case(tmp_path):
+    (tmp_path / "tiny.ini").write_text(CASE)
+    return tmp_path / "tiny.ini"
+
+
+def test_run_writes_the_series_with_overrides(tmp_path, case):
+    h5py = pytest.importorskip("h5py")
+    out = tmp_path / "tiny.h5"
+    s = sandslide.run(case, out, set={"time.end": 0.75, "time.output_every": 0.25,
+                                      "model.repose_angle": 30}, threads=1)
+    assert s["output"] == str(out) and s["end"] == "done", s
+    assert s["time"] == 0.75 and s["snapshots"] == 4 and s["steps"] > 0, s
+    with h5py.File(out, "r") as f:
+        height = f["height"][...]
+        time = f["time"][...]
+        angle = f.attrs["repose_angle_deg"]
+        overrides = f.attrs["case_overrides"]
+    assert height.shape == (4, 16, 20), f"/height is {height.shape}"
+    assert list(time) == [0.0, 0.25, 0.5, 0.75], f"/time {time}: the overrides not applied"
+    assert angle == 30.0, f"repose_angle_deg {angle}: model.repose_angle=30 not applied"
+    assert "model.repose_angle=30" in str(overrides), overrides
+    assert height[-1, :, -1].max() < 0.2, "no sand left through the open east side"
+
+    with pytest.raises(sandslide.InputError, match="exists"):
+        sandslide.run(case, out)                   # refused without force
+    s = sandslide.run(case, out, set=["time.end=0.5"], force=True, threads=1)
+    assert s["snapshots"] == 2 and s["threads"] == 1, s
+    with pytest.raises(sandslide.InputError, match="nonsense"):
+        sandslide.run(case, tmp_path / "bad.h5", set={"model.nonsense": 1})
+
+
+# Debian's netCDF4 warns that it was built against another numpy
+@pytest.mark.filterwarnings("ignore:numpy.ndarray size changed")
+def test_open_gives_a_dataset(tmp_path, case):
+    pytest.importorskip("xarray")
+    out = tmp_path / "tiny.h5"
+    sandslide.run(case, out, threads=1)
+    with sandslide.open(out) as ds:
+        assert ds["height"].dims == ("time", "y", "x"), ds["height"].dims
+        assert list(ds["time"].values) == [0.0, 0.5, 1.0], ds["time"].values
+        assert ds.sizes["x"] == 20 and ds.sizes["y"] == 16, dict(ds.sizes)
+
+
+def test_version():
+    assert sandslide.version() == sandslide.__version__
+    out = cli(["--version"], ROOT).stdout
+    assert out.startswith(f"sandslide {sandslide.__version__} "), out
+
+
+# ---- finding the library ---------------------------------------------------
+
+def import_in(pythonpath, env_library, code="import sandslide"):
+    env = dict(os.environ, PYTHONPATH=str(pythonpath))
+    env.pop("SANDSLIDE_LIBRARY", None)
+    if env_library is not None:
+        env["SANDSLIDE_LIBRARY"] = str(env_library)
+    return subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
+                          text=True, timeout=60)
+
+
+def package_copy(tmp_path):
+    """The module's files alone, away from the build tree."""
+    dest = tmp_path / "site" / "sandslide"
+    shutil.copytree(os.path.dirname(sandslide.__file__), dest,
+                    ignore=shutil.ignore_patterns("__pycache__", "_library.py"))
+    return dest.parent
+
+
+BUILD_LIB = os.environ.get("SANDSLIDE_LIBRARY") or os.path.join(ROOT, "build",
+                                                                 "libsandslide.so.0")
+
+
+def test_missing_library_says_what_was_tried(tmp_path):
+    r = import_in(package_copy(tmp_path), tmp_path / "nowhere" / "libsandslide.so.0")
+    assert r.returncode != 0 and "ImportError" in r.stderr, r.stderr
+    assert "SANDSLIDE_LIBRARY" in r.stderr and "nowhere" in r.stderr, r.stderr
+    import ctypes.util
+    if ctypes.util.find_library("sandslide"):
+        pytest.skip("a libsandslide is installed where the loader looks")
+    r = import_in(package_copy(tmp_path / "b"), None)
+    assert r.returncode != 0 and "ImportError" in r.stderr, r.stderr
+    for tried in ("SANDSLIDE_LIBRARY", "_library.PATH", "build tree", "find_library"):
+        assert tried in r.stderr, f"the message does not say it tried {tried}: {r.stderr}"
+
+
+def test_library_from_the_environment_or_the_installed_path(tmp_path):
+    code = "import sandslide; print(sandslide._native.lib._name, sandslide.version())"
+    r = import_in(package_copy(tmp_path), BUILD_LIB, code)
+    assert r.returncode == 0 and r.stdout.split() == [BUILD_LIB, sandslide.__version__], \
+        r.stdout + r.stderr
+    site = package_copy(tmp_path / "installed")
+    (site / "sandslide" / "_library.py").write_text(f"PATH = {BUILD_LIB!r}\n")
+    r = import_in(site, None, code)
+    assert r.returncode == 0 and r.stdout.split()[0] == BUILD_LIB, r.stdout + r.stderr
