@@ -281,9 +281,17 @@ $(HOOK_BIN): tests/hooks/nan_step.c $(MAIN_OBJ) $(BUILD)/libsandslide.a $(BUILD)
 	$(Q)$(CC) $(filter-out -MMD -MP,$(ALL_CFLAGS)) tests/hooks/nan_step.c $(MAIN_OBJ) \
 	  $(BUILD)/libsandslide.a $(ALL_LDFLAGS) -Wl,--wrap=ss_stepper_advance $(LIBS) -o $@
 
+# The Python module's tests load the library into python3: a sanitized one
+# needs its run-time libraries loaded first, and Python's own allocations
+# are not ours to report as leaks.
+ifeq ($(SANITIZE),1)
+  PY_SAN_ENV = LD_PRELOAD="$$($(CC) -print-file-name=libasan.so) $$($(CC) -print-file-name=libubsan.so)" \
+               ASAN_OPTIONS=detect_leaks=0:exitcode=86
+endif
+
 # The README's test command.  The layering check, the C test programs
 # (each prints "N passed, M failed"), the fuzz corpora replayed, then the
-# CLI/file tests with pytest.
+# CLI/file tests and the Python module's with pytest.
 test check: all $(TEST_BIN) $(HOOK_BIN) headers-check check-layering $(FUZZ_REPLAY)
 	@fail=0; for t in $(TEST_BIN); do \
 	  echo "== $$t"; OMP_NUM_THREADS=$${OMP_NUM_THREADS:-2} ./$$t || fail=1; \
@@ -294,6 +302,10 @@ test check: all $(TEST_BIN) $(HOOK_BIN) headers-check check-layering $(FUZZ_REPL
 	  SANDSLIDE_MAKEFLAGS="BUILD=$(BUILD) SANITIZE=$(SANITIZE) MPI=$(MPI) OPENMP=$(OPENMP) GDAL=$(GDAL)" \
 	  SANDSLIDE_CC="$(CC)" SANDSLIDE_LDFLAGS="$(ALL_LDFLAGS)" \
 	  $(PYTHON) -m pytest -q tests/cli || fail=1; \
+	echo "== tests/python (pytest)"; \
+	$(PY_SAN_ENV) SANDSLIDE=$(abspath $(BUILD)/sandslide) \
+	  SANDSLIDE_LIBRARY=$(abspath $(BUILD)/$(SONAME)) PYTHONPATH=python \
+	  $(PYTHON) -m pytest -q tests/python || fail=1; \
 	exit $$fail
 
 # The distributed tests (make MPI=1 test-mpi): the C test of the halo and
