@@ -1,7 +1,32 @@
 /*
- * xdmf.c - the XDMF sidecar of an HDF5 output (xdmf.h): a temporal
- * collection of 2DCoRectMesh grids, height from time slice k of /height
- * through a HyperSlab DataItem, cell_type from /cell_type.
+ * xdmf.c - the XDMF sidecar of an HDF5 output (xdmf.h), in the form that
+ * ParaView's default reader for .xmf, XDMF3 (VTK's vtkXdmf3Reader), reads
+ * right: checked with ParaView 5.11 by tests/cli/test_paraview.py.
+ *
+ * Each snapshot is a uniform grid:
+ *
+ *   - Topology 3DCoRectMesh of 1 x (ny+1) x (nx+1) points, Geometry
+ *     ORIGIN_DXDYDZ "0 y0 x0" / "1 dy dx" (slowest first).  Both XDMF
+ *     readers of VTK turn a 2DCoRectMesh into a grid in VTK's y-z plane (x
+ *     east along VTK y, y north along VTK z); one layer of points in z
+ *     keeps x and y where they belong, the surface at z = 0.
+ *   - The geometry's numbers carry NumberType="Float" Precision="8": XDMF's
+ *     default is float32, which moved an origin of 1.3 m to 1.2999999523.
+ *   - height: time slice k of /height (time, y, x) in XDMF3's own HDF
+ *     syntax, "FILE:/height|START:STRIDE:COUNT:DATASPACE".  Not a
+ *     DataItem of ItemType="HyperSlab": XDMF3 keeps such an item as a
+ *     reference without a number type until it is read, and VTK asks the
+ *     type first (vtkXdmf3DataSet::XdmfToVTKArray), so ParaView dropped
+ *     the heights ("Skipping unrecognized array type [None]").  The legacy
+ *     reader (XDMFReader, xdmf2) does not know this syntax, and it cannot
+ *     read the 3-D grid's cell attributes either (it selects 0 layers of
+ *     cells in z); no form of the time slice reads in both.
+ *   - cell_type: /cell_type as NumberType="Char" (int8, CF flags 0 flow,
+ *     1 wall, 2 open).  HDF5 converts as it reads, so files whose
+ *     cell_type is uint8 read the same values.
+ *
+ * Times are written with 17 significant digits: each reads back as the
+ * very double of /time.
  */
 #include "io/xdmf.h"
 
@@ -32,25 +57,24 @@ static void put_grid(FILE *f, const char *h5_name, int nx, int ny, double origin
 {
 	fprintf(f, "   <Grid Name=\"snapshot_%lld\" GridType=\"Uniform\">\n"
 	           "    <Time Value=\"%.17g\"/>\n"
-	           "    <Topology TopologyType=\"2DCoRectMesh\" Dimensions=\"%d %d\"/>\n"
-	           "    <Geometry GeometryType=\"ORIGIN_DXDY\">\n"
-	           "     <DataItem Format=\"XML\" Dimensions=\"2\">%.17g %.17g</DataItem>\n"
-	           "     <DataItem Format=\"XML\" Dimensions=\"2\">%.17g %.17g</DataItem>\n"
+	           "    <Topology TopologyType=\"3DCoRectMesh\" Dimensions=\"1 %d %d\"/>\n"
+	           "    <Geometry GeometryType=\"ORIGIN_DXDYDZ\">\n"
+	           "     <DataItem Format=\"XML\" NumberType=\"Float\" Precision=\"8\" "
+	           "Dimensions=\"3\">0 %.17g %.17g</DataItem>\n"
+	           "     <DataItem Format=\"XML\" NumberType=\"Float\" Precision=\"8\" "
+	           "Dimensions=\"3\">1 %.17g %.17g</DataItem>\n"
 	           "    </Geometry>\n"
 	           "    <Attribute Name=\"height\" AttributeType=\"Scalar\" Center=\"Cell\">\n"
-	           "     <DataItem ItemType=\"HyperSlab\" Dimensions=\"1 %d %d\" Type=\"HyperSlab\">\n"
-	           "      <DataItem Dimensions=\"3 3\" Format=\"XML\">%lld 0 0 1 1 1 1 %d %d</DataItem>\n"
-	           "      <DataItem Format=\"HDF\" NumberType=\"Float\" Precision=\"8\" "
-	           "Dimensions=\"%lld %d %d\">",
-	        k, time, ny + 1, nx + 1, origin_y, origin_x, dy, dx, ny, nx, k, ny, nx, count, ny,
-	        nx);
+	           "     <DataItem Format=\"HDF\" NumberType=\"Float\" Precision=\"8\" "
+	           "Dimensions=\"1 %d %d\">",
+	        k, time, ny + 1, nx + 1, origin_y, origin_x, dy, dx, ny, nx);
 	put_xml_text(f, h5_name);
-	fprintf(f, ":/height</DataItem>\n"
-	           "     </DataItem>\n    </Attribute>\n"
+	fprintf(f, ":/height|%lld 0 0:1 1 1:1 %d %d:%lld %d %d</DataItem>\n"
+	           "    </Attribute>\n"
 	           "    <Attribute Name=\"cell_type\" AttributeType=\"Scalar\" Center=\"Cell\">\n"
-	           "     <DataItem Format=\"HDF\" NumberType=\"UChar\" Precision=\"1\" "
+	           "     <DataItem Format=\"HDF\" NumberType=\"Char\" Precision=\"1\" "
 	           "Dimensions=\"%d %d\">",
-	        ny, nx);
+	        k, ny, nx, count, ny, nx, ny, nx);
 	put_xml_text(f, h5_name);
 	fputs(":/cell_type</DataItem>\n    </Attribute>\n   </Grid>\n", f);
 }

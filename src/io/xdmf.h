@@ -1,9 +1,9 @@
 /*
  * xdmf.h - the XDMF sidecar OUT.xmf of an HDF5 output: a temporal
  * collection of one uniform grid per snapshot, so that ParaView opens the
- * series.  The layout it describes is SPEC section 5: height (time, y, x)
- * float64, cell_type (y, x) 8-bit, cell-centred, row 0 the south row.  Not
- * installed.
+ * series with its default reader (XDMF3, "Xdmf3ReaderS").  The layout it
+ * describes is SPEC section 5: height (time, y, x) float64, cell_type (y, x)
+ * 8-bit, cell-centred, row 0 the south row.  Not installed.
  */
 #ifndef SANDSLIDE_IO_XDMF_H
 #define SANDSLIDE_IO_XDMF_H
