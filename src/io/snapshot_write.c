@@ -40,6 +40,7 @@
 #include "sandslide/comm.h"
 #include "sandslide/error.h"
 #include "io/snapshot_layout.h"
+#include "io/xdmf.h"
 
 static double diag_get(const struct ss_diagnostics *d, int k)
 {
@@ -552,51 +553,6 @@ static int append_value(hid_t d, long long index, double v)
 	return r < 0 ? -1 : 0;
 }
 
-static int write_sidecar(const struct ss_snapshot *s)
-{
-	const struct ss_grid *g = &s->grid;
-	const int ny = (int)g->global_ny;   /* the whole grid's */
-	char tmp[4200];
-	snprintf(tmp, sizeof tmp, "%s.tmp", s->xmf_path);
-	FILE *f = fopen(tmp, "w");
-	if (!f)
-		return -1;
-	const char *base = strrchr(s->path, '/') ? strrchr(s->path, '/') + 1 : s->path;
-	fprintf(f, "<?xml version=\"1.0\" ?>\n<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n"
-	           "<Xdmf Version=\"3.0\">\n <Domain>\n"
-	           "  <Grid Name=\"sand\" GridType=\"Collection\" CollectionType=\"Temporal\">\n");
-	for (long long k = 0; k < s->count; k++) {
-		fprintf(f, "   <Grid Name=\"snapshot_%lld\" GridType=\"Uniform\">\n"
-		           "    <Time Value=\"%.17g\"/>\n"
-		           "    <Topology TopologyType=\"2DCoRectMesh\" Dimensions=\"%d %d\"/>\n"
-		           "    <Geometry GeometryType=\"ORIGIN_DXDY\">\n"
-		           "     <DataItem Format=\"XML\" Dimensions=\"2\">%.17g %.17g</DataItem>\n"
-		           "     <DataItem Format=\"XML\" Dimensions=\"2\">%.17g %.17g</DataItem>\n"
-		           "    </Geometry>\n"
-		           "    <Attribute Name=\"height\" AttributeType=\"Scalar\" Center=\"Cell\">\n"
-		           "     <DataItem ItemType=\"HyperSlab\" Dimensions=\"1 %d %d\" Type=\"HyperSlab\">\n"
-		           "      <DataItem Dimensions=\"3 3\" Format=\"XML\">%lld 0 0 1 1 1 1 %d %d</DataItem>\n"
-		           "      <DataItem Format=\"HDF\" NumberType=\"Float\" Precision=\"8\" "
-		           "Dimensions=\"%lld %d %d\">%s:/height</DataItem>\n"
-		           "     </DataItem>\n    </Attribute>\n"
-		           "    <Attribute Name=\"cell_type\" AttributeType=\"Scalar\" Center=\"Cell\">\n"
-		           "     <DataItem Format=\"HDF\" NumberType=\"UChar\" Precision=\"1\" "
-		           "Dimensions=\"%d %d\">%s:/cell_type</DataItem>\n"
-		           "    </Attribute>\n   </Grid>\n",
-		        k, s->times[k], ny + 1, g->nx + 1, g->origin_y, g->origin_x, g->dy, g->dx,
-		        ny, g->nx, k, ny, g->nx, s->count, ny, g->nx, base,
-		        ny, g->nx, base);
-	}
-	fprintf(f, "  </Grid>\n </Domain>\n</Xdmf>\n");
-	int bad = ferror(f);
-	bad |= fclose(f) != 0;
-	if (bad || rename(tmp, s->xmf_path) != 0) {
-		remove(tmp);
-		return -1;
-	}
-	return 0;
-}
-
 /* text with XML's five special characters escaped (a WKT has quotes) */
 static void xml_text(FILE *f, const char *text)
 {
@@ -815,7 +771,8 @@ static int append(struct ss_snapshot *s, double time_s, const double *height,
 	    write_gdal_sidecar(s, s->has_bedrock))
 		return ss_error_fail("cannot write GDAL's sidecar '%s.aux.xml': %s", s->path,
 		                     strerror(errno));
-	if (is_root() && write_sidecar(s))
+	if (is_root() && ss_xdmf_write(s->xmf_path, s->path, g->nx, (int)g->global_ny, g->origin_x,
+	                              g->origin_y, g->dx, g->dy, s->times, s->count))
 		return ss_error_fail("cannot write the XDMF sidecar '%s': %s", s->xmf_path,
 		                     strerror(errno));
 	return SS_OK;
