@@ -16,7 +16,7 @@ import subprocess
 import numpy as np
 import pytest
 
-from conftest import BASE, asc_text, edit, h5open, run_ok
+from conftest import BASE, asc_text, edit, h5open, run, run_ok
 
 # 20 x 16 cells of 0.1 m from (1, 2); a wall block in the north-west and a
 # cone off centre, so no symmetry hides a flip.
@@ -141,6 +141,8 @@ def test_cdo_reads_elapsed_time_and_missing_walls(run_files):
         assert miss == walls, f"CDO counts {miss} missing cells, not the {walls} walls:\n{line}"
 
 
+@pytest.mark.skipif("GDAL: on" not in run(["--version"]).stdout,
+                    reason="this build reads no GeoTIFF (make GDAL=0, or the MPI build)")
 def test_crs_kept_from_geotiff_to_h5_and_back(tmp_path):
     """relax of a GeoTIFF with a CRS into .h5 writes the CF grid mapping
     /crs; relax of that .h5 into GeoTIFF gives the CRS, geotransform and

@@ -144,6 +144,40 @@ def test_program_against_static_library(staged, tmp_path):
     assert "libsandslide" not in ldd, f"linked the shared library:\n{ldd}"
 
 
+def test_python_module_finds_the_installed_library(tmp_path):
+    """Installed without DESTDIR under a prefix of its own, the Python
+    module loads the library make install told it of (no
+    SANDSLIDE_LIBRARY) and relaxes a ramp."""
+    prefix = tmp_path / "prefix"
+    env = dict(os.environ)
+    env.pop("MAKEFLAGS", None)
+    env.pop("MAKELEVEL", None)
+    r = subprocess.run(["make", "--no-print-directory", *MAKEFLAGS, "install",
+                        "PREFIX=" + str(prefix)], cwd=ROOT, env=env, capture_output=True,
+                       text=True, timeout=300)
+    assert r.returncode == 0, r.stdout + r.stderr
+    found = [d for d, _, files in os.walk(prefix / "lib") if "_library.py" in files]
+    assert len(found) == 1, f"the module is not installed once under {prefix}/lib: {found}"
+    pythondir = os.path.dirname(found[0])
+    env.pop("SANDSLIDE_LIBRARY", None)
+    code = ("import numpy as np, sandslide\n"
+            "h = np.add.outer(np.zeros(8), np.arange(12.0))  # a 45 deg ramp\n"
+            "r, rep = sandslide.relax(h, dx=1.0, threads=1)\n"
+            "from sandslide import _native\n"
+            "print(sandslide.__file__, _native.lib._name, rep['steady'], "
+            "rep['max_slope_after_deg'])\n")
+    r = subprocess.run(["/usr/bin/python3", "-c", code], cwd=tmp_path, capture_output=True,
+                       text=True, timeout=120, env=dict(env, PYTHONPATH=pythondir))
+    assert r.returncode == 0, f"the installed module failed:\n{r.stderr}"
+    words = r.stdout.split()
+    assert words[0].startswith(pythondir), f"imported {words[0]}, not the installed module"
+    assert words[1] == str(prefix / "lib" / "libsandslide.so.0"), \
+        f"loaded {words[1]}, not the installed library"
+    assert words[-2] == "True" and float(words[-1]) <= 35.0 + 1e-6, r.stdout
+    with open(os.path.join(found[0], "_library.py")) as f:
+        assert str(prefix / "lib" / "libsandslide.so.0") in f.read()
+
+
 def test_man_page_renders(staged):
     _, root = staged
     page = os.path.join(root, "share", "man", "man1", "sandslide.1")
