@@ -11,11 +11,10 @@
  */
 #include "sandslide/relax.h"
 
-#include <errno.h>
 #include <math.h>
-#include <stdlib.h>
 #include <string.h>
 
+#include "app/named.h"
 #include "base/strings.h"
 #include "sandslide/error.h"
 
@@ -27,46 +26,67 @@ struct owned_options {
 	char *text[TEXT_COUNT];      /* NULL, or the value of o's text field */
 };
 
-enum key_kind { REAL, INT, FLAG, TEXT, CLOSURE, INTEGRATOR, SIDES, NODATA };
+/* The words relax's --sides and --nodata take. */
+static int parse_sides(const char *value, void *field)
+{
+	/* periodic sides make no sense for a DEM: the CLI refuses them */
+	enum ss_side_kind side;
+	if (ss_side_kind_parse(value, &side) || side == SS_SIDE_PERIODIC)
+		return -1;
+	*(enum ss_side_kind *)field = side;
+	return 0;
+}
 
-struct key {
-	const char *name;            /* relax's option without "--" */
-	enum key_kind kind;
-	size_t offset;               /* of the field in struct ss_relax_options */
-	double lo, hi;               /* REAL, INT */
-	const char *expected;        /* for the message, as the CLI says it */
-	int text;                    /* TEXT: its slot in owned_options */
-};
+static int parse_nodata(const char *value, void *field)
+{
+	if (strcmp(value, "wall") && strcmp(value, "open"))
+		return -1;
+	*(enum ss_cell_type *)field = !strcmp(value, "wall") ? SS_CELL_WALL : SS_CELL_OPEN;
+	return 0;
+}
+
+static int parse_closure(const char *value, void *field)
+{
+	return ss_closure_parse(value, field);
+}
+
+static int parse_integrator(const char *value, void *field)
+{
+	return ss_integrator_parse(value, field);
+}
 
 #define AT(m) offsetof(struct ss_relax_options, m)
-#define RANGE(n, m, l, h, e) {n, REAL, AT(m), l, h, e, 0}
+#define RANGE(n, m, l, h, e) {n, SS_NAMED_REAL, AT(m), l, h, e, 0, NULL}
 #define POSITIVE(n, m, e) RANGE(n, m, 1e-300, 1e300, e)
+#define WORD(n, m, e, f) {n, SS_NAMED_WORD, AT(m), 0, 0, e, 0, f}
+#define TEXT(n, m, slot) {n, SS_NAMED_TEXT, AT(m), 0, 0, "a path", slot, NULL}
 
-static const struct key keys[] = {
+static const struct ss_named keys[] = {
 	RANGE("angle", angle_deg, 1e-9, 90.0 - 1e-9, "degrees in (0, 90)"),
-	{"closure", CLOSURE, AT(closure), 0, 0, SS_CLOSURE_NAMES, 0},
+	WORD("closure", closure, SS_CLOSURE_NAMES, parse_closure),
 	RANGE("gamma", gamma, 1e-6, 1e6, "a number > 0"),
 	POSITIVE("nu", nu, "m^2/s > 0"),
 	POSITIVE("tol", tol, "m/s > 0"),
 	POSITIVE("slope-tol", slope_tol, "a number > 0"),
-	{"integrator", INTEGRATOR, AT(integrator), 0, 0, SS_INTEGRATOR_NAMES, 0},
-	{"rkl2-max-stages", INT, AT(rkl2_max_stages), 2, 100000, "an integer >= 2", 0},
+	WORD("integrator", integrator, SS_INTEGRATOR_NAMES, parse_integrator),
+	{"rkl2-max-stages", SS_NAMED_INT, AT(rkl2_max_stages), 2, 100000, "an integer >= 2", 0,
+	 NULL},
 	POSITIVE("rkl2-tol", rkl2_tol, "a number > 0"),
 	POSITIVE("max-time", max_time, "s > 0"),
 	RANGE("cfl", cfl, 1e-9, 1.0, "(0, 1]"),
-	{"threads", INT, AT(threads), 1, 4096, "an integer from 1 to 4096", 0},
-	{"sides", SIDES, AT(sides), 0, 0, "wall or open", 0},
-	{"nodata", NODATA, AT(nodata_type), 0, 0, "wall or open", 0},
+	{"threads", SS_NAMED_INT, AT(threads), 1, 4096, "an integer from 1 to 4096", 0, NULL},
+	WORD("sides", sides, "wall or open", parse_sides),
+	WORD("nodata", nodata_type, "wall or open", parse_nodata),
 	RANGE("open-level", open_level, -1e300, 1e300, "a height in m"),
 	POSITIVE("dx", read.cellsize, "m > 0"),
 	POSITIVE("zscale", read.zscale, "m per grey level > 0"),
 	RANGE("zoffset", read.zoffset, -1e300, 1e300, "m"),
 	POSITIVE("output-every", output_every, "s > 0"),
-	{"force", FLAG, AT(force), 0, 0, "1 or 0", 0},
-	{"dem", TEXT, AT(dem), 0, 0, "a path", TEXT_DEM},
-	{"output", TEXT, AT(output), 0, 0, "a path", TEXT_OUTPUT},
-	{"report", TEXT, AT(report), 0, 0, "a path", TEXT_REPORT},
-	{"bedrock", TEXT, AT(bedrock), 0, 0, "a path", TEXT_BEDROCK},
+	{"force", SS_NAMED_FLAG, AT(force), 0, 0, "1 or 0", 0, NULL},
+	TEXT("dem", dem, TEXT_DEM),
+	TEXT("output", output, TEXT_OUTPUT),
+	TEXT("report", report, TEXT_REPORT),
+	TEXT("bedrock", bedrock, TEXT_BEDROCK),
 };
 
 struct ss_relax_options *ss_relax_options_create(void)
@@ -88,99 +108,12 @@ void ss_relax_options_destroy(struct ss_relax_options *o)
 	ss_free(w);
 }
 
-/* key names option name, '_' standing for '-' ("max_time" is "max-time"). */
-static int same_key(const char *key, const char *name)
-{
-	for (; *key && *name; key++, name++)
-		if (*key != *name && !(*key == '_' && *name == '-'))
-			return 0;
-	return *key == *name;
-}
-
-/* "unknown relax option 'KEY': expected angle, closure, ..." */
-static int unknown_key(const char *key)
-{
-	char names[512];
-	struct ss_strbuf b = {names, sizeof names, 0};
-	for (size_t k = 0; k < sizeof keys / sizeof *keys; k++)
-		ss_strbuf_printf(&b, "%s%s", k ? ", " : "", keys[k].name);
-	return ss_error_input("unknown relax option '%s': expected one of %s", key, names);
-}
-
-/* value parsed for k into target; 0, or -1 when it is not what k takes */
-static int parse(const struct key *k, const char *value, void *target)
-{
-	char *end;
-	errno = 0;
-	switch (k->kind) {
-	case REAL: {
-		const double v = strtod(value, &end);
-		if (end == value || *end || errno || !isfinite(v) || !(v >= k->lo && v <= k->hi))
-			return -1;
-		*(double *)target = v;
-		return 0;
-	}
-	case INT: {
-		const long v = strtol(value, &end, 10);
-		if (end == value || *end || errno || v < (long)k->lo || v > (long)k->hi)
-			return -1;
-		*(int *)target = (int)v;
-		return 0;
-	}
-	case FLAG:
-		if (strcmp(value, "0") && strcmp(value, "1"))
-			return -1;
-		*(int *)target = value[0] == '1';
-		return 0;
-	case CLOSURE:
-		return ss_closure_parse(value, target);
-	case INTEGRATOR:
-		return ss_integrator_parse(value, target);
-	case SIDES: {
-		/* periodic sides make no sense for a DEM: the CLI refuses them */
-		enum ss_side_kind side;
-		if (ss_side_kind_parse(value, &side) || side == SS_SIDE_PERIODIC)
-			return -1;
-		*(enum ss_side_kind *)target = side;
-		return 0;
-	}
-	case NODATA:
-		if (strcmp(value, "wall") && strcmp(value, "open"))
-			return -1;
-		*(enum ss_cell_type *)target = !strcmp(value, "wall") ? SS_CELL_WALL : SS_CELL_OPEN;
-		return 0;
-	case TEXT:
-		break;
-	}
-	return -1;
-}
-
 int ss_relax_options_set(struct ss_relax_options *o, const char *key, const char *value)
 {
-	const struct key *k = NULL;
-	for (size_t n = 0; n < sizeof keys / sizeof *keys && !k; n++)
-		if (same_key(key, keys[n].name))
-			k = &keys[n];
-	if (!k)
-		return unknown_key(key);
-	if (!value || !*value)
-		return ss_error_input("%s needs a value: %s", key, k->expected);
-	void *target = (char *)o + k->offset;
-	if (k->kind != TEXT) {
-		if (parse(k, value, target))
-			return ss_error_input("%s '%s': expected %s", key, value, k->expected);
-		return SS_OK;
-	}
-	struct owned_options *w = (struct owned_options *)o;
-	const size_t n = strlen(value) + 1;
-	char *copy = ss_alloc(n, 1, "an option's text");
-	if (!copy)
-		return SS_ERR_FAIL;
-	memcpy(copy, value, n);
-	ss_free(w->text[k->text]);
-	w->text[k->text] = copy;
-	*(const char **)target = copy;
-	return SS_OK;
+	static const struct ss_named_table table = {"relax", keys, sizeof keys / sizeof *keys};
+	const struct ss_named *k = ss_named_find(&table, key);
+	return k ? ss_named_set(k, key, value, o, ((struct owned_options *)o)->text)
+	         : SS_ERR_INPUT;
 }
 
 int ss_relax_report_json(const struct ss_relax_options *o, const struct ss_relax_report *r,

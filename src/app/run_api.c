@@ -15,6 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "app/named.h"
 #include "base/strings.h"
 #include "sandslide/error.h"
 
@@ -28,30 +29,20 @@ struct owned_options {
 	int set_room;                /* entries allocated at sets */
 };
 
-enum key_kind { INT, FLAG, TEXT, TILE, SET };
-
-struct key {
-	const char *name;            /* run's option without "--" ("case": CASE.ini) */
-	enum key_kind kind;
-	size_t offset;               /* of the field in struct ss_run_options */
-	long lo, hi;                 /* INT */
-	const char *expected;        /* for the message, as the CLI says it */
-	int text;                    /* TEXT: its slot in owned_options */
-};
-
 #define AT(m) offsetof(struct ss_run_options, m)
+#define TEXT(n, m, e, slot) {n, SS_NAMED_TEXT, AT(m), 0, 0, e, slot, NULL}
 
-static const struct key keys[] = {
-	{"case", TEXT, AT(case_path), 0, 0, "a path", TEXT_CASE},
-	{"output", TEXT, AT(output), 0, 0, "a path", TEXT_OUTPUT},
-	{"restart", TEXT, AT(restart), 0, 0, "a path", TEXT_RESTART},
-	{"history", TEXT, AT(history), 0, 0, "a text", TEXT_HISTORY},
-	{"set", SET, 0, 0, 0, "SECTION.KEY=VALUE", 0},
-	{"threads", INT, AT(threads), 1, 4096, "an integer from 1 to 4096", 0},
-	{"force", FLAG, AT(force), 0, 0, "1 or 0", 0},
-	{"reference-kernel", FLAG, AT(reference_kernel), 0, 0, "1 or 0", 0},
-	{"deflate", INT, AT(deflate), 0, 9, "0 to 9", 0},
-	{"tile", TILE, 0, 0, 0, "NXxNY, e.g. 256x64", 0},
+static const struct ss_named keys[] = {
+	TEXT("case", case_path, "a path", TEXT_CASE),
+	TEXT("output", output, "a path", TEXT_OUTPUT),
+	TEXT("restart", restart, "a path", TEXT_RESTART),
+	TEXT("history", history, "a text", TEXT_HISTORY),
+	{"set", SS_NAMED_OWN, 0, 0, 0, "SECTION.KEY=VALUE", 0, NULL},
+	{"threads", SS_NAMED_INT, AT(threads), 1, 4096, "an integer from 1 to 4096", 0, NULL},
+	{"force", SS_NAMED_FLAG, AT(force), 0, 0, "1 or 0", 0, NULL},
+	{"reference-kernel", SS_NAMED_FLAG, AT(reference_kernel), 0, 0, "1 or 0", 0, NULL},
+	{"deflate", SS_NAMED_INT, AT(deflate), 0, 9, "0 to 9", 0, NULL},
+	{"tile", SS_NAMED_OWN, 0, 0, 0, "NXxNY, e.g. 256x64", 0, NULL},
 };
 
 struct ss_run_options *ss_run_options_create(void)
@@ -71,24 +62,6 @@ void ss_run_options_destroy(struct ss_run_options *o)
 		ss_free(w->sets[k]);
 	ss_free(w->sets);
 	ss_free(w);
-}
-
-/* key names option name, '_' standing for '-' */
-static int same_key(const char *key, const char *name)
-{
-	for (; *key && *name; key++, name++)
-		if (*key != *name && !(*key == '_' && *name == '-'))
-			return 0;
-	return *key == *name;
-}
-
-static int unknown_key(const char *key)
-{
-	char names[256];
-	struct ss_strbuf b = {names, sizeof names, 0};
-	for (size_t k = 0; k < sizeof keys / sizeof *keys; k++)
-		ss_strbuf_printf(&b, "%s%s", k ? ", " : "", keys[k].name);
-	return ss_error_input("unknown run option '%s': expected one of %s", key, names);
 }
 
 /* An integer in [lo, hi] from all of s into *out; 0, or -1. */
@@ -120,15 +93,6 @@ static int parse_tile(const char *s, struct ss_run_options *o)
 	return 0;
 }
 
-static char *copy_text(const char *s)
-{
-	const size_t n = strlen(s) + 1;
-	char *copy = ss_alloc(n, 1, "an option's text");
-	if (copy)
-		memcpy(copy, s, n);
-	return copy;
-}
-
 /* One more override at the end of o's list. */
 static int append_set(struct owned_options *w, const char *value)
 {
@@ -144,7 +108,7 @@ static int append_set(struct owned_options *w, const char *value)
 		w->sets = sets;
 		w->set_room = room;
 	}
-	char *copy = copy_text(value);
+	char *copy = ss_named_copy(value);
 	if (!copy)
 		return SS_ERR_FAIL;
 	w->sets[o->override_count++] = copy;
@@ -154,44 +118,19 @@ static int append_set(struct owned_options *w, const char *value)
 
 int ss_run_options_set(struct ss_run_options *o, const char *key, const char *value)
 {
-	const struct key *k = NULL;
-	for (size_t n = 0; n < sizeof keys / sizeof *keys && !k; n++)
-		if (same_key(key, keys[n].name))
-			k = &keys[n];
+	static const struct ss_named_table table = {"run", keys, sizeof keys / sizeof *keys};
+	const struct ss_named *k = ss_named_find(&table, key);
 	if (!k)
-		return unknown_key(key);
+		return SS_ERR_INPUT;
+	struct owned_options *w = (struct owned_options *)o;
+	if (k->kind != SS_NAMED_OWN)
+		return ss_named_set(k, key, value, o, w->text);
 	if (!value || !*value)
 		return ss_error_input("%s needs a value: %s", key, k->expected);
-	struct owned_options *w = (struct owned_options *)o;
-	void *target = (char *)o + k->offset;
-	int bad = 0;
-	switch (k->kind) {
-	case INT:
-		bad = parse_int(value, k->lo, k->hi, target);
-		break;
-	case FLAG:
-		bad = strcmp(value, "0") && strcmp(value, "1");
-		if (!bad)
-			*(int *)target = value[0] == '1';
-		break;
-	case TILE:
-		bad = parse_tile(value, o);
-		break;
-	case SET:
+	if (!strcmp(k->name, "set"))
 		return append_set(w, value);
-	case TEXT: {
-		char *copy = copy_text(value);
-		if (!copy)
-			return SS_ERR_FAIL;
-		ss_free(w->text[k->text]);
-		w->text[k->text] = copy;
-		*(const char **)target = copy;
-		break;
-	}
-	}
-	if (bad)
-		return ss_error_input("%s '%s': expected %s", key, value, k->expected);
-	return SS_OK;
+	return parse_tile(value, o) ? ss_error_input("%s '%s': expected %s", key, value, k->expected)
+	                            : SS_OK;
 }
 
 static const char *end_name(enum ss_run_end end)
