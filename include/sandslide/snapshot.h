@@ -122,7 +122,8 @@ int ss_snapshot_destroy(struct ss_snapshot *s);
  * written for it. */
 int ss_snapshot_named_netcdf(const char *path);
 
-/* Path of the XDMF sidecar for an output path: "run.h5" -> "run.xmf". */
+/* Path of the XDMF sidecar for an output path: "run.h5" -> "run.xmf",
+ * another name gets ".xmf" added ("run.nc" -> "run.nc.xmf"). */
 void ss_snapshot_sidecar_path(const char *path, char *out, size_t size);
 
 /* What `sandslide info` prints.  Arrays have `count` entries. */

@@ -403,12 +403,14 @@ int ss_snapshot_named_netcdf(const char *path)
 	       (n > 4 && !strcasecmp(path + n - 4, ".nc4"));
 }
 
+/* "run.h5" -> "run.xmf" (SPEC section 5); any other name keeps its
+ * extension, "run.nc" -> "run.nc.xmf", so that run.h5 and run.nc beside it
+ * do not share (and overwrite) one sidecar. */
 void ss_snapshot_sidecar_path(const char *path, char *out, size_t size)
 {
-	const char *slash = strrchr(path, '/');
-	const char *dot = strrchr(path, '.');
-	size_t stem = dot && (!slash || dot > slash) ? (size_t)(dot - path) : strlen(path);
-	snprintf(out, size, "%.*s.xmf", (int)stem, path);
+	const size_t n = strlen(path);
+	const int h5 = n > 3 && !strcasecmp(path + n - 3, ".h5") && path[n - 4] != '/';
+	snprintf(out, size, "%.*s.xmf", (int)(h5 ? n - 3 : n), path);
 }
 
 static void close_handles(struct ss_snapshot *s)

@@ -40,6 +40,10 @@ def run_files(tmp_path_factory):
     (d / "case.ini").write_text(CASE)
     for name in ("run.h5", "run.nc"):
         run_ok(["run", "case.ini", "-o", name, "-q"], cwd=d)
+    # each its own XDMF sidecar, naming its own file
+    assert "run.h5:/height" in (d / "run.xmf").read_text(), "run.xmf does not name run.h5"
+    assert "run.nc:/height" in (d / "run.nc.xmf").read_text(), \
+        "run.nc.xmf does not name run.nc"
     with h5open(d / "run.h5") as f:
         ref = {k: f[k][...] for k in ("height", "cell_type", "time", "x", "y")}
     assert (ref["cell_type"] == 1).any(), "test bug: the case has no walls"
