@@ -409,6 +409,8 @@ install: all
 	$(if $(PY_SRC),$(INSTALL) -m 644 $(PY_SRC) $(DESTDIR)$(PYTHONDIR)/sandslide/)
 	printf '# written by make install: the library this module loads\nPATH = "%s"\n' \
 	  '$(LIBDIR)/$(SONAME)' > $(DESTDIR)$(PYTHONDIR)/sandslide/_library.py
+	@# the loader's cache, for a system folder (root, no DESTDIR)
+	@[ -n "$(DESTDIR)" ] || [ "$$(id -u)" != 0 ] || ! command -v ldconfig >/dev/null || ldconfig
 	@echo "installed sandslide $(VERSION) under $(DESTDIR)$(PREFIX) (Python module in $(DESTDIR)$(PYTHONDIR))"
 
 uninstall:
