@@ -285,8 +285,8 @@ $(HOOK_BIN): tests/hooks/nan_step.c $(MAIN_OBJ) $(BUILD)/libsandslide.a $(BUILD)
 # needs its run-time libraries loaded first, and Python's own allocations
 # are not ours to report as leaks.
 ifeq ($(SANITIZE),1)
-  PY_SAN_ENV = LD_PRELOAD="$$($(CC) -print-file-name=libasan.so) $$($(CC) -print-file-name=libubsan.so)" \
-               ASAN_OPTIONS=detect_leaks=0:exitcode=86
+  PY_PRELOAD = $$($(CC) -print-file-name=libasan.so) $$($(CC) -print-file-name=libubsan.so)
+  PY_SAN_ENV = LD_PRELOAD="$(PY_PRELOAD)" ASAN_OPTIONS=detect_leaks=0:exitcode=86
 endif
 
 # The README's test command.  The layering check, the C test programs
@@ -300,7 +300,7 @@ test check: all $(TEST_BIN) $(HOOK_BIN) headers-check check-layering $(FUZZ_REPL
 	echo "== tests/cli (pytest)"; \
 	SANDSLIDE_MPI= SANDSLIDE=$(abspath $(BUILD)/sandslide) SANDSLIDE_NAN=$(abspath $(HOOK_BIN)) \
 	  SANDSLIDE_MAKEFLAGS="BUILD=$(BUILD) SANITIZE=$(SANITIZE) MPI=$(MPI) OPENMP=$(OPENMP) GDAL=$(GDAL)" \
-	  SANDSLIDE_CC="$(CC)" SANDSLIDE_LDFLAGS="$(ALL_LDFLAGS)" \
+	  SANDSLIDE_CC="$(CC)" SANDSLIDE_LDFLAGS="$(ALL_LDFLAGS)" SANDSLIDE_PY_PRELOAD="$(PY_PRELOAD)" \
 	  $(PYTHON) -m pytest -q tests/cli || fail=1; \
 	echo "== tests/python (pytest)"; \
 	$(PY_SAN_ENV) SANDSLIDE=$(abspath $(BUILD)/sandslide) \

@@ -10,8 +10,9 @@ and relaxes the installed example DEM, against the shared library and
 against the static one.
 
 `make test` passes the build's settings (SANDSLIDE_MAKEFLAGS, SANDSLIDE_CC,
-SANDSLIDE_LDFLAGS) so that the sanitized and MPI suites install their own
-build; run alone, the test installs build/.
+SANDSLIDE_LDFLAGS, and SANDSLIDE_PY_PRELOAD: the sanitizers' run-time
+libraries python3 must load first) so that the sanitized and MPI suites
+install their own build; run alone, the test installs build/.
 """
 import os
 import re
@@ -160,6 +161,9 @@ def test_python_module_finds_the_installed_library(tmp_path):
     assert len(found) == 1, f"the module is not installed once under {prefix}/lib: {found}"
     pythondir = os.path.dirname(found[0])
     env.pop("SANDSLIDE_LIBRARY", None)
+    if os.environ.get("SANDSLIDE_PY_PRELOAD"):   # a sanitized library (make SANITIZE=1)
+        env.update(LD_PRELOAD=os.environ["SANDSLIDE_PY_PRELOAD"],
+                   ASAN_OPTIONS="detect_leaks=0:exitcode=86")
     code = ("import numpy as np, sandslide\n"
             "h = np.add.outer(np.zeros(8), np.arange(12.0))  # a 45 deg ramp\n"
             "r, rep = sandslide.relax(h, dx=1.0, threads=1)\n"
