@@ -2,13 +2,13 @@
  * relax_dem.c - a program a user writes against the installed library:
  * built by tests/cli/test_install.py with `pkg-config --cflags --libs
  * sandslide` from a DESTDIR tree, so that it sees only the installed
- * headers, library and example DEM.
+ * headers and library.
  *
  *     relax_dem VERSION DEM OUT.asc
  *
  * Checks that ss_version() is VERSION, then relaxes DEM to OUT.asc and
  * checks the physics: steady, no sand face steeper than the 35 deg repose
- * angle, flow volume conserved (the DEM has no open cells or sides).
+ * angle, flow volume conserved (the DEM given has no open cells or sides).
  */
 #include <math.h>
 #include <stdio.h>
