@@ -40,7 +40,7 @@
 #include "sandslide/comm.h"
 #include "sandslide/error.h"
 #include "io/snapshot_layout.h"
-#include "io/xdmf.h"
+#include "io/sidecar.h"
 
 static double diag_get(const struct ss_diagnostics *d, int k)
 {
@@ -555,66 +555,6 @@ static int append_value(hid_t d, long long index, double v)
 	return r < 0 ? -1 : 0;
 }
 
-/* text with XML's five special characters escaped (a WKT has quotes) */
-static void xml_text(FILE *f, const char *text)
-{
-	for (const char *c = text; *c; c++) {
-		switch (*c) {
-		case '&': fputs("&amp;", f); break;
-		case '<': fputs("&lt;", f); break;
-		case '>': fputs("&gt;", f); break;
-		case '"': fputs("&quot;", f); break;
-		case '\'': fputs("&apos;", f); break;
-		default: fputc(*c, f);
-		}
-	}
-}
-
-/*
- * GDAL's PAM sidecar, path.aux.xml: `gdalinfo run.h5` picks GDAL's HDF5
- * driver (its netCDF driver takes HDF5 files only named .nc, .nc4, .cdf),
- * which reads no dimension scales and so finds no georeferencing.  The
- * sidecar gives each grid variable its geotransform (x = x0 + column dx,
- * y = y0 + row dy: row 0 is the south row, so the pixel height is
- * positive and GDAL, QGIS and gdalwarp place the image right way up), the
- * CRS of the input DEM and NaN as no data.  Written once, with the first
- * snapshot; a file named .nc needs none.
- */
-static int write_gdal_sidecar(const struct ss_snapshot *s, int has_bedrock)
-{
-	const struct ss_grid *g = &s->grid;
-	char path[4200], tmp[4210];
-	snprintf(path, sizeof path, "%s.aux.xml", s->path);
-	snprintf(tmp, sizeof tmp, "%s.tmp", path);
-	FILE *f = fopen(tmp, "w");
-	if (!f)
-		return -1;
-	static const char *const names[] = {"height", "cell_type", "bedrock"};
-	fprintf(f, "<PAMDataset>\n");
-	for (int v = 0; v < (has_bedrock ? 3 : 2); v++) {
-		fprintf(f, "  <Subdataset name=\"//%s\">\n    <PAMDataset>\n", names[v]);
-		if (s->crs_wkt) {
-			fprintf(f, "      <SRS dataAxisToSRSAxisMapping=\"1,2\">");
-			xml_text(f, s->crs_wkt);
-			fprintf(f, "</SRS>\n");
-		}
-		fprintf(f, "      <GeoTransform>%.17g, %.17g, 0, %.17g, 0, %.17g</GeoTransform>\n",
-		        g->origin_x, g->dx, g->origin_y, g->dy);
-		if (v != 1)
-			fprintf(f, "      <PAMRasterBand band=\"1\"><NoDataValue>nan</NoDataValue>"
-			           "</PAMRasterBand>\n");
-		fprintf(f, "    </PAMDataset>\n  </Subdataset>\n");
-	}
-	fprintf(f, "</PAMDataset>\n");
-	int bad = ferror(f);
-	bad |= fclose(f) != 0;
-	if (bad || rename(tmp, path) != 0) {
-		remove(tmp);
-		return -1;
-	}
-	return 0;
-}
-
 /* Root attribute restart_state = steps, inflow sum and carry, outflow sum
  * and carry of the last snapshot: a restart continues the compensated sums
  * with the very same bits. */
@@ -770,7 +710,8 @@ static int append(struct ss_snapshot *s, double time_s, const double *height,
 	s->times[k] = time_s;
 	s->count = k + 1;
 	if (k == 0 && is_root() && !ss_snapshot_named_netcdf(s->path) &&
-	    write_gdal_sidecar(s, s->has_bedrock))
+	    ss_gdal_sidecar_write(s->path, s->grid.origin_x, s->grid.origin_y, s->grid.dx,
+	                          s->grid.dy, s->crs_wkt, s->has_bedrock))
 		return ss_error_fail("cannot write GDAL's sidecar '%s.aux.xml': %s", s->path,
 		                     strerror(errno));
 	if (is_root() && ss_xdmf_write(s->xmf_path, s->path, g->nx, (int)g->global_ny, g->origin_x,

@@ -1,9 +1,10 @@
 /*
- * xdmf.c - the XDMF sidecar of an HDF5 output (xdmf.h), in the form that
- * ParaView's default reader for .xmf, XDMF3 (VTK's vtkXdmf3Reader), reads
- * right: checked with ParaView 5.11 by tests/cli/test_paraview.py.
+ * sidecar.c - the files beside an HDF5 output that other tools read
+ * (sidecar.h): GDAL's .aux.xml and the XDMF sidecar.
  *
- * Each snapshot is a uniform grid:
+ * The XDMF is in the form that ParaView's default reader for .xmf, XDMF3
+ * (VTK's vtkXdmf3Reader), reads right: checked with ParaView 5.11 by
+ * tests/cli/test_paraview.py.  Each snapshot is a uniform grid:
  *
  *   - Topology 3DCoRectMesh of 1 x (ny+1) x (nx+1) points, Geometry
  *     ORIGIN_DXDYDZ "0 y0 x0" / "1 dy dx" (slowest first).  Both XDMF
@@ -28,28 +29,110 @@
  * Times are written with 17 significant digits: each reads back as the
  * very double of /time.
  */
-#include "io/xdmf.h"
+#include "io/sidecar.h"
 
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-/* name as XML text: a file may be named "a&b.h5".  (A ':' or '|' in the
- * name cannot be written so that XDMF3 reads it: it splits the reference
- * at them.) */
-static void put_xml_text(FILE *f, const char *name)
+/* text as XML text: a file may be named "a&b.h5", a WKT has quotes.  (A
+ * ':' or '|' in a file name cannot be written so that XDMF3 reads it: it
+ * splits the reference at them.) */
+static void put_xml_text(FILE *f, const char *text)
 {
-	for (const char *c = name; *c; c++) {
+	for (const char *c = text; *c; c++) {
 		switch (*c) {
 		case '&': fputs("&amp;", f); break;
 		case '<': fputs("&lt;", f); break;
 		case '>': fputs("&gt;", f); break;
 		case '"': fputs("&quot;", f); break;
+		case '\'': fputs("&apos;", f); break;
 		default: fputc(*c, f); break;
 		}
 	}
 }
+
+/* The end of a sidecar written to tmp: closed, renamed to path; 0, or -1
+ * with errno set and tmp removed. */
+static int finish(FILE *f, const char *tmp, const char *path)
+{
+	int bad = ferror(f);
+	int e = errno;
+	if (fclose(f) != 0 && !bad) {
+		bad = 1;
+		e = errno;
+	}
+	if (!bad && rename(tmp, path) != 0) {
+		bad = 1;
+		e = errno;
+	}
+	if (bad) {
+		remove(tmp);
+		errno = e ? e : EIO;   /* a stream error need not leave errno */
+	}
+	return bad ? -1 : 0;
+}
+
+/* "path.tmp", malloc'ed (errno ENOMEM when not) */
+static char *tmp_name(const char *path)
+{
+	const size_t len = strlen(path);
+	char *tmp = malloc(len + sizeof ".tmp");
+	if (!tmp) {
+		errno = ENOMEM;
+		return NULL;
+	}
+	memcpy(tmp, path, len);
+	memcpy(tmp + len, ".tmp", sizeof ".tmp");
+	return tmp;
+}
+
+/* ---- GDAL's .aux.xml --------------------------------------------------- */
+
+int ss_gdal_sidecar_write(const char *h5_path, double origin_x, double origin_y, double dx,
+                          double dy, const char *crs_wkt, int has_bedrock)
+{
+	const size_t len = strlen(h5_path);
+	char *path = malloc(len + sizeof ".aux.xml");
+	if (!path) {
+		errno = ENOMEM;
+		return -1;
+	}
+	memcpy(path, h5_path, len);
+	memcpy(path + len, ".aux.xml", sizeof ".aux.xml");
+	char *tmp = tmp_name(path);
+	FILE *f = tmp ? fopen(tmp, "w") : NULL;
+	if (!f) {
+		free(tmp);
+		free(path);
+		return -1;
+	}
+	errno = 0;
+	static const char *const names[] = {"height", "cell_type", "bedrock"};
+	fputs("<PAMDataset>\n", f);
+	for (int v = 0; v < (has_bedrock ? 3 : 2); v++) {
+		fprintf(f, "  <Subdataset name=\"//%s\">\n    <PAMDataset>\n", names[v]);
+		if (crs_wkt) {
+			fputs("      <SRS dataAxisToSRSAxisMapping=\"1,2\">", f);
+			put_xml_text(f, crs_wkt);
+			fputs("</SRS>\n", f);
+		}
+		fprintf(f, "      <GeoTransform>%.17g, %.17g, 0, %.17g, 0, %.17g</GeoTransform>\n",
+		        origin_x, dx, origin_y, dy);
+		if (v != 1)   /* cell_type has no missing value */
+			fputs("      <PAMRasterBand band=\"1\"><NoDataValue>nan</NoDataValue>"
+			      "</PAMRasterBand>\n", f);
+		fputs("    </PAMDataset>\n  </Subdataset>\n", f);
+	}
+	fputs("</PAMDataset>\n", f);
+	const int err = finish(f, tmp, path);
+	free(tmp);
+	free(path);
+	return err;
+}
+
+/* ---- XDMF ----------------------------------------------------------------- */
 
 static void put_grid(FILE *f, const char *h5_name, int nx, int ny, double origin_x,
                      double origin_y, double dx, double dy, double time, long long k,
@@ -85,16 +168,8 @@ int ss_xdmf_write(const char *xmf_path, const char *h5_path, int nx, int ny,
 {
 	const char *slash = strrchr(h5_path, '/');
 	const char *h5_name = slash ? slash + 1 : h5_path;
-	const size_t len = strlen(xmf_path);
-	char *tmp = malloc(len + sizeof ".tmp");
-	if (!tmp) {
-		errno = ENOMEM;
-		return -1;
-	}
-	memcpy(tmp, xmf_path, len);
-	memcpy(tmp + len, ".tmp", sizeof ".tmp");
-
-	FILE *f = fopen(tmp, "w");
+	char *tmp = tmp_name(xmf_path);
+	FILE *f = tmp ? fopen(tmp, "w") : NULL;
 	if (!f) {
 		free(tmp);
 		return -1;
@@ -106,21 +181,7 @@ int ss_xdmf_write(const char *xmf_path, const char *h5_path, int nx, int ny,
 	for (long long k = 0; k < count; k++)
 		put_grid(f, h5_name, nx, ny, origin_x, origin_y, dx, dy, times[k], k, count);
 	fputs("  </Grid>\n </Domain>\n</Xdmf>\n", f);
-
-	int bad = ferror(f);
-	int e = errno;
-	if (fclose(f) != 0 && !bad) {
-		bad = 1;
-		e = errno;
-	}
-	if (!bad && rename(tmp, xmf_path) != 0) {
-		bad = 1;
-		e = errno;
-	}
-	if (bad) {
-		remove(tmp);
-		errno = e ? e : EIO;   /* a stream error need not leave errno */
-	}
+	const int err = finish(f, tmp, xmf_path);
 	free(tmp);
-	return bad ? -1 : 0;
+	return err;
 }
