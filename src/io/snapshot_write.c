@@ -331,7 +331,7 @@ static int write_static(struct ss_snapshot *s, const uint8_t *cell_types,
 		H5Pset_deflate(dcpl, (unsigned)meta->deflate);
 	}
 	H5Pset_fletcher32(dcpl);
-	const double fill = NAN;
+	const double fill = NAN;   /* the _FillValue: a cell never written is missing */
 	H5Pset_fill_value(dcpl, H5T_NATIVE_DOUBLE, &fill);
 	s->height = bad ? -1 : H5Dcreate2(f, "height", H5T_IEEE_F64LE, space, H5P_DEFAULT,
 	                                  dcpl, H5P_DEFAULT);
@@ -636,8 +636,11 @@ static int write_heights(struct ss_snapshot *s, long long k, const double *heigh
 		const long long b1 = b0 + s->band_rows < g->global_ny ? b0 + s->band_rows
 		                                                      : g->global_ny;
 		const long long hi = b1 < end ? b1 : end;
-		const hsize_t n = hi > lo ? (hsize_t)(hi - lo) * (hsize_t)g->nx : 1;
-		hid_t ms = H5Screate_simple(1, &n, NULL);
+		/* the memory space has the file selection's shape, so that HDF5
+		 * copies straight into the chunks (a 1-D one took the general
+		 * gather-scatter path: 3x the output time of the 2048^2 cone) */
+		const hsize_t mdims[3] = {1, hi > lo ? (hsize_t)(hi - lo) : 1, (hsize_t)g->nx};
+		hid_t ms = H5Screate_simple(3, mdims, NULL);
 		if (hi > lo) {
 			for (long long j = lo; j < hi; j++) {
 				const ptrdiff_t row = ss_grid_index(g, 0, (int)(j - first));
