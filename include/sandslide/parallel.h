@@ -11,8 +11,12 @@ int ss_parallel_max_threads(void);
 void ss_parallel_set_threads(int n);
 /* Number of the calling thread in its parallel region (0 outside). */
 int ss_parallel_thread_id(void);
-/* Processors available to this process. */
+/* Processors this process may run on (its CPU affinity). */
 int ss_parallel_processors(void);
+/* Threads to use when none are asked for: OMP_NUM_THREADS when set (what a
+ * batch system grants), else the processors this process may run on
+ * divided by share (the processes sharing them, >= 1), at least 1. */
+int ss_parallel_default_threads(int share);
 /* Seconds on a monotonic clock (as omp_get_wtime, also without OpenMP):
  * differences time the phases of a run and the benchmarks. */
 double ss_parallel_wall_seconds(void);

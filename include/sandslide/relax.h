@@ -44,8 +44,9 @@ struct ss_relax_options {
 	double rkl2_tol;
 	double max_time;                  /* s; INFINITY: until steady */
 	double cfl;
-	int threads;                      /* <= 0: the processors of this
-	                                     * node over its ranks (comm.h) */
+	int threads;                      /* <= 0: OMP_NUM_THREADS, else the
+	                                     * processors this process may run
+	                                     * on over the node's ranks */
 	enum ss_side_kind sides;          /* all four grid sides */
 	enum ss_cell_type nodata_type;    /* SS_CELL_OPEN or SS_CELL_WALL */
 	double open_level;                /* m; NAN: the lowest height of the DEM */

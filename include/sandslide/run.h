@@ -35,8 +35,9 @@ struct ss_run_options {
 	const char *output;          /* NULL: out/<case name>.h5 */
 	const char *const *overrides; /* "SECTION.KEY=VALUE" */
 	int override_count;
-	int threads;                 /* <= 0: the processors of this
-	                                * node over its ranks (comm.h) */
+	int threads;                 /* <= 0: OMP_NUM_THREADS, else the
+	                                * processors this process may run on
+	                                * over the node's ranks (parallel.h) */
 	int tile_nx, tile_ny;        /* <= 0: defaults */
 	int reference_kernel;        /* use the reference sweep (sweep.h) */
 	int deflate;                 /* HDF5 deflate level 0..9 */

@@ -24,10 +24,8 @@ void ss_drive_init(struct ss_drive *d, struct ss_stepper *st, double started)
 
 void ss_drive_set_threads(int threads)
 {
-	if (threads <= 0) {
-		threads = ss_parallel_processors() / ss_comm_node_ranks();
-		threads = threads > 0 ? threads : 1;
-	}
+	if (threads <= 0)
+		threads = ss_parallel_default_threads(ss_comm_node_ranks());
 	ss_parallel_set_threads(threads);
 }
 

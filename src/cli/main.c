@@ -87,7 +87,8 @@ static int exit_status(int status)
 #define THREADS(at)                                                                  \
 	{.name = "--threads", .value = "N", .kind = CLI_INT, .offset = at, .lo = 1,  \
 	 .hi = 4096, .expected = "an integer from 1 to 4096",                        \
-	 .help = "OpenMP threads (default: all processors)"}
+	 .help = "OpenMP threads (default: OMP_NUM_THREADS, else\n"                 \
+	         "the processors this process may run on)"}
 #define QUIET(at, h) {.name = "--quiet", .alias = "-q", .kind = CLI_FLAG, .offset = at, .help = h}
 #define FORCE(at, h) {.name = "--force", .kind = CLI_FLAG, .offset = at, .help = h}
 #define TILE(at, h)                                                                  \
@@ -505,7 +506,7 @@ static int cmd_render(int argc, char **argv)
 	const int status = cli_parse(&cmd, argc, argv, 2);
 	if (status != CLI_GO_ON)
 		return status;
-	ss_parallel_set_threads(a.threads > 0 ? a.threads : ss_parallel_processors());
+	ss_parallel_set_threads(a.threads > 0 ? a.threads : ss_parallel_default_threads(1));
 	if (a.bench) {
 		struct ss_render_bench_report report;
 		const int err = ss_render_bench(a.bench_n, 5, &report);

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "sandslide/comm.h"
+#include "sandslide/parallel.h"
 
 static void format_duration(double s, char *buf, size_t size)
 {
@@ -106,8 +107,9 @@ void cli_print_relax_end(const struct ss_relax_report *r, double angle_deg, int 
 	       r->steps, strcmp(r->integrator, "rkl2") ? "steps (euler)" : "super-steps (rkl2)",
 	       r->time, r->evaluations);
 	printf("cells moved %lld, volume moved %.6g m^3, steepest sand face %.4f -> "
-	       "%.4f deg (repose %g), wall %.3f s\n", r->cells_moved, r->volume_moved,
-	       r->max_slope_before_deg, r->max_slope_after_deg, angle_deg, r->wall_seconds);
+	       "%.4f deg (repose %g), wall %.3f s on %d threads\n", r->cells_moved,
+	       r->volume_moved, r->max_slope_before_deg, r->max_slope_after_deg, angle_deg,
+	       r->wall_seconds, ss_parallel_max_threads());
 }
 
 void cli_bench_header(void *context, const struct ss_bench_header *h)
