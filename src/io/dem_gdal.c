@@ -23,6 +23,7 @@
 #include <cpl_error.h>
 #include <cpl_string.h>
 #include <gdal.h>
+#include <ogr_srs_api.h>
 
 static void gdal_start(void)
 {
@@ -63,6 +64,45 @@ static void flip_rows(double *v, int nx, int ny)
 	}
 }
 
+/* 1 when wkt is a geographic CRS: coordinates in degrees of longitude and
+ * latitude, which the model would take for metres (every face ~90 deg). */
+static int geographic(const char *wkt)
+{
+	OGRSpatialReferenceH srs = OSRNewSpatialReference(wkt);
+	const int g = srs && OSRIsGeographic(srs);
+	if (srs)
+		OSRDestroySpatialReference(srs);
+	return g;
+}
+
+/* The refusal of a DEM in degrees, with the gdalwarp command that puts it
+ * in metres: the UTM zone (WGS 84) of its centre when the geotransform
+ * gives one. */
+static int refuse_degrees(const char *path, const char *context, const char *wkt,
+                          const struct ss_raster *r, int nx, int ny)
+{
+	OGRSpatialReferenceH srs = OSRNewSpatialReference(wkt);
+	const char *name = srs ? OSRGetName(srs) : NULL;
+	char crs[160];
+	snprintf(crs, sizeof crs, "%s", name && *name ? name : "a geographic CRS");
+	if (srs)
+		OSRDestroySpatialReference(srs);
+	char target[64] = "EPSG:<a projected CRS in metres, e.g. your UTM zone>";
+	if (r->has_geotransform) {
+		/* x is longitude, y latitude: GDAL's traditional GIS order */
+		const double lon = r->geotransform[0] + 0.5 * nx * r->geotransform[1];
+		const double lat = r->geotransform[3] + 0.5 * ny * r->geotransform[5];
+		if (lon >= -180.0 && lon <= 180.0 && lat >= -90.0 && lat <= 90.0) {
+			int zone = (int)floor((lon + 180.0) / 6.0) + 1;
+			zone = zone < 1 ? 1 : zone > 60 ? 60 : zone;
+			snprintf(target, sizeof target, "EPSG:%d", (lat >= 0.0 ? 32600 : 32700) + zone);
+		}
+	}
+	return ss_error_input_at(context, "'%s' is in %s: its cells are degrees, not metres; "
+	                         "reproject it first, e.g. gdalwarp -t_srs %s -r bilinear '%s' "
+	                         "dem-m.tif", path, crs, target, path);
+}
+
 static int read_dataset(GDALDatasetH ds, const char *path, const char *context,
                         struct ss_raster *r)
 {
@@ -92,6 +132,8 @@ static int read_dataset(GDALDatasetH ds, const char *path, const char *context,
 		r->y0 = gt[3] + ny * gt[5];
 	}
 	const char *wkt = GDALGetProjectionRef(ds);
+	if (wkt && *wkt && geographic(wkt))
+		return refuse_degrees(path, context, wkt, r, nx, ny);
 	if (wkt && *wkt && !(r->crs_wkt = ss_dem_strdup(wkt)))
 		return SS_ERR_FAIL;
 

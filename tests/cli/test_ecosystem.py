@@ -191,3 +191,35 @@ def test_crs_kept_from_geotiff_to_h5_and_back(tmp_path):
     assert h.GetSpatialRef() is not None and \
         h.GetSpatialRef().IsSame(direct.GetSpatialRef()), "no CRS through the HDF5 driver"
     assert os.path.isfile(tmp_path / "dem.h5.aux.xml")
+
+
+@pytest.mark.skipif("GDAL: on" not in run(["--version"]).stdout,
+                    reason="this build reads no GeoTIFF (make GDAL=0, or the MPI build)")
+def test_dem_in_degrees_refused_with_the_gdalwarp_that_fixes_it(tmp_path):
+    """A DEM in a geographic CRS would be taken as metres (every face ~90
+    deg, a run that crawls for ever): exit 2, one line that says degrees
+    and gives the gdalwarp command to the UTM zone of its centre, which
+    then gives a DEM relax takes."""
+    g = gdal()
+    rows = [[(i * j) % 7 + 0.1 * i for i in range(12)] for j in range(10)]
+    (tmp_path / "dem.asc").write_text(asc_text(rows, cellsize=1.0))
+    # around Zurich (8.5 E, 47.4 N): UTM zone 32 north, EPSG:32632
+    g.Translate(str(tmp_path / "deg.tif"), str(tmp_path / "dem.asc"), outputSRS="EPSG:4326",
+                outputBounds=[8.5, 47.4, 8.5108, 47.391])
+    r = run(["relax", "deg.tif", "-o", "out.asc"], cwd=tmp_path)
+    assert r.returncode == 2, r.stderr
+    assert r.stderr.count("\n") == 1 and "degrees, not metres" in r.stderr, r.stderr
+    m = re.search(r"e\.g\. (gdalwarp -t_srs EPSG:32632 .*)$", r.stderr.strip())
+    assert m, f"no gdalwarp command to UTM zone 32N in: {r.stderr}"
+    assert not (tmp_path / "out.asc").exists(), "an output was written"
+    # in the southern hemisphere, the southern UTM zone
+    g.Translate(str(tmp_path / "south.tif"), str(tmp_path / "dem.asc"),
+                outputSRS="EPSG:4326", outputBounds=[-70.5, -33.4, -70.49, -33.41])
+    r = run(["relax", "south.tif", "-o", "out.asc"], cwd=tmp_path)
+    assert r.returncode == 2 and "EPSG:32719" in r.stderr, r.stderr
+    # the suggested command works
+    if shutil.which("gdalwarp"):
+        cmd = m.group(1).replace("'", "").split()
+        subprocess.run(cmd, cwd=tmp_path, check=True, capture_output=True)
+        r = run(["relax", "dem-m.tif", "-o", "m.tif", "-q"], cwd=tmp_path)
+        assert r.returncode == 0, f"the reprojected DEM is refused: {r.stderr}"
