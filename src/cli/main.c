@@ -44,7 +44,7 @@ static const char usage_main[] =
 	"  bench            measure the sweep's throughput on synthetic surfaces\n"
 	"\n"
 	"  sandslide --version    print the version\n"
-	"  sandslide CMD --help   options of a command\n";
+	"  sandslide CMD --help   options of a command (also: sandslide help CMD)\n";
 
 /* The signal that asked a run to stop (SIGINT or SIGTERM), 0 while none
  * did: the run finishes its substep, writes a snapshot and returns, and the
@@ -690,7 +690,7 @@ static int main_usage_error(const char *fmt, const char *arg)
 	fflush(stdout);
 	fputs("sandslide: ", stderr);
 	fprintf(stderr, fmt, arg);
-	fprintf(stderr, "\n\n%s", usage_main);
+	fputs(" (see 'sandslide --help')\n", stderr);
 	return 2;
 }
 
@@ -710,6 +710,15 @@ static int command(int argc, char **argv)
 	if (argc < 2)
 		return main_usage_error("%s", "no command given");
 	const char *cmd = argv[1];
+	if (!strcmp(cmd, "help") && argc > 2) {   /* help CMD: that command's --help */
+		for (int k = 0; k < COUNT(commands); k++)
+			if (!strcmp(argv[2], commands[k].name)) {
+				char *args[] = {argv[0], argv[2], "--help", NULL};
+				return commands[k].run(3, args);
+			}
+		return main_usage_error("help: unknown command '%s': expected run, relax, info, "
+		                        "render or bench", argv[2]);
+	}
 	if (!strcmp(cmd, "-h") || !strcmp(cmd, "--help") || !strcmp(cmd, "help")) {
 		fputs(usage_main, stdout);
 		return 0;

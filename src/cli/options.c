@@ -93,6 +93,9 @@ void cli_help(const struct cli_command *c, FILE *f)
 		fprintf(f, "\n%s", c->outro);
 }
 
+/* One line: the mistake, then where the options are ("sandslide run
+ * --help", the command's name taken from its usage line).  The whole help
+ * after each mistake buried the line that mattered. */
 int cli_usage_error(const struct cli_command *c, const char *fmt, ...)
 {
 	if (ss_comm_rank() != 0)
@@ -103,8 +106,10 @@ int cli_usage_error(const struct cli_command *c, const char *fmt, ...)
 	va_start(ap, fmt);
 	vfprintf(stderr, fmt, ap);
 	va_end(ap);
-	fputs("\n\n", stderr);
-	cli_help(c, stderr);
+	const char *name = strstr(c->usage, "sandslide ");
+	const int len = name ? (int)strcspn(name + 10, " \n") : 0;
+	fprintf(stderr, " (see 'sandslide %.*s%s--help')\n", len, len ? name + 10 : "",
+	        len ? " " : "");
 	return 2;
 }
 

@@ -277,6 +277,16 @@ int ss_dem_read(const char *spec, const char *context, const struct ss_dem_read_
 		ss_dem_read_options_init(&defaults);
 		opt = &defaults;
 	}
+	/* a file that is not there is that, whatever its extension (GDAL said
+	 * "no reason given", an unknown extension "unknown raster format");
+	 * GDAL's virtual paths (/vsizip/, /vsicurl/) are GDAL's to check */
+	const char *dataset = h5_dataset(spec);
+	char file[4096];
+	snprintf(file, sizeof file, "%.*s", dataset ? (int)(dataset - 1 - spec) : (int)strlen(spec),
+	         spec);
+	struct stat sb;
+	if (strncmp(file, "/vsi", 4) != 0 && stat(file, &sb) != 0 && errno == ENOENT)
+		return ss_error_input_at(context, "cannot open '%s': %s", file, strerror(ENOENT));
 	enum ss_dem_format format = opt->format != SS_DEM_AUTO ? opt->format : format_of(spec);
 	if (format == SS_DEM_AUTO) {
 		/* any other raster GDAL recognises; else name what is accepted */

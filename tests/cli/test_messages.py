@@ -1,0 +1,52 @@
+"""Messages that point at the real mistake (issue 16): a usage error is one
+line that ends with where the options are; `sandslide help CMD` prints that
+command's help; a missing GDAL raster says so."""
+import re
+
+import pytest
+
+from conftest import run
+
+
+@pytest.mark.parametrize("args,where", [
+    (["run", "--threads", "0", "x.ini"], "sandslide run --help"),
+    (["relax", "--bogus"], "sandslide relax --help"),
+    (["render", "x.h5", "--fps", "0"], "sandslide render --help"),
+    (["bench", "--threads", "x"], "sandslide bench --help"),
+    (["info"], "sandslide info --help"),
+    (["frob"], "sandslide --help"),
+    ([], "sandslide --help"),
+    (["help", "nosuch"], "sandslide --help"),
+])
+def test_usage_error_is_one_line_with_where_to_look(tmp_path, args, where):
+    r = run(args, cwd=tmp_path)
+    assert r.returncode == 2, (args, r.returncode, r.stderr)
+    assert r.stderr.count("\n") == 1, f"{args}: not one line:\n{r.stderr}"
+    assert r.stderr.startswith("sandslide: ") and f"(see '{where}')" in r.stderr, r.stderr
+    assert r.stdout == "", f"{args}: printed on stdout: {r.stdout!r}"
+
+
+@pytest.mark.parametrize("cmd", ["run", "relax", "info", "render", "bench"])
+def test_help_cmd_is_the_commands_help(tmp_path, cmd):
+    a, b = run(["help", cmd], cwd=tmp_path), run([cmd, "--help"], cwd=tmp_path)
+    assert a.returncode == 0 and a.stdout == b.stdout, \
+        f"'sandslide help {cmd}' is not '{cmd} --help':\n{a.stdout[:300]}"
+    assert a.stdout.startswith(f"usage: sandslide {cmd}"), a.stdout[:200]
+
+
+@pytest.mark.parametrize("name", ["nosuch.tif", "nosuch.xyz", "nosuch.asc", "nosuch.png",
+                                  "nosuch.h5", "nosuch.h5:/height"])
+def test_missing_dem_says_no_such_file(tmp_path, name):
+    r = run(["relax", name], cwd=tmp_path)
+    assert r.returncode == 2 and r.stderr.count("\n") == 1, r.stderr
+    want = name.split(":")[0]
+    assert f"cannot open '{want}': No such file or directory" in r.stderr, r.stderr
+
+
+def test_missing_bedrock_is_blamed_on_bedrock(tmp_path):
+    (tmp_path / "dem.asc").write_text("ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\n"
+                                      "cellsize 1\n0 0\n0 0\n")
+    r = run(["relax", "dem.asc", "--bedrock", "rock.tif"], cwd=tmp_path)
+    assert r.returncode == 2, r.stderr
+    assert re.match(r"sandslide: --bedrock: cannot open 'rock.tif': No such file", r.stderr), \
+        r.stderr
