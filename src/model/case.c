@@ -398,6 +398,30 @@ static int region_shape(struct parse *p, struct ss_region *r, const char *key,
 	return SS_OK;
 }
 
+/* "the case has no [source nosuch]: its source sections are room, pour" */
+static int no_such_region(struct parse *p, enum ss_region_role role, const char *name)
+{
+	const struct ss_case *c = p->c;
+	char names[512] = "";
+	size_t used = 0;
+	int found = 0;
+	for (int k = 0; k < c->region_count; k++) {
+		if (c->regions[k].role != role)
+			continue;
+		const int n = snprintf(names + used, sizeof names - used, "%s%s", found ? ", " : "",
+		                       c->regions[k].name);
+		if (n < 0 || (size_t)n >= sizeof names - used)
+			break;
+		used += (size_t)n;
+		found++;
+	}
+	if (!found)
+		return fail_at(p, "the case has no [%s %s], and no %s section at all",
+		               region_prefix[role], name, region_prefix[role]);
+	return fail_at(p, "the case has no [%s %s]: its %s sections are %s", region_prefix[role],
+	               name, region_prefix[role], names);
+}
+
 static int apply_region_key(struct parse *p, const char *section, const char *key,
                             const char *value)
 {
@@ -405,7 +429,11 @@ static int apply_region_key(struct parse *p, const char *section, const char *ke
 	const char *name;
 	if (region_section(section, &role, &name))
 		return fail_at(p, "unknown section [%s]: expected " SECTIONS_ACCEPTED, section);
-	struct ss_region *r = region_find(p, role, name, 1);
+	/* --set changes a section of the case; it does not make one up (an
+	 * --set of a misspelt name said the new section "has no shape") */
+	struct ss_region *r = region_find(p, role, name, !p->overriding);
+	if (!r && p->overriding && !p->failed)
+		return no_such_region(p, role, name);
 	if (!r)
 		return SS_ERR_INPUT;
 
@@ -807,9 +835,15 @@ static int finish(struct parse *p)
 		if (r->role == SS_REGION_SOURCE && !r->rate_where[0])
 			return ss_error_input("%s: [source %s] is missing 'rate' (m/s, > 0)",
 			                      r->where, r->name);
-		if (r->role == SS_REGION_SOURCE && !(r->stop > r->start))
+		if (r->role == SS_REGION_SOURCE && !(r->stop > r->start)) {
+			/* blame the value that came last: an --set over the file */
+			const char *at = !strncmp(r->stop_where, "--set", 5) ? r->stop_where
+			               : !strncmp(r->start_where, "--set", 5) ? r->start_where
+			               : r->stop_where[0] ? r->stop_where
+			               : r->start_where[0] ? r->start_where : r->where;
 			return ss_error_input("%s: [source %s] stop = %g s is not after start = %g s",
-			                      r->where, r->name, r->stop, r->start);
+			                      at, r->name, r->stop, r->start);
+		}
 		if ((err = check_shape_extent(c, r)))
 			return err;
 	}

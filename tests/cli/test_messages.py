@@ -50,3 +50,41 @@ def test_missing_bedrock_is_blamed_on_bedrock(tmp_path):
     assert r.returncode == 2, r.stderr
     assert re.match(r"sandslide: --bedrock: cannot open 'rock.tif': No such file", r.stderr), \
         r.stderr
+
+
+DOOR = ["run", "door.ini", "-o", "x.h5"]
+
+
+@pytest.fixture
+def door(tmp_path):
+    import shutil
+    from conftest import CASES
+    shutil.copy(f"{CASES}/door.ini", tmp_path / "door.ini")
+    return tmp_path
+
+
+@pytest.mark.parametrize("setting,want", [
+    ("source nosuch.rate=1e-3", "the case has no [source nosuch]: its source sections are room"),
+    ("wall nosuch.rect=0 0 1 1", "the case has no [wall nosuch]: its wall sections are "
+                                 "room_south, room_north, jamb_south, jamb_north"),
+    ("open x.rect=0 0 1 1", "the case has no [open x], and no open section at all"),
+])
+def test_set_on_a_missing_section_names_those_there_are(door, setting, want):
+    r = run(DOOR + ["--set", setting], cwd=door)
+    assert r.returncode == 2 and r.stderr.count("\n") == 1, r.stderr
+    assert r.stderr == f"sandslide: --set {setting}: {want}\n", r.stderr
+    assert not (door / "x.h5").exists()
+
+
+def test_start_stop_error_blames_the_set_that_made_it(door):
+    r = run(DOOR + ["--set", "source room.start=100", "--set", "source room.stop=50"], cwd=door)
+    assert r.returncode == 2, r.stderr
+    assert r.stderr.startswith("sandslide: --set source room.stop=50: [source room] stop = "
+                               "50 s is not after start = 100 s"), r.stderr
+    # from the file alone, the file's line of stop
+    text = re.sub(r"(?m)^rate = 1e-3.*$", "rate = 1e-3\nstart = 9\nstop = 5",
+                  (door / "door.ini").read_text())
+    (door / "door.ini").write_text(text)
+    r = run(DOOR, cwd=door)
+    line = text.splitlines().index("stop = 5") + 1
+    assert r.stderr.startswith(f"sandslide: door.ini:{line}: [source room] stop = 5 s"), r.stderr
