@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include "app/drive.h"
 #include "io/output.h"
@@ -31,7 +32,9 @@ void ss_relax_options_init(struct ss_relax_options *o)
 	ss_dem_read_options_init(&o->read);
 }
 
-/* "dir/name.asc" -> "out/name-relaxed.asc"; "FILE.h5:/dataset" -> .h5 */
+/* "dir/name.asc" -> "out/name-relaxed.asc"; "FILE.h5:/dataset" -> .h5; a
+ * raster relax reads but does not write (.img, .vrt, .xyz: other GDAL
+ * formats) -> .tif, which keeps its georeferencing */
 static void default_output(const char *dem, char *out, size_t size)
 {
 	const char *base = strrchr(dem, '/') ? strrchr(dem, '/') + 1 : dem;
@@ -43,6 +46,16 @@ static void default_output(const char *dem, char *out, size_t size)
 			dot = p;
 	const int stem = dot && dot != base ? (int)(dot - base) : len;
 	snprintf(out, size, "out/%.*s-relaxed%.*s", stem, base, len - stem, base + stem);
+	static const char *const written[] = {".asc", ".png", ".tif", ".tiff", ".h5", ".nc",
+	                                      ".nc4"};
+	const char *ext = base + stem;
+	const int ext_len = len - stem;
+	int known = 0;
+	for (size_t k = 0; k < sizeof written / sizeof *written; k++)
+		known |= (int)strlen(written[k]) == ext_len &&
+		         !strncasecmp(ext, written[k], (size_t)ext_len);
+	if (!known && ss_dem_gdal_available())
+		snprintf(out, size, "out/%.*s-relaxed.tif", stem, base);
 }
 
 /*

@@ -223,3 +223,21 @@ def test_dem_in_degrees_refused_with_the_gdalwarp_that_fixes_it(tmp_path):
         subprocess.run(cmd, cwd=tmp_path, check=True, capture_output=True)
         r = run(["relax", "dem-m.tif", "-o", "m.tif", "-q"], cwd=tmp_path)
         assert r.returncode == 0, f"the reprojected DEM is refused: {r.stderr}"
+
+
+@pytest.mark.skipif("GDAL: on" not in run(["--version"]).stdout,
+                    reason="this build reads no GeoTIFF (make GDAL=0, or the MPI build)")
+def test_relax_of_a_format_it_does_not_write_defaults_to_geotiff(tmp_path):
+    """relax dem.img without -o: out/dem-relaxed.tif with the .img's
+    georeferencing (it blamed an -o that was never given)."""
+    g = gdal()
+    rows = [[(3 * i + 7 * j) % 11 for i in range(12)] for j in range(10)]
+    (tmp_path / "dem.asc").write_text(asc_text(rows, cellsize=1.0))
+    g.Translate(str(tmp_path / "dem.img"), str(tmp_path / "dem.asc"), format="HFA",
+                outputSRS="EPSG:32632", outputBounds=[500000, 5200010, 500012, 5200000])
+    r = run(["relax", "dem.img", "-q"], cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    out = g.Open(str(tmp_path / "out" / "dem-relaxed.tif"))
+    assert out.GetDriver().ShortName == "GTiff"
+    assert out.GetSpatialRef().GetAuthorityCode(None) == "32632", out.GetProjection()
+    np.testing.assert_allclose(out.GetGeoTransform(), (500000, 1, 0, 5200010, 0, -1))
