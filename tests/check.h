@@ -8,6 +8,9 @@
  *   check_report()                     prints "N passed, M failed", exit code
  *   check_now()                        monotonic clock, s (for timings)
  *   struct rng, rng_next/uniform/int   splitmix64: reproducible random states
+ *   check_scratch_make(name)           a mkdtemp folder /tmp/NAME.XXXXXX for files
+ *   check_scratch(), check_file(name)  its path, and a file's path in it
+ *   check_write_file(path, text)       text into a new file (exits 2 if it cannot)
  *
  * Each CHECK counts as one check; a test function may make many.
  */
@@ -19,6 +22,42 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <time.h>
+
+/* The scratch folder of a test program (one per program). */
+static inline char *check_scratch(void)
+{
+	static char dir[64];
+	return dir;
+}
+
+/* Make it, /tmp/NAME.XXXXXX; 0, or -1 after perror. */
+static inline int check_scratch_make(const char *name)
+{
+	snprintf(check_scratch(), 64, "/tmp/%s.XXXXXX", name);
+	if (mkdtemp(check_scratch()))
+		return 0;
+	perror("mkdtemp");
+	return -1;
+}
+
+/* scratch/name into a static buffer (two in turn, enough for one call) */
+static inline const char *check_file(const char *name)
+{
+	static char buf[2][512];
+	static int k;
+	k ^= 1;
+	snprintf(buf[k], sizeof buf[k], "%s/%s", check_scratch(), name);
+	return buf[k];
+}
+
+static inline void check_write_file(const char *path, const char *text)
+{
+	FILE *f = fopen(path, "wb");
+	if (!f || fputs(text, f) == EOF || fclose(f)) {
+		perror(path);
+		exit(2);
+	}
+}
 
 static inline double check_now(void)
 {

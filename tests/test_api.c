@@ -20,26 +20,6 @@
 #include "sandslide/relax.h"
 #include "sandslide/run.h"
 
-static char dir[64];
-
-static const char *at(const char *name)
-{
-	static char buf[2][512];
-	static int k;
-	k ^= 1;
-	snprintf(buf[k], sizeof buf[k], "%s/%s", dir, name);
-	return buf[k];
-}
-
-static void write_file(const char *path, const char *text)
-{
-	FILE *f = fopen(path, "wb");
-	if (!f || fputs(text, f) == EOF || fclose(f)) {
-		perror(path);
-		exit(2);
-	}
-}
-
 /* A steep pile off-centre on a ramp, rows south first, a hole of no data. */
 enum { NX = 24, NY = 20 };
 static void pile(double *h)
@@ -146,7 +126,7 @@ static void relax_heights_gives_the_bits_of_a_relaxed_file(void)
 	double h[NX * NY], got[NX * NY];
 	pile(h);
 	/* the file: north row first, "%.17g", -9999 for no data */
-	FILE *f = fopen(at("pile.asc"), "w");
+	FILE *f = fopen(check_file("pile.asc"), "w");
 	if (!f)
 		exit(2);
 	fprintf(f, "ncols %d\nnrows %d\nxllcorner 0\nyllcorner 0\ncellsize 0.5\n"
@@ -158,9 +138,9 @@ static void relax_heights_gives_the_bits_of_a_relaxed_file(void)
 	fclose(f);
 
 	char dem[512], out[512], report[512];
-	snprintf(dem, sizeof dem, "%s", at("pile.asc"));
-	snprintf(out, sizeof out, "%s", at("out.asc"));
-	snprintf(report, sizeof report, "%s", at("report.json"));
+	snprintf(dem, sizeof dem, "%s", check_file("pile.asc"));
+	snprintf(out, sizeof out, "%s", check_file("out.asc"));
+	snprintf(report, sizeof report, "%s", check_file("report.json"));
 	struct ss_relax_options o;
 	ss_relax_options_init(&o);
 	o.dem = dem;
@@ -253,12 +233,12 @@ static void run_options_and_a_case(void)
 	CHECK(o != NULL, "create");
 	if (!o)
 		return;
-	write_file(at("tiny.ini"), "[grid]\nnx = 12\nny = 10\ndx = 0.1\n\n[model]\n"
+	check_write_file(check_file("tiny.ini"), "[grid]\nnx = 12\nny = 10\ndx = 0.1\n\n[model]\n"
 	           "closure = coulomb\nrepose_angle = 35\nnu = 0.1\n\n[time]\nend = 1\n"
 	           "output_every = 0.5\n\n[boundary]\nwest = wall\neast = open\nsouth = wall\n"
 	           "north = wall\n\n[initial]\ntype = flat\nheight = 0.2\n");
-	CHECK(ss_run_options_set(o, "case", at("tiny.ini")) == SS_OK, "case");
-	CHECK(ss_run_options_set(o, "output", at("tiny.h5")) == SS_OK, "output");
+	CHECK(ss_run_options_set(o, "case", check_file("tiny.ini")) == SS_OK, "case");
+	CHECK(ss_run_options_set(o, "output", check_file("tiny.h5")) == SS_OK, "output");
 	for (int k = 0; k < 20; k++)    /* more than the first allocation */
 		CHECK(ss_run_options_set(o, "set", k % 2 ? "time.end=0.5" : "time.end=2") == SS_OK,
 		      "set %d", k);
@@ -281,24 +261,22 @@ static void run_options_and_a_case(void)
 	      ss_run_case_json(o, json, sizeof json) == SS_OK, "--force");
 	ss_run_options_destroy(o);
 	ss_run_options_destroy(NULL);
-	remove(at("tiny.h5"));
-	remove(at("tiny.xmf"));
-	remove(at("tiny.ini"));
+	remove(check_file("tiny.h5"));
+	remove(check_file("tiny.xmf"));
+	remove(check_file("tiny.h5.aux.xml"));   /* GDAL's sidecar */
+	remove(check_file("tiny.ini"));
 }
 
 int main(void)
 {
-	snprintf(dir, sizeof dir, "/tmp/ss_test_api_XXXXXX");
-	if (!mkdtemp(dir)) {
-		perror("mkdtemp");
+	if (check_scratch_make("ss_test_api"))
 		return 2;
-	}
 	ss_error_set_quiet(1);   /* the checks read ss_error_last_message() */
 	RUN(relax_options_are_checked_as_the_cli_checks_them);
 	RUN(report_json_fits_or_says_so);
 	RUN(relax_heights_gives_the_bits_of_a_relaxed_file);
 	RUN(bedrock_in_memory_holds_the_sand);
 	RUN(run_options_and_a_case);
-	rmdir(dir);
+	rmdir(check_scratch());
 	return check_report();
 }

@@ -19,27 +19,6 @@
 #include "sandslide/dem.h"
 #include "sandslide/error.h"
 
-static char dir[64];
-
-/* dir/name into a static buffer (two in turn, enough for one call) */
-static const char *at(const char *name)
-{
-	static char buf[2][512];
-	static int k;
-	k ^= 1;
-	snprintf(buf[k], sizeof buf[k], "%s/%s", dir, name);
-	return buf[k];
-}
-
-static void write_file(const char *path, const char *text)
-{
-	FILE *f = fopen(path, "wb");
-	if (!f || fputs(text, f) == EOF || fclose(f)) {
-		perror(path);
-		exit(2);
-	}
-}
-
 /* Whole file into a malloc'd buffer; *size its length. */
 static char *slurp(const char *path, size_t *size)
 {
@@ -61,10 +40,10 @@ static char *slurp(const char *path, size_t *size)
 	return b;
 }
 
-/* Files in dir whose name starts with '.': leftover temporaries. */
+/* Files in the scratch folder whose name starts with '.': leftover temporaries. */
 static int hidden_files(void)
 {
-	DIR *d = opendir(dir);
+	DIR *d = opendir(check_scratch());
 	int n = 0;
 	for (struct dirent *e; d && (e = readdir(d));)
 		n += e->d_name[0] == '.' && strcmp(e->d_name, ".") && strcmp(e->d_name, "..");
@@ -75,14 +54,14 @@ static int hidden_files(void)
 
 static void remove_dir(void)
 {
-	DIR *d = opendir(dir);
+	DIR *d = opendir(check_scratch());
 	for (struct dirent *e; d && (e = readdir(d));) {
 		if (strcmp(e->d_name, ".") && strcmp(e->d_name, ".."))
-			unlink(at(e->d_name));
+			unlink(check_file(e->d_name));
 	}
 	if (d)
 		closedir(d);
-	rmdir(dir);
+	rmdir(check_scratch());
 }
 
 /* stderr into a file while a call is expected to fail, so the messages
@@ -93,7 +72,7 @@ static void capture_begin(void)
 {
 	fflush(stderr);
 	saved_stderr = dup(2);
-	int fd = open(at("stderr.txt"), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+	int fd = open(check_file("stderr.txt"), O_WRONLY | O_CREAT | O_TRUNC, 0600);
 	dup2(fd, 2);
 	close(fd);
 }
@@ -106,10 +85,10 @@ static const char *capture_end(void)
 	dup2(saved_stderr, 2);
 	close(saved_stderr);
 	size_t n;
-	char *b = slurp(at("stderr.txt"), &n);
+	char *b = slurp(check_file("stderr.txt"), &n);
 	snprintf(captured, sizeof captured, "%s", b ? b : "");
 	free(b);
-	unlink(at("stderr.txt"));
+	unlink(check_file("stderr.txt"));
 	return captured;
 }
 
@@ -181,7 +160,7 @@ static void asc_round_trip_is_bit_exact(void)
 	struct rng g = {20240605};
 	const int nx = 13, ny = 7;
 	/* a file as another program writes it: odd corner, NODATA cells */
-	FILE *f = fopen(at("in.asc"), "w");
+	FILE *f = fopen(check_file("in.asc"), "w");
 	fprintf(f, "NCOLS %d\nnrows %d\nxllcorner 612345.67\nyllcorner -4200.125\n"
 	           "cellsize 0.3\nNODATA_value -9999\n", nx, ny);
 	double expect[13 * 7];
@@ -201,7 +180,7 @@ static void asc_round_trip_is_bit_exact(void)
 	fclose(f);
 
 	struct ss_raster a, b;
-	int err = ss_dem_read(at("in.asc"), NULL, NULL, &a);
+	int err = ss_dem_read(check_file("in.asc"), NULL, NULL, &a);
 	CHECK(err == SS_OK, "read in.asc: %d", err);
 	CHECK(a.nx == nx && a.ny == ny, "size %d x %d", a.nx, a.ny);
 	CHECK(a.format == SS_DEM_ASC && a.cellsize == 0.3 && a.cellsize_y == 0.3 &&
@@ -215,9 +194,9 @@ static void asc_round_trip_is_bit_exact(void)
 	CHECK(flags_ok, "nodata flags where the file has -9999, south row first");
 	CHECK(values_ok, "every value read exactly (0 at nodata cells)");
 
-	err = ss_dem_write(at("out.asc"), SS_DEM_AUTO, &a);
+	err = ss_dem_write(check_file("out.asc"), SS_DEM_AUTO, &a);
 	CHECK(err == SS_OK, "write out.asc: %d", err);
-	err = ss_dem_read(at("out.asc"), NULL, NULL, &b);
+	err = ss_dem_read(check_file("out.asc"), NULL, NULL, &b);
 	CHECK(err == SS_OK, "read out.asc: %d", err);
 	CHECK(same_values(&a, &b), "values bit-identical after write and read");
 	CHECK(same_flags(&a, &b), "nodata flags identical");
@@ -225,7 +204,7 @@ static void asc_round_trip_is_bit_exact(void)
 	      b.nodata_value == -9999.0, "corner, cell size and NODATA_value kept");
 	CHECK(hidden_files() == 0, "no temporary file left");
 	size_t n;
-	char *text = slurp(at("out.asc"), &n);
+	char *text = slurp(check_file("out.asc"), &n);
 	CHECK(text && strstr(text, "xllcorner 612345.67\n") && strstr(text, "NODATA_value -9999\n"),
 	      "header written as corner and NODATA_value");
 	free(text);
@@ -235,24 +214,24 @@ static void asc_round_trip_is_bit_exact(void)
 
 static void asc_keeps_centre_and_rectangular_cells(void)
 {
-	write_file(at("c.asc"), "ncols 3\nnrows 2\nxllcenter 10\nyllcenter 20\ndx 2\ndy 4\n"
+	check_write_file(check_file("c.asc"), "ncols 3\nnrows 2\nxllcenter 10\nyllcenter 20\ndx 2\ndy 4\n"
 	                        "1 2 3\n4 5 6\n");
 	struct ss_raster a, b;
-	int err = ss_dem_read(at("c.asc"), NULL, NULL, &a);
+	int err = ss_dem_read(check_file("c.asc"), NULL, NULL, &a);
 	CHECK(err == SS_OK, "read c.asc: %d", err);
 	CHECK(a.x0 == 9.0 && a.y0 == 18.0 && a.asc_center, "centre %g %g gives the corner", a.x0, a.y0);
 	CHECK(a.cellsize == 2.0 && a.cellsize_y == 4.0, "dx, dy %g %g", a.cellsize, a.cellsize_y);
 	CHECK(a.values[0] == 4.0 && a.values[5] == 3.0, "south row first: %g %g", a.values[0],
 	      a.values[5]);
 	CHECK(!a.nodata && !a.has_nodata_value, "no nodata without NODATA_value");
-	err = ss_dem_write(at("c2.asc"), SS_DEM_ASC, &a);
+	err = ss_dem_write(check_file("c2.asc"), SS_DEM_ASC, &a);
 	size_t n;
-	char *text = slurp(at("c2.asc"), &n);
+	char *text = slurp(check_file("c2.asc"), &n);
 	CHECK(err == SS_OK && text && strstr(text, "xllcenter 10\nyllcenter 20\ndx 2\ndy 4\n") &&
 	      !strstr(text, "NODATA"), "written back with xllcenter, dx, dy and no NODATA: %s",
 	      text ? text : "(none)");
 	free(text);
-	CHECK(ss_dem_read(at("c2.asc"), NULL, NULL, &b) == SS_OK && same_values(&a, &b),
+	CHECK(ss_dem_read(check_file("c2.asc"), NULL, NULL, &b) == SS_OK && same_values(&a, &b),
 	      "values kept");
 	ss_raster_release(&a);
 	ss_raster_release(&b);
@@ -293,10 +272,10 @@ static void asc_malformed_is_refused(void)
 		 {"from (-8.5e+307, -inf)", "finite extent"}},
 	};
 	for (size_t a = 0; a < sizeof bad / sizeof *bad; a++) {
-		write_file(at("bad.asc"), bad[a].text);
+		check_write_file(check_file("bad.asc"), bad[a].text);
 		struct ss_raster r;
 		capture_begin();
-		int err = ss_dem_read(at("bad.asc"), "case.ini:9", NULL, &r);
+		int err = ss_dem_read(check_file("bad.asc"), "case.ini:9", NULL, &r);
 		const char *msg = capture_end();
 		ss_raster_release(&r);
 		CHECK(err == SS_ERR_INPUT, "case %zu: status %d", a, err);
@@ -311,16 +290,16 @@ static void asc_malformed_is_refused(void)
 
 static void cellsize_option_must_agree(void)
 {
-	write_file(at("g.asc"), "ncols 1\nnrows 1\nxllcorner 0\nyllcorner 0\ncellsize 0.5\n7\n");
+	check_write_file(check_file("g.asc"), "ncols 1\nnrows 1\nxllcorner 0\nyllcorner 0\ncellsize 0.5\n7\n");
 	struct ss_dem_read_options o;
 	ss_dem_read_options_init(&o);
 	struct ss_raster r;
 	o.cellsize = 0.5;
-	CHECK(ss_dem_read(at("g.asc"), NULL, &o, &r) == SS_OK, "agreeing cell size accepted");
+	CHECK(ss_dem_read(check_file("g.asc"), NULL, &o, &r) == SS_OK, "agreeing cell size accepted");
 	ss_raster_release(&r);
 	o.cellsize = 0.25;
 	capture_begin();
-	int err = ss_dem_read(at("g.asc"), NULL, &o, &r);
+	int err = ss_dem_read(check_file("g.asc"), NULL, &o, &r);
 	const char *msg = capture_end();
 	ss_raster_release(&r);
 	CHECK(err == SS_ERR_INPUT && strstr(msg, "0.25") && strstr(msg, "0.5"),
@@ -328,7 +307,7 @@ static void cellsize_option_must_agree(void)
 	ss_dem_read_options_init(&o);
 	o.zscale = 0.1;
 	capture_begin();
-	err = ss_dem_read(at("g.asc"), NULL, &o, &r);
+	err = ss_dem_read(check_file("g.asc"), NULL, &o, &r);
 	msg = capture_end();
 	ss_raster_release(&r);
 	CHECK(err == SS_ERR_INPUT && strstr(msg, "PNG"), "zscale on an .asc is refused: %s", msg);
@@ -360,9 +339,9 @@ static void png16_round_trip(void)
 		if (a.values[k] > hi)
 			hi = a.values[k], khi = k;
 	}
-	int err = ss_dem_write(at("h.png"), SS_DEM_AUTO, &a);
+	int err = ss_dem_write(check_file("h.png"), SS_DEM_AUTO, &a);
 	CHECK(err == SS_OK, "write h.png: %d", err);
-	err = ss_dem_read(at("h.png"), NULL, NULL, &b);
+	err = ss_dem_read(check_file("h.png"), NULL, NULL, &b);
 	CHECK(err == SS_OK, "read h.png: %d", err);
 	CHECK(b.nx == a.nx && b.ny == a.ny && b.format == SS_DEM_PNG, "size %d x %d", b.nx, b.ny);
 	CHECK(b.png_zmin == lo && b.png_zmax == hi, "range from the text chunks exact: %.17g %.17g",
@@ -374,8 +353,8 @@ static void png16_round_trip(void)
 	CHECK(b.cellsize == a.cellsize && b.x0 == a.x0 && b.y0 == a.y0,
 	      "cell size and corner from dx_m, x0_m, y0_m");
 	/* a heightmap read and written again keeps every bit */
-	CHECK(ss_dem_write(at("h2.png"), SS_DEM_PNG, &b) == SS_OK, "write h2.png");
-	CHECK(ss_dem_read(at("h2.png"), NULL, NULL, &c) == SS_OK && same_values(&b, &c) &&
+	CHECK(ss_dem_write(check_file("h2.png"), SS_DEM_PNG, &b) == SS_OK, "write h2.png");
+	CHECK(ss_dem_read(check_file("h2.png"), NULL, NULL, &c) == SS_OK && same_values(&b, &c) &&
 	      same_flags(&b, &c), "second round trip bit-identical");
 	CHECK(hidden_files() == 0, "no temporary file left");
 
@@ -384,7 +363,7 @@ static void png16_round_trip(void)
 	memset(&im, 0, sizeof im);
 	im.version = PNG_IMAGE_VERSION;
 	uint16_t *px = NULL;
-	if (png_image_begin_read_from_file(&im, at("h.png"))) {
+	if (png_image_begin_read_from_file(&im, check_file("h.png"))) {
 		im.format = PNG_FORMAT_LINEAR_Y;
 		px = malloc(PNG_IMAGE_SIZE(im));
 		png_image_finish_read(&im, NULL, px, 0, NULL);
@@ -450,9 +429,9 @@ static void png_from_renderer_convention(void)
 {
 	const uint16_t grey[6] = {0, 1, 2, 65535, 32768, 65534};   /* north row first */
 	const char *const texts[] = {"style=gray16", "zmin_m=-1.5", "zmax_m=2.5"};
-	write_gray16(at("r.png"), 3, 2, grey, texts, 3, 0);
+	write_gray16(check_file("r.png"), 3, 2, grey, texts, 3, 0);
 	struct ss_raster r;
-	int err = ss_dem_read(at("r.png"), NULL, NULL, &r);
+	int err = ss_dem_read(check_file("r.png"), NULL, NULL, &r);
 	CHECK(err == SS_OK, "read r.png: %d", err);
 	const double step = 4.0 / 65534.0;
 	/* south row first: (65535, 32768, 65534) then (0, 1, 2) */
@@ -468,10 +447,10 @@ static void png_from_renderer_convention(void)
 static void png_with_explicit_scale(void)
 {
 	const uint16_t grey[4] = {0, 10, 1000, 65535};
-	write_gray16(at("plain.png"), 2, 2, grey, NULL, 0, -1);
+	write_gray16(check_file("plain.png"), 2, 2, grey, NULL, 0, -1);
 	struct ss_raster r;
 	capture_begin();
-	int err = ss_dem_read(at("plain.png"), "relax", NULL, &r);
+	int err = ss_dem_read(check_file("plain.png"), "relax", NULL, &r);
 	const char *msg = capture_end();
 	ss_raster_release(&r);
 	CHECK(err == SS_ERR_INPUT && strstr(msg, "plain.png") && strstr(msg, "zscale") &&
@@ -482,7 +461,7 @@ static void png_with_explicit_scale(void)
 	o.zscale = 0.01;
 	o.zoffset = 5.0;
 	o.cellsize = 2.0;
-	err = ss_dem_read(at("plain.png"), NULL, &o, &r);
+	err = ss_dem_read(check_file("plain.png"), NULL, &o, &r);
 	CHECK(err == SS_OK, "read with zscale: %d", err);
 	CHECK(!r.nodata, "grey 0 is a height without tRNS or a gray16 range");
 	CHECK(r.values[2] == 5.0 && r.values[0] == 5.0 + 0.01 * 1000 &&
@@ -491,8 +470,8 @@ static void png_with_explicit_scale(void)
 	CHECK(r.cellsize == 2.0 && r.cellsize_y == 2.0, "cell size from the options");
 	ss_raster_release(&r);
 
-	write_gray16(at("trns.png"), 2, 2, grey, NULL, 0, 10);
-	err = ss_dem_read(at("trns.png"), NULL, &o, &r);
+	write_gray16(check_file("trns.png"), 2, 2, grey, NULL, 0, 10);
+	err = ss_dem_read(check_file("trns.png"), NULL, &o, &r);
 	CHECK(err == SS_OK && r.nodata && r.nodata[3] && !r.nodata[2],
 	      "the tRNS grey marks no data");
 	ss_raster_release(&r);
@@ -500,7 +479,7 @@ static void png_with_explicit_scale(void)
 	ss_dem_read_options_init(&o);
 	o.zoffset = 1.0;
 	capture_begin();
-	err = ss_dem_read(at("plain.png"), NULL, &o, &r);
+	err = ss_dem_read(check_file("plain.png"), NULL, &o, &r);
 	msg = capture_end();
 	ss_raster_release(&r);
 	CHECK(err == SS_ERR_INPUT && strstr(msg, "zoffset"), "zoffset alone is refused: %s", msg);
@@ -516,10 +495,10 @@ static void png_not_gray16_is_refused(void)
 	im.width = 4;
 	im.height = 3;
 	im.format = PNG_FORMAT_GRAY;
-	CHECK(png_image_write_to_file(&im, at("eight.png"), 0, px, 0, NULL), "write eight.png");
+	CHECK(png_image_write_to_file(&im, check_file("eight.png"), 0, px, 0, NULL), "write eight.png");
 	struct ss_raster r;
 	capture_begin();
-	int err = ss_dem_read(at("eight.png"), NULL, NULL, &r);
+	int err = ss_dem_read(check_file("eight.png"), NULL, NULL, &r);
 	const char *msg = capture_end();
 	ss_raster_release(&r);
 	CHECK(err == SS_ERR_INPUT && strstr(msg, "eight.png") && strstr(msg, "8-bit") &&
@@ -530,16 +509,16 @@ static void png_not_gray16_is_refused(void)
 	im.width = 2;
 	im.height = 2;
 	im.format = PNG_FORMAT_RGB;
-	CHECK(png_image_write_to_file(&im, at("rgb.png"), 0, px, 0, NULL), "write rgb.png");
+	CHECK(png_image_write_to_file(&im, check_file("rgb.png"), 0, px, 0, NULL), "write rgb.png");
 	capture_begin();
-	err = ss_dem_read(at("rgb.png"), NULL, NULL, &r);
+	err = ss_dem_read(check_file("rgb.png"), NULL, NULL, &r);
 	msg = capture_end();
 	ss_raster_release(&r);
 	CHECK(err == SS_ERR_INPUT && strstr(msg, "RGB"), "RGB PNG refused: %s", msg);
 
-	write_file(at("fake.png"), "GIF89a not a png at all");
+	check_write_file(check_file("fake.png"), "GIF89a not a png at all");
 	capture_begin();
-	err = ss_dem_read(at("fake.png"), NULL, NULL, &r);
+	err = ss_dem_read(check_file("fake.png"), NULL, NULL, &r);
 	msg = capture_end();
 	ss_raster_release(&r);
 	CHECK(err == SS_ERR_INPUT && strstr(msg, "not a PNG"), "non-PNG refused: %s", msg);
@@ -563,9 +542,9 @@ static void png_too_short_for_its_size_is_refused(void)
 {
 	const uint16_t grey[16] = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16};
 	const char *const texts[] = {"zmin_m=0", "zmax_m=1"};
-	write_gray16(at("claims.png"), 4, 4, grey, texts, 2, -1);
+	write_gray16(check_file("claims.png"), 4, 4, grey, texts, 2, -1);
 	size_t size;
-	unsigned char *b = (unsigned char *)slurp(at("claims.png"), &size);
+	unsigned char *b = (unsigned char *)slurp(check_file("claims.png"), &size);
 	CHECK(b && size > 33 && memcmp(b + 12, "IHDR", 4) == 0, "claims.png starts with IHDR");
 	if (!b || size <= 33) {
 		free(b);
@@ -577,13 +556,13 @@ static void png_too_short_for_its_size_is_refused(void)
 	const uint32_t crc = png_crc(b + 12, 17);
 	const unsigned char be[4] = {crc >> 24, crc >> 16 & 0xff, crc >> 8 & 0xff, crc & 0xff};
 	memcpy(b + 29, be, 4);
-	FILE *f = fopen(at("claims.png"), "wb");
+	FILE *f = fopen(check_file("claims.png"), "wb");
 	fwrite(b, 1, size, f);
 	fclose(f);
 	free(b);
 	struct ss_raster r;
 	capture_begin();
-	int err = ss_dem_read(at("claims.png"), NULL, NULL, &r);
+	int err = ss_dem_read(check_file("claims.png"), NULL, NULL, &r);
 	const char *msg = capture_end();
 	ss_raster_release(&r);
 	CHECK(err == SS_ERR_INPUT && strstr(msg, "cannot hold 1000000 x 1000000") &&
@@ -596,9 +575,9 @@ static void png_chunk_longer_than_file_is_refused(void)
 {
 	const uint16_t grey[4] = {1, 2, 3, 4};
 	const char *const texts[] = {"zmin_m=0", "zmax_m=1"};
-	write_gray16(at("long.png"), 2, 2, grey, texts, 2, -1);
+	write_gray16(check_file("long.png"), 2, 2, grey, texts, 2, -1);
 	size_t size;
-	unsigned char *b = (unsigned char *)slurp(at("long.png"), &size);
+	unsigned char *b = (unsigned char *)slurp(check_file("long.png"), &size);
 	unsigned char *t = NULL;
 	for (size_t k = 0; b && !t && k + 4 <= size; k++)
 		if (memcmp(b + k, "tEXt", 4) == 0)
@@ -609,13 +588,13 @@ static void png_chunk_longer_than_file_is_refused(void)
 		return;
 	}
 	memcpy(t - 4, "\x64\x78\x5f\x6d", 4);   /* length 1685610349 */
-	FILE *f = fopen(at("long.png"), "wb");
+	FILE *f = fopen(check_file("long.png"), "wb");
 	fwrite(b, 1, size, f);
 	fclose(f);
 	free(b);
 	struct ss_raster r;
 	capture_begin();
-	int err = ss_dem_read(at("long.png"), NULL, NULL, &r);
+	int err = ss_dem_read(check_file("long.png"), NULL, NULL, &r);
 	const char *msg = capture_end();
 	ss_raster_release(&r);
 	CHECK(err == SS_ERR_INPUT && strstr(msg, "chunk tEXt claims 1685610349 bytes") &&
@@ -627,56 +606,56 @@ static void writes_are_atomic_and_spare_the_input(void)
 	struct rng g = {99};
 	struct ss_raster a, b;
 	random_raster(&a, 5, 4, &g, 0);
-	CHECK(ss_dem_write(at("src.asc"), SS_DEM_AUTO, &a) == SS_OK, "write src.asc");
+	CHECK(ss_dem_write(check_file("src.asc"), SS_DEM_AUTO, &a) == SS_OK, "write src.asc");
 	ss_raster_release(&a);
-	CHECK(ss_dem_read(at("src.asc"), NULL, NULL, &b) == SS_OK, "read src.asc");
+	CHECK(ss_dem_read(check_file("src.asc"), NULL, NULL, &b) == SS_OK, "read src.asc");
 	size_t n0, n1;
-	char *before = slurp(at("src.asc"), &n0);
+	char *before = slurp(check_file("src.asc"), &n0);
 
 	/* writing over the file it came from (even by another name) */
 	capture_begin();
-	int err = ss_dem_write(at("src.asc"), SS_DEM_AUTO, &b);
+	int err = ss_dem_write(check_file("src.asc"), SS_DEM_AUTO, &b);
 	const char *msg = capture_end();
 	CHECK(err == SS_ERR_INPUT && strstr(msg, "read from"), "overwriting the input refused: %s",
 	      msg);
-	CHECK(symlink("src.asc", at("alias.asc")) == 0, "symlink");
+	CHECK(symlink("src.asc", check_file("alias.asc")) == 0, "symlink");
 	capture_begin();
-	err = ss_dem_write(at("alias.asc"), SS_DEM_AUTO, &b);
+	err = ss_dem_write(check_file("alias.asc"), SS_DEM_AUTO, &b);
 	capture_end();
 	CHECK(err == SS_ERR_INPUT, "overwriting the input through a link refused");
-	unlink(at("alias.asc"));
+	unlink(check_file("alias.asc"));
 
 	/* a failed write leaves an existing output whole */
-	write_file(at("old.asc"), "keep me\n");
+	check_write_file(check_file("old.asc"), "keep me\n");
 	b.values[3] = NAN;
 	capture_begin();
-	err = ss_dem_write(at("old.asc"), SS_DEM_AUTO, &b);
+	err = ss_dem_write(check_file("old.asc"), SS_DEM_AUTO, &b);
 	msg = capture_end();
 	CHECK(err == SS_ERR_FAIL && strstr(msg, "column 4, row 1"), "a NaN height is not written: %s",
 	      msg);
-	char *old = slurp(at("old.asc"), &n1);
+	char *old = slurp(check_file("old.asc"), &n1);
 	CHECK(old && !strcmp(old, "keep me\n"), "the earlier file is untouched");
 	free(old);
 	b.values[3] = 1.0;
 
 	/* unwritable places and formats */
 	capture_begin();
-	err = ss_dem_write(at("no/such/dir/x.asc"), SS_DEM_AUTO, &b);
+	err = ss_dem_write(check_file("no/such/dir/x.asc"), SS_DEM_AUTO, &b);
 	msg = capture_end();
 	CHECK(err == SS_ERR_INPUT && strstr(msg, "x.asc") && strstr(msg, "No such file"),
 	      "missing folder: %s", msg);
 	capture_begin();
-	err = ss_dem_write(at("x.h5"), SS_DEM_AUTO, &b);
+	err = ss_dem_write(check_file("x.h5"), SS_DEM_AUTO, &b);
 	msg = capture_end();
 	CHECK(err == SS_ERR_INPUT && strstr(msg, "HDF5"), "HDF5 is not written here: %s", msg);
 	b.cellsize = b.cellsize_y = NAN;
 	capture_begin();
-	err = ss_dem_write(at("nocell.asc"), SS_DEM_AUTO, &b);
+	err = ss_dem_write(check_file("nocell.asc"), SS_DEM_AUTO, &b);
 	msg = capture_end();
 	CHECK(err == SS_ERR_INPUT && strstr(msg, "cell size"), "asc needs a cell size: %s", msg);
-	CHECK(access(at("nocell.asc"), F_OK) != 0, "and nothing was written");
+	CHECK(access(check_file("nocell.asc"), F_OK) != 0, "and nothing was written");
 
-	char *after = slurp(at("src.asc"), &n1);
+	char *after = slurp(check_file("src.asc"), &n1);
 	CHECK(before && after && n0 == n1 && !memcmp(before, after, n0), "the input is unchanged");
 	CHECK(hidden_files() == 0, "no temporary file left after failures");
 	free(before);
@@ -693,8 +672,8 @@ static void nodata_value_avoids_real_heights(void)
 	a.values[0] = -9999.0;   /* a real height equal to the usual marker */
 	a.nodata = calloc(3, 1);
 	a.nodata[2] = 1;
-	CHECK(ss_dem_write(at("nd.asc"), SS_DEM_AUTO, &a) == SS_OK, "write nd.asc");
-	CHECK(ss_dem_read(at("nd.asc"), NULL, NULL, &b) == SS_OK, "read nd.asc");
+	CHECK(ss_dem_write(check_file("nd.asc"), SS_DEM_AUTO, &a) == SS_OK, "write nd.asc");
+	CHECK(ss_dem_read(check_file("nd.asc"), NULL, NULL, &b) == SS_OK, "read nd.asc");
 	CHECK(b.nodata_value == -99999.0 && b.values[0] == -9999.0 && same_flags(&a, &b),
 	      "another marker is chosen, %g, and the height survives", b.nodata_value);
 	ss_raster_release(&a);
@@ -716,13 +695,13 @@ static void geotiff_round_trip(void)
 	random_raster(&a, 17, 11, &g, 1);
 	if (!ss_dem_gdal_available()) {
 		capture_begin();
-		int err = ss_dem_write(at("g.tif"), SS_DEM_AUTO, &a);
+		int err = ss_dem_write(check_file("g.tif"), SS_DEM_AUTO, &a);
 		const char *msg = capture_end();
 		CHECK(err == SS_ERR_INPUT && strstr(msg, "unavailable in this build"),
 		      "without GDAL a .tif is refused clearly: %s", msg);
-		write_file(at("g.tif"), "II*");
+		check_write_file(check_file("g.tif"), "II*");
 		capture_begin();
-		err = ss_dem_read(at("g.tif"), NULL, NULL, &b);
+		err = ss_dem_read(check_file("g.tif"), NULL, NULL, &b);
 		msg = capture_end();
 		ss_raster_release(&b);
 		CHECK(err == SS_ERR_INPUT && strstr(msg, "unavailable in this build") &&
@@ -738,9 +717,9 @@ static void geotiff_round_trip(void)
 	a.crs_wkt = strdup(utm33n);
 	a.has_nodata_value = 1;
 	a.nodata_value = -32768.0;
-	int err = ss_dem_write(at("g.tif"), SS_DEM_AUTO, &a);
+	int err = ss_dem_write(check_file("g.tif"), SS_DEM_AUTO, &a);
 	CHECK(err == SS_OK, "write g.tif: %d", err);
-	err = ss_dem_read(at("g.tif"), NULL, NULL, &b);
+	err = ss_dem_read(check_file("g.tif"), NULL, NULL, &b);
 	CHECK(err == SS_OK, "read g.tif: %d", err);
 	CHECK(b.format == SS_DEM_GDAL && same_values(&a, &b) && same_flags(&a, &b),
 	      "values bit-identical, nodata flags kept");
@@ -756,8 +735,8 @@ static void geotiff_round_trip(void)
 	      "CRS kept: %s", b.crs_wkt ? b.crs_wkt : "(none)");
 
 	/* again from what was read: geotransform and CRS exactly as read */
-	err = ss_dem_write(at("g2.tif"), SS_DEM_GDAL, &b);
-	CHECK(err == SS_OK && ss_dem_read(at("g2.tif"), NULL, NULL, &c) == SS_OK, "g2.tif");
+	err = ss_dem_write(check_file("g2.tif"), SS_DEM_GDAL, &b);
+	CHECK(err == SS_OK && ss_dem_read(check_file("g2.tif"), NULL, NULL, &c) == SS_OK, "g2.tif");
 	CHECK(same_values(&b, &c) && same_flags(&b, &c) &&
 	      !memcmp(b.geotransform, c.geotransform, sizeof b.geotransform) &&
 	      c.crs_wkt && !strcmp(b.crs_wkt, c.crs_wkt), "second round trip identical");
@@ -766,8 +745,8 @@ static void geotiff_round_trip(void)
 	/* a GeoTIFF to .asc keeps the corner and nodata */
 	b.cellsize_y = b.cellsize = 30.0;
 	b.has_geotransform = 0;
-	err = ss_dem_write(at("g.asc"), SS_DEM_AUTO, &b);
-	CHECK(err == SS_OK && ss_dem_read(at("g.asc"), NULL, NULL, &c) == SS_OK &&
+	err = ss_dem_write(check_file("g.asc"), SS_DEM_AUTO, &b);
+	CHECK(err == SS_OK && ss_dem_read(check_file("g.asc"), NULL, NULL, &c) == SS_OK &&
 	      same_values(&b, &c) && same_flags(&b, &c) && c.nodata_value == -32768.0 &&
 	      c.x0 == 500000.0, "GeoTIFF to .asc");
 	ss_raster_release(&c);
@@ -776,18 +755,18 @@ static void geotiff_round_trip(void)
 	const double rotated[6] = {0, 1, 0.5, 0, 0.5, -1};
 	memcpy(b.geotransform, rotated, sizeof rotated);
 	b.has_geotransform = 1;
-	CHECK(ss_dem_write(at("rot.tif"), SS_DEM_AUTO, &b) == SS_OK, "write rot.tif");
+	CHECK(ss_dem_write(check_file("rot.tif"), SS_DEM_AUTO, &b) == SS_OK, "write rot.tif");
 	capture_begin();
-	err = ss_dem_read(at("rot.tif"), NULL, NULL, &c);
+	err = ss_dem_read(check_file("rot.tif"), NULL, NULL, &c);
 	const char *msg = capture_end();
 	ss_raster_release(&c);
 	CHECK(err == SS_ERR_INPUT && strstr(msg, "rotated") && strstr(msg, "north-up"),
 	      "rotated refused: %s", msg);
 
 	/* something that is no raster */
-	write_file(at("junk.tif"), "II*\0 this is not a TIFF");
+	check_write_file(check_file("junk.tif"), "II*\0 this is not a TIFF");
 	capture_begin();
-	err = ss_dem_read(at("junk.tif"), "case.ini:4", NULL, &c);
+	err = ss_dem_read(check_file("junk.tif"), "case.ini:4", NULL, &c);
 	msg = capture_end();
 	ss_raster_release(&c);
 	CHECK(err == SS_ERR_INPUT && strstr(msg, "case.ini:4") && strstr(msg, "junk.tif") &&
@@ -799,11 +778,8 @@ static void geotiff_round_trip(void)
 
 int main(void)
 {
-	snprintf(dir, sizeof dir, "/tmp/test_dem.XXXXXX");
-	if (!mkdtemp(dir)) {
-		perror("mkdtemp");
+	if (check_scratch_make("test_dem"))
 		return 2;
-	}
 	RUN(format_from_path);
 	RUN(asc_round_trip_is_bit_exact);
 	RUN(asc_keeps_centre_and_rectangular_cells);

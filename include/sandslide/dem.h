@@ -115,6 +115,10 @@ int ss_dem_read(const char *spec, const char *context,
  * infinite value in a cell with data. */
 int ss_dem_write(const char *path, enum ss_dem_format format, const struct ss_raster *r);
 
+/* The format of path from its extension, SS_DEM_AUTO when it is none of
+ * those below; prints nothing. */
+enum ss_dem_format ss_dem_format_of(const char *path);
+
 /* The format of path from its extension (".asc", ".png", ".tif", ".tiff",
  * ".h5" or "FILE.h5:/dataset", any case).  SS_ERR_INPUT listing the
  * accepted extensions otherwise (after context, which may be NULL). */

@@ -10,7 +10,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <strings.h>
 
 #include "app/drive.h"
 #include "io/output.h"
@@ -46,15 +45,7 @@ static void default_output(const char *dem, char *out, size_t size)
 			dot = p;
 	const int stem = dot && dot != base ? (int)(dot - base) : len;
 	snprintf(out, size, "out/%.*s-relaxed%.*s", stem, base, len - stem, base + stem);
-	static const char *const written[] = {".asc", ".png", ".tif", ".tiff", ".h5", ".nc",
-	                                      ".nc4"};
-	const char *ext = base + stem;
-	const int ext_len = len - stem;
-	int known = 0;
-	for (size_t k = 0; k < sizeof written / sizeof *written; k++)
-		known |= (int)strlen(written[k]) == ext_len &&
-		         !strncasecmp(ext, written[k], (size_t)ext_len);
-	if (!known && ss_dem_gdal_available())
+	if (ss_dem_format_of(out) == SS_DEM_AUTO && ss_dem_gdal_available())
 		snprintf(out, size, "out/%.*s-relaxed.tif", stem, base);
 }
 

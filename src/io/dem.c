@@ -115,8 +115,7 @@ static const char *h5_dataset(const char *spec)
 	return hit ? hit + 1 : NULL;
 }
 
-/* The format from the extension, SS_DEM_AUTO when it is none we know. */
-static enum ss_dem_format format_of(const char *path)
+enum ss_dem_format ss_dem_format_of(const char *path)
 {
 	if (has_suffix(path, ".asc"))
 		return SS_DEM_ASC;
@@ -124,15 +123,14 @@ static enum ss_dem_format format_of(const char *path)
 		return SS_DEM_PNG;
 	if (has_suffix(path, ".tif") || has_suffix(path, ".tiff"))
 		return SS_DEM_GDAL;
-	if (has_suffix(path, ".h5") || has_suffix(path, ".nc") || has_suffix(path, ".nc4") ||
-	    h5_dataset(path))
+	if (has_suffix(path, ".h5") || ss_snapshot_named_netcdf(path) || h5_dataset(path))
 		return SS_DEM_H5;
 	return SS_DEM_AUTO;
 }
 
 int ss_dem_format_from_path(const char *path, const char *context, enum ss_dem_format *format)
 {
-	*format = format_of(path);
+	*format = ss_dem_format_of(path);
 	if (*format != SS_DEM_AUTO)
 		return SS_OK;
 	return ss_error_input_at(context, "'%s': unknown raster format: expected " SS_DEM_ACCEPTED_READ,
@@ -287,7 +285,7 @@ int ss_dem_read(const char *spec, const char *context, const struct ss_dem_read_
 	struct stat sb;
 	if (strncmp(file, "/vsi", 4) != 0 && stat(file, &sb) != 0 && errno == ENOENT)
 		return ss_error_input_at(context, "cannot open '%s': %s", file, strerror(ENOENT));
-	enum ss_dem_format format = opt->format != SS_DEM_AUTO ? opt->format : format_of(spec);
+	enum ss_dem_format format = opt->format != SS_DEM_AUTO ? opt->format : ss_dem_format_of(spec);
 	if (format == SS_DEM_AUTO) {
 		/* any other raster GDAL recognises; else name what is accepted */
 		if (ss_dem_gdal_available() && ss_dem_gdal_identify(spec))

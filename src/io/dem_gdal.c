@@ -17,6 +17,7 @@
 #ifdef SS_HAVE_GDAL
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -64,12 +65,15 @@ static void flip_rows(double *v, int nx, int ny)
 	}
 }
 
-/* 1 when wkt is a geographic CRS: coordinates in degrees of longitude and
- * latitude, which the model would take for metres (every face ~90 deg). */
-static int geographic(const char *wkt)
+/* 1 when wkt is a geographic CRS (coordinates in degrees of longitude and
+ * latitude, which the model would take for metres: every face ~90 deg),
+ * with its name in name. */
+static int geographic(const char *wkt, char *name, size_t size)
 {
 	OGRSpatialReferenceH srs = OSRNewSpatialReference(wkt);
 	const int g = srs && OSRIsGeographic(srs);
+	const char *n = g ? OSRGetName(srs) : NULL;
+	snprintf(name, size, "%s", n && *n ? n : "a geographic CRS");
 	if (srs)
 		OSRDestroySpatialReference(srs);
 	return g;
@@ -78,15 +82,9 @@ static int geographic(const char *wkt)
 /* The refusal of a DEM in degrees, with the gdalwarp command that puts it
  * in metres: the UTM zone (WGS 84) of its centre when the geotransform
  * gives one. */
-static int refuse_degrees(const char *path, const char *context, const char *wkt,
+static int refuse_degrees(const char *path, const char *context, const char *crs,
                           const struct ss_raster *r, int nx, int ny)
 {
-	OGRSpatialReferenceH srs = OSRNewSpatialReference(wkt);
-	const char *name = srs ? OSRGetName(srs) : NULL;
-	char crs[160];
-	snprintf(crs, sizeof crs, "%s", name && *name ? name : "a geographic CRS");
-	if (srs)
-		OSRDestroySpatialReference(srs);
 	char target[64] = "EPSG:<a projected CRS in metres, e.g. your UTM zone>";
 	if (r->has_geotransform) {
 		/* x is longitude, y latitude: GDAL's traditional GIS order */
@@ -132,8 +130,9 @@ static int read_dataset(GDALDatasetH ds, const char *path, const char *context,
 		r->y0 = gt[3] + ny * gt[5];
 	}
 	const char *wkt = GDALGetProjectionRef(ds);
-	if (wkt && *wkt && geographic(wkt))
-		return refuse_degrees(path, context, wkt, r, nx, ny);
+	char crs[160];
+	if (wkt && *wkt && geographic(wkt, crs, sizeof crs))
+		return refuse_degrees(path, context, crs, r, nx, ny);
 	if (wkt && *wkt && !(r->crs_wkt = ss_dem_strdup(wkt)))
 		return SS_ERR_FAIL;
 

@@ -74,18 +74,19 @@ static int finish(FILE *f, const char *tmp, const char *path)
 	return bad ? -1 : 0;
 }
 
-/* "path.tmp", malloc'ed (errno ENOMEM when not) */
-static char *tmp_name(const char *path)
+/* path with suffix added ("run.h5" ".aux.xml"), malloc'ed; NULL with
+ * errno ENOMEM */
+static char *with_suffix(const char *path, const char *suffix)
 {
-	const size_t len = strlen(path);
-	char *tmp = malloc(len + sizeof ".tmp");
-	if (!tmp) {
+	const size_t len = strlen(path), add = strlen(suffix) + 1;
+	char *out = malloc(len + add);
+	if (!out) {
 		errno = ENOMEM;
 		return NULL;
 	}
-	memcpy(tmp, path, len);
-	memcpy(tmp + len, ".tmp", sizeof ".tmp");
-	return tmp;
+	memcpy(out, path, len);
+	memcpy(out + len, suffix, add);
+	return out;
 }
 
 /* ---- GDAL's .aux.xml --------------------------------------------------- */
@@ -93,15 +94,8 @@ static char *tmp_name(const char *path)
 int ss_gdal_sidecar_write(const char *h5_path, double origin_x, double origin_y, double dx,
                           double dy, const char *crs_wkt, int has_bedrock)
 {
-	const size_t len = strlen(h5_path);
-	char *path = malloc(len + sizeof ".aux.xml");
-	if (!path) {
-		errno = ENOMEM;
-		return -1;
-	}
-	memcpy(path, h5_path, len);
-	memcpy(path + len, ".aux.xml", sizeof ".aux.xml");
-	char *tmp = tmp_name(path);
+	char *path = with_suffix(h5_path, ".aux.xml");
+	char *tmp = path ? with_suffix(path, ".tmp") : NULL;
 	FILE *f = tmp ? fopen(tmp, "w") : NULL;
 	if (!f) {
 		free(tmp);
@@ -168,7 +162,7 @@ int ss_xdmf_write(const char *xmf_path, const char *h5_path, int nx, int ny,
 {
 	const char *slash = strrchr(h5_path, '/');
 	const char *h5_name = slash ? slash + 1 : h5_path;
-	char *tmp = tmp_name(xmf_path);
+	char *tmp = with_suffix(xmf_path, ".tmp");
 	FILE *f = tmp ? fopen(tmp, "w") : NULL;
 	if (!f) {
 		free(tmp);

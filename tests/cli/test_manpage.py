@@ -98,29 +98,22 @@ def roff_words(args):
         if args[k] in " \t":
             k += 1
             continue
+        quoted = args[k] == '"'
+        k += quoted
         word = []
-        if args[k] == '"':
-            k += 1
-            while k < len(args):
-                if args[k] == '"':
-                    if args[k + 1:k + 2] == '"':
-                        word.append('"')
-                        k += 2
-                        continue
+        while k < len(args):
+            if quoted and args[k] == '"':
+                if args[k + 1:k + 2] != '"':
                     k += 1
                     break
-                if args[k] == "\\" and k + 1 < len(args):
-                    word.append(args[k:k + 2])
-                    k += 2
-                    continue
-                word.append(args[k])
-                k += 1
-        else:
-            while k < len(args) and args[k] not in " \t":
-                if args[k] == "\\" and k + 1 < len(args):
-                    word.append(args[k:k + 2])
-                    k += 2
-                    continue
+                word.append('"')
+                k += 2
+            elif not quoted and args[k] in " \t":
+                break
+            elif args[k] == "\\" and k + 1 < len(args):
+                word.append(args[k:k + 2])   # an escape stays whole
+                k += 2
+            else:
                 word.append(args[k])
                 k += 1
         words.append("".join(word))
