@@ -269,7 +269,8 @@ $(FUZZ_BUILD)/fuzz_%: tests/fuzz/fuzz_%.c $(FUZZ_BUILD)/lf/libsandslide.a $(wild
 $(FUZZ_BUILD)/replay/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/replay.c $(FUZZ_BUILD)/replay/libsandslide.a $(wildcard tests/fuzz/*.h)
 	@$(if $(Q),echo '  LINK    $@')
 	$(Q)$(CC) $(filter-out -MMD -MP,$(FUZZ_CFLAGS)) $(filter %.c %.a,$^) $(LIBS) -o $@
--include $(wildcard $(FUZZ_BUILD)/*/*/*.d)
+# replay/render/x.d and replay/src/io/x.d: the tiers are one level deeper
+-include $(wildcard $(FUZZ_BUILD)/*/*/*.d $(FUZZ_BUILD)/*/*/*/*.d)
 
 # The test hook of the non-finite guard (tests/hooks/nan_step.c): the
 # command line linked again with the stepper's advance wrapped, so that a
