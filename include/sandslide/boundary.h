@@ -32,6 +32,10 @@ struct ss_boundary {
 
 /* Parse "wall", "open" or "periodic"; returns 0, or -1 if unknown. */
 int ss_side_kind_parse(const char *name, enum ss_side_kind *kind);
+/* "wall", "open" or "periodic". */
+const char *ss_side_kind_name(enum ss_side_kind kind);
+/* "west", "east", "south" or "north". */
+const char *ss_side_name(enum ss_side side);
 
 /* SS_ERR_INPUT unless opposite sides are both periodic or both not. */
 int ss_boundary_check(const struct ss_boundary *b);

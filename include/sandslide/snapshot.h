@@ -25,6 +25,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "sandslide/boundary.h"
 #include "sandslide/diagnostics.h"
 #include "sandslide/grid.h"
 
@@ -46,6 +47,8 @@ struct ss_snapshot_meta {
 	const char *crs_wkt;     /* coordinate reference system of x and y (WKT,
 	                          * from the input DEM), or NULL: written as the
 	                          * CF grid mapping variable /crs */
+	const struct ss_boundary *boundary; /* the grid's sides (root attribute
+	                          * boundary), or NULL: not written */
 };
 
 /* Call first in a program: HDF5 quiet (errors are reported by the callers)
@@ -186,6 +189,9 @@ struct ss_snapshot_file {
 	double origin_x, origin_y;  /* lower-left corner, m (NAN without /x, /y) */
 	double *time;               /* count entries, s */
 	char *crs_wkt;              /* the CRS of x and y (/crs), NULL if none */
+	unsigned wall_sides;        /* bit 1 << enum ss_side (boundary.h) for each
+	                             * side that is a wall; 0 when the file does
+	                             * not say (written before the attribute) */
 	struct ss_snapshot_file_h5 *h5;
 };
 

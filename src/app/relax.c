@@ -328,7 +328,7 @@ static int open_output(struct relax *x, const struct ss_relax_report *rep)
 		.case_text = "", .closure = ss_closure_name(o->closure),
 		.integrator = ss_integrator_name(x->st.integrator),
 		.repose_angle_deg = o->angle_deg, .nu = o->nu, .gamma = o->gamma,
-		.bedrock = x->st.bedrock, .crs_wkt = x->dem.crs_wkt,
+		.bedrock = x->st.bedrock, .crs_wkt = x->dem.crs_wkt, .boundary = &x->st.boundary,
 	};
 	return ss_drive_create(d, &meta);
 }

@@ -228,6 +228,7 @@ static int open_output(struct run *r)
 		.integrator = ss_integrator_name(r->st.integrator),
 		.repose_angle_deg = r->c.repose_angle_deg, .nu = r->c.nu, .gamma = r->c.gamma,
 		.deflate = o->deflate, .bedrock = r->st.bedrock, .case_overrides = overrides,
+		.boundary = &r->st.boundary,
 	};
 	err = ss_drive_create(d, &meta);
 	free(overrides);

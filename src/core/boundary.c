@@ -27,6 +27,16 @@ int ss_side_kind_parse(const char *name, enum ss_side_kind *kind)
 	return -1;
 }
 
+const char *ss_side_kind_name(enum ss_side_kind kind)
+{
+	return (unsigned)kind < 3 ? side_kind_names[kind] : "?";
+}
+
+const char *ss_side_name(enum ss_side side)
+{
+	return (unsigned)side < 4 ? side_names[side] : "?";
+}
+
 int ss_boundary_check(const struct ss_boundary *b)
 {
 	for (int s = 0; s < 4; s += 2) {

@@ -13,6 +13,12 @@
 /* Root attribute `source` starts with this ("sandslide 0.1.0"). */
 #define SS_SNAPSHOT_SOURCE "sandslide"
 
+/* Root attribute `boundary`: the kinds of the grid's four sides as the
+ * case file's [boundary] names them, "west=wall east=open south=open
+ * north=open" (the renderer draws wall sides).  Files written before it
+ * have none. */
+#define SS_SNAPSHOT_BOUNDARY "boundary"
+
 /* /height chunks are 1 x 256 x 256 (fewer rows or columns on small grids):
  * readers take whole chunks of rows at a time. */
 #define SS_SNAPSHOT_CHUNK_SIDE 256

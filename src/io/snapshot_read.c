@@ -655,6 +655,32 @@ static int first_value(const struct h5in *in, const char *name, double *v)
 	return err;
 }
 
+/* The wall sides from the root attribute boundary ("west=wall east=open
+ * ..."); none when it is missing.  A word that is not side=kind makes the
+ * file damaged. */
+static int read_wall_sides(struct ss_snapshot_file *f)
+{
+	const struct h5in *in = &f->h5->in;
+	char text[256], *save = NULL;
+	int err = attr_string(in, in->file, SS_SNAPSHOT_BOUNDARY, text, sizeof text);
+	for (char *w = strtok_r(text, " ", &save); w && !err; w = strtok_r(NULL, " ", &save)) {
+		char *eq = strchr(w, '=');
+		enum ss_side_kind kind;
+		int side = -1;
+		for (int k = 0; eq && k < 4; k++)
+			if ((size_t)(eq - w) == strlen(ss_side_name(k)) &&
+			    !strncmp(w, ss_side_name(k), (size_t)(eq - w)))
+				side = k;
+		if (side < 0 || ss_side_kind_parse(eq + 1, &kind))
+			err = damaged(in, "root attribute %s has '%s': expected SIDE=KIND, SIDE west, "
+			              "east, south or north and KIND wall, open or periodic",
+			              SS_SNAPSHOT_BOUNDARY, w);
+		else if (kind == SS_SIDE_WALL)
+			f->wall_sides |= 1u << side;
+	}
+	return err;
+}
+
 /* The definition of snapshot.h, the sizes and geometry into f. */
 static int check_definition(struct ss_snapshot_file *f)
 {
@@ -680,6 +706,8 @@ static int check_definition(struct ss_snapshot_file *f)
 	f->origin_y = y0 - 0.5 * f->dy;
 	f->origin_x = isfinite(f->origin_x) ? f->origin_x : NAN;
 	f->origin_y = isfinite(f->origin_y) ? f->origin_y : NAN;
+	if ((err = read_wall_sides(f)))
+		return err;
 	/* the optional CF grid mapping variable /crs of a georeferenced run */
 	if (H5Lexists(in->file, "crs", H5P_DEFAULT) > 0) {
 		hid_t crs = H5Oopen(in->file, "crs", H5P_DEFAULT);

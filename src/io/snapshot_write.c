@@ -378,6 +378,11 @@ static int write_static(struct ss_snapshot *s, const uint8_t *cell_types,
 	}
 
 	/* global attributes */
+	char sides[128] = "";
+	if (meta->boundary)
+		for (int k = 0; k < 4; k++)
+			snprintf(sides + strlen(sides), sizeof sides - strlen(sides), "%s%s=%s",
+			         k ? " " : "", ss_side_name(k), ss_side_kind_name(meta->boundary->side[k]));
 	char source[64];
 	snprintf(source, sizeof source, SS_SNAPSHOT_SOURCE " %s", SS_VERSION);
 	bad = bad || attr_string(f, "Conventions", "CF-1.8") ||
@@ -388,7 +393,8 @@ static int write_static(struct ss_snapshot *s, const uint8_t *cell_types,
 	      attr_doubles(f, "dx", &g->dx, 1) || attr_doubles(f, "dy", &g->dy, 1) ||
 	      attr_string(f, "case", meta->case_text) ||
 	      (meta->integrator && attr_string(f, "integrator", meta->integrator)) ||
-	      attr_string(f, "case_overrides", meta->case_overrides ? meta->case_overrides : "");
+	      attr_string(f, "case_overrides", meta->case_overrides ? meta->case_overrides : "") ||
+	      (meta->boundary && attr_string(f, SS_SNAPSHOT_BOUNDARY, sides));
 	if (x >= 0)
 		H5Dclose(x);
 	if (y >= 0)
