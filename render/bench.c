@@ -86,7 +86,7 @@ int ss_render_bench(int n, int repeats, struct ss_render_bench_report *report)
 	ss_render_options_default(&o);
 	o.scale = 1;   /* one pixel per cell, as the frames below are fed (the
 	                  default enlarges grids under 512 cells a side) */
-	const struct ss_render_field f = {n, n, 1e-3, 1e-3, n, h, type, 0.0};
+	const struct ss_render_field f = {n, n, 1e-3, 1e-3, n, h, type, 0.0, 0};
 
 	/* As in a series: the plan (scale, pixel types) once, then per frame
 	 * the colouring of the heights, one pixel per cell, into a new picture.
@@ -95,14 +95,14 @@ int ss_render_bench(int n, int repeats, struct ss_render_bench_report *report)
 	struct ss_render_plan plan;
 	struct ss_render_image img = {0};
 	const double *north = h + (size_t)(n - 1) * n;
-	int err = ss_render_plan_init(&plan, &o, n, n, f.dx, f.dy, type, n, 0.0, 0.35, 1);
+	int err = ss_render_plan_init(&plan, &o, n, n, f.dx, f.dy, type, n, 0, 0.0, 0.35, 1);
 	if (err)
 		goto out_free;
-	err = ss_render_plan_draw(&plan, north, -(ptrdiff_t)n, 0.0, &img, 1);
+	err = ss_render_plan_draw(&plan, north, -(ptrdiff_t)n, NULL, NULL, 0.0, &img, 1);
 	for (int r = 0; r < repeats && !err; r++) {
 		struct ss_render_image again;
 		const double t0 = ss_parallel_wall_seconds();
-		err = ss_render_plan_draw(&plan, north, -(ptrdiff_t)n, 0.0, &again, 1);
+		err = ss_render_plan_draw(&plan, north, -(ptrdiff_t)n, NULL, NULL, 0.0, &again, 1);
 		times[r] = ss_parallel_wall_seconds() - t0;
 		if (!err)
 			ss_render_image_release(&again);

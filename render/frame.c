@@ -24,8 +24,8 @@ void ss_render_options_default(struct ss_render_options *o)
 	o->azimuth_deg = 315.0;
 	o->altitude_deg = 45.0;
 	o->zscale = 1.0;
-	o->view_azimuth_deg = 200.0;
-	o->view_elevation_deg = 45.0;
+	o->view_azimuth_deg = NAN;      /* from the open side (view_azimuth) */
+	o->view_elevation_deg = 55.0;
 	o->compression = 6;
 }
 
@@ -45,7 +45,7 @@ int ss_render_options_check(const struct ss_render_options *o)
 		return ss_error_input("--max-size %d: expected 8 to 65536 px", o->max_size);
 	if (o->scale < 0 || o->scale > 100)
 		return ss_error_input("--scale %d: expected 1 to 100 px per cell", o->scale);
-	if (!isfinite(o->view_azimuth_deg))
+	if (isinf(o->view_azimuth_deg))
 		return ss_error_input("--view-azimuth %g: expected a finite angle in degrees",
 		                      o->view_azimuth_deg);
 	if (!(o->view_elevation_deg > 0.0 && o->view_elevation_deg < 90.0))
@@ -95,9 +95,63 @@ void ss_render_plan_release(struct ss_render_plan *p)
 	p->pixel_type = NULL;
 }
 
+/* Thickness of a wall side: a cell, and at least 1 % of the longer side
+ * of the map so it shows on large grids (3 px at least). */
+static int border_px(const struct ss_render_resampler *rs)
+{
+	const int cell = (int)ceil(fmax((double)rs->width / rs->nx, (double)rs->height / rs->ny));
+	const int t = (int)ceil(0.01 * fmax(rs->width, rs->height));
+	return cell > t ? (cell > 3 ? cell : 3) : (t > 3 ? t : 3);
+}
+
+/*
+ * The oblique camera's default bearing: from the open side.  The camera
+ * looks from the grid's centre away from the centroid of the walls (wall
+ * pixels and wall sides, by area), turned 30 degrees for a three-quarter
+ * view, so that the walls stand behind the sand rather than in front of
+ * it (the door case: from the east-south-east, over the cone, through the
+ * door into the room).  With no walls, or walls all round, 200 (south-
+ * south-west).
+ */
+static double view_azimuth(const struct ss_render_plan *p)
+{
+	const int W = p->rs.width, H = p->rs.height;
+	const double lx = W * p->rs.px_dx, ly = H * p->rs.px_dy;
+	double area = 0.0, mx = 0.0, my = 0.0;   /* wall area and its moments, m */
+	for (int y = 0; y < H; y++)
+		for (int x = 0; x < W; x++)
+			if (p->pixel_type[(size_t)y * W + x] == SS_CELL_WALL) {
+				area += 1.0;
+				mx += x + 0.5;
+				my += H - y - 0.5;
+			}
+	const double a_px = p->rs.px_dx * p->rs.px_dy;
+	area *= a_px;
+	mx *= a_px * p->rs.px_dx;
+	my *= a_px * p->rs.px_dy;
+	const double *t = p->wall_m;   /* the sides: strips along the grid */
+	const double side_area[4] = {t[SS_WEST] * ly, t[SS_EAST] * ly, t[SS_SOUTH] * lx,
+	                             t[SS_NORTH] * lx};
+	const double side_x[4] = {-0.5 * t[SS_WEST], lx + 0.5 * t[SS_EAST], 0.5 * lx, 0.5 * lx};
+	const double side_y[4] = {0.5 * ly, 0.5 * ly, -0.5 * t[SS_SOUTH], ly + 0.5 * t[SS_NORTH]};
+	for (int s = 0; s < 4; s++) {
+		area += side_area[s];
+		mx += side_area[s] * side_x[s];
+		my += side_area[s] * side_y[s];
+	}
+	if (!(area > 0.0))
+		return 200.0;
+	const double vx = 0.5 * lx - mx / area, vy = 0.5 * ly - my / area;   /* walls -> centre */
+	if (hypot(vx, vy) < 0.05 * hypot(lx, ly))
+		return 200.0;
+	const double bearing = atan2(vx, vy) * (180.0 / M_PI) + 30.0;   /* clockwise from north */
+	return bearing < 0.0 ? bearing + 360.0 : bearing;
+}
+
 int ss_render_plan_init(struct ss_render_plan *p, const struct ss_render_options *look,
                         int nx, int ny, double dx, double dy, const uint8_t *cell_type,
-                        ptrdiff_t type_stride, double zmin, double zmax, int parallel)
+                        ptrdiff_t type_stride, unsigned wall_sides, double zmin,
+                        double zmax, int parallel)
 {
 	memset(p, 0, sizeof *p);
 	p->look = *look;
@@ -117,22 +171,122 @@ int ss_render_plan_init(struct ss_render_plan *p, const struct ss_render_options
 	}
 	ss_render_resample_types(&p->rs, cell_type, type_stride, p->pixel_type, parallel);
 
-	p->pic_w = w;
-	p->pic_h = h;
-	if (look->style == SS_RENDER_OBLIQUE) {
-		const struct ss_render_raster r = {w, h, p->rs.px_dx, p->rs.px_dy, NULL, w, NULL, 1, 1};
-		ss_render_oblique_size(&r, look, zmin, zmax, &p->pic_w, &p->pic_h);
+	/* gray16's pixels are data, one per cell: nothing is drawn round them */
+	const int border = look->style == SS_RENDER_GRAY16 ? 0 : border_px(&p->rs);
+	for (int side = 0; side < 4; side++) {
+		p->border[side] = wall_sides & 1u << side ? border : 0;
+		p->wall_m[side] = p->border[side] * (side < 2 ? p->rs.px_dx : p->rs.px_dy);
 	}
+	p->pic_w = w + p->border[SS_WEST] + p->border[SS_EAST];
+	p->pic_h = h + p->border[SS_SOUTH] + p->border[SS_NORTH];
+	if (look->style == SS_RENDER_OBLIQUE) {
+		if (isnan(p->look.view_azimuth_deg))
+			p->look.view_azimuth_deg = view_azimuth(p);
+		struct ss_render_raster r = {w, h, p->rs.px_dx, p->rs.px_dy, NULL, w, NULL, 1, 1,
+		                             NULL, NULL, {0}};
+		memcpy(r.wall_m, p->wall_m, sizeof r.wall_m);
+		ss_render_oblique_size(&r, &p->look, zmin, zmax, &p->pic_w, &p->pic_h);
+	}
+	p->label_h = look->label ? ss_render_label_height(p->pic_w, p->pic_h) : 0;
 	p->image_w = p->pic_w;
-	p->image_h = p->pic_h;
+	p->image_h = p->label_h + p->pic_h;
 	if (look->colorbar)
 		p->image_w += ss_render_colorbar_width(p->pic_w, p->pic_h, zmin, zmax);
 	return SS_OK;
 }
 
+/* Resample one cell field (south first, stride) onto float pixels. */
+static int resample_to_float(const struct ss_render_plan *p, const double *field,
+                             ptrdiff_t stride, const uint8_t *cell_type,
+                             ptrdiff_t type_stride, double *acc_hw, double *acc_w,
+                             float *out, int parallel)
+{
+	(void)parallel;   /* used by the pragmas only */
+	const ptrdiff_t n = (ptrdiff_t)p->rs.width * p->rs.height;
+	memset(acc_hw, 0, (size_t)n * sizeof *acc_hw);
+	memset(acc_w, 0, (size_t)n * sizeof *acc_w);
+	ss_render_resample_rows(&p->rs, field, stride, cell_type, type_stride, 0, p->rs.ny, acc_hw,
+	                        acc_w, parallel);
+	ss_render_resample_finish(&p->rs, acc_hw, acc_w, parallel);
+	#pragma omp parallel for schedule(static) if(parallel)
+	for (ptrdiff_t k = 0; k < n; k++)
+		out[k] = isnan(acc_hw[k]) ? 0.0f : (float)acc_hw[k];
+	return SS_OK;
+}
+
+int ss_render_plan_gradients(const struct ss_render_plan *p, const double *h,
+                             ptrdiff_t stride, const uint8_t *cell_type,
+                             ptrdiff_t type_stride, float **gx, float **gy, int parallel)
+{
+	(void)parallel;   /* used by the pragmas only */
+	const int nx = p->rs.nx, ny = p->rs.ny;
+	const size_t cells = (size_t)nx * ny, pixels = (size_t)p->rs.width * p->rs.height;
+	*gx = *gy = NULL;
+	uint8_t *types = ss_alloc(cells, 1, "cell types, north first");
+	double *cgx = ss_alloc(cells, sizeof *cgx, "cell gradients");
+	double *cgy = ss_alloc(cells, sizeof *cgy, "cell gradients");
+	double *acc_hw = ss_alloc(pixels, sizeof *acc_hw, "resampled gradients");
+	double *acc_w = ss_alloc(pixels, sizeof *acc_w, "resampling weights");
+	*gx = ss_alloc(pixels, sizeof **gx, "pixel gradients");
+	*gy = ss_alloc(pixels, sizeof **gy, "pixel gradients");
+	int err = types && cgx && cgy && acc_hw && acc_w && *gx && *gy ? SS_OK : SS_ERR_FAIL;
+	if (!err) {
+		/* the cells as a raster of their own: one px per cell, north first */
+		#pragma omp parallel for schedule(static) if(parallel)
+		for (int y = 0; y < ny; y++)
+			for (int x = 0; x < nx; x++) {
+				const int t = cell_type ? cell_type[(ptrdiff_t)(ny - 1 - y) * type_stride + x]
+				                        : SS_CELL_FLOW;
+				types[(size_t)y * nx + x] = (uint8_t)(t <= SS_CELL_OPEN ? t : SS_CELL_WALL);
+			}
+		const struct ss_render_raster cr = {
+			nx, ny, p->rs.px_dx * p->rs.width / nx, p->rs.px_dy * p->rs.height / ny,
+			h + (ptrdiff_t)(ny - 1) * stride, -stride, types, 1, 1, NULL, NULL, {0},
+		};
+		/* cgx, cgy south first, like the heights the resampler takes */
+		#pragma omp parallel for schedule(static) if(parallel)
+		for (int y = 0; y < ny; y++)
+			for (int x = 0; x < nx; x++) {
+				const size_t k = (size_t)(ny - 1 - y) * nx + x;
+				const double v = ss_render_raster_h(&cr, x, y);
+				cgx[k] = cgy[k] = 0.0;
+				if (types[(size_t)y * nx + x] != SS_CELL_WALL && !isnan(v))
+					ss_render_gradient(&cr, x, y, &cgx[k], &cgy[k]);
+			}
+		resample_to_float(p, cgx, nx, cell_type, type_stride, acc_hw, acc_w, *gx, parallel);
+		resample_to_float(p, cgy, nx, cell_type, type_stride, acc_hw, acc_w, *gy, parallel);
+	}
+	ss_free(types);
+	ss_free(cgx);
+	ss_free(cgy);
+	ss_free(acc_hw);
+	ss_free(acc_w);
+	if (err) {
+		ss_free(*gx);
+		ss_free(*gy);
+		*gx = *gy = NULL;
+	}
+	return err;
+}
+
+/* The walls outside the grid's wall sides, in the walls' colour. */
+static void draw_wall_sides(const struct ss_render_plan *p, struct ss_render_image *img)
+{
+	static const uint8_t wall[3] = {SS_RENDER_WALL_RGB};
+	const int x0 = p->border[SS_WEST], x1 = p->pic_w - p->border[SS_EAST];
+	const int y0 = p->label_h + p->border[SS_NORTH];
+	const int y1 = p->label_h + p->pic_h - p->border[SS_SOUTH];
+	for (int y = p->label_h; y < p->label_h + p->pic_h; y++) {
+		uint8_t *row = img->pixels + (size_t)y * img->row_bytes;
+		for (int x = 0; x < p->pic_w; x++)
+			if (x < x0 || x >= x1 || y < y0 || y >= y1)
+				memcpy(row + 3 * (size_t)x, wall, 3);
+	}
+}
+
 int ss_render_plan_draw(const struct ss_render_plan *p, const double *pixel_h,
-                        ptrdiff_t stride, double time, struct ss_render_image *img,
-                        int parallel)
+                        ptrdiff_t stride, const float *gx, const float *gy, double time,
+                        struct ss_render_image *img, int parallel)
 {
 	const struct ss_render_options *o = &p->look;
 	const int gray = o->style == SS_RENDER_GRAY16;
@@ -146,28 +300,41 @@ int ss_render_plan_draw(const struct ss_render_plan *p, const double *pixel_h,
 		img->px_dx = p->rs.px_dx;
 		img->px_dy = p->rs.px_dy;
 	}
-	const struct ss_render_raster r = {
+	struct ss_render_raster r = {
 		p->rs.width, p->rs.height, p->rs.px_dx, p->rs.px_dy, pixel_h, stride, p->pixel_type,
 		p->rs.width > p->rs.nx ? (int)lround((double)p->rs.width / p->rs.nx) : 1,
 		p->rs.height > p->rs.ny ? (int)lround((double)p->rs.height / p->rs.ny) : 1,
+		gx, gy, {0},
 	};
+	memcpy(r.wall_m, p->wall_m, sizeof r.wall_m);
+	/* the picture's part of the frame, below the label strip; the map's
+	 * part of that, inside the wall sides */
+	struct ss_render_image pic = *img, map = *img;
+	pic.pixels += (size_t)p->label_h * img->row_bytes;
+	pic.height = p->pic_h;
+	map.pixels = pic.pixels + (size_t)p->border[SS_NORTH] * img->row_bytes +
+	             3 * (size_t)p->border[SS_WEST];
+	map.width = p->rs.width;
+	map.height = p->rs.height;
 	switch (o->style) {
 	case SS_RENDER_GRAY16:
 		ss_render_gray16(&r, p->zmin, p->zmax, img, parallel);
 		break;
 	case SS_RENDER_OBLIQUE:
-		if (ss_render_oblique(&r, o, p->zmin, p->zmax, img, parallel)) {
+		if (ss_render_oblique(&r, o, p->zmin, p->zmax, &pic, parallel)) {
 			ss_render_image_release(img);
 			return SS_ERR_FAIL;
 		}
 		break;
 	case SS_RENDER_SHADED:
 	default:
-		ss_render_shaded(&r, o, p->zmin, p->zmax, img, parallel);
+		draw_wall_sides(p, img);
+		ss_render_shaded(&r, o, p->zmin, p->zmax, &map, parallel);
 		break;
 	}
 	if (o->colorbar)
-		ss_render_draw_colorbar(img, p->pic_w, p->pic_h, o->cmap, p->zmin, p->zmax);
+		ss_render_draw_colorbar(img, p->pic_w, p->label_h, p->pic_h, o->cmap, p->zmin,
+		                        p->zmax);
 	if (o->label)
 		ss_render_draw_label(img, p->pic_w, p->pic_h, time);
 	return SS_OK;
@@ -187,73 +354,111 @@ static int alloc_accumulators(const struct ss_render_plan *p, double **hw, doubl
 	return SS_OK;
 }
 
-/* The pixel heights of snapshot t: one pixel per cell reads the snapshot
- * as it is (rows flipped by a negative stride, no copy); otherwise the
- * cells stream through the resampler a block of rows at a time. */
-static int snapshot_heights(const struct ss_render_plan *p, struct ss_render_source *s,
-                            long long t, double **buf, double **acc_w, const double **h,
-                            ptrdiff_t *stride, int parallel)
+/* The heights of a frame: the pixels' (h, stride) and, on an enlarged
+ * grid, the gradients; what holds them is freed by frame_release. */
+struct frame_heights {
+	const double *h;
+	ptrdiff_t stride;
+	double *buf, *acc_w, *cells;
+	float *gx, *gy;
+};
+
+static void frame_release(struct frame_heights *f)
+{
+	ss_free(f->buf);
+	ss_free(f->acc_w);
+	ss_free(f->cells);
+	ss_free(f->gx);
+	ss_free(f->gy);
+	memset(f, 0, sizeof *f);
+}
+
+/* The whole of snapshot t, south row first, into *out (nx * ny). */
+static int read_snapshot(struct ss_render_source *s, long long t, double **out)
 {
 	struct ss_snapshot_file *f = &s->file;
-	*acc_w = NULL;
 	const int block = ss_snapshot_file_block_rows(f);
+	*out = ss_alloc((size_t)f->nx * (size_t)f->ny, sizeof **out, "snapshot heights");
+	if (!*out)
+		return SS_ERR_FAIL;
+	for (int j0 = 0; j0 < f->ny; j0 += block) {
+		const int rows = f->ny - j0 < block ? f->ny - j0 : block;
+		int err = ss_snapshot_file_read_rows(f, t, j0, rows, *out + (size_t)j0 * f->nx);
+		if (err)
+			return err;
+	}
+	return SS_OK;
+}
+
+/* The pixel heights of snapshot t: one pixel per cell reads the snapshot
+ * as it is (rows flipped by a negative stride, no copy); an enlarged grid
+ * is read whole (it is smaller than the picture) for its gradients;
+ * otherwise the cells stream through the resampler a block of rows at a
+ * time, so a 16384^2 snapshot never needs to be in memory at once. */
+static int snapshot_heights(const struct ss_render_plan *p, struct ss_render_source *s,
+                            long long t, struct frame_heights *fh, int parallel)
+{
+	struct ss_snapshot_file *f = &s->file;
+	memset(fh, 0, sizeof *fh);
+	int err;
 	if (ss_render_resampler_is_identity(&p->rs)) {
-		*buf = ss_alloc((size_t)f->nx * (size_t)f->ny, sizeof **buf, "snapshot heights");
-		if (!*buf)
-			return SS_ERR_FAIL;
-		for (int j0 = 0; j0 < f->ny; j0 += block) {
-			const int rows = f->ny - j0 < block ? f->ny - j0 : block;
-			int err = ss_snapshot_file_read_rows(f, t, j0, rows, *buf + (size_t)j0 * f->nx);
-			if (err)
-				return err;
-		}
-		*h = *buf + (size_t)(f->ny - 1) * f->nx;
-		*stride = -(ptrdiff_t)f->nx;
+		if ((err = read_snapshot(s, t, &fh->buf)))
+			return err;
+		fh->h = fh->buf + (size_t)(f->ny - 1) * f->nx;
+		fh->stride = -(ptrdiff_t)f->nx;
 		return SS_OK;
 	}
-	double *rows_buf = ss_alloc((size_t)block * (size_t)f->nx, sizeof *rows_buf, "height rows");
-	if (!rows_buf || alloc_accumulators(p, buf, acc_w)) {
-		ss_free(rows_buf);
+	if (alloc_accumulators(p, &fh->buf, &fh->acc_w))
 		return SS_ERR_FAIL;
+	fh->h = fh->buf;
+	fh->stride = p->rs.width;
+	if (ss_render_plan_enlarges(p)) {
+		if ((err = read_snapshot(s, t, &fh->cells)))
+			return err;
+		ss_render_resample_rows(&p->rs, fh->cells, f->nx, s->cell_type, f->nx, 0, f->ny,
+		                        fh->buf, fh->acc_w, parallel);
+		ss_render_resample_finish(&p->rs, fh->buf, fh->acc_w, parallel);
+		return ss_render_plan_gradients(p, fh->cells, f->nx, s->cell_type, f->nx, &fh->gx,
+		                                &fh->gy, parallel);
 	}
-	int err = SS_OK;
+	const int block = ss_snapshot_file_block_rows(f);
+	double *rows_buf = ss_alloc((size_t)block * (size_t)f->nx, sizeof *rows_buf, "height rows");
+	if (!rows_buf)
+		return SS_ERR_FAIL;
+	err = SS_OK;
 	for (int j0 = 0; j0 < f->ny && !err; j0 += block) {
 		const int rows = f->ny - j0 < block ? f->ny - j0 : block;
 		if (!(err = ss_snapshot_file_read_rows(f, t, j0, rows, rows_buf)))
 			ss_render_resample_rows(&p->rs, rows_buf, f->nx, s->cell_type, f->nx, j0, rows,
-			                        *buf, *acc_w, parallel);
+			                        fh->buf, fh->acc_w, parallel);
 	}
 	ss_free(rows_buf);
 	if (!err)
-		ss_render_resample_finish(&p->rs, *buf, *acc_w, parallel);
-	*h = *buf;
-	*stride = p->rs.width;
+		ss_render_resample_finish(&p->rs, fh->buf, fh->acc_w, parallel);
 	return err;
 }
 
 int ss_render_plan_snapshot(const struct ss_render_plan *p, struct ss_render_source *s,
                             long long t, const char *path, int parallel)
 {
-	double *buf = NULL, *w = NULL;
-	const double *h;
-	ptrdiff_t stride;
-	int err = snapshot_heights(p, s, t, &buf, &w, &h, &stride, parallel);
+	struct frame_heights fh;
+	int err = snapshot_heights(p, s, t, &fh, parallel);
 	if (!err) {
 		struct ss_render_image img;
-		err = ss_render_plan_draw(p, h, stride, s->file.time[t], &img, parallel);
+		err = ss_render_plan_draw(p, fh.h, fh.stride, fh.gx, fh.gy, s->file.time[t], &img,
+		                          parallel);
 		if (!err) {
 			img.snapshot = t;
 			snprintf(img.source, sizeof img.source, "%s", s->file.name);
-			if (p->look.style != SS_RENDER_OBLIQUE) {
-				img.x0 = s->file.origin_x;
-				img.y0 = s->file.origin_y;
+			if (p->look.style != SS_RENDER_OBLIQUE) {   /* the map's lower-left corner */
+				img.x0 = s->file.origin_x - p->border[SS_WEST] * p->rs.px_dx;
+				img.y0 = s->file.origin_y - p->border[SS_SOUTH] * p->rs.px_dy;
 			}
 			err = ss_render_write_png(&img, path, p->look.compression);
 			ss_render_image_release(&img);
 		}
 	}
-	ss_free(w);
-	ss_free(buf);
+	frame_release(&fh);
 	return err;
 }
 
@@ -294,20 +499,26 @@ int ss_render_field(const struct ss_render_field *f, const struct ss_render_opti
 	}
 	struct ss_render_plan p;
 	if ((err = ss_render_plan_init(&p, o, f->nx, f->ny, f->dx, f->dy, f->cell_type, f->stride,
-	                               zmin, zmax, 1)))
+	                               f->wall_sides, zmin, zmax, 1)))
 		return err;
 	if (ss_render_resampler_is_identity(&p.rs)) {   /* the cells are the pixels */
 		err = ss_render_plan_draw(&p, f->height + (ptrdiff_t)(f->ny - 1) * f->stride,
-		                          -f->stride, f->time, img, 1);
+		                          -f->stride, NULL, NULL, f->time, img, 1);
 		goto out_plan;
 	}
 	double *hw, *w;
+	float *gx = NULL, *gy = NULL;
 	if ((err = alloc_accumulators(&p, &hw, &w)))
 		goto out_plan;
 	ss_render_resample_rows(&p.rs, f->height, f->stride, f->cell_type, f->stride, 0, f->ny,
 	                        hw, w, 1);
 	ss_render_resample_finish(&p.rs, hw, w, 1);
-	err = ss_render_plan_draw(&p, hw, p.rs.width, f->time, img, 1);
+	if (!ss_render_plan_enlarges(&p) ||
+	    !(err = ss_render_plan_gradients(&p, f->height, f->stride, f->cell_type, f->stride,
+	                                     &gx, &gy, 1)))
+		err = ss_render_plan_draw(&p, hw, p.rs.width, gx, gy, f->time, img, 1);
+	ss_free(gx);
+	ss_free(gy);
 	ss_free(w);
 	ss_free(hw);
 out_plan:

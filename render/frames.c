@@ -109,7 +109,8 @@ int ss_render_frames_add(struct ss_render_frames *fr, const char *path, long lon
 		fr->planned = 0;
 		if ((err = series_scale(fr, &s, index, bounds, &zmin, &zmax)) ||
 		    (err = ss_render_plan_init(&fr->plan, &fr->look, s.file.nx, s.file.ny, s.file.dx,
-		                               s.file.dy, s.cell_type, s.file.nx, zmin, zmax, 1)))
+		                               s.file.dy, s.cell_type, s.file.nx, s.file.wall_sides,
+		                               zmin, zmax, 1)))
 			goto out_source;
 		fr->planned = 1;
 	}

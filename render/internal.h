@@ -80,6 +80,11 @@ struct ss_render_raster {
 	const uint8_t *type;        /* enum ss_cell_type, width * height, north first */
 	int step_x, step_y;         /* px between the points of the gradient
 	                             * stencil: one cell (at least one px) */
+	const float *gx, *gy;       /* the gradient per pixel (width * height, north
+	                             * first), or NULL: from h (ss_render_gradient) */
+	double wall_m[4];           /* oblique: thickness of the wall drawn along
+	                             * each side (enum ss_side: west, east, south,
+	                             * north), m; 0: none */
 };
 
 static inline double ss_render_raster_h(const struct ss_render_raster *r, int x, int y)
@@ -87,13 +92,16 @@ static inline double ss_render_raster_h(const struct ss_render_raster *r, int x,
 	return r->h[(ptrdiff_t)y * r->stride + x];
 }
 
-/* Height gradient (dh/dx east, dh/dy north) at pixel (x, y) by Horn's
- * 3 x 3 weighted differences over points step_x, step_y pixels apart; next
- * to a wall, NaN or the edge, the lines that reach one take one-sided
- * differences instead.  Only for pixels with sand.  On a grid enlarged K times the
- * points are a cell apart: differences of the bilinear surface across one
- * cell are the bilinear interpolation of the cells' own differences, so
- * the shading varies smoothly instead of in flat squares per cell. */
+/* Height gradient (dh/dx east, dh/dy north) at pixel (x, y): r->gx, r->gy
+ * when given, else Horn's 3 x 3 weighted differences over points step_x,
+ * step_y pixels apart; next to a wall, NaN or the edge, the lines that
+ * reach one take one-sided differences instead.  Only for pixels with
+ * sand.  A grid enlarged K times gives gx, gy: the cells' own gradients
+ * (step 1 on the cells), interpolated like the heights, so the shading
+ * varies smoothly instead of in flat squares per cell, and the half cell
+ * beyond the last cell centre at an edge or wall, where the interpolated
+ * surface is flat, takes the slope of its cell instead of a band of
+ * different shading (frame.c). */
 void ss_render_gradient(const struct ss_render_raster *r, int x, int y, double *gx,
                         double *gy);
 
@@ -138,12 +146,17 @@ int ss_render_text_width(const char *text, int scale);
  * pictures), clipped to the picture. */
 void ss_render_draw_text(struct ss_render_image *img, int x, int y, int scale,
                          const char *text, const uint8_t rgb[3]);
-/* "t = 12.5 s" on a dark box at the top left. */
+/* Rows of the strip above a pic_w x pic_h picture that holds the label. */
+int ss_render_label_height(int pic_w, int pic_h);
+/* "t = 12.5 s" in the strip: rows 0 .. ss_render_label_height - 1 of img,
+ * white, the text black, so it covers nothing of the picture. */
 void ss_render_draw_label(struct ss_render_image *img, int pic_w, int pic_h, double time);
 /* Width of the colour-bar strip added right of a pic_w x pic_h picture. */
 int ss_render_colorbar_width(int pic_w, int pic_h, double zmin, double zmax);
-/* Draw the colour bar in columns x0 .. img->width - 1. */
-void ss_render_draw_colorbar(struct ss_render_image *img, int x0, int pic_h,
+/* Draw the colour bar in columns x0 .. img->width - 1 beside the picture's
+ * rows y0 .. y0 + pic_h - 1: the bar with a frame, ticks at round heights
+ * outside it, each end labelled. */
+void ss_render_draw_colorbar(struct ss_render_image *img, int x0, int y0, int pic_h,
                              enum ss_render_cmap cmap, double zmin, double zmax);
 
 /* ---- series.c: a sandslide file and its cell types ------------------ */
@@ -173,28 +186,63 @@ int ss_render_source_range(struct ss_render_source *s, long long first, long lon
 int ss_render_scale_resolve(double *zmin, double *zmax, double lo, double hi,
                             const char *what);
 
-/* Everything that is the same for all frames of a series. */
+/*
+ * Everything that is the same for all frames of a series.  A frame is laid
+ * out as
+ *
+ *     +---------------------------+--------+
+ *     | label strip (label_h rows)|        |
+ *     +---------------------------+ colour |
+ *     | wall | map rs.width x     |  bar   |
+ *     | side | rs.height px  ...  |        |
+ *     +---------------------------+--------+
+ *
+ * where the picture (pic_w x pic_h) is the map with a wall drawn outside
+ * each grid side that is a wall (border[side] px; the map styles), or the
+ * oblique view.
+ */
 struct ss_render_plan {
 	struct ss_render_options look;
 	double zmin, zmax;          /* m, resolved */
 	struct ss_render_resampler rs;
 	uint8_t *pixel_type;        /* rs.width * rs.height */
-	int image_w, image_h;       /* the picture with its colour bar */
-	int pic_w, pic_h;           /* the picture without it */
+	int border[4];              /* px of wall outside each side (enum ss_side) */
+	int label_h;                /* rows of the label strip, 0 without label */
+	int image_w, image_h;       /* the whole frame */
+	int pic_w, pic_h;           /* the picture, without label strip and colour bar */
+	double wall_m[4];           /* border[] in m, for the oblique view */
 };
 
 /* Set up a plan for a grid of nx x ny cells (cell_type with stride, NULL:
- * all flow) once zmin and zmax are known. */
+ * all flow; wall_sides: bit 1 << enum ss_side for each wall side) once
+ * zmin and zmax are known. */
 int ss_render_plan_init(struct ss_render_plan *p, const struct ss_render_options *look,
                         int nx, int ny, double dx, double dy, const uint8_t *cell_type,
-                        ptrdiff_t type_stride, double zmin, double zmax, int parallel);
+                        ptrdiff_t type_stride, unsigned wall_sides, double zmin,
+                        double zmax, int parallel);
 void ss_render_plan_release(struct ss_render_plan *p);
 
+/* Whether the plan enlarges the grid, so that frames take their gradients
+ * from the cells (ss_render_plan_gradients). */
+static inline int ss_render_plan_enlarges(const struct ss_render_plan *p)
+{
+	return p->rs.width > p->rs.nx || p->rs.height > p->rs.ny;
+}
+
+/* The cells' gradients (Horn, one-sided at walls and edges) interpolated
+ * onto the pixels like the heights: *gx, *gy (rs.width * rs.height each,
+ * north first; ss_free both).  h and cell_type are the whole grid, south
+ * row first, with strides. */
+int ss_render_plan_gradients(const struct ss_render_plan *p, const double *h,
+                             ptrdiff_t stride, const uint8_t *cell_type,
+                             ptrdiff_t type_stride, float **gx, float **gy, int parallel);
+
 /* Colour the pixel heights (pixel (x, y) at pixel_h[y * stride + x], y = 0
- * north) into img (initialised here), with label and colour bar. */
+ * north; gx, gy from ss_render_plan_gradients or NULL) into img
+ * (initialised here), with the wall sides, label and colour bar. */
 int ss_render_plan_draw(const struct ss_render_plan *p, const double *pixel_h,
-                        ptrdiff_t stride, double time, struct ss_render_image *img,
-                        int parallel);
+                        ptrdiff_t stride, const float *gx, const float *gy, double time,
+                        struct ss_render_image *img, int parallel);
 
 /* Render snapshot t of s to path (parallel: split rows between threads). */
 int ss_render_plan_snapshot(const struct ss_render_plan *p, struct ss_render_source *s,

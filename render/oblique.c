@@ -9,12 +9,19 @@
  *     the colour map and lit like the shaded style (Horn gradient);
  *     vertices on walls take the mean height of their sand neighbours, so
  *     the surface runs under the wall blocks without a step;
- *   - walls: a block per wall pixel, its top 10 % of the height range
- *     above zmax, sides only where the neighbour is not a wall;
+ *   - walls: a block per wall pixel, sides only where the neighbour is
+ *     not a wall, and a block along each grid side that is a wall
+ *     (wall_m thick).  Each wall (a 4-connected set of wall pixels, or a
+ *     grid side) is WALL_RISE of the height range taller than the highest
+ *     sand that touches it in this frame, and never above the scale's top:
+ *     walls as tall as the scale would hide the sand behind them for most
+ *     of a video, while a room fills, and a column among low sand would
+ *     hide what lies behind it;
  *   - a skirt down to a base 8 % of the range below zmin along the edges
  *     of the grid, so the sand reads as a solid slab.
  * Camera: at compass bearing view_azimuth and elevation view_elevation
- * from the centre of the scene's box, far enough that the box's bounding
+ * from the centre of the scene's box (the grid with its wall sides, up to
+ * the scale's top plus WALL_RISE), far enough that the box's bounding
  * sphere fills a 30 degree field of view; the picture frames the projected
  * box.  The framing depends only on the grid and the height scale, so
  * every frame of a series has the same camera.
@@ -35,7 +42,7 @@
 #include "sandslide/grid.h"
 #include "sandslide/parallel.h"
 
-#define WALL_RISE 0.10          /* wall tops above zmax, fraction of the range */
+#define WALL_RISE 0.06          /* wall tops above the sand, fraction of the range */
 #define BASE_DEPTH 0.08         /* slab base below zmin, fraction of the range */
 #define FIELD_OF_VIEW_DEG 30.0
 #define MARGIN 0.03             /* of the picture width, on every side */
@@ -51,7 +58,10 @@ struct camera {
 	double scale;               /* px per unit of projected coordinate */
 	double margin;              /* px */
 	int width, height;          /* px */
-	double z_floor, z_wall;     /* m, scene heights of the base and wall tops */
+	double z_floor, z_wall;     /* m, scene heights of the base and of the
+	                             * highest wall top (the framing) */
+	double z_top;               /* m, the top of the block being drawn */
+	double x0, x1, y0, y1;      /* m, the scene's extent with its wall sides */
 };
 
 static void project(const struct camera *c, double x, double y, double z, double *sx,
@@ -70,12 +80,16 @@ static void project(const struct camera *c, double x, double y, double z, double
 static void camera_init(struct camera *c, const struct ss_render_raster *ra,
                         const struct ss_render_options *o, double zmin, double zmax)
 {
-	const double lx = ra->width * ra->px_dx, ly = ra->height * ra->px_dy;
 	const double range = o->zscale * (zmax - zmin);
 	c->z_floor = -BASE_DEPTH * range;
-	c->z_wall = (1.0 + WALL_RISE) * range;
-	const double cx = 0.5 * lx, cy = 0.5 * ly, cz = 0.5 * (c->z_floor + c->z_wall);
-	const double dz = c->z_wall - c->z_floor;
+	c->z_top = c->z_wall = (1.0 + WALL_RISE) * range;
+	c->x0 = -ra->wall_m[SS_WEST];
+	c->x1 = ra->width * ra->px_dx + ra->wall_m[SS_EAST];
+	c->y0 = -ra->wall_m[SS_SOUTH];
+	c->y1 = ra->height * ra->px_dy + ra->wall_m[SS_NORTH];
+	const double lx = c->x1 - c->x0, ly = c->y1 - c->y0;
+	const double cx = 0.5 * (c->x0 + c->x1), cy = 0.5 * (c->y0 + c->y1);
+	const double cz = 0.5 * (c->z_floor + c->z_wall), dz = c->z_wall - c->z_floor;
 	const double radius = 0.5 * sqrt(lx * lx + ly * ly + dz * dz);
 	const double dist = radius / sin(0.5 * FIELD_OF_VIEW_DEG * M_PI / 180.0);
 	const double az = o->view_azimuth_deg * M_PI / 180.0;
@@ -94,8 +108,8 @@ static void camera_init(struct camera *c, const struct ss_render_raster *ra,
 	double sx0 = INFINITY, sx1 = -INFINITY, sy0 = INFINITY, sy1 = -INFINITY;
 	for (int k = 0; k < 8; k++) {
 		double sx, sy, iz;
-		project(c, k & 1 ? lx : 0.0, k & 2 ? ly : 0.0, k & 4 ? c->z_wall : c->z_floor, &sx,
-		        &sy, &iz);
+		project(c, k & 1 ? c->x1 : c->x0, k & 2 ? c->y1 : c->y0,
+		        k & 4 ? c->z_wall : c->z_floor, &sx, &sy, &iz);
 		sx0 = fmin(sx0, sx), sx1 = fmax(sx1, sx);
 		sy0 = fmin(sy0, sy), sy1 = fmax(sy1, sy);
 	}
@@ -306,27 +320,22 @@ static void draw_skirt(struct target *t, const struct ss_render_raster *r,
 	}
 }
 
-/* A block on wall pixel (x, y): its top, and sides facing non-walls. */
-static void draw_wall(struct target *t, const struct ss_render_raster *r,
-                      const struct camera *c, const struct ss_render_light *light, int x,
-                      int y)
+/* A block over [x0, x1] x [y0, y1] from the base to the frame's wall
+ * tops: its top, and the sides in `sides` (bit s: south, east, north,
+ * west for s = 0..3). */
+static void draw_block(struct target *t, const struct camera *c,
+                       const struct ss_render_light *light, double x0, double x1, double y0,
+                       double y1, unsigned sides)
 {
-	const int W = r->width, H = r->height;
-	const double x0 = x * r->px_dx, x1 = (x + 1) * r->px_dx;
-	const double y1 = (H - y) * r->px_dy, y0 = (H - y - 1) * r->px_dy;   /* north, south */
-	const double zt = c->z_wall, zb = c->z_floor;
-	/* quick reject on the top face's projection, widened by the sides */
-	struct vtx top[4];
+	const double zt = c->z_top, zb = c->z_floor;
+	struct vtx top[4], bot[4];
 	const double bt = face_light(light, 0, 0, 1);
-	top[0] = make_vtx(c, x0, y0, zt, wall_rgb, bt);
-	top[1] = make_vtx(c, x1, y0, zt, wall_rgb, bt);
-	top[2] = make_vtx(c, x1, y1, zt, wall_rgb, bt);
-	top[3] = make_vtx(c, x0, y1, zt, wall_rgb, bt);
-	struct vtx bot[4];
-	bot[0] = make_vtx(c, x0, y0, zb, wall_rgb, 1.0);
-	bot[1] = make_vtx(c, x1, y0, zb, wall_rgb, 1.0);
-	bot[2] = make_vtx(c, x1, y1, zb, wall_rgb, 1.0);
-	bot[3] = make_vtx(c, x0, y1, zb, wall_rgb, 1.0);
+	const double xs[4] = {x0, x1, x1, x0}, ys[4] = {y0, y0, y1, y1};
+	for (int k = 0; k < 4; k++) {
+		top[k] = make_vtx(c, xs[k], ys[k], zt, wall_rgb, bt);
+		bot[k] = make_vtx(c, xs[k], ys[k], zb, wall_rgb, 1.0);
+	}
+	/* quick reject on the projection of the whole block */
 	float lo = top[0].y, hi = top[0].y;
 	for (int k = 0; k < 4; k++) {
 		lo = fminf(lo, fminf(top[k].y, bot[k].y));
@@ -335,13 +344,9 @@ static void draw_wall(struct target *t, const struct ss_render_raster *r,
 	if (outside_band(t, lo, hi))
 		return;
 	draw_quad(t, &top[0], &top[1], &top[2], &top[3]);
-	/* sides: south (0-1), east (1-2), north (2-3), west (3-0) */
-	static const int nb[4][2] = {{0, 1}, {1, 0}, {0, -1}, {-1, 0}};
 	static const double normal[4][2] = {{0, -1}, {1, 0}, {0, 1}, {-1, 0}};
 	for (int s = 0; s < 4; s++) {
-		const int xn = x + nb[s][0], yn = y + nb[s][1];
-		if (xn >= 0 && yn >= 0 && xn < W && yn < H &&
-		    r->type[(size_t)yn * W + xn] == SS_CELL_WALL)
+		if (!(sides & 1u << s))
 			continue;
 		const double b = face_light(light, normal[s][0], normal[s][1], 0.0);
 		struct vtx a = top[s], d = top[(s + 1) & 3], p = bot[(s + 1) & 3], q = bot[s];
@@ -353,9 +358,64 @@ static void draw_wall(struct target *t, const struct ss_render_raster *r,
 	}
 }
 
+/* The tops of the walls of a frame, m: top[label[k]] for wall pixel k,
+ * top[n_walls + side] for the grid sides. */
+struct wall_tops {
+	int *label;                 /* width * height; -1: not a wall */
+	double *top;
+	int n_walls;
+};
+
+/* A block on wall pixel (x, y), with sides facing non-walls. */
+static void draw_wall(struct target *t, const struct ss_render_raster *r, struct camera c,
+                      const struct ss_render_light *light, int x, int y)
+{
+	const int W = r->width, H = r->height;
+	static const int nb[4][2] = {{0, 1}, {1, 0}, {0, -1}, {-1, 0}};   /* S E N W */
+	unsigned sides = 0;
+	for (int s = 0; s < 4; s++) {
+		const int xn = x + nb[s][0], yn = y + nb[s][1];
+		if (!(xn >= 0 && yn >= 0 && xn < W && yn < H &&
+		      r->type[(size_t)yn * W + xn] == SS_CELL_WALL))
+			sides |= 1u << s;
+	}
+	draw_block(t, &c, light, x * r->px_dx, (x + 1) * r->px_dx, (H - y - 1) * r->px_dy,
+	           (H - y) * r->px_dy, sides);
+}
+
+/* The walls along the grid's wall sides.  Their inner faces stand on the
+ * surface's outermost vertices, half a pixel inside the grid, so no gap
+ * shows between them; the west and east ones take the corners. */
+static void draw_wall_sides(struct target *t, const struct ss_render_raster *r,
+                            struct camera c, const struct ss_render_light *light,
+                            const double top[4])
+{
+	const double hx = 0.5 * r->px_dx, hy = 0.5 * r->px_dy;
+	const double lx = r->width * r->px_dx, ly = r->height * r->px_dy;
+	const double *m = r->wall_m;
+	if (m[SS_SOUTH] > 0.0) {
+		c.z_top = top[SS_SOUTH];
+		draw_block(t, &c, light, hx, lx - hx, -m[SS_SOUTH] + hy, hy, 0xf);
+	}
+	if (m[SS_NORTH] > 0.0) {
+		c.z_top = top[SS_NORTH];
+		draw_block(t, &c, light, hx, lx - hx, ly - hy, ly + m[SS_NORTH] - hy, 0xf);
+	}
+	if (m[SS_WEST] > 0.0) {
+		c.z_top = top[SS_WEST];
+		draw_block(t, &c, light, -m[SS_WEST] + hx, hx, -m[SS_SOUTH] + hy,
+		           ly + m[SS_NORTH] - hy, 0xf);
+	}
+	if (m[SS_EAST] > 0.0) {
+		c.z_top = top[SS_EAST];
+		draw_block(t, &c, light, lx - hx, lx + m[SS_EAST] - hx, -m[SS_SOUTH] + hy,
+		           ly + m[SS_NORTH] - hy, 0xf);
+	}
+}
+
 static void draw_band(struct target *t, const struct ss_render_raster *r,
                       const struct camera *c, const struct ss_render_light *light,
-                      const struct vtx *v)
+                      const struct vtx *v, const struct wall_tops *tops)
 {
 	const int W = r->width, H = r->height;
 	for (int y = 0; y + 1 < H; y++)
@@ -369,10 +429,113 @@ static void draw_band(struct target *t, const struct ss_render_raster *r,
 			draw_quad(t, a, b, e, d);
 		}
 	draw_skirt(t, r, c, light, v);
+	struct camera at = *c;
 	for (int y = 0; y < H; y++)
-		for (int x = 0; x < W; x++)
-			if (r->type[(size_t)y * W + x] == SS_CELL_WALL)
-				draw_wall(t, r, c, light, x, y);
+		for (int x = 0; x < W; x++) {
+			const size_t k = (size_t)y * W + x;
+			if (r->type[k] == SS_CELL_WALL) {
+				at.z_top = tops->top[tops->label[k]];
+				draw_wall(t, r, at, light, x, y);
+			}
+		}
+	draw_wall_sides(t, r, at, light, tops->top + tops->n_walls);
+}
+
+static void wall_tops_release(struct wall_tops *w)
+{
+	ss_free(w->label);
+	ss_free(w->top);
+	memset(w, 0, sizeof *w);
+}
+
+/* Raise a top to sand height v (m) if v is sand, finite and higher. */
+static inline void touch(double *top, double v)
+{
+	if (v > *top)   /* NaN is never higher */
+		*top = v;
+}
+
+/*
+ * The walls of a frame and their tops: the 4-connected sets of wall
+ * pixels (a flood fill with a stack), each as tall as the highest sand
+ * among the 8 neighbours of its pixels, the grid sides as the highest sand
+ * along them; then WALL_RISE of the range above that, in scene heights,
+ * at most the framing's top.  Serial: a fill does not split into rows.
+ */
+static int wall_tops_init(struct wall_tops *w, const struct ss_render_raster *r,
+                          const struct ss_render_options *o, const struct camera *c,
+                          double zmin, double zmax)
+{
+	const int W = r->width, H = r->height;
+	const size_t n = (size_t)W * H;
+	memset(w, 0, sizeof *w);
+	int *stack = ss_alloc(n, sizeof *stack, "wall fill stack");
+	w->label = ss_alloc(n, sizeof *w->label, "wall labels");
+	if (!stack || !w->label) {
+		ss_free(stack);
+		wall_tops_release(w);
+		return SS_ERR_FAIL;
+	}
+	for (size_t k = 0; k < n; k++)
+		w->label[k] = -1;
+	for (size_t k = 0; k < n; k++) {
+		if (r->type[k] != SS_CELL_WALL || w->label[k] >= 0)
+			continue;
+		size_t top = 0;
+		stack[top++] = (int)k;
+		w->label[k] = w->n_walls;
+		while (top) {
+			const int m = stack[--top], x = m % W, y = m / W;
+			static const int nb[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
+			for (int d = 0; d < 4; d++) {
+				const int xn = x + nb[d][0], yn = y + nb[d][1];
+				if (xn < 0 || yn < 0 || xn >= W || yn >= H)
+					continue;
+				const size_t q = (size_t)yn * W + xn;
+				if (r->type[q] == SS_CELL_WALL && w->label[q] < 0) {
+					w->label[q] = w->n_walls;
+					stack[top++] = (int)q;
+				}
+			}
+		}
+		w->n_walls++;
+	}
+	ss_free(stack);
+	w->top = ss_alloc((size_t)w->n_walls + 4, sizeof *w->top, "wall tops");
+	if (!w->top) {
+		wall_tops_release(w);
+		return SS_ERR_FAIL;
+	}
+	for (int k = 0; k < w->n_walls + 4; k++)
+		w->top[k] = -INFINITY;
+	for (int y = 0; y < H; y++)
+		for (int x = 0; x < W; x++) {
+			const size_t k = (size_t)y * W + x;
+			if (r->type[k] == SS_CELL_WALL)
+				continue;
+			const double v = ss_render_raster_h(r, x, y);
+			for (int b = -1; b <= 1; b++)
+				for (int a = -1; a <= 1; a++) {
+					const int xn = x + a, yn = y + b;
+					if (xn >= 0 && yn >= 0 && xn < W && yn < H && w->label[(size_t)yn * W + xn] >= 0)
+						touch(&w->top[w->label[(size_t)yn * W + xn]], v);
+				}
+			double *side = w->top + w->n_walls;   /* rows run south, so y = 0 is north */
+			if (x == 0)
+				touch(&side[SS_WEST], v);
+			if (x == W - 1)
+				touch(&side[SS_EAST], v);
+			if (y == H - 1)
+				touch(&side[SS_SOUTH], v);
+			if (y == 0)
+				touch(&side[SS_NORTH], v);
+		}
+	const double range = o->zscale * (zmax - zmin);
+	for (int k = 0; k < w->n_walls + 4; k++) {
+		const double h = isfinite(w->top[k]) ? fmax(fmin(w->top[k], zmax), zmin) : zmin;
+		w->top[k] = fmin(o->zscale * (h - zmin) + WALL_RISE * range, c->z_wall);
+	}
+	return SS_OK;
 }
 
 int ss_render_oblique(const struct ss_render_raster *r, const struct ss_render_options *o,
@@ -384,11 +547,15 @@ int ss_render_oblique(const struct ss_render_raster *r, const struct ss_render_o
 		SS_BUG("oblique picture %d x %d, camera %d x %d", img->width, img->height, c.width,
 		       c.height);
 	const size_t n = (size_t)r->width * r->height;
+	struct wall_tops tops;
+	if (wall_tops_init(&tops, r, o, &c, zmin, zmax))
+		return SS_ERR_FAIL;
 	struct vtx *v = ss_alloc(n, sizeof *v, "oblique vertices");
 	float *depth = ss_alloc((size_t)img->width * img->height, sizeof *depth, "depth buffer");
 	if (!v || !depth) {
 		ss_free(v);
 		ss_free(depth);
+		wall_tops_release(&tops);
 		return SS_ERR_FAIL;
 	}
 	for (int y = 0; y < img->height; y++)   /* the sky */
@@ -408,9 +575,10 @@ int ss_render_oblique(const struct ss_render_raster *r, const struct ss_render_o
 		if (t.y1 > img->height)
 			t.y1 = img->height;
 		if (t.y0 < t.y1)
-			draw_band(&t, r, &c, &light, v);
+			draw_band(&t, r, &c, &light, v, &tops);
 	}
 	ss_free(depth);
 	ss_free(v);
+	wall_tops_release(&tops);
 	return SS_OK;
 }

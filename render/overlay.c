@@ -119,28 +119,22 @@ void ss_render_draw_text(struct ss_render_image *img, int x, int y, int scale,
 	}
 }
 
-/* Darken a box to `keep` of its colour, so light text on it reads over
- * any map colour. */
-static void darken_box(struct ss_render_image *img, int x0, int y0, int x1, int y1,
-                       double keep)
+/* The label strip: a line of text with 2 font pixels above and below. */
+int ss_render_label_height(int pic_w, int pic_h)
 {
-	for (int y = y0 < 0 ? 0 : y0; y < y1 && y < img->height; y++)
-		for (int x = x0 < 0 ? 0 : x0; x < x1 && x < img->width; x++) {
-			uint8_t *p = img->pixels + (size_t)y * img->row_bytes + 3 * (size_t)x;
-			for (int c = 0; c < 3; c++)
-				p[c] = (uint8_t)(p[c] * keep + 0.5);
-		}
+	return (GLYPH_H + 4) * ss_render_font_scale(pic_w, pic_h);
 }
 
 void ss_render_draw_label(struct ss_render_image *img, int pic_w, int pic_h, double time)
 {
-	const int k = ss_render_font_scale(pic_w, pic_h), pad = 2 * k;
+	const int k = ss_render_font_scale(pic_w, pic_h);
+	static const uint8_t black[3] = {0, 0, 0};
 	char text[64];
 	snprintf(text, sizeof text, "t = %g s", time);
-	const int w = ss_render_text_width(text, k), h = GLYPH_H * k;
-	static const uint8_t white[3] = {255, 255, 255};
-	darken_box(img, pad, pad, pad + w + 2 * pad, pad + h + 2 * pad, 0.35);
-	ss_render_draw_text(img, 2 * pad, 2 * pad, k, text, white);
+	for (int y = 0; y < ss_render_label_height(pic_w, pic_h) && y < img->height; y++)
+		memset(img->pixels + (size_t)y * img->row_bytes, SS_RENDER_BACKGROUND,
+		       3 * (size_t)(pic_w < img->width ? pic_w : img->width));
+	ss_render_draw_text(img, 2 * k, 2 * k, k, text, black);
 }
 
 void ss_render_format_height(double z, double step, char *out, size_t size)
@@ -164,9 +158,24 @@ static double tick_step(double zmin, double zmax)
 	return (n < 1.5 ? 1.0 : n < 3.5 ? 2.0 : n < 7.5 ? 5.0 : 10.0) * mag;
 }
 
-/* Layout of the strip, in multiples of the font scale k. */
+/* An end of the scale that is not a tick is labelled one digit finer
+ * than the ticks ("0.80" at the top of ticks 0.0 .. 0.6). */
+static void end_label(double z, double step, char *out, size_t size)
+{
+	const double q = z / step;
+	ss_render_format_height(z, fabs(q - round(q)) < 1e-9 ? step : step / 10.0, out, size);
+}
+
+/*
+ * Layout of the strip, in multiples of the font scale k:
+ *
+ *     margin | bar (framed) | tick | gap | labels | margin
+ *
+ * The ticks stick out of the bar's frame, and a gap of 4 k separates them
+ * from the labels, so a tick never reads as a minus sign.
+ */
 struct bar_layout {
-	int k, margin, bar_w, text_w;
+	int k, margin, bar_w, tick, gap, text_w;
 };
 
 static struct bar_layout bar_layout(int pic_w, int pic_h, double zmin, double zmax)
@@ -175,14 +184,18 @@ static struct bar_layout bar_layout(int pic_w, int pic_h, double zmin, double zm
 	l.k = ss_render_font_scale(pic_w, pic_h);
 	l.margin = 4 * l.k;
 	l.bar_w = 5 * l.k;
+	l.tick = 2 * l.k;
+	l.gap = 4 * l.k;
 	l.text_w = ss_render_text_width("m", l.k);
 	const double step = tick_step(zmin, zmax);
+	char s[32];
 	for (double z = ceil(zmin / step - 1e-9) * step; z <= zmax + 1e-9 * step; z += step) {
-		char s[32];
 		ss_render_format_height(z, step, s, sizeof s);
-		const int w = ss_render_text_width(s, l.k);
-		if (w > l.text_w)
-			l.text_w = w;
+		l.text_w = fmax(l.text_w, ss_render_text_width(s, l.k));
+	}
+	for (int end = 0; end < 2; end++) {
+		end_label(end ? zmax : zmin, step, s, sizeof s);
+		l.text_w = fmax(l.text_w, ss_render_text_width(s, l.k));
 	}
 	return l;
 }
@@ -190,10 +203,19 @@ static struct bar_layout bar_layout(int pic_w, int pic_h, double zmin, double zm
 int ss_render_colorbar_width(int pic_w, int pic_h, double zmin, double zmax)
 {
 	const struct bar_layout l = bar_layout(pic_w, pic_h, zmin, zmax);
-	return 3 * l.margin + l.bar_w + 2 * l.k + l.text_w;
+	return 2 * l.margin + l.bar_w + l.tick + l.gap + l.text_w;
 }
 
-void ss_render_draw_colorbar(struct ss_render_image *img, int x0, int pic_h,
+/* Fill the box [x0, x1) x [y0, y1) with rgb. */
+static void fill(struct ss_render_image *img, int x0, int y0, int x1, int y1,
+                 const uint8_t rgb[3])
+{
+	for (int y = y0; y < y1; y++)
+		for (int x = x0; x < x1; x++)
+			put(img, x, y, rgb);
+}
+
+void ss_render_draw_colorbar(struct ss_render_image *img, int x0, int y0, int pic_h,
                              enum ss_render_cmap cmap, double zmin, double zmax)
 {
 	const struct bar_layout l = bar_layout(x0, pic_h, zmin, zmax);
@@ -205,26 +227,38 @@ void ss_render_draw_colorbar(struct ss_render_image *img, int x0, int pic_h,
 		memset(img->pixels + (size_t)y * img->row_bytes + 3 * (size_t)x0,
 		       SS_RENDER_BACKGROUND, 3 * (size_t)(img->width - x0));
 
-	const int bx = x0 + l.margin, top = 2 * l.margin + GLYPH_H * l.k;
-	const int bottom = pic_h - l.margin - GLYPH_H * l.k / 2 - 1;
-	if (bottom - top < 2)
+	const int k = l.k, line = (k + 1) / 2, text_h = GLYPH_H * k;
+	const int bx = x0 + l.margin, top = y0 + 2 * l.margin + text_h;
+	const int bottom = y0 + pic_h - l.margin - text_h / 2 - 1;
+	if (bottom - top < 2 * text_h)
 		return;   /* a picture too small for a bar */
-	ss_render_draw_text(img, bx, l.margin, l.k, "m", black);
+	ss_render_draw_text(img, bx, y0 + l.margin, k, "m", black);
 	for (int y = top; y <= bottom; y++) {
 		const double z = zmax - (double)(y - top) / (bottom - top) * (zmax - zmin);
-		const uint8_t *c = lut[ss_render_cmap_index(z, zmin, zmax)];
-		for (int x = bx; x < bx + l.bar_w; x++)
-			put(img, x, y, c);
+		fill(img, bx, y, bx + l.bar_w, y + 1, lut[ss_render_cmap_index(z, zmin, zmax)]);
 	}
+	/* the frame: one line round the bar */
+	fill(img, bx - line, top - line, bx + l.bar_w + line, top, black);
+	fill(img, bx - line, bottom + 1, bx + l.bar_w + line, bottom + 1 + line, black);
+	fill(img, bx - line, top, bx, bottom + 1, black);
+	fill(img, bx + l.bar_w, top, bx + l.bar_w + line, bottom + 1, black);
+
+	const int tick_x0 = bx + l.bar_w + line, text_x = tick_x0 + l.tick + l.gap;
 	const double step = tick_step(zmin, zmax);
+	char s[32];
+	/* the ends, then the ticks between that leave room for their labels */
+	for (int end = 0; end < 2; end++) {
+		const int y = end ? top : bottom;
+		end_label(end ? zmax : zmin, step, s, sizeof s);
+		fill(img, tick_x0, y - line / 2, tick_x0 + l.tick, y - line / 2 + line, black);
+		ss_render_draw_text(img, text_x, y - text_h / 2, k, s, black);
+	}
 	for (double z = ceil(zmin / step - 1e-9) * step; z <= zmax + 1e-9 * step; z += step) {
 		const int y = top + (int)lround((zmax - z) / (zmax - zmin) * (bottom - top));
-		char s[32];
+		if (y - top < text_h + 2 * k || bottom - y < text_h + 2 * k)
+			continue;   /* an end's label is there */
 		ss_render_format_height(z, step, s, sizeof s);
-		for (int x = bx + l.bar_w; x < bx + l.bar_w + l.k + 1; x++)
-			for (int v = 0; v < (l.k + 1) / 2; v++)
-				put(img, x, y + v, black);
-		ss_render_draw_text(img, bx + l.bar_w + 2 * l.k + l.margin / 2, y - GLYPH_H * l.k / 2,
-		                    l.k, s, black);
+		fill(img, tick_x0, y - line / 2, tick_x0 + l.tick, y - line / 2 + line, black);
+		ss_render_draw_text(img, text_x, y - text_h / 2, k, s, black);
 	}
 }

@@ -192,6 +192,34 @@ static int check_video_path(const char *video)
 	return SS_OK;
 }
 
+/* Without force, nothing that exists is replaced: not the frames about
+ * to be written (frame_00000.png .. of the n chosen) nor the video. */
+static int check_not_there(const struct ss_render_series_options *o, long long n)
+{
+	if (o->force)
+		return SS_OK;
+	long long first = -1, there = 0;
+	char path[4200];
+	for (long long k = 0; k < n; k++) {
+		ss_render_frame_path(o->output_dir, k, path, sizeof path);
+		if (access(path, F_OK) == 0) {
+			there++;
+			first = first < 0 ? k : first;
+		}
+	}
+	ss_render_frame_path(o->output_dir, first, path, sizeof path);
+	if (there == 1)
+		return ss_error_input("'%s' exists: give --force to replace it, or -o another "
+		                      "folder", path);
+	if (there)
+		return ss_error_input("'%s' exists, and %lld more of the %lld frames to write: give "
+		                      "--force to replace them, or -o another folder", path,
+		                      there - 1, n);
+	if (o->video && access(o->video, F_OK) == 0)
+		return ss_error_input("'%s' exists: give --force to replace it", o->video);
+	return SS_OK;
+}
+
 /* The chosen snapshots, in time order. */
 static int select_frames(const struct ss_render_series_options *o,
                          const struct ss_render_source *s, long long **sel, long long *n)
@@ -292,12 +320,12 @@ int ss_render_series(const struct ss_render_series_options *o,
 	}
 	if ((err = select_frames(o, &s, &sel, &n)) ||
 	    (err = ss_render_check_dir(o->output_dir, 0)) ||
-	    (o->video && (err = check_video_path(o->video))) ||
+	    (o->video && (err = check_video_path(o->video))) || (err = check_not_there(o, n)) ||
 	    (err = series_scale(o, &s, &zmin, &zmax)))
 		goto out_source;
 	struct ss_render_plan plan;
 	if ((err = ss_render_plan_init(&plan, &o->look, s.file.nx, s.file.ny, s.file.dx, s.file.dy,
-	                               s.cell_type, s.file.nx, zmin, zmax, 1)))
+	                               s.cell_type, s.file.nx, s.file.wall_sides, zmin, zmax, 1)))
 		goto out_source;
 	if ((err = ss_render_check_dir(o->output_dir, 1)))
 		goto out_plan;

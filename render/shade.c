@@ -116,6 +116,12 @@ static inline int gradient_inside(const struct ss_render_raster *r, int x, int y
 void ss_render_gradient(const struct ss_render_raster *r, int x, int y, double *gx,
                         double *gy)
 {
+	if (r->gx) {
+		const size_t k = (size_t)y * r->width + x;
+		*gx = r->gx[k];
+		*gy = r->gy[k];
+		return;
+	}
 	if (gradient_inside(r, x, y, gx, gy))
 		return;
 	/* pixel rows run east, pixel columns south: north is -y */

@@ -16,6 +16,7 @@
 
 #include <png.h>
 
+#include "sandslide/boundary.h"
 #include "sandslide/error.h"
 #include "sandslide/grid.h"
 #include "sandslide/parallel.h"
@@ -36,7 +37,7 @@ static void field_init(struct field *t, int nx, int ny)
 {
 	t->h = calloc((size_t)nx * ny, sizeof *t->h);
 	t->type = calloc((size_t)nx * ny, 1);
-	t->f = (struct ss_render_field){nx, ny, 0.01, 0.01, nx, t->h, t->type, 12.5};
+	t->f = (struct ss_render_field){nx, ny, 0.01, 0.01, nx, t->h, t->type, 12.5, 0};
 }
 
 static void field_release(struct field *t)
@@ -496,7 +497,15 @@ static void test_contours(void)
 	field_release(&t);
 }
 
-/* The time label and the colour bar are drawn, in their places. */
+static int is_rgb(const uint8_t *p, int r, int g, int b)
+{
+	return p[0] == r && p[1] == g && p[2] == b;
+}
+
+/* The time label sits in a white strip above the map, so it covers none
+ * of it; the colour bar is framed, its ticks stand clear of their labels
+ * (a tick that touches a label reads as a minus sign) and both its ends
+ * are labelled. */
 static void test_label_and_colorbar(void)
 {
 	struct field t;
@@ -506,44 +515,170 @@ static void test_label_and_colorbar(void)
 	struct ss_render_options o;
 	ss_render_options_default(&o);
 	o.zmin = 0.0;
-	o.zmax = 1.0;
+	o.zmax = 0.797;
 	struct ss_render_image plain, labelled;
 	CHECK(ss_render_field(&t.f, &o, &plain) == SS_OK, "render");
 	o.label = 1;
 	CHECK(ss_render_field(&t.f, &o, &labelled) == SS_OK, "render");
-	int inside = 0, outside = 0;
-	for (int y = 0; y < plain.height; y++)
-		for (int x = 0; x < plain.width; x++) {
-			const int changed = memcmp(rgb_at(&plain, x, y), rgb_at(&labelled, x, y), 3) != 0;
-			if (x < plain.width / 2 && y < plain.height / 8)
-				inside += changed;
-			else
-				outside += changed;
+	const int strip = labelled.height - plain.height;
+	CHECK(labelled.width == plain.width && strip > 7,
+	      "the label adds a strip of rows above the map: %d x %d -> %d x %d", plain.width,
+	      plain.height, labelled.width, labelled.height);
+	int map_same = strip > 0;
+	for (int y = 0; y < plain.height && map_same; y++)
+		map_same &= !memcmp(rgb_at(&plain, 0, y), rgb_at(&labelled, 0, y + strip),
+		                    3 * (size_t)plain.width);
+	CHECK(map_same, "the label covers no pixel of the map");
+	int black = 0, white = 0, other = 0;
+	for (int y = 0; y < strip; y++)
+		for (int x = 0; x < labelled.width; x++) {
+			const uint8_t *p = rgb_at(&labelled, x, y);
+			black += is_rgb(p, 0, 0, 0);
+			white += is_rgb(p, 255, 255, 255);
+			other += !is_rgb(p, 0, 0, 0) && !is_rgb(p, 255, 255, 255);
 		}
-	CHECK(inside > 500 && outside == 0, "label in the top-left corner only: %d in, %d out",
-	      inside, outside);
+	CHECK(black > 100 && white > black && other == 0,
+	      "the strip is black text on white: %d black, %d white, %d other", black, white,
+	      other);
 	ss_render_image_release(&labelled);
 
 	o.label = 0;
 	o.colorbar = 1;
 	struct ss_render_image bar;
 	CHECK(ss_render_field(&t.f, &o, &bar) == SS_OK, "render");
-	int map_same = 1;
-	for (int y = 0; y < plain.height; y++)
+	map_same = bar.height == plain.height;
+	for (int y = 0; y < plain.height && map_same; y++)
 		map_same &= !memcmp(rgb_at(&plain, 0, y), rgb_at(&bar, 0, y), 3 * (size_t)plain.width);
 	CHECK(map_same, "the bar leaves the map as it was");
 	/* the bar's colours run from the top of the map (top) to its bottom */
 	uint8_t lut[256][3];
 	ss_render_cmap_table(o.cmap, lut);
-	int found_top = 0, found_bottom = 0;
+	int top = -1, bottom = -1, bar_x0 = -1, bar_x1 = -1;
 	for (int y = 0; y < bar.height; y++)
 		for (int x = plain.width; x < bar.width; x++) {
-			found_top |= y < bar.height / 4 && !memcmp(rgb_at(&bar, x, y), lut[255], 3);
-			found_bottom |= y > 3 * bar.height / 4 && !memcmp(rgb_at(&bar, x, y), lut[0], 3);
+			if (!memcmp(rgb_at(&bar, x, y), lut[255], 3) && top < 0)
+				top = y, bar_x0 = x;
+			if (!memcmp(rgb_at(&bar, x, y), lut[0], 3))
+				bottom = y;
 		}
-	CHECK(found_top && found_bottom, "zmax's colour at the top, zmin's at the bottom");
+	CHECK(top >= 0 && top < bar.height / 4 && bottom > 3 * bar.height / 4,
+	      "zmax's colour at the top (row %d), zmin's at the bottom (row %d)", top, bottom);
+	if (top < 0 || bottom < 0)
+		goto out;
+	for (bar_x1 = bar_x0; bar_x1 < bar.width && !memcmp(rgb_at(&bar, bar_x1, top), lut[255], 3);
+	     bar_x1++)
+		;
+	CHECK(is_rgb(rgb_at(&bar, bar_x0 - 1, (top + bottom) / 2), 0, 0, 0) &&
+	      is_rgb(rgb_at(&bar, bar_x1, (top + bottom) / 2), 0, 0, 0) &&
+	      is_rgb(rgb_at(&bar, (bar_x0 + bar_x1) / 2, top - 1), 0, 0, 0) &&
+	      is_rgb(rgb_at(&bar, (bar_x0 + bar_x1) / 2, bottom + 1), 0, 0, 0),
+	      "a black frame round the bar");
+	/* Right of the frame, in each row: a tick (black run from the frame),
+	 * a white gap of at least 3 px, then the label's first pixels. */
+	int ticks = 0, close = 0, labelled_top = 0, labelled_bottom = 0;
+	for (int y = top - 1; y <= bottom + 1; y++) {
+		int x = bar_x1 + 1;
+		if (!is_rgb(rgb_at(&bar, x, y), 0, 0, 0))
+			continue;
+		ticks++;
+		while (x < bar.width && is_rgb(rgb_at(&bar, x, y), 0, 0, 0))
+			x++;
+		const int gap0 = x;
+		while (x < bar.width && is_rgb(rgb_at(&bar, x, y), 255, 255, 255))
+			x++;
+		close += x < bar.width && x - gap0 < 3;
+	}
+	for (int y = 0; y < bar.height; y++)
+		for (int x = bar_x1 + 4; x < bar.width; x++)
+			if (is_rgb(rgb_at(&bar, x, y), 0, 0, 0)) {
+				labelled_top |= abs(y - top) <= 3;
+				labelled_bottom |= abs(y - bottom) <= 3;
+			}
+	CHECK(ticks >= 3 && close == 0, "%d tick rows, %d closer than 3 px to their label",
+	      ticks, close);
+	CHECK(labelled_top && labelled_bottom, "both ends labelled: top %d, bottom %d",
+	      labelled_top, labelled_bottom);
+out:
 	ss_render_image_release(&bar);
 	ss_render_image_release(&plain);
+	field_release(&t);
+}
+
+/* A grid side that is a wall is drawn as one, outside the map, in the
+ * walls' colour; the map itself is the same pixels. */
+static void test_wall_sides_drawn(void)
+{
+	struct field t;
+	field_init(&t, 60, 40);
+	for (int j = 0; j < 40; j++)
+		for (int i = 0; i < 60; i++)
+			*H(&t, i, j) = 0.01 * i + 0.002 * j;
+	struct ss_render_options o;
+	ss_render_options_default(&o);
+	struct ss_render_image open, walled;
+	CHECK(ss_render_field(&t.f, &o, &open) == SS_OK, "render");
+	t.f.wall_sides = 1u << SS_WEST | 1u << SS_NORTH;
+	CHECK(ss_render_field(&t.f, &o, &walled) == SS_OK, "render");
+	const int bw = walled.width - open.width, bn = walled.height - open.height;
+	CHECK(bw >= 9 && bw == bn, "a wall of at least a cell (9 px) west and north: %d, %d", bw,
+	      bn);
+	int wall = 1, same = 1;
+	for (int y = 0; y < walled.height; y++)
+		for (int x = 0; x < walled.width; x++) {
+			const uint8_t *p = rgb_at(&walled, x, y);
+			if (x < bw || y < bn)
+				wall &= is_rgb(p, SS_RENDER_WALL_RGB);
+			else
+				same &= !memcmp(p, rgb_at(&open, x - bw, y - bn), 3);
+		}
+	CHECK(wall, "the west and north strips are wall coloured");
+	CHECK(same, "the map is the same pixels beside them");
+	ss_render_image_release(&open);
+	ss_render_image_release(&walled);
+	field_release(&t);
+}
+
+/* A plane with walls inside and along its sides shades as one face: no
+ * band of other brightness along the edges or the walls, enlarged (the
+ * half cell beyond the last cell centre) or one pixel per cell.  The
+ * height scale lies below the plane, so every sand pixel has the map's
+ * top colour and differs only by its shading. */
+static void test_no_shading_band(void)
+{
+	struct field t;
+	field_init(&t, 30, 20);
+	for (int j = 0; j < 20; j++)
+		for (int i = 0; i < 30; i++) {
+			*H(&t, i, j) = 1.0 + 0.02 * i - 0.013 * j;
+			if (i >= 12 && i < 16 && j >= 5 && j < 14)
+				*T(&t, i, j) = SS_CELL_WALL;
+		}
+	t.f.wall_sides = 1u << SS_WEST | 1u << SS_NORTH;
+	struct ss_render_options o;
+	ss_render_options_default(&o);
+	o.zmin = -2.0;
+	o.zmax = -1.0;
+	for (int scale = 1; scale <= 7; scale += 6) {
+		o.scale = scale;
+		struct ss_render_image img;
+		CHECK(ss_render_field(&t.f, &o, &img) == SS_OK, "render");
+		uint8_t first[3] = {0, 0, 0};
+		int n = 0, differ = 0, worst = 0;
+		for (int y = 0; y < img.height; y++)
+			for (int x = 0; x < img.width; x++) {
+				const uint8_t *p = rgb_at(&img, x, y);
+				if (is_rgb(p, SS_RENDER_WALL_RGB))
+					continue;
+				if (!n++)
+					memcpy(first, p, 3);
+				const int d = abs(p[0] - first[0]) + abs(p[1] - first[1]) + abs(p[2] - first[2]);
+				differ += d > 1;
+				worst = d > worst ? d : worst;
+			}
+		CHECK(n > 500 && differ == 0, "%d px a cell: %d of %d sand pixels shade differently "
+		      "(by up to %d levels)", scale, differ, n, worst);
+		ss_render_image_release(&img);
+	}
 	field_release(&t);
 }
 
@@ -634,6 +769,79 @@ static void test_oblique_block(void)
 	field_release(&flat);
 	field_release(&block);
 	field_release(&wall);
+}
+
+/* Walls are drawn a little taller than the sand beside them, not as tall
+ * as the scale: a wall block among sand at 0.1 m of a 0 .. 1 m scale
+ * (with a pile of 0.9 m in a far corner) seen from the south at 45
+ * degrees changes a region about as tall as it is wide: its top and a
+ * side 0.06 m tall.  Up to the scale's top (1.06 m) it would be six times
+ * taller than wide. */
+static void test_oblique_walls_follow_sand(void)
+{
+	struct ss_render_options o;
+	ss_render_options_default(&o);
+	o.style = SS_RENDER_OBLIQUE;
+	o.zmin = 0.0;
+	o.zmax = 1.0;
+	o.view_azimuth_deg = 180.0;
+	o.view_elevation_deg = 45.0;
+	struct field bare, walled;
+	field_init(&bare, 60, 60);
+	field_init(&walled, 60, 60);
+	for (int j = 0; j < 60; j++)
+		for (int i = 0; i < 60; i++) {
+			*H(&bare, i, j) = *H(&walled, i, j) = i >= 52 && j >= 52 ? 0.9 : 0.1;
+			if (i >= 25 && i < 35 && j >= 20 && j < 30)
+				*T(&walled, i, j) = SS_CELL_WALL;
+		}
+	struct ss_render_image a, b;
+	CHECK(ss_render_field(&bare.f, &o, &a) == SS_OK &&
+	      ss_render_field(&walled.f, &o, &b) == SS_OK, "render");
+	int x0 = a.width, x1 = -1, y0 = a.height, y1 = -1;
+	for (int y = 0; y < a.height; y++)
+		for (int x = 0; x < a.width; x++)
+			if (memcmp(rgb_at(&a, x, y), rgb_at(&b, x, y), 3)) {
+				x0 = x < x0 ? x : x0, x1 = x > x1 ? x : x1;
+				y0 = y < y0 ? y : y0, y1 = y > y1 ? y : y1;
+			}
+	CHECK(x1 > x0 && y1 - y0 < 2 * (x1 - x0),
+	      "the wall block changes %d rows of %d columns: a low wall", y1 - y0 + 1, x1 - x0 + 1);
+	ss_render_image_release(&a);
+	ss_render_image_release(&b);
+	field_release(&bare);
+	field_release(&walled);
+}
+
+/* Without --view-azimuth the camera looks from the open side: walls on
+ * the west put it east-south-east (120), on the east west-north-west
+ * (300); with no walls, 200 as before. */
+static void test_oblique_view_from_open_side(void)
+{
+	struct field t;
+	field_init(&t, 40, 30);
+	for (int j = 0; j < 30; j++)
+		for (int i = 0; i < 40; i++)
+			*H(&t, i, j) = 0.1 + 0.004 * i + 0.002 * j;
+	struct ss_render_options o;
+	ss_render_options_default(&o);
+	o.style = SS_RENDER_OBLIQUE;
+	const unsigned sides[3] = {1u << SS_WEST, 1u << SS_EAST, 0};
+	const double bearing[3] = {120.0, 300.0, 200.0};
+	for (int k = 0; k < 3; k++) {
+		t.f.wall_sides = sides[k];
+		struct ss_render_options given = o;
+		given.view_azimuth_deg = bearing[k];
+		struct ss_render_image a, b;
+		CHECK(ss_render_field(&t.f, &o, &a) == SS_OK && ss_render_field(&t.f, &given, &b) ==
+		      SS_OK, "render");
+		CHECK(a.width == b.width && a.height == b.height &&
+		      !memcmp(a.pixels, b.pixels, a.row_bytes * a.height),
+		      "wall sides 0x%x: the default view is from %g degrees", sides[k], bearing[k]);
+		ss_render_image_release(&a);
+		ss_render_image_release(&b);
+	}
+	field_release(&t);
 }
 
 /* ---- the colour map and the options ----------------------------------- */
@@ -728,7 +936,11 @@ int main(void)
 	RUN(test_picture_sizes);
 	RUN(test_contours);
 	RUN(test_label_and_colorbar);
+	RUN(test_wall_sides_drawn);
+	RUN(test_no_shading_band);
 	RUN(test_oblique_block);
+	RUN(test_oblique_walls_follow_sand);
+	RUN(test_oblique_view_from_open_side);
 	RUN(test_dune_lightness_linear);
 	RUN(test_bad_options);
 	RUN(test_write_failure_leaves_nothing);

@@ -63,8 +63,9 @@ struct ss_render_options {
 	int scale;                  /* px per cell; 0: 1 for gray16, otherwise the
 	                             * smallest giving a side of at least 512 px */
 	double view_azimuth_deg;    /* oblique: camera's compass bearing from the
-	                             * centre of the grid (200: south-south-west) */
-	double view_elevation_deg;  /* oblique: camera above the horizon, (0, 90) (45) */
+	                             * centre of the grid; NAN (default): from the
+	                             * open side, away from the walls */
+	double view_elevation_deg;  /* oblique: camera above the horizon, (0, 90) (55) */
 	int compression;            /* zlib level of the PNG, 0..9 (6) */
 };
 
@@ -95,6 +96,8 @@ struct ss_render_field {
 	const uint8_t *cell_type;   /* enum ss_cell_type (grid.h), same layout;
 	                             * NULL: every cell is a flow cell */
 	double time;                /* s */
+	unsigned wall_sides;        /* bit 1 << enum ss_side (boundary.h) for each
+	                             * grid side that is a wall, drawn as one */
 };
 
 /* A picture: rows from the top (north), samples interleaved. */
@@ -148,6 +151,8 @@ struct ss_render_series_options {
 	double time;                /* s: the snapshot nearest this; NAN: unused */
 	const char *video;          /* FILE.mp4 to assemble with ffmpeg, or NULL */
 	int fps;                    /* frames per second of the video (24) */
+	int force;                  /* replace frames and a video that exist;
+	                             * else SS_ERR_INPUT before anything is written */
 	struct ss_render_options look;
 };
 
@@ -178,7 +183,8 @@ struct ss_render_series_report {
  * ffmpeg on PATH the frames are kept, and that is success).  Everything is
  * checked before the first frame is written.  Returns SS_OK (*report
  * filled), SS_ERR_INPUT (not a sandslide file, no snapshots, a range
- * outside the series, an unwritable folder, zmin >= zmax) or SS_ERR_FAIL.
+ * outside the series, an unwritable folder, zmin >= zmax, frames or the
+ * video there already without force) or SS_ERR_FAIL.
  */
 int ss_render_series(const struct ss_render_series_options *o,
                      struct ss_render_series_report *report);

@@ -129,10 +129,11 @@ static const struct cli_option look_options[] = {
 	NUMBER("--azimuth", "DEG", azimuth_deg,
 	       "light from this compass bearing (default 315: north-west)"),
 	NUMBER("--altitude", "DEG", altitude_deg, "light above the horizon (default 45)"),
-	NUMBER("--zscale", "S", zscale, "vertical exaggeration of shading and view (default 1)"),
+	NUMBER("--zscale", "S", zscale, "vertical exaggeration of shading and of the oblique\n"
+	                                "view (default 1)"),
 	NUMBER("--contour", "DZ", contour, "contour lines every DZ m (shaded)"),
 	{.name = "--label", .kind = CLI_FLAG, .offset = LOOK(label),
-	 .help = "draw the simulated time on each frame"},
+	 .help = "the simulated time in a strip above each frame"},
 	{.name = "--colorbar", .kind = CLI_FLAG, .offset = LOOK(colorbar),
 	 .help = "add a colour bar with the height scale"},
 	{.name = "--max-size", .value = "PX", .kind = CLI_INT, .offset = LOOK(max_size),
@@ -143,9 +144,10 @@ static const struct cli_option look_options[] = {
 	 .help = "K pixels per cell (default 1 for gray16, otherwise\n"
 	         "enough for a side of 512 px)"},
 	NUMBER("--view-azimuth", "DEG", view_azimuth_deg,
-	       "oblique: the camera's bearing from the centre (200)"),
+	       "oblique: the camera's bearing from the centre (default:\n"
+	       "from the open side, away from the walls)"),
 	NUMBER("--view-elevation", "DEG", view_elevation_deg,
-	       "oblique: the camera above the horizon (45)"),
+	       "oblique: the camera above the horizon (55)"),
 	{.name = "--compression", .value = "N", .kind = CLI_INT, .offset = LOOK(compression),
 	 .lo = 0, .hi = 9, .expected = "0 to 9",
 	 .help = "zlib level of the PNGs, 0 to 9 (default 6)"},
@@ -459,7 +461,7 @@ static int cmd_relax(int argc, char **argv)
 
 struct render_args {
 	struct ss_render_series_options o;
-	int threads, quiet, bench, bench_n;
+	int threads, quiet, bench, bench_n, no_label, no_colorbar;
 };
 
 #define RENDER(m) offsetof(struct render_args, m)
@@ -478,6 +480,11 @@ static const struct cli_option render_options[] = {
 	         "is on PATH; without it the frames are kept"},
 	{.name = "--fps", .value = "N", .kind = CLI_INT, .offset = RENDER(o.fps), .lo = 1,
 	 .hi = 240, .expected = "1 to 240", .help = "frames per second of the video (default 24)"},
+	{.name = "--no-label", .kind = CLI_FLAG, .offset = RENDER(no_label),
+	 .help = "no time label on a video's frames (--video draws one)"},
+	{.name = "--no-colorbar", .kind = CLI_FLAG, .offset = RENDER(no_colorbar),
+	 .help = "no colour bar on a video's frames (--video adds one)"},
+	FORCE(RENDER(o.force), "replace existing frames and video (else refused)"),
 	THREADS(RENDER(threads)),
 	QUIET(RENDER(quiet), "no summary"),
 	{.name = "--bench", .value = "[N]", .kind = CLI_OPTIONAL_INT, .offset = RENDER(bench),
@@ -516,6 +523,15 @@ static int cmd_render(int argc, char **argv)
 	}
 	if (!a.o.input)
 		return cli_usage_error(&cmd, "render needs a sandslide output file");
+	/* a video is watched without its file: it shows the time and the scale */
+	if (a.o.video && a.o.look.style != SS_RENDER_GRAY16) {
+		a.o.look.label |= !a.no_label;
+		a.o.look.colorbar |= !a.no_colorbar;
+	}
+	if (a.no_label)
+		a.o.look.label = 0;
+	if (a.no_colorbar)
+		a.o.look.colorbar = 0;
 	struct ss_render_series_report report;
 	const int err = ss_render_series(&a.o, &report);
 	if (!err)

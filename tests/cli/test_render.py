@@ -105,7 +105,8 @@ def test_every_frame_in_time_order(series, tmp_path):
         if k == 0:
             scale = zs
         assert zs == scale, "one height scale for the whole series"
-    assert sizes == {(520, 416)}, "20 x 16 cells at 26 px per cell"
+    assert sizes == {(520 + 26, 416 + 2 * 26)}, \
+        "20 x 16 cells at 26 px per cell, and a wall a cell thick west, south and north"
     with h5open(d / "out.h5") as f:
         h = f["height"][:]
         walls = f["cell_type"][:] == 1
@@ -157,11 +158,85 @@ def test_styles_label_colorbar_and_size(series, tmp_path):
     run_ok(["render", d / "out.h5", "-o", tmp_path / "c", "--frames", "4", "--colorbar",
             "--contour", "0.05", "--cmap", "terrain", "-q"])
     info = read_png(tmp_path / "c" / "frame_00000.png")
-    assert info["height"] == 416 and info["width"] > 520, "the colour bar widens the picture"
+    assert info["height"] == 468 and info["width"] > 546, "the colour bar widens the picture"
     run_ok(["render", d / "out.h5", "-o", tmp_path / "m", "--frames", "4", "--max-size", "10",
             "-q"])
     info = read_png(tmp_path / "m" / "frame_00000.png")
-    assert (info["width"], info["height"]) == (10, 8), "--max-size 10 on 20 x 16 cells"
+    assert (info["width"], info["height"]) == (10 + 3, 8 + 6), \
+        "--max-size 10 on 20 x 16 cells, and walls 3 px thick west, south and north"
+
+
+def test_wall_sides_drawn(series, tmp_path):
+    """The file says which grid sides are walls (root attribute boundary),
+    and the frames draw them as walls: the case's west, south and north."""
+    d, _ = series
+    with h5open(d / "out.h5") as f:
+        sides = f.attrs["boundary"]
+    assert sides == b"west=wall east=open south=wall north=wall", sides
+    run_ok(["render", d / "out.h5", "-o", tmp_path, "--frames", "4", "-q"])
+    px = read_png(tmp_path / "frame_00000.png", pixels=True)["pixels"]
+    wall = np.array([0x2b, 0x2b, 0x30])
+    assert np.all(px[:, :26] == wall), "west: a wall 26 px (a cell) wide"
+    assert np.all(px[:26, :] == wall) and np.all(px[-26:, :] == wall), "north and south"
+    assert not np.all(px[26:-26, -1] == wall), "east is open: sand to the edge"
+
+
+def test_label_strip_covers_nothing(series, tmp_path):
+    """--label puts the time in a white strip above the picture, which is
+    otherwise the same pixels."""
+    d, times = series
+    run_ok(["render", d / "out.h5", "-o", tmp_path / "a", "--frames", "2", "-q"])
+    run_ok(["render", d / "out.h5", "-o", tmp_path / "b", "--frames", "2", "--label", "-q"])
+    a = read_png(tmp_path / "a" / "frame_00000.png", pixels=True)["pixels"]
+    b = read_png(tmp_path / "b" / "frame_00000.png", pixels=True)["pixels"]
+    strip = b.shape[0] - a.shape[0]
+    assert b.shape[1] == a.shape[1] and strip > 7, (a.shape, b.shape)
+    assert np.array_equal(b[strip:], a), "the picture below the strip is untouched"
+    label = b[:strip]
+    black = np.all(label == 0, axis=2)
+    white = np.all(label == 255, axis=2)
+    assert np.all(black | white) and black.sum() > 50, "black text on white"
+
+
+def test_force(series, tmp_path):
+    """Frames and a video that exist are replaced only with --force (exit 2
+    and nothing touched without it)."""
+    d, _ = series
+    run_ok(["render", d / "out.h5", "-o", tmp_path / "f", "--frames", "0:2", "-q"])
+    before = (tmp_path / "f" / "frame_00001.png").read_bytes()
+    r = run(["render", d / "out.h5", "-o", tmp_path / "f", "--frames", "3:5", "-q"])
+    assert r.returncode == 2, r.stderr
+    assert "frame_00000.png' exists, and 1 more of the 2 frames" in r.stderr, r.stderr
+    assert "--force" in r.stderr and len(r.stderr.splitlines()) == 1, r.stderr
+    assert (tmp_path / "f" / "frame_00001.png").read_bytes() == before, "untouched"
+    run_ok(["render", d / "out.h5", "-o", tmp_path / "f", "--frames", "3:5", "-q", "--force"])
+    assert read_png(tmp_path / "f" / "frame_00001.png")["text"]["snapshot"] == "4"
+    (tmp_path / "v.mp4").write_bytes(b"an earlier video")
+    r = run(["render", d / "out.h5", "-o", tmp_path / "g", "--video", tmp_path / "v.mp4"])
+    assert r.returncode == 2 and "v.mp4' exists: give --force" in r.stderr, r.stderr
+    assert not (tmp_path / "g").exists()
+    assert (tmp_path / "v.mp4").read_bytes() == b"an earlier video"
+
+
+def test_video_frames_have_time_and_scale(series, tmp_path):
+    """--video draws the time label and the colour bar unless told not to
+    (ffmpeg is kept off PATH: only the frames are looked at)."""
+    d, _ = series
+    empty = tmp_path / "bin"
+    empty.mkdir()
+    env = {**os.environ, "PATH": str(empty)}
+    size = {}
+    for name, extra in (("plain", []), ("video", ["--video", tmp_path / "v.mp4"]),
+                        ("bare", ["--video", tmp_path / "w.mp4", "--no-label",
+                                  "--no-colorbar"])):
+        r = run(["render", d / "out.h5", "-o", tmp_path / name, "--frames", "4", "-q"] + extra,
+                env=env)
+        assert r.returncode == 0, r.stderr
+        info = read_png(tmp_path / name / "frame_00000.png")
+        size[name] = (info["width"], info["height"])
+    assert size["video"][0] > size["plain"][0] + 30, f"a colour bar: {size}"
+    assert size["video"][1] > size["plain"][1], f"a label strip: {size}"
+    assert size["bare"] == size["plain"], f"--no-label --no-colorbar: {size}"
 
 
 def test_same_bytes_on_one_and_two_threads(series, tmp_path):
