@@ -11,9 +11,10 @@
  *     the surface runs under the wall blocks without a step;
  *   - walls: a block per wall pixel, sides only where the neighbour is
  *     not a wall, and a block along each grid side that is a wall
- *     (wall_m thick).  Each wall (a 4-connected set of wall pixels, or a
- *     grid side) is WALL_RISE of the height range taller than the highest
- *     sand that touches it in this frame, and never above the scale's top:
+ *     (wall_m thick).  Each wall (a 4-connected set of wall pixels) is
+ *     WALL_RISE of the height range taller than the highest sand that
+ *     touches it in this frame, and never above the scale's top (a grid
+ *     side follows the sand along it, WALL_RISE above it):
  *     walls as tall as the scale would hide the sand behind them for most
  *     of a video, while a room fills, and a column among low sand would
  *     hide what lies behind it;
@@ -358,12 +359,14 @@ static void draw_block(struct target *t, const struct camera *c,
 	}
 }
 
-/* The tops of the walls of a frame, m: top[label[k]] for wall pixel k,
- * top[n_walls + side] for the grid sides. */
+/* The walls of a frame: top[label[k]] (m) for wall pixel k, and the scene
+ * heights of the surface along each grid side that is a wall (edge_z[side],
+ * from its south or west end). */
 struct wall_tops {
 	int *label;                 /* width * height; -1: not a wall */
 	double *top;
 	int n_walls;
+	double *edge_z[4];
 };
 
 /* A block on wall pixel (x, y), with sides facing non-walls. */
@@ -383,33 +386,89 @@ static void draw_wall(struct target *t, const struct ss_render_raster *r, struct
 	           (H - y) * r->px_dy, sides);
 }
 
-/* The walls along the grid's wall sides.  Their inner faces stand on the
- * surface's outermost vertices, half a pixel inside the grid, so no gap
- * shows between them; the west and east ones take the corners. */
-static void draw_wall_sides(struct target *t, const struct ss_render_raster *r,
-                            struct camera c, const struct ss_render_light *light,
-                            const double top[4])
+/* A quad of one colour: the face of normal n. */
+static void draw_face(struct target *t, const struct camera *c,
+                      const struct ss_render_light *light, double p[4][3], double nx,
+                      double ny, double nz)
 {
-	const double hx = 0.5 * r->px_dx, hy = 0.5 * r->px_dy;
-	const double lx = r->width * r->px_dx, ly = r->height * r->px_dy;
+	const double b = face_light(light, nx, ny, nz);
+	struct vtx v[4];
+	float lo = INFINITY, hi = -INFINITY;
+	for (int k = 0; k < 4; k++) {
+		v[k] = make_vtx(c, p[k][0], p[k][1], p[k][2], wall_rgb, b);
+		lo = fminf(lo, v[k].y);
+		hi = fmaxf(hi, v[k].y);
+	}
+	if (!outside_band(t, lo, hi))
+		draw_quad(t, &v[0], &v[1], &v[2], &v[3]);
+}
+
+/*
+ * The wall along a grid side that is a wall: a strip wall_m thick outside
+ * the surface's outermost vertices (half a pixel inside the grid, so no
+ * gap shows), whose top follows the sand along the edge WALL_RISE of the
+ * range above it.  A terrain's edge (relax's sides are walls) then stays
+ * in view behind a low lip instead of behind a wall as tall as its
+ * highest point.  The west and east strips run on over the corners of a
+ * south or north wall.
+ */
+static void draw_wall_side(struct target *t, const struct ss_render_raster *r,
+                           const struct camera *c, const struct ss_render_light *light,
+                           const double *edge_z, int side)
+{
+	const int W = r->width, H = r->height, along_x = side >= SS_SOUTH;
+	const int n = along_x ? W : H;
 	const double *m = r->wall_m;
-	if (m[SS_SOUTH] > 0.0) {
-		c.z_top = top[SS_SOUTH];
-		draw_block(t, &c, light, hx, lx - hx, -m[SS_SOUTH] + hy, hy, 0xf);
+	const double hx = 0.5 * r->px_dx, hy = 0.5 * r->px_dy;
+	const double lx = W * r->px_dx, ly = H * r->px_dy;
+	/* the inner line and the outward direction */
+	const double in = side == SS_WEST ? hx : side == SS_EAST ? lx - hx
+	                : side == SS_SOUTH ? hy : ly - hy;
+	const double out = side == SS_WEST || side == SS_SOUTH ? -1.0 : 1.0;
+	const double range = c->z_wall / (1.0 + WALL_RISE);   /* the scale, zscale'd */
+	/* along the side: first and last pixel centres, extended over corners */
+	const double step = along_x ? r->px_dx : r->px_dy;
+	const double a0 = 0.5 * step - (along_x ? 0.0 : m[SS_SOUTH]);
+	const double a1 = (n - 0.5) * step + (along_x ? 0.0 : m[SS_NORTH]);
+	double a_0 = 0.0, t0 = 0.0, s0 = 0.0;   /* along, top, sand of the previous point */
+	for (int k = -1; k <= n; k++) {
+		const int e = k < 0 ? 0 : k >= n ? n - 1 : k;
+		const double a = k < 0 ? a0 : k >= n ? a1 : (k + 0.5) * step;
+		const double zs = edge_z[e];
+		const double zt = fmin(zs + WALL_RISE * range, c->z_wall);
+		if (k > -1 && a > a_0) {
+			double q[4][3];
+#define AT(i, u, v, z) (q[i][0] = along_x ? (u) : (v), q[i][1] = along_x ? (v) : (u), \
+			q[i][2] = (z))
+			/* top */
+			AT(0, a_0, in, t0), AT(1, a, in, zt), AT(2, a, in + out * m[side], zt),
+			AT(3, a_0, in + out * m[side], t0);
+			draw_face(t, c, light, q, 0.0, 0.0, 1.0);
+			/* outer face, down to the base */
+			AT(0, a_0, in + out * m[side], t0), AT(1, a, in + out * m[side], zt),
+			AT(2, a, in + out * m[side], c->z_floor), AT(3, a_0, in + out * m[side], c->z_floor);
+			draw_face(t, c, light, q, along_x ? 0.0 : out, along_x ? out : 0.0, 0.0);
+			/* inner face, down to the sand */
+			AT(0, a_0, in, t0), AT(1, a, in, zt), AT(2, a, in, zs), AT(3, a_0, in, s0);
+			draw_face(t, c, light, q, along_x ? 0.0 : -out, along_x ? -out : 0.0, 0.0);
+#undef AT
+		}
+		a_0 = a, t0 = zt, s0 = zs;
 	}
-	if (m[SS_NORTH] > 0.0) {
-		c.z_top = top[SS_NORTH];
-		draw_block(t, &c, light, hx, lx - hx, ly - hy, ly + m[SS_NORTH] - hy, 0xf);
-	}
-	if (m[SS_WEST] > 0.0) {
-		c.z_top = top[SS_WEST];
-		draw_block(t, &c, light, -m[SS_WEST] + hx, hx, -m[SS_SOUTH] + hy,
-		           ly + m[SS_NORTH] - hy, 0xf);
-	}
-	if (m[SS_EAST] > 0.0) {
-		c.z_top = top[SS_EAST];
-		draw_block(t, &c, light, lx - hx, lx + m[SS_EAST] - hx, -m[SS_SOUTH] + hy,
-		           ly + m[SS_NORTH] - hy, 0xf);
+	/* the two ends, closed from the top to the base */
+	for (int end = 0; end < 2; end++) {
+		const double a = end ? a1 : a0;
+		const double zt = fmin(edge_z[end ? n - 1 : 0] + WALL_RISE * range, c->z_wall);
+		double q[4][3];
+		const double u[4] = {a, a, a, a}, v[4] = {in, in + out * m[side], in + out * m[side], in};
+		const double z[4] = {zt, zt, c->z_floor, c->z_floor};
+		for (int k = 0; k < 4; k++) {
+			q[k][0] = along_x ? u[k] : v[k];
+			q[k][1] = along_x ? v[k] : u[k];
+			q[k][2] = z[k];
+		}
+		const double dir = end ? 1.0 : -1.0;
+		draw_face(t, c, light, q, along_x ? dir : 0.0, along_x ? 0.0 : dir, 0.0);
 	}
 }
 
@@ -438,13 +497,17 @@ static void draw_band(struct target *t, const struct ss_render_raster *r,
 				draw_wall(t, r, at, light, x, y);
 			}
 		}
-	draw_wall_sides(t, r, at, light, tops->top + tops->n_walls);
+	for (int side = 0; side < 4; side++)
+		if (tops->edge_z[side])
+			draw_wall_side(t, r, c, light, tops->edge_z[side], side);
 }
 
 static void wall_tops_release(struct wall_tops *w)
 {
 	ss_free(w->label);
 	ss_free(w->top);
+	for (int side = 0; side < 4; side++)
+		ss_free(w->edge_z[side]);
 	memset(w, 0, sizeof *w);
 }
 
@@ -501,12 +564,25 @@ static int wall_tops_init(struct wall_tops *w, const struct ss_render_raster *r,
 		w->n_walls++;
 	}
 	ss_free(stack);
-	w->top = ss_alloc((size_t)w->n_walls + 4, sizeof *w->top, "wall tops");
-	if (!w->top) {
+	w->top = ss_alloc((size_t)w->n_walls + 1, sizeof *w->top, "wall tops");
+	int err = w->top ? SS_OK : SS_ERR_FAIL;
+	for (int side = 0; side < 4 && !err; side++)
+		if (r->wall_m[side] > 0.0 &&
+		    !(w->edge_z[side] = ss_alloc(side < 2 ? H : W, sizeof *w->edge_z[side],
+		                                 "wall side heights")))
+			err = SS_ERR_FAIL;
+	if (err) {
 		wall_tops_release(w);
-		return SS_ERR_FAIL;
+		return err;
 	}
-	for (int k = 0; k < w->n_walls + 4; k++)
+	const double base = zmin - BASE_DEPTH * (zmax - zmin);
+	for (int side = 0; side < 4; side++)
+		for (int k = 0; w->edge_z[side] && k < (side < 2 ? H : W); k++) {
+			const int x = side == SS_WEST ? 0 : side == SS_EAST ? W - 1 : k;
+			const int y = side < 2 ? H - 1 - k : side == SS_SOUTH ? H - 1 : 0;
+			w->edge_z[side][k] = o->zscale * (mesh_height(r, x, y, base) - zmin);
+		}
+	for (int k = 0; k < w->n_walls; k++)
 		w->top[k] = -INFINITY;
 	for (int y = 0; y < H; y++)
 		for (int x = 0; x < W; x++) {
@@ -520,18 +596,9 @@ static int wall_tops_init(struct wall_tops *w, const struct ss_render_raster *r,
 					if (xn >= 0 && yn >= 0 && xn < W && yn < H && w->label[(size_t)yn * W + xn] >= 0)
 						touch(&w->top[w->label[(size_t)yn * W + xn]], v);
 				}
-			double *side = w->top + w->n_walls;   /* rows run south, so y = 0 is north */
-			if (x == 0)
-				touch(&side[SS_WEST], v);
-			if (x == W - 1)
-				touch(&side[SS_EAST], v);
-			if (y == H - 1)
-				touch(&side[SS_SOUTH], v);
-			if (y == 0)
-				touch(&side[SS_NORTH], v);
 		}
 	const double range = o->zscale * (zmax - zmin);
-	for (int k = 0; k < w->n_walls + 4; k++) {
+	for (int k = 0; k < w->n_walls; k++) {
 		const double h = isfinite(w->top[k]) ? fmax(fmin(w->top[k], zmax), zmin) : zmin;
 		w->top[k] = fmin(o->zscale * (h - zmin) + WALL_RISE * range, c->z_wall);
 	}

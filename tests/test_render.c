@@ -813,6 +813,46 @@ static void test_oblique_walls_follow_sand(void)
 	field_release(&walled);
 }
 
+/* Pixels of a picture that are neither white (sky) nor grey (walls). */
+static int coloured_pixels(const struct ss_render_image *img)
+{
+	int n = 0;
+	for (int y = 0; y < img->height; y++)
+		for (int x = 0; x < img->width; x++) {
+			const uint8_t *p = rgb_at(img, x, y);
+			const int lo = p[0] < p[1] ? (p[0] < p[2] ? p[0] : p[2]) : (p[1] < p[2] ? p[1] : p[2]);
+			const int hi = p[0] > p[1] ? (p[0] > p[2] ? p[0] : p[2]) : (p[1] > p[2] ? p[1] : p[2]);
+			n += hi - lo > 30;
+		}
+	return n;
+}
+
+/* A grid side that is a wall follows the sand along it, a little above:
+ * walls on all four sides of sand at 0.1 m round a pile of 0.9 m hide
+ * little of it (as tall as the pile, the near wall would hide most). */
+static void test_oblique_wall_sides_follow_sand(void)
+{
+	struct field t;
+	field_init(&t, 60, 40);
+	for (int j = 0; j < 40; j++)
+		for (int i = 0; i < 60; i++)
+			*H(&t, i, j) = 0.1 + 0.8 * exp(-(pow(i - 30, 2) + pow(j - 20, 2)) / 50.0);
+	struct ss_render_options o;
+	ss_render_options_default(&o);
+	o.style = SS_RENDER_OBLIQUE;
+	o.view_azimuth_deg = 180.0;
+	o.view_elevation_deg = 40.0;
+	struct ss_render_image open, walled;
+	CHECK(ss_render_field(&t.f, &o, &open) == SS_OK, "render");
+	t.f.wall_sides = 0xf;
+	CHECK(ss_render_field(&t.f, &o, &walled) == SS_OK, "render");
+	const int a = coloured_pixels(&open), b = coloured_pixels(&walled);
+	CHECK(b > 0.85 * a, "walls all round leave %d of %d sand pixels in view", b, a);
+	ss_render_image_release(&open);
+	ss_render_image_release(&walled);
+	field_release(&t);
+}
+
 /* Without --view-azimuth the camera looks from the open side: walls on
  * the west put it east-south-east (120), on the east west-north-west
  * (300); with no walls, 200 as before. */
@@ -940,6 +980,7 @@ int main(void)
 	RUN(test_no_shading_band);
 	RUN(test_oblique_block);
 	RUN(test_oblique_walls_follow_sand);
+	RUN(test_oblique_wall_sides_follow_sand);
 	RUN(test_oblique_view_from_open_side);
 	RUN(test_dune_lightness_linear);
 	RUN(test_bad_options);
