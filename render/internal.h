@@ -146,6 +146,17 @@ int ss_render_colorbar_width(int pic_w, int pic_h, double zmin, double zmax);
 void ss_render_draw_colorbar(struct ss_render_image *img, int x0, int pic_h,
                              enum ss_render_cmap cmap, double zmin, double zmax);
 
+/* ---- png.c: encoding and atomic writes ------------------------------ */
+
+/* img as PNG bytes in memory: *data (malloc'd: free it) of *size bytes,
+ * the same bytes ss_render_write_png writes. */
+int ss_render_encode_png(const struct ss_render_image *img, int compression,
+                         unsigned char **data, size_t *size);
+
+/* size bytes to "path.partial", renamed to path once complete and closed
+ * (an existing path is replaced only then). */
+int ss_render_write_file(const char *path, const void *data, size_t size);
+
 /* ---- series.c: a sandslide file and its cell types ------------------ */
 
 /* The file (sizes, geometry, times; heights are read through it with
