@@ -55,13 +55,15 @@ SOVERSION  := 0
 DEB_hdf5-serial  := libhdf5-dev
 DEB_hdf5-openmpi := libhdf5-openmpi-dev
 DEB_libpng := libpng-dev
+# zlib (libpng's own compressor) deflates the heights of render --html
+DEB_zlib   := zlib1g-dev
 DEB_inih   := libinih-dev
 ifeq ($(MPI),1)
   PC_HDF5  := hdf5-openmpi
 else
   PC_HDF5  := hdf5-serial
 endif
-PC_MODULES := $(PC_HDF5) libpng inih
+PC_MODULES := $(PC_HDF5) libpng zlib inih
 DEB_BUILD  := pkg-config $(foreach m,$(PC_MODULES),$(DEB_$(m)))
 ifeq ($(MPI),1)
   DEB_BUILD += openmpi-bin libopenmpi-dev

@@ -231,29 +231,42 @@ static int snapshot_heights(const struct ss_render_plan *p, struct ss_render_sou
 	return err;
 }
 
-int ss_render_plan_snapshot(const struct ss_render_plan *p, struct ss_render_source *s,
-                            long long t, const char *path, int parallel)
+int ss_render_plan_image(const struct ss_render_plan *p, struct ss_render_source *s,
+                         long long t, struct ss_render_image *img, double *pixel_h,
+                         int parallel)
 {
 	double *buf = NULL, *w = NULL;
 	const double *h;
 	ptrdiff_t stride;
+	memset(img, 0, sizeof *img);
 	int err = snapshot_heights(p, s, t, &buf, &w, &h, &stride, parallel);
+	if (!err)
+		err = ss_render_plan_draw(p, h, stride, s->file.time[t], img, parallel);
 	if (!err) {
-		struct ss_render_image img;
-		err = ss_render_plan_draw(p, h, stride, s->file.time[t], &img, parallel);
-		if (!err) {
-			img.snapshot = t;
-			snprintf(img.source, sizeof img.source, "%s", s->file.name);
-			if (p->look.style != SS_RENDER_OBLIQUE) {
-				img.x0 = s->file.origin_x;
-				img.y0 = s->file.origin_y;
-			}
-			err = ss_render_write_png(&img, path, p->look.compression);
-			ss_render_image_release(&img);
+		img->snapshot = t;
+		snprintf(img->source, sizeof img->source, "%s", s->file.name);
+		if (p->look.style != SS_RENDER_OBLIQUE) {
+			img->x0 = s->file.origin_x;
+			img->y0 = s->file.origin_y;
 		}
+		if (pixel_h)
+			for (int y = 0; y < p->rs.height; y++)
+				memcpy(pixel_h + (size_t)y * p->rs.width, h + (ptrdiff_t)y * stride,
+				       (size_t)p->rs.width * sizeof *pixel_h);
 	}
 	ss_free(w);
 	ss_free(buf);
+	return err;
+}
+
+int ss_render_plan_snapshot(const struct ss_render_plan *p, struct ss_render_source *s,
+                            long long t, const char *path, int parallel)
+{
+	struct ss_render_image img;
+	int err = ss_render_plan_image(p, s, t, &img, NULL, parallel);
+	if (!err)
+		err = ss_render_write_png(&img, path, p->look.compression);
+	ss_render_image_release(&img);
 	return err;
 }
 
