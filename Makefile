@@ -3,7 +3,8 @@
 #   make            build build/sandslide, build/libsandslide.a and .so
 #   make deps       install the Debian packages building and running need
 #   make deps-test  add those the test suite needs (pytest, GDAL's tools,
-#                   xarray, CDO, ParaView, clang for the race check)
+#                   xarray, CDO, ParaView, Chromium and selenium for the
+#                   HTML viewer, clang for the race check)
 #   make test       build and run every test (C programs, then CLI tests)
 #   make install    bin, lib (.so and .a), headers, sandslide.pc, the man
 #                   page, the example cases and the Python module under
@@ -77,6 +78,9 @@ DEB_RUN    := ffmpeg python3-numpy
 # tested inside pvbatch.
 DEB_TEST   := python3-h5py python3-pytest netcdf-bin gdal-bin python3-gdal \
               python3-xarray python3-netcdf4 cdo paraview python3-paraview man-db groff-base
+# render --html's page is tested in headless Chromium through selenium
+# (tests/cli/test_html.py), its screenshot read with PIL
+DEB_TEST   += chromium chromium-driver python3-selenium python3-pil
 
 # Goals that need no library: do not probe pkg-config for them.
 NO_PROBE_GOALS := deps deps-test clean help uninstall
