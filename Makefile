@@ -3,7 +3,8 @@
 #   make            build build/sandslide, build/libsandslide.a and .so
 #   make deps       install the Debian packages building and running need
 #   make deps-test  add those the test suite needs (pytest, GDAL's tools,
-#                   xarray, CDO, ParaView, clang for the race check)
+#                   xarray, CDO, ParaView, Chromium and selenium for the
+#                   HTML viewer, clang for the race check)
 #   make test       build and run every test (C programs, then CLI tests)
 #   make install    bin, lib (.so and .a), headers, sandslide.pc, the man
 #                   page, the example cases and the Python module under
@@ -55,13 +56,15 @@ SOVERSION  := 0
 DEB_hdf5-serial  := libhdf5-dev
 DEB_hdf5-openmpi := libhdf5-openmpi-dev
 DEB_libpng := libpng-dev
+# zlib (libpng's own compressor) deflates the heights of render --html
+DEB_zlib   := zlib1g-dev
 DEB_inih   := libinih-dev
 ifeq ($(MPI),1)
   PC_HDF5  := hdf5-openmpi
 else
   PC_HDF5  := hdf5-serial
 endif
-PC_MODULES := $(PC_HDF5) libpng inih
+PC_MODULES := $(PC_HDF5) libpng zlib inih
 DEB_BUILD  := pkg-config $(foreach m,$(PC_MODULES),$(DEB_$(m)))
 ifeq ($(MPI),1)
   DEB_BUILD += openmpi-bin libopenmpi-dev
@@ -75,6 +78,9 @@ DEB_RUN    := ffmpeg python3-numpy
 # tested inside pvbatch.
 DEB_TEST   := python3-h5py python3-pytest netcdf-bin gdal-bin python3-gdal \
               python3-xarray python3-netcdf4 cdo paraview python3-paraview man-db groff-base
+# render --html's page is tested in headless Chromium through selenium
+# (tests/cli/test_html.py), its screenshot read with PIL
+DEB_TEST   += chromium chromium-driver python3-selenium python3-pil
 
 # Goals that need no library: do not probe pkg-config for them.
 NO_PROBE_GOALS := deps deps-test clean help uninstall
@@ -449,6 +455,6 @@ clean:
 	rm -rf $(BUILD)
 
 help:
-	@sed -n '3,15p' Makefile | sed 's/^# \{0,1\}//'
+	@sed -n '3,/^#$$/{/^#$$/!p}' Makefile | sed 's/^# \{0,1\}//'
 
 -include $(LIB_OBJ:.o=.d) $(MAIN_OBJ:.o=.d) $(TEST_BIN:=.d)

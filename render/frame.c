@@ -438,27 +438,40 @@ static int snapshot_heights(const struct ss_render_plan *p, struct ss_render_sou
 	return err;
 }
 
+int ss_render_plan_image(const struct ss_render_plan *p, struct ss_render_source *s,
+                         long long t, struct ss_render_image *img, double *pixel_h,
+                         int parallel)
+{
+	struct frame_heights fh;
+	memset(img, 0, sizeof *img);
+	int err = snapshot_heights(p, s, t, &fh, parallel);
+	if (!err)
+		err = ss_render_plan_draw(p, fh.h, fh.stride, fh.gx, fh.gy, s->file.time[t], img,
+		                          parallel);
+	if (!err) {
+		img->snapshot = t;
+		snprintf(img->source, sizeof img->source, "%s", s->file.name);
+		if (p->look.style != SS_RENDER_OBLIQUE) {   /* the map's lower-left corner */
+			img->x0 = s->file.origin_x - p->border[SS_WEST] * p->rs.px_dx;
+			img->y0 = s->file.origin_y - p->border[SS_SOUTH] * p->rs.px_dy;
+		}
+		if (pixel_h)
+			for (int y = 0; y < p->rs.height; y++)
+				memcpy(pixel_h + (size_t)y * p->rs.width, fh.h + (ptrdiff_t)y * fh.stride,
+				       (size_t)p->rs.width * sizeof *pixel_h);
+	}
+	frame_release(&fh);
+	return err;
+}
+
 int ss_render_plan_snapshot(const struct ss_render_plan *p, struct ss_render_source *s,
                             long long t, const char *path, int parallel)
 {
-	struct frame_heights fh;
-	int err = snapshot_heights(p, s, t, &fh, parallel);
-	if (!err) {
-		struct ss_render_image img;
-		err = ss_render_plan_draw(p, fh.h, fh.stride, fh.gx, fh.gy, s->file.time[t], &img,
-		                          parallel);
-		if (!err) {
-			img.snapshot = t;
-			snprintf(img.source, sizeof img.source, "%s", s->file.name);
-			if (p->look.style != SS_RENDER_OBLIQUE) {   /* the map's lower-left corner */
-				img.x0 = s->file.origin_x - p->border[SS_WEST] * p->rs.px_dx;
-				img.y0 = s->file.origin_y - p->border[SS_SOUTH] * p->rs.px_dy;
-			}
-			err = ss_render_write_png(&img, path, p->look.compression);
-			ss_render_image_release(&img);
-		}
-	}
-	frame_release(&fh);
+	struct ss_render_image img;
+	int err = ss_render_plan_image(p, s, t, &img, NULL, parallel);
+	if (!err)
+		err = ss_render_write_png(&img, path, p->look.compression);
+	ss_render_image_release(&img);
 	return err;
 }
 

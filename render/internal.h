@@ -159,6 +159,17 @@ int ss_render_colorbar_width(int pic_w, int pic_h, double zmin, double zmax);
 void ss_render_draw_colorbar(struct ss_render_image *img, int x0, int y0, int pic_h,
                              enum ss_render_cmap cmap, double zmin, double zmax);
 
+/* ---- png.c: encoding and atomic writes ------------------------------ */
+
+/* img as PNG bytes in memory: *data (malloc'd: free it) of *size bytes,
+ * the same bytes ss_render_write_png writes. */
+int ss_render_encode_png(const struct ss_render_image *img, int compression,
+                         unsigned char **data, size_t *size);
+
+/* size bytes to "path.partial", renamed to path once complete and closed
+ * (an existing path is replaced only then). */
+int ss_render_write_file(const char *path, const void *data, size_t size);
+
 /* ---- series.c: a sandslide file and its cell types ------------------ */
 
 /* The file (sizes, geometry, times; heights are read through it with
@@ -244,9 +255,51 @@ int ss_render_plan_draw(const struct ss_render_plan *p, const double *pixel_h,
                         ptrdiff_t stride, const float *gx, const float *gy, double time,
                         struct ss_render_image *img, int parallel);
 
+/* Render snapshot t of s into img (initialised here; release it, also
+ * after a failure), with its time, snapshot, source and map corner; when
+ * pixel_h is not NULL, also copy there the pixel heights it was coloured
+ * from (rs.width x rs.height, north row first, NAN without sand). */
+int ss_render_plan_image(const struct ss_render_plan *p, struct ss_render_source *s,
+                         long long t, struct ss_render_image *img, double *pixel_h,
+                         int parallel);
+
 /* Render snapshot t of s to path (parallel: split rows between threads). */
 int ss_render_plan_snapshot(const struct ss_render_plan *p, struct ss_render_source *s,
                             long long t, const char *path, int parallel);
+
+/* ---- html.c: the self-contained viewer (--html) ---------------------- */
+
+struct ss_render_html;
+
+/* SS_ERR_INPUT unless the viewer can be written to path: its folder exists
+ * and is writable, and path is not a folder, nor an existing file unless
+ * force. */
+int ss_render_html_check_path(const char *path, int force);
+
+/* A viewer of the n snapshots sel (in the order shown) of s drawn with
+ * plan p (both must outlive it).  scale_given: --zmin or --zmax was
+ * given, so the heights are quantised over the scale widened to the
+ * snapshots' range, which is read here. */
+int ss_render_html_create(struct ss_render_html **out, const struct ss_render_plan *p,
+                          struct ss_render_source *s, const long long *sel, long long n,
+                          int scale_given);
+
+/* 1 if ss_render_html_add needs the pixel heights (the picture is smaller
+ * than the grid on some axis), 0 if it reads the cells itself. */
+int ss_render_html_wants_pixels(const struct ss_render_html *h);
+
+/* Frame k: snapshot t, its PNG (malloc'd; the viewer owns it from here on,
+ * also on failure), and its pixel heights if wanted (ss_render_plan_image).
+ * Distinct k may be added from several threads at once. */
+int ss_render_html_add(struct ss_render_html *h, long long k, long long t, unsigned char *png,
+                       size_t png_size, const double *pixel_h);
+
+/* Write the page (every frame added) to path atomically; *bytes its size.
+ * fps: the speed it starts with. */
+int ss_render_html_write(struct ss_render_html *h, const char *path, int fps, size_t *bytes);
+
+/* ss_render_html_destroy(NULL) is a no-op. */
+void ss_render_html_destroy(struct ss_render_html *h);
 
 /* series_render.c: dir must be a writable folder, or a missing one whose
  * parent is (created when `create`); SS_ERR_INPUT says which it is not. */

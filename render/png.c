@@ -7,9 +7,11 @@
  * samples are kept native in memory and swapped to the PNG's big-endian
  * order by libpng on little-endian machines.
  *
- * A frame is written as "NAME.partial" and renamed to NAME once it is
- * complete and closed, so a picture with the final name is always whole,
- * even if the program is killed while writing.
+ * A picture is encoded in memory (ss_render_encode_png, which the HTML
+ * viewer embeds as it is) and a frame then written as "NAME.partial" and
+ * renamed to NAME once it is complete and closed
+ * (ss_render_write_file), so a picture with the final name is always
+ * whole, even if the program is killed while writing.
  */
 #include "internal.h"
 
@@ -143,8 +145,40 @@ static void fill_texts(struct png_texts *x, const struct ss_render_image *img)
 		                        "value >= 1; value 0: wall or no data (transparent)");
 }
 
-/* Encode img into the open file f; returns 0, or -1 with failure->message. */
-static int encode(FILE *f, const struct ss_render_image *img, int compression,
+/* The PNG's bytes as libpng hands them over: a buffer that grows. */
+struct png_sink {
+	unsigned char *data;
+	size_t size, capacity;
+};
+
+static void on_png_write(png_structp png, png_bytep bytes, png_size_t n)
+{
+	struct png_sink *s = png_get_io_ptr(png);
+	if (n > s->capacity - s->size) {
+		size_t cap = s->capacity ? s->capacity : 1 << 16;
+		while (cap - s->size < n) {
+			if (cap > SIZE_MAX / 2)
+				png_error(png, "out of memory");
+			cap *= 2;
+		}
+		unsigned char *more = realloc(s->data, cap);
+		if (!more)
+			png_error(png, "out of memory");
+		s->data = more;
+		s->capacity = cap;
+	}
+	memcpy(s->data + s->size, bytes, n);
+	s->size += n;
+}
+
+static void on_png_flush(png_structp png)
+{
+	(void)png;   /* memory needs no flushing */
+}
+
+/* Encode img into sink; returns 0, or -1 with failure->message (the sink
+ * is then freed). */
+static int encode(const struct ss_render_image *img, int compression, struct png_sink *sink,
                   struct png_failure *failure)
 {
 	png_bytep *rows = malloc((size_t)img->height * sizeof *rows);
@@ -169,9 +203,11 @@ static int encode(FILE *f, const struct ss_render_image *img, int compression,
 	if (setjmp(png_jmpbuf(png))) {
 		png_destroy_write_struct(&png, &info);
 		free(rows);
+		free(sink->data);
+		*sink = (struct png_sink){0};
 		return -1;
 	}
-	png_init_io(png, f);
+	png_set_write_fn(png, sink, on_png_write, on_png_flush);
 	png_set_IHDR(png, info, (png_uint_32)img->width, (png_uint_32)img->height,
 	             img->bit_depth, img->channels == 3 ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_GRAY,
 	             PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
@@ -191,7 +227,22 @@ static int encode(FILE *f, const struct ss_render_image *img, int compression,
 	return 0;
 }
 
-int ss_render_write_png(const struct ss_render_image *img, const char *path, int compression)
+int ss_render_encode_png(const struct ss_render_image *img, int compression,
+                         unsigned char **data, size_t *size)
+{
+	struct png_sink sink = {0};
+	struct png_failure failure = {""};
+	*data = NULL;
+	*size = 0;
+	if (encode(img, compression, &sink, &failure))
+		return ss_error_fail("cannot encode a picture of %d x %d px as PNG: %s", img->width,
+		                     img->height, failure.message);
+	*data = sink.data;
+	*size = sink.size;
+	return SS_OK;
+}
+
+int ss_render_write_file(const char *path, const void *data, size_t size)
 {
 	const size_t n = strlen(path) + sizeof ".partial";
 	char *tmp = malloc(n);
@@ -205,28 +256,30 @@ int ss_render_write_png(const struct ss_render_image *img, const char *path, int
 		free(tmp);
 		return err;
 	}
-	struct png_failure failure = {""};
-	int bad = encode(f, img, compression, &failure);
 	int e = 0;
-	if (fflush(f) != 0 || ferror(f)) {
+	errno = 0;
+	if (fwrite(data, 1, size, f) != size || fflush(f) != 0 || ferror(f))
+		e = errno ? errno : EIO;
+	if (fclose(f) != 0 && !e)
 		e = errno;
-		bad = 1;
-	}
-	if (fclose(f) != 0 && !e) {
+	if (!e && rename(tmp, path) != 0)
 		e = errno;
-		bad = 1;
-	}
-	if (!bad && rename(tmp, path) != 0) {
-		e = errno;
-		bad = 1;
-	}
 	int err = SS_OK;
-	if (bad) {
+	if (e) {
 		remove(tmp);
-		err = ss_error_fail("cannot write '%s': %s", path,
-		                    failure.message[0] ? failure.message
-		                                       : e ? strerror(e) : "write error");
+		err = ss_error_fail("cannot write '%s': %s", path, strerror(e));
 	}
 	free(tmp);
+	return err;
+}
+
+int ss_render_write_png(const struct ss_render_image *img, const char *path, int compression)
+{
+	struct png_sink sink = {0};
+	struct png_failure failure = {""};
+	if (encode(img, compression, &sink, &failure))
+		return ss_error_fail("cannot write '%s': %s", path, failure.message);
+	const int err = ss_render_write_file(path, sink.data, sink.size);
+	free(sink.data);
 	return err;
 }

@@ -4,9 +4,11 @@
  *
  * Everything that can be checked is checked before the first frame is
  * written: the file, the frame selection, the output folder, the video's
- * folder and the height scale.  The scale is the whole file's lowest and
- * highest height on flow and open cells unless --zmin/--zmax give it, so
- * colours mean the same heights in every frame.
+ * folder, the viewer's file (html.c) and the height scale.  The scale is
+ * the whole file's lowest and highest height on flow and open cells unless
+ * --zmin/--zmax give it, so colours mean the same heights in every frame.
+ * Each frame is rendered once: its PNG bytes go to the folder, the viewer
+ * (--html) or both.
  *
  * Parallel work: a series of frames small enough to hold one per thread
  * goes frame by frame to the threads (encoding a PNG is serial, so this is
@@ -200,14 +202,15 @@ static int check_not_there(const struct ss_render_series_options *o, long long n
 		return SS_OK;
 	long long first = -1, there = 0;
 	char path[4200];
-	for (long long k = 0; k < n; k++) {
+	for (long long k = 0; o->output_dir && k < n; k++) {
 		ss_render_frame_path(o->output_dir, k, path, sizeof path);
 		if (access(path, F_OK) == 0) {
 			there++;
 			first = first < 0 ? k : first;
 		}
 	}
-	ss_render_frame_path(o->output_dir, first, path, sizeof path);
+	if (there)
+		ss_render_frame_path(o->output_dir, first, path, sizeof path);
 	if (there == 1)
 		return ss_error_input("'%s' exists: give --force to replace it, or -o another "
 		                      "folder", path);
@@ -236,9 +239,43 @@ static int select_frames(const struct ss_render_series_options *o,
 	return err ? err : sort_by_time(s, *sel, *n);
 }
 
+/* One frame: its PNG to the folder (dir, or NULL) and to the viewer (html,
+ * or NULL). */
+static int render_one(const struct ss_render_plan *p, struct ss_render_source *s, long long k,
+                      long long t, const char *dir, struct ss_render_html *html, int parallel)
+{
+	double *pixel_h = NULL;
+	if (html && ss_render_html_wants_pixels(html)) {
+		pixel_h = ss_alloc((size_t)p->rs.width * (size_t)p->rs.height, sizeof *pixel_h,
+		                   "pixel heights");
+		if (!pixel_h)
+			return SS_ERR_FAIL;
+	}
+	struct ss_render_image img;
+	unsigned char *png = NULL;
+	size_t size = 0;
+	int err = ss_render_plan_image(p, s, t, &img, pixel_h, parallel);
+	if (!err)
+		err = ss_render_encode_png(&img, p->look.compression, &png, &size);
+	ss_render_image_release(&img);
+	if (!err && dir) {
+		char path[4200];
+		ss_render_frame_path(dir, k, path, sizeof path);
+		err = ss_render_write_file(path, png, size);
+	}
+	if (!err && html) {
+		err = ss_render_html_add(html, k, t, png, size, pixel_h);
+		png = NULL;   /* the viewer's now */
+	}
+	free(png);
+	ss_free(pixel_h);
+	return err;
+}
+
 /* Render the frames; the first failure stops the others. */
 static int render_frames(const struct ss_render_plan *p, struct ss_render_source *s,
-                         const long long *sel, long long n, const char *dir)
+                         const long long *sel, long long n, const char *dir,
+                         struct ss_render_html *html)
 {
 	const int by_frames = n > 1 && ss_parallel_max_threads() > 1 &&
 	                      (long long)p->image_w * p->image_h <= FRAME_PARALLEL_MAX_PIXELS;
@@ -251,9 +288,7 @@ static int render_frames(const struct ss_render_plan *p, struct ss_render_source
 		failed = err;
 		if (failed)
 			continue;
-		char path[4200];
-		ss_render_frame_path(dir, k, path, sizeof path);
-		const int e = ss_render_plan_snapshot(p, s, sel[k], path, !by_frames);
+		const int e = render_one(p, s, k, sel[k], dir, html, !by_frames);
 		if (e) {
 			#pragma omp critical(ss_render_first_error)
 			if (!err)
@@ -293,9 +328,12 @@ static void report_frames(const struct ss_render_series_options *o,
 	r->zmin = p->zmin;
 	r->zmax = p->zmax;
 	r->threads = ss_parallel_max_threads();
-	ss_render_frame_path(o->output_dir, n, r->stale, sizeof r->stale);
-	if (access(r->stale, F_OK) != 0)
-		r->stale[0] = '\0';
+	r->stale[0] = '\0';
+	if (o->output_dir) {
+		ss_render_frame_path(o->output_dir, n, r->stale, sizeof r->stale);
+		if (access(r->stale, F_OK) != 0)
+			r->stale[0] = '\0';
+	}
 }
 
 int ss_render_series(const struct ss_render_series_options *o,
@@ -306,8 +344,11 @@ int ss_render_series(const struct ss_render_series_options *o,
 	int err = ss_render_options_check(&o->look);
 	if (err)
 		return err;
-	if (o->video && (o->fps < 1 || o->fps > 240))
+	if ((o->video || o->html) && (o->fps < 1 || o->fps > 240))
 		return ss_error_input("--fps %d: expected 1 to 240 frames per second", o->fps);
+	if (!o->output_dir && (o->video || !o->html))
+		return ss_error_input("no folder for the frames: %s", o->video ? "--video needs one"
+		                      : "give one, or --html to put the frames in a viewer");
 
 	struct ss_render_source s;
 	if ((err = ss_render_source_open(&s, o->input)))
@@ -319,26 +360,39 @@ int ss_render_series(const struct ss_render_series_options *o,
 		goto out_source;
 	}
 	if ((err = select_frames(o, &s, &sel, &n)) ||
-	    (err = ss_render_check_dir(o->output_dir, 0)) ||
+	    (o->output_dir && (err = ss_render_check_dir(o->output_dir, 0))) ||
 	    (o->video && (err = check_video_path(o->video))) || (err = check_not_there(o, n)) ||
+	    (o->html && (err = ss_render_html_check_path(o->html, o->force))) ||
 	    (err = series_scale(o, &s, &zmin, &zmax)))
 		goto out_source;
 	struct ss_render_plan plan;
 	if ((err = ss_render_plan_init(&plan, &o->look, s.file.nx, s.file.ny, s.file.dx, s.file.dy,
 	                               s.cell_type, s.file.nx, s.file.wall_sides, zmin, zmax, 1)))
 		goto out_source;
-	if ((err = ss_render_check_dir(o->output_dir, 1)))
+	struct ss_render_html *html = NULL;
+	if (o->html && (err = ss_render_html_create(&html, &plan, &s, sel, n,
+	                                            !isnan(o->look.zmin) || !isnan(o->look.zmax))))
 		goto out_plan;
+	if (o->output_dir && (err = ss_render_check_dir(o->output_dir, 1)))
+		goto out_html;
 
 	const double t0 = ss_parallel_wall_seconds();
-	if ((err = render_frames(&plan, &s, sel, n, o->output_dir)))
-		goto out_plan;
+	if ((err = render_frames(&plan, &s, sel, n, o->output_dir, html)))
+		goto out_html;
 	report->render_seconds = ss_parallel_wall_seconds() - t0;
 	report_frames(o, &s, &plan, sel, n, report);
+	if (html) {
+		size_t bytes;
+		if ((err = ss_render_html_write(html, o->html, o->fps, &bytes)))
+			goto out_html;
+		report->html_bytes = (long long)bytes;
+	}
 	report->seconds = ss_parallel_wall_seconds() - started;
 	if (o->video)
 		err = ss_render_video(o->output_dir, n, o->fps, o->video, &report->video);
 
+out_html:
+	ss_render_html_destroy(html);
 out_plan:
 	ss_render_plan_release(&plan);
 out_source:

@@ -145,14 +145,22 @@ int ss_render_write_png(const struct ss_render_image *img, const char *path,
 /* `sandslide render`: a series of frames from a sandslide HDF5 file. */
 struct ss_render_series_options {
 	const char *input;          /* the .h5 file */
-	const char *output_dir;     /* frames go here (created if missing) */
+	const char *output_dir;     /* frames go here (created if missing); NULL:
+	                             * no frame files (only with html, no video) */
 	const char *frames;         /* "A:B:STEP" (B exclusive, as a Python slice;
 	                             * negative counts from the end), "A", or NULL: all */
 	double time;                /* s: the snapshot nearest this; NAN: unused */
 	const char *video;          /* FILE.mp4 to assemble with ffmpeg, or NULL */
-	int fps;                    /* frames per second of the video (24) */
-	int force;                  /* replace frames and a video that exist;
-	                             * else SS_ERR_INPUT before anything is written */
+	int fps;                    /* frames per second of the video, and the
+	                             * speed the viewer starts at (24) */
+	const char *html;           /* FILE.html: a self-contained viewer of the
+	                             * frames (PNG frames embedded as base64, a
+	                             * slider, play/pause, the colour bar, and
+	                             * the height under the mouse from heights
+	                             * embedded quantised to 16 bits), or NULL */
+	int force;                  /* replace frames, a video and a viewer that
+	                             * exist; else SS_ERR_INPUT before anything is
+	                             * written */
 	struct ss_render_options look;
 };
 
@@ -175,16 +183,18 @@ struct ss_render_series_report {
 	char stale[4200];           /* the frame file after the last, left by an
 	                             * earlier render; "" if there is none */
 	enum ss_render_video_made video;
+	long long html_bytes;       /* size of the viewer written, 0 if none */
 };
 
 /*
  * Render the chosen snapshots of o->input to output_dir/frame_00000.png,
  * frame_00001.png, ... in time order, then the video if asked for (without
- * ffmpeg on PATH the frames are kept, and that is success).  Everything is
- * checked before the first frame is written.  Returns SS_OK (*report
- * filled), SS_ERR_INPUT (not a sandslide file, no snapshots, a range
- * outside the series, an unwritable folder, zmin >= zmax, frames or the
- * video there already without force) or SS_ERR_FAIL.
+ * ffmpeg on PATH the frames are kept, and that is success), and the
+ * viewer o->html if asked for (the same frames, rendered once for both).
+ * Everything is checked before the first frame is written.  Returns SS_OK
+ * (*report filled), SS_ERR_INPUT (not a sandslide file, no snapshots, a
+ * range outside the series, an unwritable folder, zmin >= zmax, frames, a
+ * video or a viewer there already without force) or SS_ERR_FAIL.
  */
 int ss_render_series(const struct ss_render_series_options *o,
                      struct ss_render_series_report *report);

@@ -479,12 +479,18 @@ static const struct cli_option render_options[] = {
 	 .help = "assemble the frames with ffmpeg (H.264, yuv420p) if it\n"
 	         "is on PATH; without it the frames are kept"},
 	{.name = "--fps", .value = "N", .kind = CLI_INT, .offset = RENDER(o.fps), .lo = 1,
-	 .hi = 240, .expected = "1 to 240", .help = "frames per second of the video (default 24)"},
+	 .hi = 240, .expected = "1 to 240",
+	 .help = "frames per second of the video, and the speed the\n"
+	         "viewer starts at (default 24)"},
 	{.name = "--no-label", .kind = CLI_FLAG, .offset = RENDER(no_label),
 	 .help = "no time label on a video's frames (--video draws one)"},
 	{.name = "--no-colorbar", .kind = CLI_FLAG, .offset = RENDER(no_colorbar),
 	 .help = "no colour bar on a video's frames (--video adds one)"},
-	FORCE(RENDER(o.force), "replace existing frames and video (else refused)"),
+	{.name = "--html", .value = "FILE.html", .kind = CLI_TEXT, .offset = RENDER(o.html),
+	 .help = "write a self-contained viewer (frames, slider, play,\n"
+	         "height under the mouse) to FILE.html; alone, no\n"
+	         "frame folder is written (with -o or --video, both)"},
+	FORCE(RENDER(o.force), "replace existing frames, video or viewer"),
 	THREADS(RENDER(threads)),
 	QUIET(RENDER(quiet), "no summary"),
 	{.name = "--bench", .value = "[N]", .kind = CLI_OPTIONAL_INT, .offset = RENDER(bench),
@@ -500,9 +506,11 @@ static int cmd_render(int argc, char **argv)
 	struct cli_command cmd = {
 		.usage = "usage: sandslide render FILE.h5 [-o DIR] [--frames A:B:STEP | --time T] "
 		         "[options]\n"
+		         "       sandslide render FILE.h5 --html FILE.html [options]\n"
 		         "       sandslide render --bench [N]\n",
 		.intro = "Draws the snapshots of a sandslide output file as PNG pictures,\n"
-		         "DIR/frame_00000.png, frame_00001.png, ... in time order (SPEC section 6).\n",
+		         "DIR/frame_00000.png, frame_00001.png, ... in time order (SPEC section 6),\n"
+		         "or into one HTML page that shows them (--html).\n",
 		.groups = {{render_options, COUNT(render_options), &a, 0},
 		           {look_options, COUNT(look_options), &a.o.look, 0}},
 		.outro = "Each PNG holds the time, the height scale and the snapshot in text chunks;\n"
@@ -532,6 +540,9 @@ static int cmd_render(int argc, char **argv)
 		a.o.look.label = 0;
 	if (a.no_colorbar)
 		a.o.look.colorbar = 0;
+	/* the viewer alone needs no frame files; a video is made from them */
+	if (a.o.html && !cli_given(&cmd, "--output") && !a.o.video)
+		a.o.output_dir = NULL;
 	struct ss_render_series_report report;
 	const int err = ss_render_series(&a.o, &report);
 	if (!err)

@@ -234,9 +234,9 @@ void cli_print_render_bench(const struct ss_render_bench_report *r)
 void cli_print_render_series(const struct ss_render_series_options *o,
                              const struct ss_render_series_report *r, int quiet)
 {
-	const size_t len = strlen(o->output_dir);
+	const size_t len = o->output_dir ? strlen(o->output_dir) : 0;
 	const double seconds = fmax(r->render_seconds, 1e-9);
-	if (!quiet) {
+	if (!quiet && o->output_dir) {
 		printf("wrote %lld frame%s of %d x %d px to %s%s (t = %g .. %g s, %s, heights %g .. "
 		       "%g m) in %.2f s: %.1f frames/s, %.1f Mpixel/s on %d threads\n", r->frames,
 		       r->frames == 1 ? "" : "s", r->width, r->height, o->output_dir,
@@ -255,5 +255,11 @@ void cli_print_render_series(const struct ss_render_series_options *o,
 		        o->output_dir);
 	} else if (r->video == SS_RENDER_VIDEO_MADE && !quiet) {
 		printf("wrote %s: %lld frames at %d frames/s\n", o->video, r->frames, o->fps);
+	}
+	if (r->html_bytes && !quiet) {
+		const double b = (double)r->html_bytes;
+		printf("wrote %s: %lld frame%s of %d x %d px, ", o->html, r->frames,
+		       r->frames == 1 ? "" : "s", r->width, r->height);
+		printf(b < 1e6 ? "%.0f kB\n" : "%.1f MB\n", b < 1e6 ? b * 1e-3 : b * 1e-6);
 	}
 }

@@ -39,7 +39,8 @@ void cli_print_info(const char *path, const struct ss_snapshot_summary *s);
 
 void cli_print_render_bench(const struct ss_render_bench_report *r);
 
-/* The frames written unless quiet, and a video that could not be made. */
+/* The frames, video and viewer written unless quiet, and a video that
+ * could not be made. */
 void cli_print_render_series(const struct ss_render_series_options *o,
                              const struct ss_render_series_report *r, int quiet);
 
