@@ -26,7 +26,7 @@ void ss_relax_options_init(struct ss_relax_options *o)
 		.tol = 1e-9, .slope_tol = 1e-6, .integrator = SS_INTEGRATOR_AUTO,
 		.rkl2_max_stages = SS_RKL2_MAX_STAGES_DEFAULT,
 		.rkl2_tol = SS_RKL2_TOL_DEFAULT, .max_time = INFINITY, .cfl = 0.9, .sides = SS_SIDE_WALL,
-		.nodata_type = SS_CELL_OPEN, .open_level = NAN, .output_every = NAN,
+		.nodata_type = SS_CELL_WALL, .open_level = NAN, .output_every = NAN,
 	};
 	ss_dem_read_options_init(&o->read);
 }
@@ -105,8 +105,8 @@ static int build_stepper(const struct ss_relax_options *o, const struct ss_raste
 
 	double level = o->open_level;
 	if (isnan(level)) {
-		/* sand that reaches a nodata cell or an open side leaves at the
-		 * lowest ground of the DEM */
+		/* sand that reaches an open side, or a nodata cell with
+		 * --nodata open, leaves at the lowest ground of the DEM */
 		level = INFINITY;
 		for (size_t m = 0; m < (size_t)r->nx * r->ny; m++)
 			if (!r->nodata || !r->nodata[m])

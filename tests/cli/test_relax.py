@@ -112,16 +112,16 @@ def test_subcritical_dem_is_returned_bit_for_bit_without_steps(tmp_path):
     assert float(head["cellsize"]) == 0.1
 
 
-def test_nodata_cells_are_kept_and_take_the_sand(tmp_path):
+def test_open_nodata_cells_are_kept_and_take_the_sand(tmp_path):
     h0 = cliff(30, 20)
     h0[5:8, 20:24] = -9999.0
     write_asc(tmp_path / "hole.asc", h0, nodata=-9999.0)
-    relax(["hole.asc", "-o", "out.asc", "--report", "r.json"], tmp_path)
+    relax(["hole.asc", "--nodata", "open", "-o", "out.asc", "--report", "r.json"], tmp_path)
     head, h = read_asc(tmp_path / "out.asc")
     assert float(head["nodata_value"]) == -9999.0
     assert np.all(h[5:8, 20:24] == -9999.0), "nodata cells lost their marker"
     rep = json.loads((tmp_path / "r.json").read_text())
-    assert rep["outflow"] >= 0.0
+    assert rep["outflow"] > 0.0, rep
     valid = h0 != -9999.0
     # what left through the open nodata cells is what the surface lost
     dv = (h0[valid].sum() - h[valid].sum()) * 0.01
