@@ -1002,7 +1002,8 @@ static void test_bedrock_slide_off(void)
 	CHECK(err == 0, "bedrock slide-off: bedrock refused");
 	if (err || prepare(&st))
 		goto out;
-	const double v0 = diag(&st).volume;
+	const struct ss_diagnostics d0 = diag(&st);
+	const double v0 = d0.volume;
 	struct thickness_watch w = {INFINITY};
 	const struct ss_advance_options o = {.steady_tol = 1e-9, .progress = watch_thickness,
 	                                     .context = &w};
@@ -1021,6 +1022,13 @@ static void test_bedrock_slide_off(void)
 	CHECK_REL(d.outflow + (d.volume - (v0 - layer * nx * ny * dx * dx)),
 	          layer * nx * ny * dx * dx, 1e-10,
 	          "bedrock slide-off: the outflow is not the sand that was there");
+	/* the steepest face in sand: at least the 45 degrees of the rock under
+	 * the layer (the open side's step is steeper), none once the rock is
+	 * bare (bare rock does not count) */
+	CHECK(d0.max_slope_deg >= 45.0 - 1e-9, "bedrock slide-off: steepest face %.6g deg "
+	      "under the layer, below the rock's 45", d0.max_slope_deg);
+	CHECK(d.max_slope_deg == 0.0, "bedrock slide-off: max_slope_deg %.6g deg on bare "
+	      "bedrock: the rock counted, not only the faces in sand", d.max_slope_deg);
 	printf("  slide-off: %lld steps to t = %.3g s, thickest remaining %.3g m, thinnest "
 	       "ever %.3g m, outflow %.6g of %.6g m^3\n", st.steps, st.time, left,
 	       w.min_thickness, d.outflow, layer * nx * ny * dx * dx);

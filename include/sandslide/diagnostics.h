@@ -11,7 +11,8 @@ struct ss_diagnostics {
 	double inflow;          /* cumulative volume added by sources, m^3 */
 	double outflow;         /* cumulative volume that left through open cells, m^3 */
 	double max_height;      /* highest flow cell, m */
-	double max_slope_deg;   /* steepest face that can carry flux, degrees */
+	double max_slope_deg;   /* steepest face in sand, degrees: bare bedrock
+	                         * does not count (ss_stepper_max_sand_slope) */
 	double steps;           /* cumulative substeps (RKL2: super-steps) */
 	double evaluations;     /* cumulative stencil evaluations */
 	double active_fraction; /* tiles swept / tiles, over the last interval */

@@ -4,9 +4,10 @@
  *
  * The DEM becomes the initial surface of a run that goes on until steady
  * (max |dh/dt| < tol, SPEC section 2) or max_time.  Cells without data are
- * open (sand leaves there, held at open_level) or walls.  With a bedrock
- * only the sand above it moves (face.h).  A source can pour sand on the DEM
- * first.  The output is a raster in the input's format (its georeferencing
+ * walls by default (sand never enters them, so a DEM below the repose angle
+ * comes back bit for bit however its outline is clipped), or open (sand
+ * leaves there, held at open_level).  With a bedrock only the sand above
+ * it moves (face.h).  A source can pour sand on the DEM first.  The output is a raster in the input's format (its georeferencing
  * and nodata kept), or with an .h5 output the full series of snapshots and
  * diagnostics (snapshot.h).  The input is never modified; every output is
  * written under a temporary name and renamed when complete, and claimed
@@ -48,7 +49,8 @@ struct ss_relax_options {
 	                                     * processors this process may run
 	                                     * on over the node's ranks */
 	enum ss_side_kind sides;          /* all four grid sides */
-	enum ss_cell_type nodata_type;    /* SS_CELL_OPEN or SS_CELL_WALL */
+	enum ss_cell_type nodata_type;    /* SS_CELL_WALL (default) or
+	                                     SS_CELL_OPEN */
 	double open_level;                /* m; NAN: the lowest height of the DEM */
 	const char *bedrock;              /* raster of the fixed base, or NULL */
 	int add_sand;                     /* pour on sand_shape: */

@@ -232,8 +232,21 @@ enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,
                                        const struct ss_advance_options *o);
 
 /* Volume, maxima and counters of the current state; wall_seconds is left to
- * the caller.  Resets the active_fraction counters. */
+ * the caller.  Resets the active_fraction counters.  max_slope_deg is
+ * ss_stepper_max_sand_slope as an angle. */
 void ss_stepper_diagnostics(struct ss_stepper *st, struct ss_diagnostics *d);
+
+/*
+ * The steepest face of the sand, s = |grad h| over every rank (fills the
+ * halo): the faces that can carry flux whose stencil lies in sand at least
+ * 1e-6 min(dx, dy) thick (ss_sweep_max_sand_slope); without a bedrock every
+ * such face.  Bare rock may stay steeper than the repose angle for ever,
+ * and a cell at the top of a rock cliff drains geometrically (a quarter of
+ * its sand per face and step, face.h), so it never quite reaches 0.  What
+ * relax reports and run's /max_slope_deg are.  The time step and the
+ * steady rule measure slopes their own way (stepper.c).
+ */
+double ss_stepper_max_sand_slope(struct ss_stepper *st);
 
 /* Tell the stepper that heights were changed from outside (every tile is
  * swept and measured again). */

@@ -106,8 +106,10 @@ def relax(heights, dx, dy=None, angle=35.0, closure="coulomb", nu=None, sides="w
     tol (m/s: steady when max |dh/dt| < tol), threads (default: every
     processor; OMP_NUM_THREADS is not consulted), and gamma, slope_tol,
     integrator ("auto", "euler", "rkl2"), rkl2_max_stages, rkl2_tol,
-    max_time (s), cfl, nodata ("open": cells without data let sand out,
-    held at open_level (default the lowest height); "wall"), open_level (m).
+    max_time (s), cfl, nodata ("wall", the default: no sand enters cells
+    without data, so a DEM below the repose angle comes back bit for bit;
+    "open": they let sand out, held at open_level, default the lowest
+    height), open_level (m).
 
     Returns (relaxed, report): relaxed a new float64 array shaped like
     heights, row 0 north, NaN where heights is; report the dict that

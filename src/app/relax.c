@@ -26,7 +26,7 @@ void ss_relax_options_init(struct ss_relax_options *o)
 		.tol = 1e-9, .slope_tol = 1e-6, .integrator = SS_INTEGRATOR_AUTO,
 		.rkl2_max_stages = SS_RKL2_MAX_STAGES_DEFAULT,
 		.rkl2_tol = SS_RKL2_TOL_DEFAULT, .max_time = INFINITY, .cfl = 0.9, .sides = SS_SIDE_WALL,
-		.nodata_type = SS_CELL_OPEN, .open_level = NAN, .output_every = NAN,
+		.nodata_type = SS_CELL_WALL, .open_level = NAN, .output_every = NAN,
 	};
 	ss_dem_read_options_init(&o->read);
 }
@@ -49,23 +49,11 @@ static void default_output(const char *dem, char *out, size_t size)
 		snprintf(out, size, "out/%.*s-relaxed.tif", stem, base);
 }
 
-/*
- * The steepest face of the sand, as an angle: faces that can carry flux
- * (SPEC section 2) whose stencil lies in sand at least 1e-6 min(dx, dy)
- * thick (ss_sweep_max_sand_slope).  A cell at the top of a rock cliff
- * drains geometrically (a quarter of its sand per face and step, face.h),
- * so it never quite reaches 0.  Without bedrock this is every face.
- */
+/* The steepest face of the sand (ss_stepper_max_sand_slope), in degrees:
+ * what run's /max_slope_deg holds too. */
 static double steepest_sand_face_deg(struct ss_stepper *st)
 {
-	const struct ss_grid *g = &st->grid;
-	ss_boundary_fill_heights(g, &st->boundary, st->height);
-	double s = st->bedrock
-	           ? ss_sweep_max_sand_slope(g, st->height, st->cell_types, st->bedrock,
-	                                     1e-6 * fmin(g->dx, g->dy))
-	           : ss_sweep_max_slope(g, st->height, st->cell_types);
-	ss_comm_reduce(&s, 1, NULL, 0);
-	return atan(s) * (180.0 / M_PI);
+	return atan(ss_stepper_max_sand_slope(st)) * (180.0 / M_PI);
 }
 
 /* The stepper for raster r: grid, closure, cell types (nodata), heights,
@@ -105,8 +93,8 @@ static int build_stepper(const struct ss_relax_options *o, const struct ss_raste
 
 	double level = o->open_level;
 	if (isnan(level)) {
-		/* sand that reaches a nodata cell or an open side leaves at the
-		 * lowest ground of the DEM */
+		/* sand that reaches an open side, or a nodata cell with
+		 * --nodata open, leaves at the lowest ground of the DEM */
 		level = INFINITY;
 		for (size_t m = 0; m < (size_t)r->nx * r->ny; m++)
 			if (!r->nodata || !r->nodata[m])

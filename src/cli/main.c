@@ -373,10 +373,11 @@ static const struct cli_option relax_options[] = {
 	 .help = "the four sides of the DEM (default wall)"},
 	{.name = "--nodata", .value = "wall|open", .kind = CLI_PARSE,
 	 .offset = RELAX(o.nodata_type), .parse = parse_nodata, .expected = "wall or open",
-	 .help = "cells without data (default open: sand leaves there)"},
+	 .help = "cells without data (default wall: no sand enters\n"
+	         "them; open: sand leaves there, at --open-level)"},
 	RANGE("--open-level", "M", o.open_level, -1e300, 1e300, "a height in m",
-	      "height held on open cells and sides (default: the\n"
-	      "lowest height of the DEM)"),
+	      "height held on open sides and open nodata cells\n"
+	      "(default: the lowest height of the DEM)"),
 	{.name = "--bedrock", .value = "FILE", .kind = CLI_TEXT, .offset = RELAX(o.bedrock),
 	 .help = "non-erodible base, a raster of the DEM's size: only\n"
 	         "the sand above it moves"},

@@ -110,6 +110,10 @@ void cli_print_relax_end(const struct ss_relax_report *r, double angle_deg, int 
 	       "%.4f deg (repose %g), wall %.3f s on %d threads\n", r->cells_moved,
 	       r->volume_moved, r->max_slope_before_deg, r->max_slope_after_deg, angle_deg,
 	       r->wall_seconds, ss_parallel_max_threads());
+	/* sand poured, and sand that left through open sides or open nodata
+	 * cells: what the volume change is made of */
+	printf("volume %.9g -> %.9g m^3: poured %.6g m^3, left through open cells and "
+	       "sides %.6g m^3\n", r->volume_before, r->volume_after, r->inflow, r->outflow);
 }
 
 void cli_bench_header(void *context, const struct ss_bench_header *h)

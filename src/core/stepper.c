@@ -765,6 +765,24 @@ enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,
 	return SS_ADVANCE_REACHED;
 }
 
+/* ss_stepper_max_sand_slope on this rank's faces (the halo filled). */
+static double max_sand_slope_here(const struct ss_stepper *st)
+{
+	const struct ss_grid *g = &st->grid;
+	if (!st->bedrock)
+		return ss_sweep_max_slope(g, st->height, st->cell_types);
+	return ss_sweep_max_sand_slope(g, st->height, st->cell_types, st->bedrock,
+	                               1e-6 * fmin(g->dx, g->dy));
+}
+
+double ss_stepper_max_sand_slope(struct ss_stepper *st)
+{
+	ss_boundary_fill_heights(&st->grid, &st->boundary, st->height);
+	double s = max_sand_slope_here(st);
+	ss_comm_reduce(&s, 1, NULL, 0);
+	return s;
+}
+
 void ss_stepper_diagnostics(struct ss_stepper *st, struct ss_diagnostics *d)
 {
 	const struct ss_grid *g = &st->grid;
@@ -795,7 +813,7 @@ void ss_stepper_diagnostics(struct ss_stepper *st, struct ss_diagnostics *d)
 	ss_comm_fold_finish(&volume, 1);
 
 	ss_boundary_fill_heights(g, &st->boundary, st->height);
-	double max[2] = {ss_sweep_max_slope(g, st->height, st->cell_types), max_height};
+	double max[2] = {max_sand_slope_here(st), max_height};
 	ss_comm_reduce(max, 2, NULL, 0);
 	const double s_max = max[0];
 	max_height = max[1];

@@ -62,7 +62,7 @@ static inline const char *ss_snapshot_diag_long_name(int k)
 		"cumulative volume added by sources",
 		"cumulative volume that left through open cells",
 		"highest sand surface on flow cells",
-		"steepest face slope that can carry flux",
+		"steepest slope of the faces in sand (bare bedrock not counted)",
 		"cumulative substeps (forward Euler) or super-steps (RKL2)",
 		"fraction of tiles swept since the previous snapshot",
 		"wall-clock time since the run started",

@@ -12,7 +12,7 @@ import zlib
 import numpy as np
 import pytest
 
-from conftest import h5open, run
+from conftest import h5open, run, text_attr
 
 TAN35 = math.tan(math.radians(35.0))
 
@@ -112,16 +112,16 @@ def test_subcritical_dem_is_returned_bit_for_bit_without_steps(tmp_path):
     assert float(head["cellsize"]) == 0.1
 
 
-def test_nodata_cells_are_kept_and_take_the_sand(tmp_path):
+def test_open_nodata_cells_are_kept_and_take_the_sand(tmp_path):
     h0 = cliff(30, 20)
     h0[5:8, 20:24] = -9999.0
     write_asc(tmp_path / "hole.asc", h0, nodata=-9999.0)
-    relax(["hole.asc", "-o", "out.asc", "--report", "r.json"], tmp_path)
+    relax(["hole.asc", "--nodata", "open", "-o", "out.asc", "--report", "r.json"], tmp_path)
     head, h = read_asc(tmp_path / "out.asc")
     assert float(head["nodata_value"]) == -9999.0
     assert np.all(h[5:8, 20:24] == -9999.0), "nodata cells lost their marker"
     rep = json.loads((tmp_path / "r.json").read_text())
-    assert rep["outflow"] >= 0.0
+    assert rep["outflow"] > 0.0, rep
     valid = h0 != -9999.0
     # what left through the open nodata cells is what the surface lost
     dv = (h0[valid].sum() - h[valid].sum()) * 0.01
@@ -361,6 +361,58 @@ bedrock = rock.asc
     assert np.array_equal(stored, rock), "/bedrock is not the bedrock file"
     assert (h - rock[None]).min() >= -1e-12, "sand went below the bedrock"
     assert (h[-1] - rock).max() < (h[0] - rock).max(), "nothing slid off"
+
+
+def test_run_max_slope_counts_the_faces_in_sand_as_relax_does(tmp_path):
+    """/max_slope_deg of `run` is the steepest face in sand, as relax's
+    report (issue 16, item 6): a bare 50 deg rock ramp in the west does not
+    count, so a 60 deg pile on the flat rock east of it ends at the repose
+    angle; relax of the run's last snapshot on the same bedrock reports the
+    same angle before it moves anything."""
+    ny, nx, dx = 24, 40, 0.05
+    y, x = (np.mgrid[0:ny, 0:nx] + 0.5) * dx
+    rock = math.tan(math.radians(50)) * np.maximum(0.0, 0.6 - x)
+    sand = rock + math.tan(math.radians(60)) * np.maximum(0.0, 0.35 - np.hypot(x - 1.3, y - 0.6))
+    write_asc(tmp_path / "rock.asc", rock, cellsize=dx)
+    write_asc(tmp_path / "sand.asc", sand, cellsize=dx)
+    (tmp_path / "ramp.ini").write_text(f"""\
+[grid]
+nx = {nx}
+ny = {ny}
+dx = {dx}
+[model]
+closure = coulomb
+repose_angle = 35
+nu = 1
+[time]
+end = steady
+output_every = 1
+[boundary]
+west = wall
+east = wall
+south = wall
+north = wall
+[initial]
+type = file
+file = sand.asc
+bedrock = rock.asc
+""")
+    r = run(["run", "ramp.ini", "-o", "ramp.h5", "-q"], cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    with h5open(tmp_path / "ramp.h5") as f:
+        slope = f["max_slope_deg"][:]
+        long_name = text_attr(f["max_slope_deg"], "long_name")
+        h = f["height"][-1]
+    assert (h - rock)[:, :10].max() == 0.0, "the ramp is not bare (test bug)"
+    assert slope[0] > 55, f"the pile starts at 60 deg: {slope!r}"
+    assert math.tan(math.radians(slope[-1])) <= TAN35 + 1e-6, (
+        f"final /max_slope_deg {slope[-1]!r}: the bare 50 deg ramp counted")
+    assert slope[-1] > 34, f"final /max_slope_deg {slope[-1]!r}: the pile is not at repose"
+    assert "sand" in long_name, f"/max_slope_deg long_name {long_name!r} does not say sand"
+    relax(["ramp.h5", "--bedrock", "rock.asc", "-o", "again.asc", "--report", "r.json"],
+          tmp_path)
+    rep = json.loads((tmp_path / "r.json").read_text())
+    assert rep["max_slope_before_deg"] == slope[-1], (rep, slope[-1])
 
 
 def gdal_built():

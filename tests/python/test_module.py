@@ -174,6 +174,27 @@ def test_nodata_cells_stay_nan():
             assert rep["outflow"] >= 0, rep
 
 
+def test_subcritical_dem_with_nan_round_it_comes_back_bit_for_bit():
+    """The default nodata treatment (walls): a gentle DEM clipped to an
+    irregular outline, NaN all round it, is not touched; nodata="open"
+    drains its edges (the check that this can fail)."""
+    ny, nx = 30, 38
+    r, c = np.mgrid[0:ny, 0:nx]
+    bump = np.exp(-((c - 25) ** 2 + (r - 9) ** 2) / 30.0)
+    h0 = 40.0 + 0.3 * c + 0.15 * (ny - r) + 1.0 * bump
+    th = np.arctan2(r - 15.0, c - 19.0)
+    outline = 13.0 + 2.0 * np.sin(3 * th + 0.5) + np.cos(5 * th)
+    h0[np.hypot(c - 19.0, (r - 15.0) / 0.8) > outline] = np.nan
+    h0[12, 20] = np.nan                                    # a void
+    assert np.isnan(h0[[0, -1], :]).all() and np.isnan(h0[:, [0, -1]]).all()
+    assert steepest_normal_gradient(h0, 1.0, 1.0) < 0.5
+    h, rep = sandslide.relax(h0, 1.0, threads=1)
+    assert rep["steps"] == 0 and rep["cells_moved"] == 0 and rep["outflow"] == 0, rep
+    assert same_bits(h, h0), f"heights changed: {np.argwhere(~(h == h0) & ~np.isnan(h0))}"
+    h, rep = sandslide.relax(h0, 1.0, nodata="open", threads=1)
+    assert rep["outflow"] > 0 and rep["cells_moved"] > 0, rep
+
+
 def test_bedrock_is_respected():
     ny, nx = 30, 40
     r, c = np.mgrid[0:ny, 0:nx]

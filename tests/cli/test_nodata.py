@@ -1,0 +1,186 @@
+"""`sandslide relax` of a DEM with cells without data (issue 16, item 6).
+
+A real DEM is mostly a clipped region: nodata all round an irregular
+outline, with voids inside.  By default (--nodata wall) the nodata cells
+are walls: sand never enters them, so a DEM that is below the repose angle
+everywhere comes back bit for bit (.asc and GeoTIFF), and a pile against
+the nodata edge relaxes with its volume kept.  --nodata open, which lets
+sand leave at --open-level (the DEM's lowest height), drains the same
+subcritical DEM at its edges: the check that the first test can fail.
+"""
+import json
+import math
+
+import numpy as np
+import pytest
+
+from conftest import run, same_bits
+
+TAN35 = math.tan(math.radians(35.0))
+NODATA = -9999.0
+DX = 0.1
+
+
+def write_asc(path, h, nodata_mask, cellsize=DX, x0=0.0, y0=0.0):
+    """h (ny, nx), row 0 = south; nodata_mask True where there is no data."""
+    ny, nx = h.shape
+    v = np.where(nodata_mask, NODATA, h)
+    head = (f"ncols {nx}\nnrows {ny}\nxllcorner {x0!r}\nyllcorner {y0!r}\n"
+            f"cellsize {cellsize!r}\nNODATA_value {NODATA!r}\n")
+    rows = [" ".join(repr(float(x)) for x in v[j]) for j in range(ny - 1, -1, -1)]
+    with open(path, "w") as f:
+        f.write(head + "\n".join(rows) + "\n")
+
+
+def read_asc(path):
+    """(header dict, values (ny, nx) south row first)."""
+    with open(path) as f:
+        tokens = f.read().split()
+    head, k = {}, 0
+    while tokens[k][0].isalpha():
+        head[tokens[k].lower()] = tokens[k + 1]
+        k += 2
+    nx, ny = int(head["ncols"]), int(head["nrows"])
+    v = np.array([float(t) for t in tokens[k:k + nx * ny]]).reshape(ny, nx)
+    return head, v[::-1]
+
+
+def clipped_dem(ny=36, nx=44):
+    """(heights, nodata mask), row 0 south: a tilted plane with a bump, not
+    symmetric along either axis, at most ~27 deg anywhere; data inside a
+    wobbly outline (a staircase of concave and convex corners), nodata all
+    round it, a one-cell void and a 2 x 3 void inside."""
+    y, x = (np.mgrid[0:ny, 0:nx] + 0.5) * DX
+    h = (5.0 + 0.30 * x + 0.12 * y + 0.08 * np.exp(-((x - 2.7) ** 2 + (y - 1.5) ** 2) / 0.15)
+         + 0.01 * np.sin(3.1 * x) * np.cos(2.2 * y))
+    th = np.arctan2(y - 1.8, x - 2.2)
+    radius = 1.7 + 0.18 * np.sin(3 * th + 0.4) + 0.1 * np.cos(5 * th)
+    nodata = np.hypot(x - 2.2, (y - 1.8) / 0.85) > radius
+    nodata[17, 14] = True
+    nodata[10:12, 25:28] = True
+    return h, nodata
+
+
+def face_slopes(h, wall, dx=DX):
+    """Largest face slope of SPEC section 2 with walls where `wall` is True
+    (and round the grid): faces touching a wall carry nothing, a wall
+    neighbour along a face is replaced by the cell itself."""
+    hp = np.pad(np.where(wall, 0.0, h), 1)
+    wp = np.pad(wall, 1, constant_values=True)
+    c = hp[1:-1, 1:-1]
+
+    def along(dj, di):
+        j0, i0 = 1 + dj, 1 + di
+        n = hp[j0:j0 + h.shape[0], i0:i0 + h.shape[1]]
+        return np.where(wp[j0:j0 + h.shape[0], i0:i0 + h.shape[1]], c, n)
+
+    cy = (along(1, 0) - along(-1, 0)) / (2 * dx)
+    cx = (along(0, 1) - along(0, -1)) / (2 * dx)
+    s = []
+    gn, gt = (c[:, 1:] - c[:, :-1]) / dx, 0.5 * (cy[:, 1:] + cy[:, :-1])
+    s.append(np.where(wall[:, 1:] | wall[:, :-1], 0.0, np.hypot(gn, gt)).max())
+    gn, gt = (c[1:, :] - c[:-1, :]) / dx, 0.5 * (cx[1:, :] + cx[:-1, :])
+    s.append(np.where(wall[1:, :] | wall[:-1, :], 0.0, np.hypot(gn, gt)).max())
+    return max(s)
+
+
+def relax(args, cwd, expect=0):
+    r = run(["relax"] + [str(a) for a in args] + ["-q", "--threads", "1"], cwd=cwd)
+    assert r.returncode == expect, (
+        f"relax {args} exited {r.returncode}, expected {expect}\n{r.stdout}\n{r.stderr}")
+    return r
+
+
+def test_the_clipped_dem_is_what_the_tests_say():
+    h, nodata = clipped_dem()
+    assert nodata[0].all() and nodata[-1].all() and nodata[:, 0].all() and nodata[:, -1].all()
+    assert 0.4 < (~nodata).mean() < 0.85
+    s = face_slopes(h, nodata)
+    assert s < math.tan(math.radians(30.0)), f"steepest face {math.degrees(math.atan(s))} deg"
+    # a staircase outline: nodata cells with data on two or more sides
+    inside = np.pad(~nodata, 1).astype(int)
+    sides = inside[:-2, 1:-1] + inside[2:, 1:-1] + inside[1:-1, :-2] + inside[1:-1, 2:]
+    assert (nodata & (sides >= 2)).sum() >= 10
+
+
+def test_subcritical_dem_with_nodata_round_it_comes_back_bit_for_bit(tmp_path):
+    h0, nodata = clipped_dem()
+    write_asc(tmp_path / "dem.asc", h0, nodata, x0=512000.5, y0=4100000.25)
+    relax(["dem.asc", "-o", "out.asc", "--report", "r.json"], tmp_path)
+    head, h = read_asc(tmp_path / "out.asc")
+    rep = json.loads((tmp_path / "r.json").read_text())
+    assert rep["steps"] == 0 and rep["cells_moved"] == 0, rep
+    assert rep["outflow"] == 0 and rep["volume_after"] == rep["volume_before"], rep
+    assert float(head["nodata_value"]) == NODATA
+    assert np.all(h[nodata] == NODATA), "a nodata cell lost its marker"
+    assert np.all(h[~nodata] != NODATA), "a cell with data became nodata"
+    assert same_bits(np.where(nodata, 0.0, h), np.where(nodata, 0.0, h0)), (
+        f"heights changed: {np.argwhere(h != np.where(nodata, NODATA, h0))[:10]}")
+
+
+def test_nodata_open_drains_the_same_dem(tmp_path):
+    """--nodata open (nodata cells held at the DEM's lowest height): the
+    edges of the same DEM drain, so the test above can fail."""
+    h0, nodata = clipped_dem()
+    write_asc(tmp_path / "dem.asc", h0, nodata)
+    relax(["dem.asc", "--nodata", "open", "-o", "out.asc", "--report", "r.json"], tmp_path)
+    _, h = read_asc(tmp_path / "out.asc")
+    rep = json.loads((tmp_path / "r.json").read_text())
+    assert rep["cells_moved"] > 20 and rep["outflow"] > 0, rep
+    assert np.all(h[nodata] == NODATA)
+    lost = (h0[~nodata].sum() - h[~nodata].sum()) * DX * DX
+    assert lost == pytest.approx(rep["outflow"], rel=1e-9), rep
+
+
+def gdal():
+    if "GDAL: on" not in run(["--version"]).stdout:
+        pytest.skip("this build has no GDAL (make GDAL=0)")
+    g = pytest.importorskip("osgeo.gdal", reason="GDAL's Python bindings (python3-gdal) "
+                            "are not installed")
+    g.UseExceptions()
+    return g
+
+
+def test_subcritical_geotiff_with_nodata_round_it_comes_back_bit_for_bit(tmp_path):
+    g = gdal()
+    h0, nodata = clipped_dem()
+    ny, nx = h0.shape
+    ds = g.GetDriverByName("GTiff").Create(str(tmp_path / "dem.tif"), nx, ny, 1,
+                                           g.GDT_Float64)
+    ds.SetGeoTransform((512000.0, DX, 0.0, 4100000.0 + ny * DX, 0.0, -DX))
+    band = ds.GetRasterBand(1)
+    band.SetNoDataValue(NODATA)
+    band.WriteArray(np.where(nodata, NODATA, h0)[::-1])   # north row first
+    ds = band = None
+    relax(["dem.tif", "-o", "out.tif", "--report", "r.json"], tmp_path)
+    rep = json.loads((tmp_path / "r.json").read_text())
+    assert rep["steps"] == 0 and rep["cells_moved"] == 0 and rep["outflow"] == 0, rep
+    out = g.Open(str(tmp_path / "out.tif"))
+    band = out.GetRasterBand(1)
+    h = band.ReadAsArray().astype(np.float64)[::-1]
+    marker = band.GetNoDataValue()
+    assert marker is not None and np.all(h[nodata] == marker), "nodata lost"
+    assert same_bits(np.where(nodata, 0.0, h), np.where(nodata, 0.0, h0)), "heights changed"
+
+
+def test_pile_against_the_nodata_edge_keeps_its_volume(tmp_path):
+    """A 60 deg pile whose foot is cut by the outline: by default its sand
+    stays in the DEM (the nodata edge is a wall), every face in sand ends
+    at the repose angle, and the nodata cells stay nodata."""
+    h0, nodata = clipped_dem()
+    y, x = (np.mgrid[0:h0.shape[0], 0:h0.shape[1]] + 0.5) * DX
+    pile = np.maximum(0.0, math.tan(math.radians(60)) * (0.6 - np.hypot(x - 3.6, y - 1.6)))
+    assert (pile[nodata] > 0.2).any() and (pile[~nodata] > 0.5).any(), "test bug"
+    h0 = h0 + pile
+    write_asc(tmp_path / "pile.asc", h0, nodata)
+    relax(["pile.asc", "-o", "out.asc", "--report", "r.json"], tmp_path)
+    _, h = read_asc(tmp_path / "out.asc")
+    rep = json.loads((tmp_path / "r.json").read_text())
+    assert rep["steady"] is True and rep["steps"] > 0 and rep["outflow"] == 0, rep
+    assert np.all(h[nodata] == NODATA), "a nodata cell lost its marker"
+    v0, v1 = h0[~nodata].sum(), h[~nodata].sum()
+    assert abs(v1 - v0) <= 1e-12 * v0, f"volume {v0!r} -> {v1!r} with nodata walls"
+    assert rep["volume_after"] == pytest.approx(rep["volume_before"], rel=1e-12), rep
+    assert math.tan(math.radians(rep["max_slope_after_deg"])) <= TAN35 + 1e-6, rep
+    s = face_slopes(np.where(nodata, 0.0, h), nodata)
+    assert s <= TAN35 + 1e-6, f"steepest face {s!r} above tan 35 = {TAN35!r}"
