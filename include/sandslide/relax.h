@@ -7,8 +7,9 @@
  * walls by default (sand never enters them, so a DEM below the repose angle
  * comes back bit for bit however its outline is clipped), or open (sand
  * leaves there, held at open_level).  With a bedrock only the sand above
- * it moves (face.h).  A source can pour sand on the DEM first.  The output is a raster in the input's format (its georeferencing
- * and nodata kept), or with an .h5 output the full series of snapshots and
+ * it moves (face.h).  A source can pour sand on the DEM first.  The output
+ * is a raster in the input's format (its georeferencing and nodata kept),
+ * or with an .h5 output the full series of snapshots and
  * diagnostics (snapshot.h).  The input is never modified; every output is
  * written under a temporary name and renamed when complete, and claimed
  * while the run lasts (no other run may write it meanwhile).  It shares the
