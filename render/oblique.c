@@ -593,8 +593,11 @@ static int wall_tops_init(struct wall_tops *w, const struct ss_render_raster *r,
 			for (int b = -1; b <= 1; b++)
 				for (int a = -1; a <= 1; a++) {
 					const int xn = x + a, yn = y + b;
-					if (xn >= 0 && yn >= 0 && xn < W && yn < H && w->label[(size_t)yn * W + xn] >= 0)
-						touch(&w->top[w->label[(size_t)yn * W + xn]], v);
+					if (xn < 0 || yn < 0 || xn >= W || yn >= H)
+						continue;
+					const int label = w->label[(size_t)yn * W + xn];
+					if (label >= 0)
+						touch(&w->top[label], v);
 				}
 		}
 	const double range = o->zscale * (zmax - zmin);
