@@ -83,11 +83,11 @@ void cli_print_run_end(const struct ss_run_summary *s, int quiet)
 		snprintf(mpi, sizeof mpi, ", mpi %.3f s", s->comm_seconds);
 	}
 	printf("wall %.3f s: slope %.3f s, sweep %.3f s, output %.3f s%s; %lld stencil "
-	       "evaluations, %.3g cell-updates/s on %s%d threads; %.0f B per cell\n",
+	       "evaluations, %.3g cell-updates/s on %s%d thread%s; %.0f B per cell\n",
 	       s->wall_seconds, s->measure_seconds, s->sweep_seconds, s->output_seconds, mpi,
 	       s->evaluations, (double)s->evaluations_here * s->cells /
 	       fmax(s->measure_seconds + s->sweep_seconds, 1e-9), ranks, s->threads,
-	       s->bytes_per_cell);
+	       s->threads == 1 ? "" : "s", s->bytes_per_cell);
 }
 
 void cli_print_relax_end(const struct ss_relax_report *r, double angle_deg, int quiet)
@@ -107,9 +107,9 @@ void cli_print_relax_end(const struct ss_relax_report *r, double angle_deg, int 
 	       r->steps, strcmp(r->integrator, "rkl2") ? "steps (euler)" : "super-steps (rkl2)",
 	       r->time, r->evaluations);
 	printf("cells moved %lld, volume moved %.6g m^3, steepest sand face %.4f -> "
-	       "%.4f deg (repose %g), wall %.3f s on %d threads\n", r->cells_moved,
+	       "%.4f deg (repose %g), wall %.3f s on %d thread%s\n", r->cells_moved,
 	       r->volume_moved, r->max_slope_before_deg, r->max_slope_after_deg, angle_deg,
-	       r->wall_seconds, ss_parallel_max_threads());
+	       r->wall_seconds, ss_parallel_max_threads(), ss_parallel_max_threads() == 1 ? "" : "s");
 	/* sand poured, and sand that left through open sides or open nodata
 	 * cells: what the volume change is made of */
 	printf("volume %.9g -> %.9g m^3: poured %.6g m^3, left through open cells and "
@@ -242,12 +242,12 @@ void cli_print_render_series(const struct ss_render_series_options *o,
 	const double seconds = fmax(r->render_seconds, 1e-9);
 	if (!quiet && o->output_dir) {
 		printf("wrote %lld frame%s of %d x %d px to %s%s (t = %g .. %g s, %s, heights %g .. "
-		       "%g m) in %.2f s: %.1f frames/s, %.1f Mpixel/s on %d threads\n", r->frames,
+		       "%g m) in %.2f s: %.1f frames/s, %.1f Mpixel/s on %d thread%s\n", r->frames,
 		       r->frames == 1 ? "" : "s", r->width, r->height, o->output_dir,
 		       len && o->output_dir[len - 1] == '/' ? "" : "/", r->t_first, r->t_last,
 		       ss_render_style_name(o->look.style), r->zmin, r->zmax, r->seconds,
 		       r->frames / seconds, (double)r->frames * r->width * r->height / seconds * 1e-6,
-		       r->threads);
+		       r->threads, r->threads == 1 ? "" : "s");
 		if (r->stale[0])
 			printf("note: %s and maybe later frames are left from an earlier render; they "
 			       "are not part of this series\n", r->stale);

@@ -18,7 +18,7 @@ def threads_used(args, cwd, env_extra=None, prefix=()):
     r = subprocess.run([*prefix, SANDSLIDE, *args], cwd=cwd, env=env, capture_output=True,
                        text=True, timeout=120)
     assert r.returncode == 0, r.stderr
-    m = re.search(r"on (\d+) threads", r.stdout)
+    m = re.search(r"on (\d+) threads?\b", r.stdout)
     assert m, f"the summary does not say the threads:\n{r.stdout}"
     return int(m.group(1))
 
