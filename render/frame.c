@@ -196,10 +196,10 @@ int ss_render_plan_init(struct ss_render_plan *p, const struct ss_render_options
 }
 
 /* Resample one cell field (south first, stride) onto float pixels. */
-static int resample_to_float(const struct ss_render_plan *p, const double *field,
-                             ptrdiff_t stride, const uint8_t *cell_type,
-                             ptrdiff_t type_stride, double *acc_hw, double *acc_w,
-                             float *out, int parallel)
+static void resample_to_float(const struct ss_render_plan *p, const double *field,
+                              ptrdiff_t stride, const uint8_t *cell_type,
+                              ptrdiff_t type_stride, double *acc_hw, double *acc_w,
+                              float *out, int parallel)
 {
 	(void)parallel;   /* used by the pragmas only */
 	const ptrdiff_t n = (ptrdiff_t)p->rs.width * p->rs.height;
@@ -211,7 +211,6 @@ static int resample_to_float(const struct ss_render_plan *p, const double *field
 	#pragma omp parallel for schedule(static) if(parallel)
 	for (ptrdiff_t k = 0; k < n; k++)
 		out[k] = isnan(acc_hw[k]) ? 0.0f : (float)acc_hw[k];
-	return SS_OK;
 }
 
 int ss_render_plan_gradients(const struct ss_render_plan *p, const double *h,

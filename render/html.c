@@ -25,8 +25,8 @@
  *            frame's array (little-endian, rows north first) is deflated
  *            with zlib and base64; the page inflates a frame's when it
  *            first needs it, with the browser's DecompressionStream
- *            (Chromium 80, Firefox 113 and later; it needs no network, so
- *            it works from file://);
+ *            (checked from file:// in Chromium 156 and Firefox 153 ESR;
+ *            it needs no network);
  *   types    the cell (or pixel) types once, the same way: 0 flow, 1 wall,
  *            2 open;
  *   scale    the colour map's 256 colours (ss_render_cmap_table), zmin and

@@ -61,7 +61,6 @@ struct camera {
 	int width, height;          /* px */
 	double z_floor, z_wall;     /* m, scene heights of the base and of the
 	                             * highest wall top (the framing) */
-	double z_top;               /* m, the top of the block being drawn */
 	double x0, x1, y0, y1;      /* m, the scene's extent with its wall sides */
 };
 
@@ -83,7 +82,7 @@ static void camera_init(struct camera *c, const struct ss_render_raster *ra,
 {
 	const double range = o->zscale * (zmax - zmin);
 	c->z_floor = -BASE_DEPTH * range;
-	c->z_top = c->z_wall = (1.0 + WALL_RISE) * range;
+	c->z_wall = (1.0 + WALL_RISE) * range;
 	c->x0 = -ra->wall_m[SS_WEST];
 	c->x1 = ra->width * ra->px_dx + ra->wall_m[SS_EAST];
 	c->y0 = -ra->wall_m[SS_SOUTH];
@@ -321,14 +320,14 @@ static void draw_skirt(struct target *t, const struct ss_render_raster *r,
 	}
 }
 
-/* A block over [x0, x1] x [y0, y1] from the base to the frame's wall
- * tops: its top, and the sides in `sides` (bit s: south, east, north,
- * west for s = 0..3). */
+/* A block over [x0, x1] x [y0, y1] from the base up to zt (m): its top,
+ * and the sides in `sides` (bit s: south, east, north, west for s =
+ * 0..3). */
 static void draw_block(struct target *t, const struct camera *c,
                        const struct ss_render_light *light, double x0, double x1, double y0,
-                       double y1, unsigned sides)
+                       double y1, double zt, unsigned sides)
 {
-	const double zt = c->z_top, zb = c->z_floor;
+	const double zb = c->z_floor;
 	struct vtx top[4], bot[4];
 	const double bt = face_light(light, 0, 0, 1);
 	const double xs[4] = {x0, x1, x1, x0}, ys[4] = {y0, y0, y1, y1};
@@ -369,9 +368,10 @@ struct wall_tops {
 	double *edge_z[4];
 };
 
-/* A block on wall pixel (x, y), with sides facing non-walls. */
-static void draw_wall(struct target *t, const struct ss_render_raster *r, struct camera c,
-                      const struct ss_render_light *light, int x, int y)
+/* A block up to zt (m) on wall pixel (x, y), with sides facing non-walls. */
+static void draw_wall(struct target *t, const struct ss_render_raster *r,
+                      const struct camera *c, const struct ss_render_light *light, int x,
+                      int y, double zt)
 {
 	const int W = r->width, H = r->height;
 	static const int nb[4][2] = {{0, 1}, {1, 0}, {0, -1}, {-1, 0}};   /* S E N W */
@@ -382,8 +382,8 @@ static void draw_wall(struct target *t, const struct ss_render_raster *r, struct
 		      r->type[(size_t)yn * W + xn] == SS_CELL_WALL))
 			sides |= 1u << s;
 	}
-	draw_block(t, &c, light, x * r->px_dx, (x + 1) * r->px_dx, (H - y - 1) * r->px_dy,
-	           (H - y) * r->px_dy, sides);
+	draw_block(t, c, light, x * r->px_dx, (x + 1) * r->px_dx, (H - y - 1) * r->px_dy,
+	           (H - y) * r->px_dy, zt, sides);
 }
 
 /* A quad of one colour: the face of normal n. */
@@ -488,14 +488,11 @@ static void draw_band(struct target *t, const struct ss_render_raster *r,
 			draw_quad(t, a, b, e, d);
 		}
 	draw_skirt(t, r, c, light, v);
-	struct camera at = *c;
 	for (int y = 0; y < H; y++)
 		for (int x = 0; x < W; x++) {
 			const size_t k = (size_t)y * W + x;
-			if (r->type[k] == SS_CELL_WALL) {
-				at.z_top = tops->top[tops->label[k]];
-				draw_wall(t, r, at, light, x, y);
-			}
+			if (r->type[k] == SS_CELL_WALL)
+				draw_wall(t, r, c, light, x, y, tops->top[tops->label[k]]);
 		}
 	for (int side = 0; side < 4; side++)
 		if (tops->edge_z[side])

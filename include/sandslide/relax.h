@@ -103,6 +103,11 @@ void ss_relax_options_destroy(struct ss_relax_options *o);
  * --add-sand has no key: use the struct. */
 int ss_relax_options_set(struct ss_relax_options *o, const char *key, const char *value);
 
+/* The words of --sides ("wall" or "open": periodic sides make no sense for
+ * a DEM) and --nodata ("wall" or "open"); 0, or -1 if word is not one. */
+int ss_relax_sides_parse(const char *word, enum ss_side_kind *sides);
+int ss_relax_nodata_parse(const char *word, enum ss_cell_type *type);
+
 struct ss_relax_report {
 	int nx, ny;
 	double dx, dy;                    /* m */

@@ -5,9 +5,6 @@
  */
 #include "app/named.h"
 
-#include <errno.h>
-#include <math.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include "base/strings.h"
@@ -47,23 +44,11 @@ char *ss_named_copy(const char *s)
 /* value parsed into field; 0, or -1 when it is not what k takes */
 static int parse(const struct ss_named *k, const char *value, void *field)
 {
-	char *end;
-	errno = 0;
 	switch (k->kind) {
-	case SS_NAMED_REAL: {
-		const double v = strtod(value, &end);
-		if (end == value || *end || errno || !isfinite(v) || !(v >= k->lo && v <= k->hi))
-			return -1;
-		*(double *)field = v;
-		return 0;
-	}
-	case SS_NAMED_INT: {
-		const long v = strtol(value, &end, 10);
-		if (end == value || *end || errno || v < (long)k->lo || v > (long)k->hi)
-			return -1;
-		*(int *)field = (int)v;
-		return 0;
-	}
+	case SS_NAMED_REAL:
+		return ss_parse_real(value, k->lo, k->hi, field);
+	case SS_NAMED_INT:
+		return ss_parse_int(value, (long)k->lo, (long)k->hi, field);
 	case SS_NAMED_FLAG:
 		if (strcmp(value, "0") && strcmp(value, "1"))
 			return -1;

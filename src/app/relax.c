@@ -49,6 +49,23 @@ static void default_output(const char *dem, char *out, size_t size)
 		snprintf(out, size, "out/%.*s-relaxed.tif", stem, base);
 }
 
+int ss_relax_sides_parse(const char *word, enum ss_side_kind *sides)
+{
+	enum ss_side_kind kind;
+	if (ss_side_kind_parse(word, &kind) || kind == SS_SIDE_PERIODIC)
+		return -1;
+	*sides = kind;
+	return 0;
+}
+
+int ss_relax_nodata_parse(const char *word, enum ss_cell_type *type)
+{
+	if (strcmp(word, "wall") && strcmp(word, "open"))
+		return -1;
+	*type = !strcmp(word, "wall") ? SS_CELL_WALL : SS_CELL_OPEN;
+	return 0;
+}
+
 /* The steepest face of the sand (ss_stepper_max_sand_slope), in degrees:
  * what run's /max_slope_deg holds too. */
 static double steepest_sand_face_deg(struct ss_stepper *st)

@@ -26,23 +26,15 @@ struct owned_options {
 	char *text[TEXT_COUNT];      /* NULL, or the value of o's text field */
 };
 
-/* The words relax's --sides and --nodata take. */
+/* The words relax's --sides and --nodata take, as WORD parsers. */
 static int parse_sides(const char *value, void *field)
 {
-	/* periodic sides make no sense for a DEM: the CLI refuses them */
-	enum ss_side_kind side;
-	if (ss_side_kind_parse(value, &side) || side == SS_SIDE_PERIODIC)
-		return -1;
-	*(enum ss_side_kind *)field = side;
-	return 0;
+	return ss_relax_sides_parse(value, field);
 }
 
 static int parse_nodata(const char *value, void *field)
 {
-	if (strcmp(value, "wall") && strcmp(value, "open"))
-		return -1;
-	*(enum ss_cell_type *)field = !strcmp(value, "wall") ? SS_CELL_WALL : SS_CELL_OPEN;
-	return 0;
+	return ss_relax_nodata_parse(value, field);
 }
 
 static int parse_closure(const char *value, void *field)

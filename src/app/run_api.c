@@ -11,8 +11,6 @@
  */
 #include "sandslide/run.h"
 
-#include <errno.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include "app/named.h"
@@ -64,35 +62,6 @@ void ss_run_options_destroy(struct ss_run_options *o)
 	ss_free(w);
 }
 
-/* An integer in [lo, hi] from all of s into *out; 0, or -1. */
-static int parse_int(const char *s, long lo, long hi, int *out)
-{
-	char *end;
-	errno = 0;
-	const long v = strtol(s, &end, 10);
-	if (end == s || *end || errno || v < lo || v > hi)
-		return -1;
-	*out = (int)v;
-	return 0;
-}
-
-/* "NXxNY" into o's tile size, as the command line's --tile */
-static int parse_tile(const char *s, struct ss_run_options *o)
-{
-	const char *x = strchr(s, 'x');
-	char nx[32];
-	int a, b;
-	if (!x || x - s >= (long)sizeof nx)
-		return -1;
-	memcpy(nx, s, (size_t)(x - s));
-	nx[x - s] = '\0';
-	if (parse_int(nx, 1, 1 << 20, &a) || parse_int(x + 1, 1, 1 << 20, &b))
-		return -1;
-	o->tile_nx = a;
-	o->tile_ny = b;
-	return 0;
-}
-
 /* One more override at the end of o's list. */
 static int append_set(struct owned_options *w, const char *value)
 {
@@ -129,8 +98,12 @@ int ss_run_options_set(struct ss_run_options *o, const char *key, const char *va
 		return ss_error_input("%s needs a value: %s", key, k->expected);
 	if (!strcmp(k->name, "set"))
 		return append_set(w, value);
-	return parse_tile(value, o) ? ss_error_input("%s '%s': expected %s", key, value, k->expected)
-	                            : SS_OK;
+	int tile[2];
+	if (ss_parse_tile(value, tile))
+		return ss_error_input("%s '%s': expected %s", key, value, k->expected);
+	o->tile_nx = tile[0];
+	o->tile_ny = tile[1];
+	return SS_OK;
 }
 
 static const char *end_name(enum ss_run_end end)

@@ -3,6 +3,7 @@
  */
 #include "base/strings.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -33,6 +34,44 @@ char *ss_strings_join(const char *const *v, int n, const char *separator, int te
 	}
 	*end = '\0';
 	return s;
+}
+
+int ss_parse_int(const char *s, long lo, long hi, int *out)
+{
+	char *end;
+	errno = 0;
+	const long v = s ? strtol(s, &end, 10) : 0;
+	if (!s || end == s || *end || errno || v < lo || v > hi)
+		return -1;
+	*out = (int)v;
+	return 0;
+}
+
+int ss_parse_real(const char *s, double lo, double hi, double *out)
+{
+	char *end;
+	errno = 0;
+	const double v = s ? strtod(s, &end) : NAN;
+	if (!s || end == s || *end || errno || !isfinite(v) || !(v >= lo && v <= hi))
+		return -1;
+	*out = v;
+	return 0;
+}
+
+int ss_parse_tile(const char *s, int tile[2])
+{
+	const char *x = strchr(s, 'x');
+	char nx[32];
+	int a, b;
+	if (!x || x - s >= (long)sizeof nx)
+		return -1;
+	memcpy(nx, s, (size_t)(x - s));
+	nx[x - s] = '\0';
+	if (ss_parse_int(nx, 1, 1 << 20, &a) || ss_parse_int(x + 1, 1, 1 << 20, &b))
+		return -1;
+	tile[0] = a;
+	tile[1] = b;
+	return 0;
 }
 
 void ss_strbuf_printf(struct ss_strbuf *b, const char *fmt, ...)

@@ -11,6 +11,14 @@
  * (after a message) when out of memory. */
 char *ss_strings_join(const char *const *v, int n, const char *separator, int terminate);
 
+/* All of s as a number in [lo, hi] (a finite one for reals) into *out:
+ * 0, or -1 when it is not one (out unchanged).  The command line's
+ * options and the options set by name (app/named.c) parse with these. */
+int ss_parse_int(const char *s, long lo, long hi, int *out);
+int ss_parse_real(const char *s, double lo, double hi, double *out);
+/* "NXxNY", each 1 to 2^20, into tile[0], tile[1] (--tile); 0 or -1. */
+int ss_parse_tile(const char *s, int tile[2]);
+
 /* Text appended to a caller's buffer (the JSON of relax's report and run's
  * summary): always NUL-terminated, cut when full, and len counts what was
  * asked even past size, as snprintf does, so the formatter's caller can

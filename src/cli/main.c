@@ -282,17 +282,12 @@ static int parse_integrator(const char *word, void *target)
 
 static int parse_sides(const char *word, void *target)
 {
-	return ss_side_kind_parse(word, target) || *(enum ss_side_kind *)target == SS_SIDE_PERIODIC
-	       ? -1 : 0;
+	return ss_relax_sides_parse(word, target);
 }
 
 static int parse_nodata(const char *word, void *target)
 {
-	enum ss_cell_type *type = target;
-	if (strcmp(word, "wall") && strcmp(word, "open"))
-		return -1;
-	*type = !strcmp(word, "wall") ? SS_CELL_WALL : SS_CELL_OPEN;
-	return 0;
+	return ss_relax_nodata_parse(word, target);
 }
 
 /* rect=X0,Y0,X1,Y1 or disk=X,Y,R into a shape; -1 if malformed. */
@@ -611,7 +606,7 @@ static int parse_bench_threads(const char *word, void *target)
 			return -1;
 		memcpy(buf, p, len);
 		buf[len] = '\0';
-		if (cli_parse_int(buf, 1, 4096, &o->threads[o->thread_count++]))
+		if (ss_parse_int(buf, 1, 4096, &o->threads[o->thread_count++]))
 			return -1;
 		p += len + (p[len] == ',');
 	}

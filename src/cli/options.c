@@ -3,50 +3,20 @@
  */
 #include "cli/options.h"
 
-#include <errno.h>
-#include <math.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/strings.h"
 #include "sandslide/comm.h"
 #include "sandslide/error.h"
 
 /* The help's second column: options on the left, their text from here. */
 #define HELP_COLUMN 24
 
-int cli_parse_int(const char *s, long lo, long hi, int *out)
-{
-	char *end;
-	errno = 0;
-	const long v = s ? strtol(s, &end, 10) : 0;
-	if (!s || end == s || *end || errno || v < lo || v > hi)
-		return -1;
-	*out = (int)v;
-	return 0;
-}
-
-int cli_parse_real(const char *s, double lo, double hi, double *out)
-{
-	char *end;
-	errno = 0;
-	const double v = s ? strtod(s, &end) : NAN;
-	if (!s || end == s || *end || errno || !isfinite(v) || !(v >= lo && v <= hi))
-		return -1;
-	*out = v;
-	return 0;
-}
-
 int cli_parse_tile(const char *s, void *tile)
 {
-	int *t = tile;
-	const char *x = strchr(s, 'x');
-	char buf[32];
-	if (!x || x - s >= (long)sizeof buf)
-		return -1;
-	snprintf(buf, sizeof buf, "%.*s", (int)(x - s), s);
-	return cli_parse_int(buf, 1, 1 << 20, &t[0]) || cli_parse_int(x + 1, 1, 1 << 20, &t[1])
-	       ? -1 : 0;
+	return ss_parse_tile(s, tile);
 }
 
 /* The option's text over the continuation lines, HELP_COLUMN indented. */
@@ -143,10 +113,10 @@ static int store(struct cli_command *c, const struct cli_option *o, void *target
 	int bad = 0;
 	switch (o->kind) {
 	case CLI_INT:
-		bad = cli_parse_int(value, (long)o->lo, (long)o->hi, target);
+		bad = ss_parse_int(value, (long)o->lo, (long)o->hi, target);
 		break;
 	case CLI_REAL:
-		bad = cli_parse_real(value, o->lo, o->hi, target);
+		bad = ss_parse_real(value, o->lo, o->hi, target);
 		break;
 	case CLI_TEXT:
 		*(const char **)target = value;
@@ -179,7 +149,7 @@ static int take(struct cli_command *c, int g, int k, const char *inline_value, i
 	if (o->kind == CLI_FLAG || o->kind == CLI_OPTIONAL_INT) {
 		*(int *)(base + o->offset) = 1;
 		if (o->kind == CLI_OPTIONAL_INT && *at + 1 < argc &&
-		    cli_parse_int(argv[*at + 1], (long)o->lo, (long)o->hi,
+		    ss_parse_int(argv[*at + 1], (long)o->lo, (long)o->hi,
 		                  (int *)(base + o->value_offset)) == 0)
 			++*at;
 		return 0;

@@ -88,9 +88,8 @@ void cli_help(const struct cli_command *c, FILE *f);
 int cli_usage_error(const struct cli_command *c, const char *fmt, ...)
 	__attribute__((format(printf, 2, 3)));
 
-/* Parsers for CLI_PARSE and the command code: 0, or -1 if malformed. */
-int cli_parse_int(const char *s, long lo, long hi, int *out);
-int cli_parse_real(const char *s, double lo, double hi, double *out);
-int cli_parse_tile(const char *s, void *tile);   /* "NXxNY" into int[2] */
+/* "NXxNY" into int[2], as CLI_PARSE calls it (ss_parse_tile); the
+ * numbers are ss_parse_int and ss_parse_real of base/strings.h. */
+int cli_parse_tile(const char *s, void *tile);
 
 #endif

@@ -191,10 +191,11 @@ static int attr_fill_nan(hid_t d)
 	return attr_doubles(d, "_FillValue", &fill, 1);
 }
 
-/* Rows of /height per chunk: a chunk is 1 x rows x min(nx, 256). */
-static int chunk_rows(long long ny)
+/* Cells along a side of a /height chunk (snapshot_layout.h): a chunk is
+ * 1 x chunk_side(ny) x chunk_side(nx). */
+static int chunk_side(long long n)
 {
-	return ny < 256 ? (int)ny : 256;
+	return n < SS_SNAPSHOT_CHUNK_SIDE ? (int)n : SS_SNAPSHOT_CHUNK_SIDE;
 }
 
 /* Rows j0 .. j0 + n - 1 (of the whole grid) of a (y, x) dataset of nx
@@ -321,8 +322,7 @@ static int write_static(struct ss_snapshot *s, const uint8_t *cell_types,
 	const hsize_t ny = (hsize_t)g->global_ny;
 	hsize_t dims[3] = {0, ny, (hsize_t)g->nx};
 	hsize_t maxdims[3] = {H5S_UNLIMITED, ny, (hsize_t)g->nx};
-	hsize_t chunk[3] = {1, (hsize_t)chunk_rows(g->global_ny),
-	                    (hsize_t)(g->nx < 256 ? g->nx : 256)};
+	hsize_t chunk[3] = {1, (hsize_t)chunk_side(g->global_ny), (hsize_t)chunk_side(g->nx)};
 	hid_t space = H5Screate_simple(3, dims, maxdims);
 	hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
 	H5Pset_chunk(dcpl, 3, chunk);
@@ -496,7 +496,7 @@ static struct ss_snapshot *snapshot_alloc(const char *path, const struct ss_grid
 	s->path = strdup(path);
 	s->xmf_path = malloc(strlen(path) + 8);
 	s->partial_path = malloc(strlen(path) + 16);
-	s->band_rows = chunk_rows(g->global_ny);
+	s->band_rows = chunk_side(g->global_ny);
 	s->band = ss_alloc((size_t)s->band_rows * (size_t)g->nx, sizeof *s->band,
 	                   "a band of heights to write");
 	s->band_types = ss_alloc((size_t)g->nx, 1, "a row of cell types");
@@ -601,7 +601,7 @@ static int space_verdict(struct ss_snapshot *s)
 	if (stat(path, &sb) != 0)
 		return 0;
 	const double ny = (double)g->global_ny;
-	const double cy = ny < 256 ? ny : 256, cx = g->nx < 256 ? g->nx : 256;
+	const double cy = chunk_side(g->global_ny), cx = chunk_side(g->nx);
 	const double chunks = ceil(ny / cy) * ceil(g->nx / cx);
 	const double bytes = chunks * cy * cx * sizeof(double) + (256 << 10);
 	if (getrlimit(RLIMIT_FSIZE, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY &&

@@ -26,33 +26,9 @@ CASES = os.path.join(ROOT, "cases")
 
 # A small valid case: 20 x 16 cells of 0.1 m, grid [0, 2] x [0, 1.6] m.
 # Flat sand 0.2 m high next to an open east side: it slides a little.
-BASE = """\
-# base case for the CLI tests
-[grid]
-nx = 20
-ny = 16
-dx = 0.1
-origin = 0 0
-
-[model]
-closure = coulomb
-repose_angle = 35
-nu = 0.1
-
-[time]
-end = 1
-output_every = 0.5
-
-[boundary]
-west = wall
-east = open
-south = wall
-north = wall
-
-[initial]
-type = flat
-height = 0.2
-"""
+# tests/python reads the same file.
+with open(os.path.join(ROOT, "tests", "base.ini")) as _f:
+    BASE = _f.read()
 
 
 def pytest_configure(config):

@@ -287,32 +287,9 @@ def test_other_inputs_are_converted():
 
 # ---- run and open ----------------------------------------------------------
 
-CASE = """\
-[grid]
-nx = 20
-ny = 16
-dx = 0.1
-origin = 0 0
-
-[model]
-closure = coulomb
-repose_angle = 35
-nu = 0.1
-
-[time]
-end = 1
-output_every = 0.5
-
-[boundary]
-west = wall
-east = open
-south = wall
-north = wall
-
-[initial]
-type = flat
-height = 0.2
-"""
+# the small case of the CLI tests (tests/cli/conftest.py's BASE)
+with open(os.path.join(ROOT, "tests", "base.ini")) as _f:
+    CASE = _f.read()
 
 
 @pytest.fixture
