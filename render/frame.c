@@ -15,20 +15,6 @@
 #define AUTO_MIN_SIDE 512       /* px: small grids are enlarged to this */
 #define MAX_PIXELS (1ll << 30)  /* a larger picture is surely a mistake */
 
-void ss_render_options_default(struct ss_render_options *o)
-{
-	memset(o, 0, sizeof *o);
-	o->style = SS_RENDER_SHADED;
-	o->cmap = SS_RENDER_CMAP_DUNE;
-	o->zmin = o->zmax = NAN;
-	o->azimuth_deg = 315.0;
-	o->altitude_deg = 45.0;
-	o->zscale = 1.0;
-	o->view_azimuth_deg = NAN;      /* from the open side (view_azimuth) */
-	o->view_elevation_deg = 55.0;
-	o->compression = 6;
-}
-
 int ss_render_options_check(const struct ss_render_options *o)
 {
 	if (!isfinite(o->azimuth_deg))

@@ -39,17 +39,18 @@ static void relax_options_are_checked_as_the_cli_checks_them(void)
 	CHECK(o != NULL, "create");
 	if (!o)
 		return;
-	CHECK(o->angle_deg == 35.0 && o->nu == 1.0 && o->tol == 1e-9, "the CLI's defaults");
-	CHECK(ss_relax_options_set(o, "angle", "30") == SS_OK && o->angle_deg == 30.0, "angle");
+	CHECK(o->model.angle_deg == 35.0 && o->model.nu == 1.0 && o->model.steady_tol == 1e-9 &&
+	      isnan(o->model.max_time) && o->sand_shape.kind == SS_SHAPE_NONE, "the table's defaults");
+	CHECK(ss_relax_options_set(o, "angle", "30") == SS_OK && o->model.angle_deg == 30.0, "angle");
 	CHECK(ss_relax_options_set(o, "angle", "95") == SS_ERR_INPUT, "angle 95 refused");
 	CHECK(!strcmp(ss_error_last_message(), "angle '95': expected degrees in (0, 90)"), "%s",
 	      ss_error_last_message());
-	CHECK(o->angle_deg == 30.0, "a refused value leaves the option as it was");
+	CHECK(o->model.angle_deg == 30.0, "a refused value leaves the option as it was");
 	CHECK(ss_relax_options_set(o, "angle", "30x") == SS_ERR_INPUT, "trailing junk refused");
-	CHECK(ss_relax_options_set(o, "max_time", "5") == SS_OK && o->max_time == 5.0, "max_time");
-	CHECK(ss_relax_options_set(o, "max-time", "6") == SS_OK && o->max_time == 6.0, "max-time");
+	CHECK(ss_relax_options_set(o, "max_time", "5") == SS_OK && o->model.max_time == 5.0, "max_time");
+	CHECK(ss_relax_options_set(o, "max-time", "6") == SS_OK && o->model.max_time == 6.0, "max-time");
 	CHECK(ss_relax_options_set(o, "closure", "casson") == SS_OK &&
-	      o->closure == SS_CLOSURE_CASSON, "closure");
+	      o->model.closure == SS_CLOSURE_CASSON, "closure");
 	CHECK(ss_relax_options_set(o, "closure", "bogus") == SS_ERR_INPUT, "bogus closure");
 	CHECK(!strcmp(ss_error_last_message(), "closure 'bogus': expected " SS_CLOSURE_NAMES),
 	      "%s", ss_error_last_message());
@@ -59,7 +60,7 @@ static void relax_options_are_checked_as_the_cli_checks_them(void)
 	CHECK(ss_relax_options_set(o, "nodata", "wall") == SS_OK &&
 	      o->nodata_type == SS_CELL_WALL, "nodata");
 	CHECK(ss_relax_options_set(o, "integrator", "rkl2") == SS_OK &&
-	      o->integrator == SS_INTEGRATOR_RKL2, "integrator");
+	      o->model.integrator == SS_INTEGRATOR_RKL2, "integrator");
 	CHECK(ss_relax_options_set(o, "threads", "3") == SS_OK && o->threads == 3, "threads");
 	CHECK(ss_relax_options_set(o, "threads", "2.5") == SS_ERR_INPUT, "threads 2.5 refused");
 	CHECK(ss_relax_options_set(o, "dx", "0.25") == SS_OK && o->read.cellsize == 0.25, "dx");
@@ -67,8 +68,13 @@ static void relax_options_are_checked_as_the_cli_checks_them(void)
 	CHECK(ss_relax_options_set(o, "force", "yes") == SS_ERR_INPUT, "force yes refused");
 	CHECK(ss_relax_options_set(o, "tol", "") == SS_ERR_INPUT, "an empty value refused");
 	CHECK(ss_relax_options_set(o, "bogus", "1") == SS_ERR_INPUT, "unknown key");
-	CHECK(!strncmp(ss_error_last_message(), "unknown relax option 'bogus': expected one of "
-	               "angle, closure", 60), "%s", ss_error_last_message());
+	CHECK(!strncmp(ss_error_last_message(), "unknown relax option 'bogus': expected one of ",
+	               46) && strstr(ss_error_last_message(), ", angle, ") &&
+	      strstr(ss_error_last_message(), ", add-sand, "), "%s", ss_error_last_message());
+	CHECK(ss_relax_options_set(o, "add-sand", "disk=5,6,2") == SS_OK &&
+	      o->sand_shape.kind == SS_SHAPE_DISK && o->sand_shape.v[2] == 2.0, "add-sand");
+	CHECK(ss_relax_options_set(o, "add-sand", "disk=5,6,0") == SS_ERR_INPUT &&
+	      o->sand_shape.v[2] == 2.0, "add-sand with R = 0 refused, the shape kept");
 
 	char path[32] = "first.asc";
 	CHECK(ss_relax_options_set(o, "output", path) == SS_OK, "output");
@@ -97,7 +103,7 @@ static void report_json_fits_or_says_so(void)
 	CHECK(strstr(buf, "\"input\": \"a \\\"quoted\\\" \\\\ path\\u000a\",") != NULL,
 	      "quotes, backslash and newline escaped: %s", buf);
 	CHECK(strstr(buf, "\"max_slope_after_deg\": null\n}\n") != NULL, "NaN is null: %s", buf);
-	CHECK(strstr(buf, "\"steady\": true, \"tol\": 1.0000000000000001e-09,") != NULL, "%s", buf);
+	CHECK(strstr(buf, "\"steady\": true, \"end\": ") && strstr(buf, "\"tol\": 1"), "%s", buf);
 	CHECK(ss_relax_report_json(&o, &r, tiny, sizeof tiny) == SS_ERR_INPUT, "too small");
 	CHECK(strstr(ss_error_last_message(), "the buffer has 40") != NULL, "%s",
 	      ss_error_last_message());
@@ -243,8 +249,11 @@ static void run_options_and_a_case(void)
 		CHECK(ss_run_options_set(o, "set", k % 2 ? "time.end=0.5" : "time.end=2") == SS_OK,
 		      "set %d", k);
 	CHECK(o->override_count == 20 && !strcmp(o->overrides[19], "time.end=0.5"), "overrides");
-	CHECK(ss_run_options_set(o, "tile", "8x4") == SS_OK && o->tile_nx == 8 &&
-	      o->tile_ny == 4, "tile");
+	CHECK(ss_run_options_set(o, "tile", "8x4") == SS_OK && o->tile[0] == 8 &&
+	      o->tile[1] == 4, "tile");
+	CHECK(ss_run_options_set(o, "set", "time.end") == SS_ERR_INPUT, "a set without '='");
+	CHECK(ss_run_options_set(o, "unset", "time.end=1") == SS_ERR_INPUT, "an unset with '='");
+	CHECK(o->override_count == 20, "refused overrides are not kept");
 	CHECK(ss_run_options_set(o, "tile", "8by4") == SS_ERR_INPUT, "bad tile");
 	CHECK(!strcmp(ss_error_last_message(), "tile '8by4': expected NXxNY, e.g. 256x64"), "%s",
 	      ss_error_last_message());

@@ -20,6 +20,7 @@
 #include <stddef.h>
 
 #include "sandslide/closure.h"
+#include "sandslide/option.h"
 
 #define SS_BENCH_MAX_CASES 8
 
@@ -60,6 +61,7 @@ struct ss_bench_result {
 	double roofline;                   /* bandwidth / bytes_per_cell */
 };
 
+/* Set ss_bench_options_init's defaults; the callbacks are the caller's. */
 struct ss_bench_options {
 	int nx, ny;                                        /* cells */
 	struct ss_bench_closure closures[SS_BENCH_MAX_CASES];
@@ -69,7 +71,8 @@ struct ss_bench_options {
 	int surfaces[SS_BENCH_SURFACES];                   /* 1: run it */
 	int repeats;                                       /* timings per case */
 	int steps;                                         /* per timing; 0: auto */
-	int tile_nx, tile_ny;                              /* < 1: defaults */
+	int tile[2];                                       /* cells per tile, nx
+	                                                    * and ny; < 1: defaults */
 	/* the figures, as they come (the caller prints them) */
 	void (*on_header)(void *context, const struct ss_bench_header *h);
 	void (*on_result)(void *context, const struct ss_bench_result *r);
@@ -78,6 +81,13 @@ struct ss_bench_options {
 
 /* The surface names "supercritical", "subcritical", "patch". */
 const char *ss_bench_surface_name(enum ss_bench_surface s);
+
+/* bench's options (option.h): the command line's parser and help read them. */
+extern const struct ss_option_table ss_bench_option_table;
+
+/* Every option at the table's default (8192^2 cells, every closure and
+ * surface, 1 and 2 threads, 5 repeats). */
+void ss_bench_options_init(struct ss_bench_options *o);
 
 /* Run the benchmark.  SS_ERR_INPUT for a bad option (a grid too small for
  * the patch, too little memory), SS_ERR_FAIL otherwise. */

@@ -1,6 +1,7 @@
 /*
- * case.h - the case file (SPEC section 4): an INI file parsed with inih,
- * plus command-line overrides "SECTION.KEY=VALUE".
+ * case.h - the case file (doc/case-file.md): an INI file parsed with inih,
+ * plus the command line's overrides, "SECTION.KEY=VALUE" (--set) and
+ * "SECTION.KEY" or "SECTION" (--unset).
  *
  *   [grid]      nx, ny, dx, dy (default dx), origin = X Y
  *   [model]     closure, repose_angle (deg), nu (m^2/s) or the physical
@@ -15,17 +16,30 @@
  *               rect = X0 Y0 X1 Y1 | disk = X Y R | polygon = X Y X Y ... |
  *               mask = PNG; sources also rate (m/s), start, stop (s)
  *
- * cases/reference.ini documents every key with units and defaults.  Every
- * error names file:line (or the --set argument) and what is accepted.
+ * The keys are one table (ss_case_option_table), which continues in the
+ * model's (model_options.h): [model] closure, repose_angle, nu, gamma and
+ * [time] cfl, steady_tol, ... are the options relax takes as --closure,
+ * --angle, ..., with the same defaults and ranges.  cases/reference.ini
+ * documents every key with units and defaults.  Every error names file:line
+ * (or the --set / --unset argument) and what is accepted.
+ *
+ * An override wins over the file: a key of the file that an override makes
+ * redundant (max_time once --set time.end gives a time, nu once --set
+ * model.delta gives the sliding layer, a cone's keys once --set
+ * initial.type=flat, ...) is dropped, and a note says so (c->notes), where
+ * the same conflict inside the file, or between two overrides, is an error.
  */
 #ifndef SANDSLIDE_CASE_H
 #define SANDSLIDE_CASE_H
 
 #include "sandslide/boundary.h"
 #include "sandslide/closure.h"
+#include "sandslide/model_options.h"
 #include "sandslide/shape.h"
 #include "sandslide/stepper.h"
 
+
+enum { SS_CASE_MAX_NOTES = 16, SS_CASE_NOTE_SIZE = 512 };
 
 enum ss_region_role { SS_REGION_WALL, SS_REGION_OPEN, SS_REGION_SOURCE };
 
@@ -53,11 +67,11 @@ struct ss_case {
 	double dx, dy;          /* m */
 	double origin_x, origin_y; /* lower-left corner, m */
 
-	/* [model] */
-	enum ss_closure_kind closure;
-	double repose_angle_deg;
-	double nu;              /* m^2/s, given or derived */
-	double gamma;           /* herschel-bulkley exponent (1 otherwise) */
+	/* [model] closure, repose_angle, nu (given or derived), gamma (1
+	 * but for herschel-bulkley), and [time] cfl, steady_tol,
+	 * steady_slope_tol, max_time, integrator, rkl2_max_stages, rkl2_tol */
+	struct ss_model_options model;
+	/* [model]: the sliding layer nu may be derived from */
 	double delta;           /* sliding layer thickness, m */
 	double density;         /* kg/m^3 */
 	double gravity;         /* m/s^2 */
@@ -68,13 +82,6 @@ struct ss_case {
 	double end;             /* s; INFINITY when steady */
 	int steady;             /* end = steady */
 	double output_every;    /* s */
-	double cfl;
-	double steady_tol;      /* m/s */
-	double steady_slope_tol; /* slope excess over tan a_cr (stepper.h) */
-	double max_time;        /* s, INFINITY by default */
-	enum ss_integrator integrator; /* SS_INTEGRATOR_AUTO by default */
-	int rkl2_max_stages;
-	double rkl2_tol; /* units of tan(a_cr) min(dx, dy) */
 
 	/* [boundary] */
 	struct ss_boundary boundary;
@@ -91,12 +98,20 @@ struct ss_case {
 
 	struct ss_region *regions; /* in file order */
 	int region_count;
+
+	/* What the overrides made of the file: the keys they dropped, one
+	 * sentence each ("[time] max_time (cases/cone.ini:31) dropped: ..."),
+	 * for the run's summary. */
+	char notes[SS_CASE_MAX_NOTES][SS_CASE_NOTE_SIZE];
+	int note_count;
 };
 
 /*
- * Read and validate the case file at path, then apply the overrides
- * ("SECTION.KEY=VALUE", e.g. "model.closure=casson" or
- * "source pour.rate=0.002").  Returns SS_OK, SS_ERR_INPUT (message names the
+ * Read and validate the case file at path, then apply the overrides in
+ * order: "SECTION.KEY=VALUE" sets a key ("model.closure=casson",
+ * "source pour.rate=0.002"), "SECTION.KEY" without '=' unsets one (as if
+ * the file did not give it: its default, or missing), and "SECTION" alone
+ * removes a wall, open or source section ("source pour").  Returns SS_OK, SS_ERR_INPUT (message names the
  * file:line or override) or SS_ERR_FAIL.  Release with ss_case_release()
  * whatever the result.
  */
@@ -108,5 +123,9 @@ void ss_case_release(struct ss_case *c);
  * resolve relative file names). */
 int ss_case_parse(struct ss_case *c, const char *path, const char *text,
                   const char *const *overrides, int override_count);
+
+/* The case file's keys ([grid], [model], [time], [boundary], [initial]),
+ * continued by the model's options (model_options.h) at c->model. */
+extern const struct ss_option_table ss_case_option_table;
 
 #endif

@@ -3,7 +3,8 @@
  * angle out (quasi-static shaping of piles on real terrain).
  *
  * The DEM becomes the initial surface of a run that goes on until steady
- * (max |dh/dt| < tol, SPEC section 2) or max_time.  Cells without data are
+ * (max |dh/dt| < tol and no sand face steeper than the repose angle:
+ * doc/model.md) or max_time.  Cells without data are
  * walls by default (sand never enters them, so a DEM below the repose angle
  * comes back bit for bit however its outline is clipped), or open (sand
  * leaves there, held at open_level).  With a bedrock only the sand above
@@ -26,6 +27,8 @@
 #include "sandslide/boundary.h"
 #include "sandslide/closure.h"
 #include "sandslide/dem.h"
+#include "sandslide/model_options.h"
+#include "sandslide/option.h"
 #include "sandslide/progress.h"
 #include "sandslide/shape.h"
 #include "sandslide/stepper.h"
@@ -34,18 +37,9 @@ struct ss_relax_options {
 	const char *dem;                  /* input: path or FILE.h5[:/dataset] */
 	struct ss_dem_read_options read;  /* PNG range, cell size */
 	const char *output;               /* NULL: out/<stem>-relaxed.<ext> */
-	enum ss_closure_kind closure;
-	double angle_deg;                 /* repose angle, (0, 90) */
-	double gamma;                     /* herschel-bulkley exponent */
-	double nu;                        /* m^2/s: sets the time scale only */
-	double tol;                       /* m/s: steady when max |dh/dt| < tol */
-	double slope_tol;                 /* and no sand face steeper than the
-	                                     angle by more (stepper.h) */
-	enum ss_integrator integrator;    /* auto: euler (relax.c says why) */
-	int rkl2_max_stages;              /* stepper.h */
-	double rkl2_tol;
-	double max_time;                  /* s; INFINITY: until steady */
-	double cfl;
+	struct ss_model_options model;    /* closure, angle, nu, tol, integrator,
+	                                   * ... (model_options.h); max_time NaN:
+	                                   * until steady */
 	int threads;                      /* <= 0: OMP_NUM_THREADS, else the
 	                                     * processors this process may run
 	                                     * on over the node's ranks */
@@ -54,8 +48,8 @@ struct ss_relax_options {
 	                                     SS_CELL_OPEN */
 	double open_level;                /* m; NAN: the lowest height of the DEM */
 	const char *bedrock;              /* raster of the fixed base, or NULL */
-	int add_sand;                     /* pour on sand_shape: */
-	struct ss_shape sand_shape;       /*   rect or disk, m */
+	struct ss_shape sand_shape;       /* pour sand on it (rect or disk, m;
+	                                   * SS_SHAPE_NONE: none): */
 	double sand_rate;                 /*   m/s */
 	double sand_duration;             /*   s, from t = 0 */
 	double output_every;              /* s, .h5 output only; NAN: 20 snapshots
@@ -82,6 +76,12 @@ struct ss_relax_options {
 	struct ss_raster *output_raster;
 };
 
+/* relax's options: name, kind, default, range, help of each (option.h),
+ * continued by the model's at o->model.  The command line, the options set
+ * by name and the Python module all read them from here. */
+extern const struct ss_option_table ss_relax_option_table;
+
+/* Every option at its default (the table's). */
 void ss_relax_options_init(struct ss_relax_options *o);
 
 /* For callers that cannot lay the struct out (a foreign-function
@@ -93,14 +93,14 @@ struct ss_relax_options *ss_relax_options_create(void);
 void ss_relax_options_destroy(struct ss_relax_options *o);
 
 /* Set option `key` of options from ss_relax_options_create to `value`,
- * parsed and checked as the command line does: keys are relax's option
- * names without the dashes ("angle", "closure", "nu", "tol", "max-time";
- * '_' may stand for '-') and value is the word the command line would
- * take ("35", "coulomb", "1" or "0" for a flag).  Text values (dem,
- * output, report, bedrock) are copied.  SS_ERR_INPUT names the key and
- * what it accepts ("angle '95': expected degrees in (0, 90)"), options
- * unchanged.  Keys other than the text ones work on any options.
- * --add-sand has no key: use the struct. */
+ * parsed and checked as the command line does (ss_relax_option_table):
+ * keys are relax's option names without the dashes ("angle", "closure",
+ * "nu", "tol", "max-time", "add-sand"; '_' may stand for '-') and value is
+ * the word the command line would take ("35", "coulomb", "disk=5,5,2",
+ * "1" or "0" for a flag).  Text values (dem, output, report, bedrock) are
+ * copied.  SS_ERR_INPUT names the key and what it accepts ("angle '95':
+ * expected degrees in (0, 90)"), options unchanged.  Keys other than the
+ * text ones work on any options. */
 int ss_relax_options_set(struct ss_relax_options *o, const char *key, const char *value);
 
 /* The words of --sides ("wall" or "open": periodic sides make no sense for
@@ -122,9 +122,12 @@ struct ss_relax_report {
 	const char *integrator;           /* "euler" or "rkl2" */
 	double time;                      /* simulated, s */
 	double wall_seconds;
-	int steady;                       /* reached max |dh/dt| < tol */
+	int steady;                       /* reached the steady rule */
 	int interrupted;                  /* by *stop_signal: the output holds
 	                                     the surface as it was then */
+	const char *end;                  /* why it stopped: "steady", "max
+	                                     time" (max_time reached first),
+	                                     "interrupted" */
 	char output[4096];
 };
 

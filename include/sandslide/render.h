@@ -28,6 +28,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include "sandslide/option.h"
 
 enum ss_render_style {
 	SS_RENDER_SHADED,   /* colour map x hillshade, 8-bit RGB */
@@ -69,6 +70,11 @@ struct ss_render_options {
 	int compression;            /* zlib level of the PNG, 0..9 (6) */
 };
 
+/* The look's options (option.h): the command line's parser and help read
+ * them; also run --frames's. */
+extern const struct ss_option_table ss_render_look_option_table;
+
+/* Every field at the table's default. */
 void ss_render_options_default(struct ss_render_options *o);
 
 /* SS_ERR_INPUT (with a message naming the option) for values out of range,
@@ -163,6 +169,13 @@ struct ss_render_series_options {
 	                             * written */
 	struct ss_render_options look;
 };
+
+/* `sandslide render`'s options (option.h), continued by the look's at
+ * look; the command line's parser and help read them. */
+extern const struct ss_option_table ss_render_option_table;
+
+/* Every field at the table's default (look too). */
+void ss_render_series_options_init(struct ss_render_series_options *o);
 
 /* What became of a video that was asked for. */
 enum ss_render_video_made {

@@ -15,6 +15,7 @@
 #include <signal.h>
 #include <stddef.h>
 
+#include "sandslide/option.h"
 #include "sandslide/progress.h"
 
 /* What a run reports after each snapshot is written and flushed. */
@@ -33,12 +34,14 @@ struct ss_run_snapshot {
 struct ss_run_options {
 	const char *case_path;
 	const char *output;          /* NULL: out/<case name>.h5 */
-	const char *const *overrides; /* "SECTION.KEY=VALUE" */
+	const char *const *overrides; /* in order: "SECTION.KEY=VALUE" sets a
+	                              * key, "SECTION.KEY" or "SECTION" unsets
+	                              * (case.h) */
 	int override_count;
 	int threads;                 /* <= 0: OMP_NUM_THREADS, else the
 	                                * processors this process may run on
 	                                * over the node's ranks (parallel.h) */
-	int tile_nx, tile_ny;        /* <= 0: defaults */
+	int tile[2];                 /* cells per tile, nx and ny; <= 0: defaults */
 	int reference_kernel;        /* use the reference sweep (sweep.h) */
 	int deflate;                 /* HDF5 deflate level 0..9 */
 	const char *history;         /* the command line, for the file */
@@ -55,6 +58,14 @@ struct ss_run_options {
 	int (*on_snapshot)(void *context, const struct ss_run_snapshot *s);
 	void *snapshot_context;
 };
+
+/* run's options: name, kind, default, range, help of each (option.h).
+ * The command line, the options set by name and the Python module all
+ * read them from here. */
+extern const struct ss_option_table ss_run_option_table;
+
+/* Every option at its default (the table's). */
+void ss_run_options_init(struct ss_run_options *o);
 
 /* How a run ended. */
 enum ss_run_end {
@@ -85,6 +96,9 @@ struct ss_run_summary {
 	double comm_seconds;         /* in MPI calls, rank 0 (comm.h) */
 	int threads;                 /* OpenMP threads of each rank */
 	int ranks;                   /* MPI ranks (comm.h) */
+	/* what the overrides made of the case: the keys they dropped (case.h) */
+	char notes[8][512];
+	int note_count;
 };
 
 /* Returns SS_OK, SS_ERR_INPUT or SS_ERR_FAIL (message already printed);
@@ -93,26 +107,28 @@ int ss_run_case(const struct ss_run_options *o, struct ss_run_summary *summary);
 
 /* For callers that cannot lay the structs out (a foreign-function
  * interface such as Python's ctypes; their fields change between
- * versions): heap options set by name.  create returns the command line's
+ * versions): heap options set by name.  create returns the table's
  * defaults, or NULL (message printed) when out of memory; destroy(NULL)
  * does nothing. */
 struct ss_run_options *ss_run_options_create(void);
 void ss_run_options_destroy(struct ss_run_options *o);
 
 /* Set option `key` of options from ss_run_options_create to `value`,
- * checked as the command line does: keys are run's option names without
- * the dashes ('_' may stand for '-'): "output", "restart", "threads",
- * "force" and "reference-kernel" ("1" or "0"), "deflate", "tile" ("NXxNY"),
- * "set" (one SECTION.KEY=VALUE override, added after those set before, as
- * --set is; the case parser checks it), and "case" (CASE.ini) and
- * "history" (the file's history attribute).  Text values are copied.
- * SS_ERR_INPUT names the key and what it accepts, options unchanged. */
+ * checked as the command line does (ss_run_option_table): keys are run's
+ * option names without the dashes ('_' may stand for '-'): "output",
+ * "restart", "threads", "force" and "reference-kernel" ("1" or "0"),
+ * "deflate", "tile" ("NXxNY"), "set" (one SECTION.KEY=VALUE override) and
+ * "unset" (one SECTION.KEY or SECTION), each added after those before, as
+ * --set and --unset are (the case parser checks them), and "case"
+ * (CASE.ini) and "history" (the file's history attribute).  Text values
+ * are copied.  SS_ERR_INPUT names the key and what it accepts, options
+ * unchanged. */
 int ss_run_options_set(struct ss_run_options *o, const char *key, const char *value);
 
 /* The summary as JSON into buf (size bytes, NUL-terminated): "output",
  * "end" ("done", "steady", "not steady", "interrupted"), "snapshots",
  * "time", "steps", "evaluations", "integrator", the threads, ranks and
- * timings; SS_ERR_INPUT when it does not fit (the message says how many
+ * timings, and the "notes" of the overrides; SS_ERR_INPUT when it does not fit (the message says how many
  * bytes it needs). */
 int ss_run_summary_json(const struct ss_run_summary *s, char *buf, size_t size);
 

@@ -17,6 +17,7 @@
 #include "sandslide/version.h"
 #include "sandslide/error.h"
 #include "sandslide/parallel.h"
+#include "sandslide/option.h"
 #include "sandslide/comm.h"
 
 #include "sandslide/grid.h"
@@ -27,6 +28,7 @@
 #include "sandslide/sweep.h"
 #include "sandslide/rkl2.h"
 #include "sandslide/stepper.h"
+#include "sandslide/model_options.h"
 
 #include "sandslide/dem.h"
 #include "sandslide/snapshot.h"

@@ -31,6 +31,17 @@ struct ss_shape {
 	char where[SS_CASE_WHERE_SIZE]; /* "file:line" of the shape key */
 };
 
+/* Parse the numbers of a rect ("X0 Y0 X1 Y1", X0 < X1 and Y0 < Y1) or a
+ * disk ("X Y R", R > 0), in m, separated by white space or commas (the
+ * case file writes "0 0 1 1", relax's --add-sand "rect=0,0,1,1"), into s's
+ * kind and v: 0, or -1 when value is not one (s unchanged).  The one
+ * place these rules are checked. */
+int ss_shape_parse_numbers(enum ss_shape_kind kind, const char *value, struct ss_shape *s);
+
+/* What a shape's value must be, for messages: "'X0 Y0 X1 Y1' in m with
+ * X0 < X1 and Y0 < Y1", ... (RECT, DISK, POLYGON). */
+const char *ss_shape_expected(enum ss_shape_kind kind);
+
 /*
  * Set mask[j * nx + i] = 1 (south row first) for every cell of g inside the
  * shape, leaving the others as they are.  *covered counts the cells inside.

@@ -27,7 +27,8 @@ from ._native import Error, InputError, RunError  # noqa: F401  (the API)
 from . import _native
 
 # open is left out: `from sandslide import *` must not hide the built-in
-__all__ = ["relax", "run", "version", "Error", "InputError", "RunError", "__version__"]
+__all__ = ["relax", "run", "options", "version", "Error", "InputError", "RunError",
+           "__version__"]
 
 
 def version():
@@ -40,6 +41,32 @@ __version__ = version()
 # Room for the JSON the library writes: a report or summary is under 1 KiB
 # but for its paths, which the library escapes (at most 6 bytes a byte).
 _JSON_BYTES = 1 << 16
+
+
+def options(command):
+    """The options of `command` ("relax" or "run") as the library's table
+    gives them (option.h), a list of dicts: "name" (relax's keyword, with
+    '_' for '-'), "case_key" (the case file's key of the same option, or
+    None), "kind", "default" (the text a user would give, or None: none),
+    "lo", "hi" (the range of a number, None when open-ended), "expected",
+    "help", "command_line" and "by_name".  The module keeps no defaults of
+    its own: a keyword left at None takes the library's."""
+    table = _native.option_table(command)
+    buf = ctypes.create_string_buffer(_JSON_BYTES)
+    _native.check(_native.lib.ss_option_table_json(table, buf, len(buf)))
+    return json.loads(buf.value.decode())
+
+
+def _options_doc(command):
+    """The options' defaults and help, for a docstring."""
+    lines = []
+    for o in options(command):
+        if not o["by_name"] or o["kind"] in ("text", "list"):
+            continue
+        default = o["default"] if o["default"] is not None else "none"
+        text = " ".join(o["help"].split())
+        lines.append(f"    {o['name'].replace('-', '_')} (default {default}): {text}")
+    return "\n".join(lines)
 
 
 def _word(value):
@@ -87,57 +114,41 @@ def _grid(name, values):
     return np.array(a[::-1], dtype=np.float64, order="C", copy=True)
 
 
-def relax(heights, dx, dy=None, angle=35.0, closure="coulomb", nu=None, sides="wall",
-          bedrock=None, tol=1e-9, threads=None, *, gamma=None, slope_tol=None,
+def relax(heights, dx, dy=None, angle=None, closure=None, nu=None, sides=None,
+          bedrock=None, tol=None, threads=None, *, gamma=None, slope_tol=None,
           integrator=None, rkl2_max_stages=None, rkl2_tol=None, max_time=None, cfl=None,
-          nodata=None, open_level=None):
+          nodata=None, open_level=None, add_sand=None, sand_rate=None, sand_duration=None):
     """Relax a DEM to the repose angle, as `sandslide relax` does.
 
     heights: 2-D array [row, column], row 0 the NORTH edge (GDAL's and
     rasterio's order), in m; NaN where there is no data.  Any real dtype
     (converted to float64; a masked array's mask becomes NaN); not modified.
-    dx, dy: cell size in m (dy: dx when None).
+    dx, dy: cell size in m (dy: dx when None).  bedrock: an array like
+    heights, the non-erodible base: only the sand above it moves (NaN only
+    where heights is NaN).
 
-    The options are relax's, with the same defaults and checks (None: the
-    library's default): angle (deg, default 35), closure ("coulomb",
-    "bingham", "herschel-bulkley", "casson"), nu (m^2/s, default 1: sets
-    the time scale only), sides ("wall" or "open"), bedrock (an array like
-    heights: only the sand above it moves; NaN only where heights is NaN),
-    tol (m/s: steady when max |dh/dt| < tol), threads (default: every
-    processor; OMP_NUM_THREADS is not consulted), and gamma, slope_tol,
-    integrator ("auto", "euler", "rkl2"), rkl2_max_stages, rkl2_tol,
-    max_time (s), cfl, nodata ("wall", the default: no sand enters cells
-    without data, so a DEM below the repose angle comes back bit for bit;
-    "open": they let sand out, held at open_level, default the lowest
-    height), open_level (m).
+    Every other keyword is relax's option of that name ('_' for '-'),
+    checked by the library as the command line checks it; None (the
+    default) takes the library's default.  add_sand is "rect=X0,Y0,X1,Y1"
+    or "disk=X,Y,R" (m) with sand_rate (m/s) and sand_duration (s).  The
+    options and their defaults, from the library (sandslide.options("relax")):
+
+{options}
 
     Returns (relaxed, report): relaxed a new float64 array shaped like
     heights, row 0 north, NaN where heights is; report the dict that
-    `sandslide relax --report FILE` writes ("steady", "steps", "time",
-    "volume_before", "volume_after", "max_slope_after_deg", ...; "input"
-    is "heights" and "output" "(array)").  Raises InputError for bad input
-    (ValueError) and RunError for a failure while running.
+    `sandslide relax --report FILE` writes ("steady", "end", "steps",
+    "time", "volume_before", "volume_after", "max_slope_after_deg", ...;
+    "input" is "heights" and "output" "(array)").  Raises InputError for
+    bad input (ValueError) and RunError for a failure while running.
     """
     h = _grid("heights", heights)
     rock = None
     if bedrock is not None:
         rock = _grid("bedrock", bedrock)
-        if rock.shape != h.shape:
+        if rock.shape != h.shape:   # the library takes one size for both
             raise InputError(f"bedrock: shape {rock.shape} differs from the heights' "
                              f"{h.shape}")
-        # the library checks these too, but names cells from the south
-        missing = np.isnan(rock) & ~np.isnan(h)
-        if missing.any():
-            r, c = np.argwhere(missing[::-1])[0]
-            raise InputError(f"bedrock[{r}, {c}] is NaN where heights has data: the "
-                             f"bedrock must be given under all the sand")
-        with np.errstate(invalid="ignore"):
-            above = rock[::-1] > h[::-1]
-        if above.any():
-            r, c = np.argwhere(above)[0]
-            raise InputError(f"bedrock[{r}, {c}] = {rock[::-1][r, c]!r} m is above heights"
-                             f"[{r}, {c}] = {h[::-1][r, c]!r} m: the surface must be at or "
-                             f"above the bedrock")
     try:
         dx = float(dx)
         dy = dx if dy is None else float(dy)
@@ -148,7 +159,8 @@ def relax(heights, dx, dy=None, angle=35.0, closure="coulomb", nu=None, sides="w
              "threads": threads, "gamma": gamma, "slope_tol": slope_tol,
              "integrator": integrator, "rkl2_max_stages": rkl2_max_stages,
              "rkl2_tol": rkl2_tol, "max_time": max_time, "cfl": cfl, "nodata": nodata,
-             "open_level": open_level}
+             "open_level": open_level, "add_sand": add_sand, "sand_rate": sand_rate,
+             "sand_duration": sand_duration}
     report = ctypes.create_string_buffer(_JSON_BYTES)
     ny, nx = h.shape
     with _native.lock, _native.Options("relax") as o:
@@ -163,18 +175,25 @@ def relax(heights, dx, dy=None, angle=35.0, closure="coulomb", nu=None, sides="w
     return np.ascontiguousarray(h[::-1]), json.loads(report.value.decode())
 
 
-def run(case, out, set=None, *, threads=None, force=False):
+relax.__doc__ = relax.__doc__.format(options=_options_doc("relax"))
+
+
+def run(case, out, set=None, *, unset=None, threads=None, force=False):
     """Run a case file, as `sandslide run CASE -o OUT [--set ...]` does.
 
     case: the case file (.ini); out: the output .h5 (its folder must
     exist; an existing file is refused unless force).  set: overrides of
     the case, a dict {"section.key": value} or a list of
-    "section.key=value" strings (--set), applied in order.  threads:
-    OpenMP threads (default every processor).
+    "section.key=value" strings (--set), applied in order; a key of the
+    case they make redundant is dropped (the summary's "notes" say which).
+    unset: keys ("section.key") or wall, open and source sections
+    ("source pour") to drop, a string or a list (--unset), applied before
+    set.  threads: OpenMP threads (default: OMP_NUM_THREADS, else every
+    processor).
 
     Returns the summary as a dict: "output", "end" ("done", "steady",
     "not steady", "interrupted"), "snapshots", "time" (s), "steps",
-    "evaluations", "integrator", "threads", "wall_seconds", ...
+    "evaluations", "integrator", "threads", "wall_seconds", "notes", ...
     """
     if set is None:
         sets = []
@@ -184,13 +203,17 @@ def run(case, out, set=None, *, threads=None, force=False):
         sets = [f"{k}={_word(v)}" for k, v in set.items()]
     else:
         sets = [_word(s) for s in set]
+    unsets = [] if unset is None else [unset] if isinstance(unset, str) else list(unset)
     history = f"python: sandslide.run({os.fspath(case)!r}, {os.fspath(out)!r}"
-    history += f", set={sets!r})" if sets else ")"
+    history += f", set={sets!r}" if sets else ""
+    history += f", unset={unsets!r})" if unsets else ")"
     summary = ctypes.create_string_buffer(_JSON_BYTES)
     with _native.lock, _native.Options("run") as o:
         o.set("case", os.fspath(case))
         o.set("output", os.fspath(out))
         o.set("history", history)
+        for u in unsets:
+            o.set("unset", u)
         for s in sets:
             o.set("set", s)
         if threads is not None:

@@ -98,6 +98,7 @@ _PROTOTYPES = {
     "ss_run_options_destroy": (None, [_P]),
     "ss_run_options_set": (_I, [_P, _S, _S]),
     "ss_run_case_json": (_I, [_P, _P, _Z]),
+    "ss_option_table_json": (_I, [_P, _P, _Z]),
 }
 for _name, (_res, _args) in _PROTOTYPES.items():
     try:
@@ -114,6 +115,16 @@ lib.ss_error_set_quiet(1)
 # The library keeps its last message, and OpenMP its thread count, per
 # process: one call at a time, whatever the Python threads do.
 lock = threading.Lock()
+
+
+def option_table(command):
+    """The address of the library's option table of command (option.h:
+    the tables are data, ss_COMMAND_option_table)."""
+    try:
+        return ctypes.addressof(ctypes.c_char.in_dll(lib, f"ss_{command}_option_table"))
+    except ValueError:
+        raise ValueError(f"sandslide: no options of a command {command!r}: expected relax or "
+                         f"run") from None
 
 
 def last_message():

@@ -6,9 +6,12 @@
 #include "sandslide/bench.h"
 
 #include <math.h>
+#include <stddef.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/strings.h"
 #include "sandslide/boundary.h"
 #include "sandslide/error.h"
 #include "sandslide/face.h"
@@ -141,7 +144,7 @@ static int run_case(const struct ss_bench_options *o, enum ss_bench_surface surf
 	if (!err)
 		err = ss_closure_init(&c, bc->kind, REPOSE_DEG, bc->gamma, NU_M2_PER_S);
 	if (!err)
-		err = ss_stepper_init(&st, &g, &c, &b, 0.9, o->tile_nx, o->tile_ny);
+		err = ss_stepper_init(&st, &g, &c, &b, 0.9, o->tile[0], o->tile[1]);
 	if (err)
 		return err;
 	set_surface(&st, surface);
@@ -250,7 +253,7 @@ int ss_bench_run(const struct ss_bench_options *o)
 		return err;
 	if (ss_grid_init(&g, o->nx, o->ny, SPACING_M, SPACING_M, 0.0, 0.0))
 		return SS_ERR_INPUT;
-	ss_tiling_init(&tiling, &g, o->tile_nx, o->tile_ny);
+	ss_tiling_init(&tiling, &g, o->tile[0], o->tile[1]);
 	if ((err = probe_bandwidth(o, &probe_n, bandwidth)))
 		return err;
 	const struct ss_bench_header h = {
@@ -280,4 +283,123 @@ int ss_bench_run(const struct ss_bench_options *o)
 		}
 	}
 	return SS_OK;
+}
+
+/* ---- the options (bench.h) ------------------------------------------- */
+
+static void add_closure(struct ss_bench_options *o, enum ss_closure_kind kind, double gamma)
+{
+	struct ss_bench_closure *c = &o->closures[o->closure_count++];
+	c->kind = kind;
+	c->gamma = gamma;
+	if (kind == SS_CLOSURE_HERSCHEL_BULKLEY)
+		snprintf(c->label, sizeof c->label, "herschel-bulkley(%g)", gamma);
+	else
+		snprintf(c->label, sizeof c->label, "%s", ss_closure_name(kind));
+}
+
+/* NAME|all: herschel-bulkley stands for gamma 0.5 and 2. */
+static int parse_closures(const char *word, void *target)
+{
+	struct ss_bench_options *o = target;
+	enum ss_closure_kind kind = SS_CLOSURE_COULOMB;
+	const int all = !strcmp(word, "all");
+	if (!all && ss_closure_parse(word, &kind))
+		return -1;
+	o->closure_count = 0;
+	for (int k = SS_CLOSURE_COULOMB; k <= SS_CLOSURE_CASSON; k++) {
+		if (!all && k != (int)kind)
+			continue;
+		if (k == SS_CLOSURE_HERSCHEL_BULKLEY) {
+			add_closure(o, SS_CLOSURE_HERSCHEL_BULKLEY, 0.5);
+			add_closure(o, SS_CLOSURE_HERSCHEL_BULKLEY, 2.0);
+		} else {
+			add_closure(o, (enum ss_closure_kind)k, 1.0);
+		}
+	}
+	return 0;
+}
+
+static int parse_surfaces(const char *word, void *target)
+{
+	struct ss_bench_options *o = target;
+	int matched = 0, on[SS_BENCH_SURFACES];
+	for (int s = 0; s < SS_BENCH_SURFACES; s++) {
+		on[s] = !strcmp(word, "all") || !strcmp(word, surface_names[s]);
+		matched |= on[s];
+	}
+	if (matched)
+		memcpy(o->surfaces, on, sizeof on);
+	return matched ? 0 : -1;
+}
+
+/* 1,2: at most SS_BENCH_MAX_CASES counts. */
+static int parse_threads(const char *word, void *target)
+{
+	struct ss_bench_options *o = target;
+	int threads[SS_BENCH_MAX_CASES], n = 0;
+	for (const char *p = word; *p;) {
+		char buf[16];
+		const size_t len = strcspn(p, ",");
+		if (len == 0 || len >= sizeof buf || n == SS_BENCH_MAX_CASES)
+			return -1;
+		memcpy(buf, p, len);
+		buf[len] = '\0';
+		if (ss_parse_int(buf, 1, 4096, &threads[n++]))
+			return -1;
+		p += len + (p[len] == ',');
+	}
+	if (n == 0)
+		return -1;
+	memcpy(o->threads, threads, (size_t)n * sizeof *threads);
+	o->thread_count = n;
+	return 0;
+}
+
+static int parse_tile(const char *value, void *field)
+{
+	return ss_parse_tile(value, field);
+}
+
+#define AT(m) offsetof(struct ss_bench_options, m)
+#define CELLS(n, m, h)                                                                 \
+	{.name = n, .value_name = "N", .kind = SS_OPTION_INT, .offset = AT(m),          \
+	 .default_value = "8192", .lo = 1, .hi = 1 << 20,                              \
+	 .expected = "a cell count from 1 to 1048576", .help = h}
+
+static const struct ss_option options[] = {
+	CELLS("nx", nx, "cells along x"),
+	CELLS("ny", ny, "cells along y"),
+	{.name = "closure", .value_name = "NAME|all", .kind = SS_OPTION_WORD, .offset = 0,
+	 .default_value = "all", .parse = parse_closures, .expected = "all, " SS_CLOSURE_NAMES,
+	 .help = "coulomb, bingham, herschel-bulkley (gamma 0.5 and 2),\n"
+	         "casson, or all"},
+	{.name = "threads", .value_name = "LIST", .kind = SS_OPTION_WORD, .offset = 0,
+	 .default_value = "1,2", .parse = parse_threads,
+	 .expected = "a list such as 1,2 (at most 8 entries from 1 to 4096)",
+	 .help = "thread counts, comma-separated"},
+	{.name = "surface", .value_name = "NAME|all", .kind = SS_OPTION_WORD, .offset = 0,
+	 .default_value = "all", .parse = parse_surfaces,
+	 .expected = "all, supercritical, subcritical or patch",
+	 .help = "supercritical (every face slides), subcritical (none\n"
+	         "does), patch (a 512 x 512 ramp on a flat floor), all"},
+	{.name = "repeats", .value_name = "N", .kind = SS_OPTION_INT, .offset = AT(repeats),
+	 .default_value = "5", .lo = 1, .hi = 64, .expected = "1 to 64",
+	 .help = "timings per case; median, min and max"},
+	{.name = "steps", .value_name = "N", .kind = SS_OPTION_INT, .offset = AT(steps), .lo = 1,
+	 .hi = 1000000, .expected = "1 to 1000000",
+	 .help = "steps per timing (default: about 0.3 s worth)"},
+	{.name = "tile", .value_name = "NXxNY", .kind = SS_OPTION_WORD, .offset = AT(tile),
+	 .parse = parse_tile, .expected = "NXxNY, e.g. 256x64",
+	 .help = "tile size of the sweep (default 256x128)"},
+};
+
+const struct ss_option_table ss_bench_option_table = {
+	.command = "bench", .options = options, .count = sizeof options / sizeof *options,
+};
+
+void ss_bench_options_init(struct ss_bench_options *o)
+{
+	memset(o, 0, sizeof *o);
+	ss_option_defaults(&ss_bench_option_table, o);
 }

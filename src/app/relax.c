@@ -13,23 +13,12 @@
 
 #include "app/drive.h"
 #include "io/output.h"
+#include "model/setup.h"
 #include "sandslide/comm.h"
 #include "sandslide/error.h"
 #include "sandslide/parallel.h"
 #include "sandslide/snapshot.h"
 #include "sandslide/stepper.h"
-
-void ss_relax_options_init(struct ss_relax_options *o)
-{
-	*o = (struct ss_relax_options){
-		.closure = SS_CLOSURE_COULOMB, .angle_deg = 35.0, .gamma = 1.0, .nu = 1.0,
-		.tol = 1e-9, .slope_tol = 1e-6, .integrator = SS_INTEGRATOR_AUTO,
-		.rkl2_max_stages = SS_RKL2_MAX_STAGES_DEFAULT,
-		.rkl2_tol = SS_RKL2_TOL_DEFAULT, .max_time = INFINITY, .cfl = 0.9, .sides = SS_SIDE_WALL,
-		.nodata_type = SS_CELL_WALL, .open_level = NAN, .output_every = NAN,
-	};
-	ss_dem_read_options_init(&o->read);
-}
 
 /* "dir/name.asc" -> "out/name-relaxed.asc"; "FILE.h5:/dataset" -> .h5; a
  * raster relax reads but does not write (.img, .vrt, .xyz: other GDAL
@@ -49,120 +38,11 @@ static void default_output(const char *dem, char *out, size_t size)
 		snprintf(out, size, "out/%.*s-relaxed.tif", stem, base);
 }
 
-int ss_relax_sides_parse(const char *word, enum ss_side_kind *sides)
-{
-	enum ss_side_kind kind;
-	if (ss_side_kind_parse(word, &kind) || kind == SS_SIDE_PERIODIC)
-		return -1;
-	*sides = kind;
-	return 0;
-}
-
-int ss_relax_nodata_parse(const char *word, enum ss_cell_type *type)
-{
-	if (strcmp(word, "wall") && strcmp(word, "open"))
-		return -1;
-	*type = !strcmp(word, "wall") ? SS_CELL_WALL : SS_CELL_OPEN;
-	return 0;
-}
-
 /* The steepest face of the sand (ss_stepper_max_sand_slope), in degrees:
  * what run's /max_slope_deg holds too. */
 static double steepest_sand_face_deg(struct ss_stepper *st)
 {
 	return atan(ss_stepper_max_sand_slope(st)) * (180.0 / M_PI);
-}
-
-/* The stepper for raster r: grid, closure, cell types (nodata), heights,
- * bedrock, the poured source; prepared. */
-static int build_stepper(const struct ss_relax_options *o, const struct ss_raster *r,
-                         const struct ss_raster *bedrock, struct ss_stepper *st)
-{
-	const double dx = isnan(o->read.cellsize) ? r->cellsize : o->read.cellsize;
-	const double dy = isnan(r->cellsize_y) || !isnan(o->read.cellsize) ? dx : r->cellsize_y;
-	if (isnan(dx))
-		return ss_error_input("%s: the file gives no cell size: give it with --dx M",
-		                      o->dem);
-	struct ss_grid g;
-	int err = ss_grid_init(&g, r->nx, r->ny, dx, dy, isnan(r->x0) ? 0.0 : r->x0,
-	                       isnan(r->y0) ? 0.0 : r->y0);
-	if (err)
-		return err;
-	/* auto is Euler for relax: a DEM comes to rest, where RKL2 damps the
-	 * stiff remainder only by ~1/2 a super-step; measured (README,
-	 * Performance): the 4096^2 terrain took 2579 RKL2 evaluations against
-	 * 1389 Euler steps, a 1024^2 one 3068 against 14487 */
-	const enum ss_integrator integrator = o->integrator == SS_INTEGRATOR_AUTO
-		? SS_INTEGRATOR_EULER : o->integrator;
-	if (integrator == SS_INTEGRATOR_RKL2 && bedrock)
-		return ss_error_input("--integrator rkl2 cannot be used with --bedrock: its stages "
-		                      "cannot keep the sand above the rock (use euler or auto)");
-	/* the memory of one rank's slab, times the ranks on this node */
-	const double need = ss_stepper_memory_bytes(&g, integrator) / ss_comm_size() *
-	                    ss_comm_node_ranks();
-	const double have = ss_memory_available_bytes();
-	if (have > 0.0 && need > have) {
-		char nb[32], hb[32];
-		return ss_error_input("%s: %d x %d cells need %s of memory; this machine has %s "
-		                      "available", o->dem, r->nx, r->ny, ss_format_bytes(need, nb),
-		                      ss_format_bytes(have, hb));
-	}
-
-	double level = o->open_level;
-	if (isnan(level)) {
-		/* sand that reaches an open side, or a nodata cell with
-		 * --nodata open, leaves at the lowest ground of the DEM */
-		level = INFINITY;
-		for (size_t m = 0; m < (size_t)r->nx * r->ny; m++)
-			if (!r->nodata || !r->nodata[m])
-				level = fmin(level, r->values[m]);
-		if (isinf(level))
-			return ss_error_input("%s: every cell is nodata: nothing to relax", o->dem);
-	}
-	struct ss_closure closure;
-	const struct ss_boundary sides = {{o->sides, o->sides, o->sides, o->sides}, level};
-	if ((err = ss_closure_init(&closure, o->closure, o->angle_deg, o->gamma, o->nu)))
-		return err;
-	if ((err = ss_stepper_init(st, &g, &closure, &sides, o->cfl, 0, 0)))
-		return err;
-	st->integrator = integrator;
-	st->rkl2_max_stages = o->rkl2_max_stages;
-	st->rkl2_tol = o->rkl2_tol;
-	/* every rank read the DEM; from here on g is this rank's slab */
-	g = st->grid;
-	const size_t first = (size_t)g.offset_j * g.nx;
-	for (int j = 0; j < g.ny; j++) {
-		for (int i = 0; i < g.nx; i++) {
-			const size_t m = first + (size_t)j * g.nx + i;
-			const ptrdiff_t k = ss_grid_index(&g, i, j);
-			st->height[k] = r->values[m];
-			if (r->nodata && r->nodata[m])
-				ss_cell_type_set(st->cell_types, k, o->nodata_type);
-		}
-	}
-	/* agreed: the collective calls of prepare follow */
-	if ((err = ss_comm_agree(bedrock ? ss_stepper_set_bedrock(st, bedrock->values + first)
-	                                 : SS_OK)))
-		return err;
-	if (o->add_sand) {
-		uint8_t *mask = ss_alloc((size_t)g.nx * g.ny, 1, "sand source mask");
-		long long covered = 0;
-		if (!mask)
-			return SS_ERR_FAIL;
-		err = ss_shape_rasterize(&o->sand_shape, &g, mask, &covered);
-		double covered_all = (double)covered, none = 0.0;
-		ss_comm_reduce(&none, 0, &covered_all, 1);
-		if (!err && covered_all == 0)
-			err = ss_error_input("--add-sand covers no cell centre of the DEM (x %g .. %g "
-			                     "m, y %g .. %g m)", g.origin_x, g.origin_x + r->nx * dx,
-			                     g.origin_y, g.origin_y + r->ny * dy);
-		if (!err)
-			err = ss_stepper_add_source(st, mask, o->sand_rate, 0.0, o->sand_duration);
-		ss_free(mask);
-		if ((err = ss_comm_agree(err)))
-			return err;
-	}
-	return ss_stepper_prepare(st);
 }
 
 static double flow_volume(struct ss_stepper *st)
@@ -225,11 +105,19 @@ struct relax {
 	double *h0;                       /* the initial heights, halo layout */
 };
 
-/* The driver's rebuild: the DEM's stepper at t = 0. */
+/* The driver's rebuild: the DEM's stepper at t = 0 (model/setup.h). */
 static int rebuild(void *context, struct ss_stepper *st)
 {
 	const struct relax *x = context;
-	return build_stepper(x->o, &x->dem, x->o->bedrock ? &x->bedrock : NULL, st);
+	const struct ss_relax_options *o = x->o;
+	const struct ss_raster_setup s = {
+		.model = &o->model, .name = o->dem, .heights = &x->dem, .dx = o->read.cellsize,
+		.sides = o->sides, .nodata_type = o->nodata_type, .open_level = o->open_level,
+		.bedrock = o->bedrock ? &x->bedrock : NULL,
+		.pour = o->sand_shape.kind != SS_SHAPE_NONE ? &o->sand_shape : NULL,
+		.pour_rate = o->sand_rate, .pour_duration = o->sand_duration,
+	};
+	return ss_setup_stepper_from_raster(&s, st);
 }
 
 /* A copy of a caller's raster (values, nodata and geometry: the writers'
@@ -252,20 +140,36 @@ static int raster_copy(const struct ss_raster *from, struct ss_raster *r)
 	return SS_OK;
 }
 
+/* What the options need together (the table checks each alone). */
+static int check_options(const struct ss_relax_options *o)
+{
+	const int pour = o->sand_shape.kind != SS_SHAPE_NONE;
+	if (!o->dem)
+		return ss_error_input("relax needs a DEM");
+	if (pour != !isnan(o->sand_rate) || pour != !isnan(o->sand_duration))
+		return ss_error_input("--add-sand, --sand-rate and --sand-duration go together");
+	if (!isnan(o->read.zoffset) && isnan(o->read.zscale))
+		return ss_error_input("--zoffset needs --zscale");
+	return SS_OK;
+}
+
 /* The inputs and the output's name and format, all checked. */
 static int read_inputs(struct relax *x, struct ss_relax_report *rep)
 {
 	const struct ss_relax_options *o = x->o;
 	if ((o->input_raster && !o->dem) || (o->bedrock_raster && !o->bedrock))
 		SS_BUG("ss_relax_run: an input raster without its name (dem, bedrock)");
+	int err = check_options(o);
+	if (err)
+		return err;
 	if (o->output_raster)
 		snprintf(rep->output, sizeof rep->output, "(array)");
 	else if (o->output)
 		snprintf(rep->output, sizeof rep->output, "%s", o->output);
 	else
 		default_output(o->dem, rep->output, sizeof rep->output);
-	int err = o->input_raster ? raster_copy(o->input_raster, &x->dem)
-	                          : ss_dem_read(o->dem, NULL, &o->read, &x->dem);
+	err = o->input_raster ? raster_copy(o->input_raster, &x->dem)
+	                      : ss_dem_read(o->dem, NULL, &o->read, &x->dem);
 	if (!err && o->output_raster && (o->output_raster->nx != x->dem.nx ||
 	                                 o->output_raster->ny != x->dem.ny))
 		err = ss_error_input("the output raster is %d x %d cells: expected the DEM's "
@@ -313,11 +217,11 @@ static int open_output(struct relax *x, const struct ss_relax_report *rep)
 	const struct ss_relax_options *o = x->o;
 	struct ss_drive *d = &x->drive;
 	const int series = x->format == SS_DEM_H5;
-	d->end = o->max_time;
-	d->steady_tol = o->tol;
-	d->steady_slope_tol = o->slope_tol;
+	d->end = ss_model_time_limit(&o->model);
+	d->steady_tol = o->model.steady_tol;
+	d->steady_slope_tol = o->model.steady_slope_tol;
 	d->output_every = !isnan(o->output_every) ? o->output_every
-	                : series && isfinite(o->max_time) ? o->max_time / 20.0 : INFINITY;
+	                : series && isfinite(d->end) ? d->end / 20.0 : INFINITY;
 	d->stop_signal = o->stop_signal;
 	d->progress = o->progress;
 	d->progress_context = o->progress_context;
@@ -330,9 +234,9 @@ static int open_output(struct relax *x, const struct ss_relax_report *rep)
 		return err;
 	const struct ss_snapshot_meta meta = {
 		.title = o->dem, .history = o->history ? o->history : "",
-		.case_text = "", .closure = ss_closure_name(o->closure),
+		.case_text = "", .closure = ss_closure_name(o->model.closure),
 		.integrator = ss_integrator_name(x->st.integrator),
-		.repose_angle_deg = o->angle_deg, .nu = o->nu, .gamma = o->gamma,
+		.repose_angle_deg = o->model.angle_deg, .nu = o->model.nu, .gamma = o->model.gamma,
 		.bedrock = x->st.bedrock, .crs_wkt = x->dem.crs_wkt, .boundary = &x->st.boundary,
 	};
 	return ss_drive_create(d, &meta);
@@ -345,6 +249,7 @@ static void measure_after(struct relax *x, enum ss_drive_end end, struct ss_rela
 	const struct ss_grid *g = &st->grid;
 	rep->steady = end == SS_DRIVE_STEADY;
 	rep->interrupted = end == SS_DRIVE_INTERRUPTED;
+	rep->end = rep->steady ? "steady" : rep->interrupted ? "interrupted" : "max time";
 	rep->steps = st->steps;
 	rep->evaluations = st->evaluations;
 	rep->integrator = ss_integrator_name(st->integrator);

@@ -1,112 +1,17 @@
 /*
  * relax_api.c - `relax` for callers that cannot lay out its structs (see
- * relax.h): options created on the heap and set by name, the report as
- * JSON in a buffer, and a flat entry point on arrays.  Python's ctypes
- * module (python/sandslide) is the caller this is written for: the struct
- * layouts change between versions, names and strings do not.
- *
- * The option names, ranges and messages are those of relax's table in
- * src/cli/main.c, so that a bad value reads the same from Python as on the
- * command line (tests/python/test_module.py compares them).
+ * relax.h): the report as JSON in a buffer, and a flat entry point on
+ * arrays.  Python's ctypes module (python/sandslide) is the caller this is
+ * written for: the struct layouts change between versions, names and
+ * strings do not.  The options set by name are relax_options.c's.
  */
 #include "sandslide/relax.h"
 
 #include <math.h>
 #include <string.h>
 
-#include "app/named.h"
 #include "base/strings.h"
 #include "sandslide/error.h"
-
-/* The text values an options object owns (its copies of the caller's). */
-enum { TEXT_DEM, TEXT_OUTPUT, TEXT_REPORT, TEXT_BEDROCK, TEXT_COUNT };
-
-struct owned_options {
-	struct ss_relax_options o;   /* first: the caller's pointer is to it */
-	char *text[TEXT_COUNT];      /* NULL, or the value of o's text field */
-};
-
-/* The words relax's --sides and --nodata take, as WORD parsers. */
-static int parse_sides(const char *value, void *field)
-{
-	return ss_relax_sides_parse(value, field);
-}
-
-static int parse_nodata(const char *value, void *field)
-{
-	return ss_relax_nodata_parse(value, field);
-}
-
-static int parse_closure(const char *value, void *field)
-{
-	return ss_closure_parse(value, field);
-}
-
-static int parse_integrator(const char *value, void *field)
-{
-	return ss_integrator_parse(value, field);
-}
-
-#define AT(m) offsetof(struct ss_relax_options, m)
-#define RANGE(n, m, l, h, e) {n, SS_NAMED_REAL, AT(m), l, h, e, 0, NULL}
-#define POSITIVE(n, m, e) RANGE(n, m, 1e-300, 1e300, e)
-#define WORD(n, m, e, f) {n, SS_NAMED_WORD, AT(m), 0, 0, e, 0, f}
-#define TEXT(n, m, slot) {n, SS_NAMED_TEXT, AT(m), 0, 0, "a path", slot, NULL}
-
-static const struct ss_named keys[] = {
-	RANGE("angle", angle_deg, 1e-9, 90.0 - 1e-9, "degrees in (0, 90)"),
-	WORD("closure", closure, SS_CLOSURE_NAMES, parse_closure),
-	RANGE("gamma", gamma, 1e-6, 1e6, "a number > 0"),
-	POSITIVE("nu", nu, "m^2/s > 0"),
-	POSITIVE("tol", tol, "m/s > 0"),
-	POSITIVE("slope-tol", slope_tol, "a number > 0"),
-	WORD("integrator", integrator, SS_INTEGRATOR_NAMES, parse_integrator),
-	{"rkl2-max-stages", SS_NAMED_INT, AT(rkl2_max_stages), 2, 100000, "an integer >= 2", 0,
-	 NULL},
-	POSITIVE("rkl2-tol", rkl2_tol, "a number > 0"),
-	POSITIVE("max-time", max_time, "s > 0"),
-	RANGE("cfl", cfl, 1e-9, 1.0, "(0, 1]"),
-	{"threads", SS_NAMED_INT, AT(threads), 1, 4096, "an integer from 1 to 4096", 0, NULL},
-	WORD("sides", sides, "wall or open", parse_sides),
-	WORD("nodata", nodata_type, "wall or open", parse_nodata),
-	RANGE("open-level", open_level, -1e300, 1e300, "a height in m"),
-	POSITIVE("dx", read.cellsize, "m > 0"),
-	POSITIVE("zscale", read.zscale, "m per grey level > 0"),
-	RANGE("zoffset", read.zoffset, -1e300, 1e300, "m"),
-	POSITIVE("output-every", output_every, "s > 0"),
-	{"force", SS_NAMED_FLAG, AT(force), 0, 0, "1 or 0", 0, NULL},
-	TEXT("dem", dem, TEXT_DEM),
-	TEXT("output", output, TEXT_OUTPUT),
-	TEXT("report", report, TEXT_REPORT),
-	TEXT("bedrock", bedrock, TEXT_BEDROCK),
-};
-
-struct ss_relax_options *ss_relax_options_create(void)
-{
-	struct owned_options *w = ss_alloc(1, sizeof *w, "relax options");
-	if (!w)
-		return NULL;
-	ss_relax_options_init(&w->o);
-	return &w->o;
-}
-
-void ss_relax_options_destroy(struct ss_relax_options *o)
-{
-	if (!o)
-		return;
-	struct owned_options *w = (struct owned_options *)o;
-	for (int k = 0; k < TEXT_COUNT; k++)
-		ss_free(w->text[k]);
-	ss_free(w);
-}
-
-int ss_relax_options_set(struct ss_relax_options *o, const char *key, const char *value)
-{
-	static const struct ss_named_table table = {"relax", keys, sizeof keys / sizeof *keys};
-	const struct ss_named *k = ss_named_find(&table, key);
-	return k ? ss_named_set(k, key, value, o, ((struct owned_options *)o)->text)
-	         : SS_ERR_INPUT;
-}
 
 int ss_relax_report_json(const struct ss_relax_options *o, const struct ss_relax_report *r,
                          char *buf, size_t size)
@@ -121,19 +26,21 @@ int ss_relax_report_json(const struct ss_relax_options *o, const struct ss_relax
 	ss_strbuf_printf(&b, ", \"dy\": ");
 	ss_strbuf_json_number(&b, r->dy, 17);
 	ss_strbuf_printf(&b, ",\n  \"closure\": \"%s\", \"repose_angle_deg\": ",
-	                 ss_closure_name(o->closure));
-	ss_strbuf_json_number(&b, o->angle_deg, 17);
+	                 ss_closure_name(o->model.closure));
+	ss_strbuf_json_number(&b, o->model.angle_deg, 17);
 	ss_strbuf_printf(&b, ", \"nu\": ");
-	ss_strbuf_json_number(&b, o->nu, 17);
-	ss_strbuf_printf(&b, ",\n  \"steady\": %s, \"tol\": ", r->steady ? "true" : "false");
-	ss_strbuf_json_number(&b, o->tol, 17);
+	ss_strbuf_json_number(&b, o->model.nu, 17);
+	ss_strbuf_printf(&b, ",\n  \"steady\": %s, \"end\": ", r->steady ? "true" : "false");
+	ss_strbuf_json_string(&b, r->end ? r->end : "");
+	ss_strbuf_printf(&b, ", \"tol\": ");
+	ss_strbuf_json_number(&b, o->model.steady_tol, 17);
 	ss_strbuf_printf(&b, ",\n  \"steps\": %lld, \"time\": ", r->steps);
 	ss_strbuf_json_number(&b, r->time, 17);
 	ss_strbuf_printf(&b, ", \"wall_seconds\": ");
 	ss_strbuf_json_number(&b, r->wall_seconds, 6);
 	ss_strbuf_printf(&b, ",\n  \"integrator\": \"%s\", \"stencil_evaluations\": %lld, "
 	                 "\"slope_tol\": ", r->integrator ? r->integrator : "", r->evaluations);
-	ss_strbuf_json_number(&b, o->slope_tol, 17);
+	ss_strbuf_json_number(&b, o->model.steady_slope_tol, 17);
 	ss_strbuf_printf(&b, ",\n  \"cells_moved\": %lld, \"volume_moved\": ", r->cells_moved);
 	ss_strbuf_json_number(&b, r->volume_moved, 17);
 	ss_strbuf_printf(&b, ",\n  \"volume_before\": ");

@@ -50,8 +50,9 @@ static int restart_case(const struct ss_run_options *o, const struct ss_restart_
 {
 	memset(c, 0, sizeof *c);
 	if (o->override_count > 0)
-		return ss_error_input("--restart %s: --set cannot change a run being continued "
-		                      "(it keeps the overrides it was started with)", o->restart);
+		return ss_error_input("--restart %s: --set and --unset cannot change a run being "
+		                      "continued (it keeps the overrides it was started with)",
+		                      o->restart);
 	int err = SS_OK;
 	if (o->case_path) {
 		struct ss_case given;
@@ -139,7 +140,7 @@ static enum ss_kernel kernel_of(const struct ss_run_options *o)
 static int rebuild(void *context, struct ss_stepper *st)
 {
 	const struct run *r = context;
-	return ss_setup_stepper(&r->c, r->o->tile_nx, r->o->tile_ny, kernel_of(r->o), st);
+	return ss_setup_stepper(&r->c, r->o->tile[0], r->o->tile[1], kernel_of(r->o), st);
 }
 
 /* The stepper of the case, where the restart file left it. */
@@ -189,7 +190,8 @@ static int report_snapshot(void *context, const char *path, long long index, dou
 	const struct ss_boundary *b = &r->c.boundary;
 	const struct ss_run_snapshot s = {
 		.path = path, .index = index, .time = time,
-		.source_rise = source_rise(&r->c, r->c.steady ? r->c.max_time : r->c.end),
+		.source_rise = source_rise(&r->c, r->c.steady ? ss_model_time_limit(&r->c.model)
+		                                              : r->c.end),
 		.open_level = b->open_level,
 		.any_open_side = b->side[SS_WEST] == SS_SIDE_OPEN || b->side[SS_EAST] == SS_SIDE_OPEN ||
 		                 b->side[SS_SOUTH] == SS_SIDE_OPEN || b->side[SS_NORTH] == SS_SIDE_OPEN,
@@ -204,9 +206,9 @@ static int open_output(struct run *r)
 	struct ss_drive *d = &r->drive;
 	char hint[4200];
 	d->output_every = r->c.output_every;
-	d->end = r->c.steady ? r->c.max_time : r->c.end;
-	d->steady_tol = r->c.steady ? r->c.steady_tol : 0.0;
-	d->steady_slope_tol = r->c.steady_slope_tol;
+	d->end = r->c.steady ? ss_model_time_limit(&r->c.model) : r->c.end;
+	d->steady_tol = r->c.steady ? r->c.model.steady_tol : 0.0;
+	d->steady_slope_tol = r->c.model.steady_slope_tol;
 	d->stop_signal = o->stop_signal;
 	d->progress = o->progress;
 	d->progress_context = o->progress_context;
@@ -224,9 +226,10 @@ static int open_output(struct run *r)
 		return SS_ERR_FAIL;
 	const struct ss_snapshot_meta meta = {
 		.title = r->c.path, .history = o->history ? o->history : "",
-		.case_text = r->c.text, .closure = ss_closure_name(r->c.closure),
+		.case_text = r->c.text, .closure = ss_closure_name(r->c.model.closure),
 		.integrator = ss_integrator_name(r->st.integrator),
-		.repose_angle_deg = r->c.repose_angle_deg, .nu = r->c.nu, .gamma = r->c.gamma,
+		.repose_angle_deg = r->c.model.angle_deg, .nu = r->c.model.nu,
+		.gamma = r->c.model.gamma,
 		.deflate = o->deflate, .bedrock = r->st.bedrock, .case_overrides = overrides,
 		.boundary = &r->st.boundary,
 	};
@@ -261,6 +264,9 @@ static void summarise(const struct run *r, enum ss_drive_end end, struct ss_run_
 	s->output_seconds = r->drive.seconds_output;
 	s->comm_seconds = ss_comm_seconds();
 	s->threads = ss_parallel_max_threads();
+	const int notes = (int)(sizeof s->notes / sizeof *s->notes);
+	for (int k = 0; k < r->c.note_count && k < notes; k++)
+		snprintf(s->notes[s->note_count++], sizeof s->notes[k], "%s", r->c.notes[k]);
 }
 
 int ss_run_case(const struct ss_run_options *o, struct ss_run_summary *summary)

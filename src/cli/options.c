@@ -1,5 +1,6 @@
 /*
- * options.c - table-driven options and their help (see options.h).
+ * options.c - arguments parsed from the option tables, and their help (see
+ * options.h).
  */
 #include "cli/options.h"
 
@@ -13,35 +14,76 @@
 
 /* The help's second column: options on the left, their text from here. */
 #define HELP_COLUMN 24
+/* Lines of help end before this column. */
+#define HELP_WIDTH 80
 
-int cli_parse_tile(const char *s, void *tile)
+static int on_command_line(const struct ss_option *o)
 {
-	return ss_parse_tile(s, tile);
+	return o->name && !(o->flags & SS_OPTION_NAMED_ONLY);
 }
 
-/* The option's text over the continuation lines, HELP_COLUMN indented. */
-static void help_lines(const char *text, FILE *f)
+/* The tables each group continues in, as groups of their own: a table's
+ * `more` options are parsed and shown like its own. */
+static void expand(struct cli_command *c)
 {
-	for (const char *p = text; *p;) {
-		const size_t n = strcspn(p, "\n");
-		fprintf(f, "%.*s\n", (int)n, p);
-		p += n;
-		if (*p == '\n' && *++p)
-			fprintf(f, "%*s", HELP_COLUMN, "");
+	if (c->group_count)
+		return;
+	int n = 0;
+	while (n < CLI_MAX_GROUPS && c->groups[n].table)
+		n++;
+	for (int g = 0; g < n; g++) {
+		const struct cli_group *from = &c->groups[g];
+		if (!from->table->more)
+			continue;
+		if (n == CLI_MAX_GROUPS)
+			SS_BUG("a command of more than %d option groups", CLI_MAX_GROUPS);
+		c->groups[n++] = (struct cli_group){
+			from->table->more, (char *)from->base + from->table->more_offset, from->hidden,
+		};
 	}
+	c->group_count = n;
+}
+
+/* The option's text over the continuation lines, HELP_COLUMN indented,
+ * with " (default X)" after it, on the last line if it fits there. */
+static void help_lines(const struct ss_option *o, FILE *f)
+{
+	const char *text = o->help ? o->help : "";
+	char last[256];
+	const char *p = text;
+	for (;;) {
+		const size_t n = strcspn(p, "\n");
+		if (!p[n] || !p[n + 1]) {   /* the last line */
+			snprintf(last, sizeof last, "%.*s", (int)n, p);
+			break;
+		}
+		fprintf(f, "%.*s\n%*s", (int)n, p, HELP_COLUMN, "");
+		p += n + 1;
+	}
+	if (!o->default_value) {
+		fprintf(f, "%s\n", last);
+		return;
+	}
+	char tail[128];
+	snprintf(tail, sizeof tail, "(default %s)", o->default_value);
+	if (HELP_COLUMN + strlen(last) + 1 + strlen(tail) < HELP_WIDTH)
+		fprintf(f, "%s%s%s\n", last, *last ? " " : "", tail);
+	else
+		fprintf(f, "%s\n%*s%s\n", last, HELP_COLUMN, "", tail);
 }
 
 /* One option's lines of help. */
-static void help_option(const struct cli_option *o, FILE *f)
+static void help_option(const struct ss_option *o, FILE *f)
 {
 	char left[64];
-	snprintf(left, sizeof left, "%s%s%s%s%s", o->alias ? o->alias : "",
-	         o->alias ? ", " : "", o->name, o->value ? " " : "", o->value ? o->value : "");
+	snprintf(left, sizeof left, "%s%s--%s%s%s", o->alias ? o->alias : "",
+	         o->alias ? ", " : "", o->name, o->value_name ? " " : "",
+	         o->value_name ? o->value_name : "");
 	if (strlen(left) + 3 <= HELP_COLUMN)
 		fprintf(f, "  %-*s", HELP_COLUMN - 2, left);
 	else
 		fprintf(f, "  %s\n%*s", left, HELP_COLUMN, "");
-	help_lines(o->help, f);
+	help_lines(o, f);
 }
 
 void cli_help(const struct cli_command *c, FILE *f)
@@ -50,13 +92,14 @@ void cli_help(const struct cli_command *c, FILE *f)
 	if (c->intro)
 		fprintf(f, "\n%s", c->intro);
 	fputc('\n', f);
-	for (int g = 0; g < CLI_MAX_GROUPS; g++) {
+	for (int g = 0; g < c->group_count; g++) {
 		const struct cli_group *group = &c->groups[g];
-		for (int k = 0; k < group->count && !group->hidden; k++) {
-			if (group->options[k].name)
-				help_option(&group->options[k], f);
-			else
-				fprintf(f, "\n%s", group->options[k].help);
+		for (int k = 0; k < group->table->count && !group->hidden; k++) {
+			const struct ss_option *o = &group->table->options[k];
+			if (on_command_line(o))
+				help_option(o, f);
+			else if (!o->name && !o->case_key)
+				fprintf(f, "\n%s", o->help);   /* a heading */
 		}
 	}
 	if (c->outro)
@@ -85,20 +128,27 @@ int cli_usage_error(const struct cli_command *c, const char *fmt, ...)
 
 /* The option that word names ("--name", "--name=value" or the alias) as
  * group *g, index *k; its inline value, if any, into *inline_value. */
-static const struct cli_option *find(const struct cli_command *c, const char *word, int *g,
-                                     int *k, const char **inline_value)
+static const struct ss_option *find(const struct cli_command *c, const char *word, int *g,
+                                    int *k, const char **inline_value)
 {
 	*inline_value = NULL;
-	for (*g = 0; *g < CLI_MAX_GROUPS; ++*g) {
-		for (*k = 0; *k < c->groups[*g].count; ++*k) {
-			const struct cli_option *o = &c->groups[*g].options[*k];
-			const size_t n = o->name ? strlen(o->name) : 0;
-			if (!n)
+	if (strncmp(word, "--", 2) && word[0] != '-')
+		return NULL;
+	for (*g = 0; *g < c->group_count; ++*g) {
+		const struct ss_option_table *t = c->groups[*g].table;
+		for (*k = 0; *k < t->count; ++*k) {
+			const struct ss_option *o = &t->options[*k];
+			if (!on_command_line(o))
 				continue;
-			if (!strcmp(word, o->name) || (o->alias && !strcmp(word, o->alias)))
+			const size_t n = strlen(o->name);
+			if (o->alias && !strcmp(word, o->alias))
 				return o;
-			if (o->value && !strncmp(word, o->name, n) && word[n] == '=') {
-				*inline_value = word + n + 1;
+			if (strncmp(word, "--", 2) || strncmp(word + 2, o->name, n))
+				continue;
+			if (!word[2 + n])
+				return o;
+			if (o->value_name && word[2 + n] == '=') {
+				*inline_value = word + 3 + n;
 				return o;
 			}
 		}
@@ -106,51 +156,39 @@ static const struct cli_option *find(const struct cli_command *c, const char *wo
 	return NULL;
 }
 
-/* Store value into o's target; 0, or 2 after a usage error. */
-static int store(struct cli_command *c, const struct cli_option *o, void *target,
+/* Store value into o's field; 0, or 2 after a usage error. */
+static int store(struct cli_command *c, const struct ss_option *o, void *field,
                  const char *value)
 {
-	int bad = 0;
-	switch (o->kind) {
-	case CLI_INT:
-		bad = ss_parse_int(value, (long)o->lo, (long)o->hi, target);
-		break;
-	case CLI_REAL:
-		bad = ss_parse_real(value, o->lo, o->hi, target);
-		break;
-	case CLI_TEXT:
-		*(const char **)target = value;
-		break;
-	case CLI_LIST: {
-		struct cli_list *l = target;
-		l->v[l->n++] = value;
-		break;
-	}
-	case CLI_PARSE:
-		bad = o->parse(value, target);
-		break;
-	case CLI_FLAG:
-	case CLI_OPTIONAL_INT:
-		break;
+	int bad;
+	if (o->kind == SS_OPTION_LIST) {
+		bad = o->parse && o->parse(value, NULL);
+		if (!bad) {
+			if (!c->list)
+				SS_BUG("--%s: a LIST option with no list to collect it", o->name);
+			c->list->v[c->list->n++] = value;
+		}
+	} else {
+		bad = ss_option_parse(o, value, field);
 	}
 	if (bad)
-		return cli_usage_error(c, "%s '%s': expected %s", o->name, value, o->expected);
+		return cli_usage_error(c, "--%s '%s': expected %s", o->name, value, o->expected);
 	return 0;
 }
 
-/* Option k of group g at argv[*k], its value taken from the word or the
+/* Option k of group g at argv[*at], its value taken from the word or the
  * next one; 0, or 2 after a usage error. */
 static int take(struct cli_command *c, int g, int k, const char *inline_value, int argc,
                 char **argv, int *at)
 {
-	const struct cli_option *o = &c->groups[g].options[k];
+	const struct ss_option *o = &c->groups[g].table->options[k];
 	char *base = c->groups[g].base;
 	c->given[g][k] = argv[*at];
-	if (o->kind == CLI_FLAG || o->kind == CLI_OPTIONAL_INT) {
+	if (o->kind == SS_OPTION_FLAG || o->kind == SS_OPTION_OPTIONAL_INT) {
 		*(int *)(base + o->offset) = 1;
-		if (o->kind == CLI_OPTIONAL_INT && *at + 1 < argc &&
+		if (o->kind == SS_OPTION_OPTIONAL_INT && *at + 1 < argc &&
 		    ss_parse_int(argv[*at + 1], (long)o->lo, (long)o->hi,
-		                  (int *)(base + o->value_offset)) == 0)
+		                 (int *)(base + o->value_offset)) == 0)
 			++*at;
 		return 0;
 	}
@@ -158,17 +196,18 @@ static int take(struct cli_command *c, int g, int k, const char *inline_value, i
 	if (!value && *at + 1 < argc)
 		value = argv[++*at];
 	if (!value || !*value)
-		return cli_usage_error(c, "%s needs %s", o->name, o->value);
+		return cli_usage_error(c, "--%s needs %s", o->name, o->value_name);
 	return store(c, o, base + o->offset, value);
 }
 
 int cli_parse(struct cli_command *c, int argc, char **argv, int first)
 {
+	expand(c);
 	c->arg_count = 0;
 	memset(c->given, 0, sizeof c->given);
-	for (int g = 0; g < CLI_MAX_GROUPS; g++)
-		if (c->groups[g].count > CLI_MAX_OPTIONS)
-			SS_BUG("an option table of %d entries", c->groups[g].count);
+	for (int g = 0; g < c->group_count; g++)
+		if (c->groups[g].table->count > CLI_MAX_OPTIONS)
+			SS_BUG("an option table of %d entries", c->groups[g].table->count);
 	for (int at = first; at < argc; at++) {
 		const char *a = argv[at], *inline_value;
 		int g, k;
@@ -194,17 +233,19 @@ int cli_parse(struct cli_command *c, int argc, char **argv, int first)
 
 const char *cli_given(const struct cli_command *c, const char *name)
 {
-	for (int g = 0; g < CLI_MAX_GROUPS; g++)
-		for (int k = 0; k < c->groups[g].count; k++)
-			if (c->groups[g].options[k].name &&
-			    !strcmp(c->groups[g].options[k].name, name))
+	for (int g = 0; g < c->group_count; g++) {
+		const struct ss_option_table *t = c->groups[g].table;
+		for (int k = 0; k < t->count; k++)
+			if (t->options[k].name && !strncmp(name, "--", 2) &&
+			    !strcmp(t->options[k].name, name + 2))
 				return c->given[g][k];
+	}
 	return NULL;
 }
 
 const char *cli_given_in(const struct cli_command *c, int g)
 {
-	for (int k = 0; k < c->groups[g].count; k++)
+	for (int k = 0; k < c->groups[g].table->count; k++)
 		if (c->given[g][k])
 			return c->given[g][k];
 	return NULL;

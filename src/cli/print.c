@@ -72,6 +72,8 @@ void cli_print_run_end(const struct ss_run_summary *s, int quiet)
 	}
 	if (quiet)
 		return;
+	for (int k = 0; k < s->note_count; k++)
+		printf("note: %s\n", s->notes[k]);
 	printf("wrote %s: %lld snapshots to t = %g s, %lld %s%s\n", s->output, s->snapshots,
 	       s->time, s->steps, strcmp(s->integrator, "rkl2") ? "steps (euler)"
 	       : "super-steps (rkl2)", s->end == SS_RUN_STEADY ? " (steady)"

@@ -33,11 +33,12 @@ int ss_integrator_parse(const char *name, enum ss_integrator *out)
 	return -1;
 }
 
-enum ss_integrator ss_integrator_resolve(enum ss_integrator asked, int has_bedrock)
+enum ss_integrator ss_integrator_resolve(enum ss_integrator asked, int has_bedrock,
+                                         int relaxing)
 {
 	if (asked != SS_INTEGRATOR_AUTO)
 		return asked;
-	return has_bedrock ? SS_INTEGRATOR_EULER : SS_INTEGRATOR_RKL2;
+	return has_bedrock || relaxing ? SS_INTEGRATOR_EULER : SS_INTEGRATOR_RKL2;
 }
 
 double ss_stepper_memory_bytes(const struct ss_grid *g, enum ss_integrator integrator)

@@ -1,13 +1,15 @@
 /*
  * case.c - case file parser (see case.h; every key is documented in
- * cases/reference.ini).
+ * doc/case-file.md and cases/reference.ini).
  *
  * inih does the INI syntax; a reader callback counts lines so that each
  * message names file:line (Debian's inih is built without line numbers in
  * the handler).  A first pass over the text checks what inih would accept
  * silently: section names, repeated sections, over-long lines, lines that
- * are neither a section, a key nor a comment.  Keys of the fixed sections
- * are described by one table, so parsing, defaults and messages agree.
+ * are neither a section, a key nor a comment.  The keys of the fixed
+ * sections are one option table (option.h), continued by the model's
+ * (model_options.h), so parsing, defaults and messages agree with relax's
+ * command line.
  */
 #include "sandslide/case.h"
 
@@ -25,86 +27,142 @@
 
 #include "sandslide/error.h"
 
-enum value_type {
-	V_COUNT,      /* integer >= 1 */
-	V_POSITIVE,   /* finite > 0 */
-	V_NONNEG,     /* finite >= 0 */
-	V_REAL,       /* finite */
-	V_ANGLE,      /* degrees in (0, 90) */
-	V_CFL,        /* (0, 1] */
-	V_CLOSURE,
-	V_SIDE,
-	V_END,        /* > 0 or "steady" */
-	V_INITIAL,
-	V_PAIR,       /* two finite numbers */
-	V_PATH,
-	V_INTEGRATOR,
-	V_STAGES,     /* integer >= 2 */
-};
+/* ---- the keys of the fixed sections ----------------------------------- */
 
-static const char *const accepted[] = {
-	[V_COUNT] = "an integer >= 1",
-	[V_POSITIVE] = "a finite number > 0",
-	[V_NONNEG] = "a finite number >= 0",
-	[V_REAL] = "a finite number",
-	[V_ANGLE] = "an angle in degrees in (0, 90)",
-	[V_CFL] = "a number in (0, 1]",
-	[V_CLOSURE] = SS_CLOSURE_NAMES,
-	[V_SIDE] = "wall, open or periodic",
-	[V_END] = "a time in s > 0, or steady",
-	[V_INITIAL] = "flat, cone or file",
-	[V_PAIR] = "two finite numbers 'X Y'",
-	[V_PATH] = "a file name",
-	[V_INTEGRATOR] = SS_INTEGRATOR_NAMES,
-	[V_STAGES] = "an integer >= 2",
-};
+/* "X Y" into two doubles */
+static int parse_pair(const char *value, void *field)
+{
+	double v[3];
+	char *end;
+	const char *s = value;
+	int n = 0;
+	for (;;) {
+		while (isspace((unsigned char)*s))
+			s++;
+		if (!*s)
+			break;
+		errno = 0;
+		const double x = strtod(s, &end);
+		if (end == s || errno == ERANGE || !isfinite(x) ||
+		    (*end && !isspace((unsigned char)*end)) || n == 3)
+			return -1;
+		v[n++] = x;
+		s = end;
+	}
+	if (n != 2)
+		return -1;
+	memcpy(field, v, 2 * sizeof *v);
+	return 0;
+}
 
-struct key_spec {
-	const char *section, *key;
-	enum value_type type;
-	size_t offset;
-};
+static int parse_side(const char *value, void *field)
+{
+	return ss_side_kind_parse(value, field);
+}
 
-#define KEY(sec, name, type, field) {sec, name, type, offsetof(struct ss_case, field)}
-static const struct key_spec keys[] = {
-	KEY("grid", "nx", V_COUNT, nx),
-	KEY("grid", "ny", V_COUNT, ny),
-	KEY("grid", "dx", V_POSITIVE, dx),
-	KEY("grid", "dy", V_POSITIVE, dy),
-	KEY("grid", "origin", V_PAIR, origin_x),
-	KEY("model", "closure", V_CLOSURE, closure),
-	KEY("model", "repose_angle", V_ANGLE, repose_angle_deg),
-	KEY("model", "nu", V_POSITIVE, nu),
-	KEY("model", "gamma", V_POSITIVE, gamma),
-	KEY("model", "delta", V_POSITIVE, delta),
-	KEY("model", "density", V_POSITIVE, density),
-	KEY("model", "gravity", V_POSITIVE, gravity),
-	KEY("model", "viscosity", V_POSITIVE, viscosity),
-	KEY("model", "consistency", V_POSITIVE, consistency),
-	KEY("time", "end", V_END, end),
-	KEY("time", "output_every", V_POSITIVE, output_every),
-	KEY("time", "cfl", V_CFL, cfl),
-	KEY("time", "steady_tol", V_POSITIVE, steady_tol),
-	KEY("time", "max_time", V_POSITIVE, max_time),
-	KEY("time", "steady_slope_tol", V_POSITIVE, steady_slope_tol),
-	KEY("time", "integrator", V_INTEGRATOR, integrator),
-	KEY("time", "rkl2_max_stages", V_STAGES, rkl2_max_stages),
-	KEY("time", "rkl2_tol", V_POSITIVE, rkl2_tol),
-	KEY("boundary", "west", V_SIDE, boundary.side[SS_WEST]),
-	KEY("boundary", "east", V_SIDE, boundary.side[SS_EAST]),
-	KEY("boundary", "south", V_SIDE, boundary.side[SS_SOUTH]),
-	KEY("boundary", "north", V_SIDE, boundary.side[SS_NORTH]),
-	KEY("boundary", "open_level", V_REAL, boundary.open_level),
-	KEY("initial", "type", V_INITIAL, initial),
-	KEY("initial", "height", V_REAL, initial_height),
-	KEY("initial", "center", V_PAIR, cone_x),
-	KEY("initial", "radius", V_POSITIVE, cone_radius),
-	KEY("initial", "angle", V_ANGLE, cone_angle_deg),
-	KEY("initial", "file", V_PATH, initial_file),
-	KEY("initial", "bedrock", V_PATH, bedrock_file),
+/* a time > 0, or "steady": INFINITY (the case's steady flag follows end) */
+static int parse_end(const char *value, void *field)
+{
+	if (!strcmp(value, "steady")) {
+		*(double *)field = INFINITY;
+		return 0;
+	}
+	char *end;
+	errno = 0;
+	const double t = strtod(value, &end);
+	if (end == value || *end || errno || !isfinite(t) || !(t > 0.0))
+		return -1;
+	*(double *)field = t;
+	return 0;
+}
+
+static int parse_initial(const char *value, void *field)
+{
+	static const char *const names[] = {"flat", "cone", "file"};
+	for (int m = 0; m < 3; m++) {
+		if (!strcmp(value, names[m])) {
+			*(enum ss_initial_type *)field = (enum ss_initial_type)m;
+			return 0;
+		}
+	}
+	return -1;
+}
+
+#define AT(m) offsetof(struct ss_case, m)
+/* > 0, finite */
+#define POSITIVE .lo = 0.0, .hi = INFINITY, .flags = SS_OPTION_LO_OPEN
+#define KEY(k, kind_, field, ...) \
+	{.case_key = k, .kind = kind_, .offset = AT(field), __VA_ARGS__}
+#define NUMBER(k, field, ...) KEY(k, SS_OPTION_REAL, field, __VA_ARGS__)
+#define WORD(k, field, f, ...) KEY(k, SS_OPTION_WORD, field, .parse = f, __VA_ARGS__)
+
+static const struct ss_option keys[] = {
+	KEY("grid.nx", SS_OPTION_INT, nx, .lo = 1, .hi = INT_MAX / 4,
+	    .flags = SS_OPTION_CASE_REQUIRED, .expected = "an integer >= 1",
+	    .help = "number of cells west to east"),
+	KEY("grid.ny", SS_OPTION_INT, ny, .lo = 1, .hi = INT_MAX / 4,
+	    .flags = SS_OPTION_CASE_REQUIRED, .expected = "an integer >= 1",
+	    .help = "number of cells south to north"),
+	NUMBER("grid.dx", dx, .lo = 0.0, .hi = INFINITY,
+	       .flags = SS_OPTION_CASE_REQUIRED | SS_OPTION_LO_OPEN,
+	       .expected = "a finite number > 0", .help = "cell size in m"),
+	NUMBER("grid.dy", dy, POSITIVE, .expected = "a finite number > 0",
+	       .help = "cell size south to north, m (default dx)"),
+	WORD("grid.origin", origin_x, parse_pair, .default_value = "0 0",
+	     .expected = "two finite numbers 'X Y'", .help = "lower-left corner, m"),
+	NUMBER("model.delta", delta, POSITIVE, .expected = "a finite number > 0",
+	       .help = "sliding layer thickness, m"),
+	NUMBER("model.density", density, POSITIVE, .expected = "a finite number > 0",
+	       .help = "kg/m^3"),
+	NUMBER("model.gravity", gravity, .default_value = "9.81", POSITIVE,
+	       .expected = "a finite number > 0", .help = "m/s^2"),
+	NUMBER("model.viscosity", viscosity, POSITIVE, .expected = "a finite number > 0",
+	       .help = "mu, Pa s (bingham, casson)"),
+	NUMBER("model.consistency", consistency, POSITIVE,
+	       .expected = "a finite number > 0", .help = "k, Pa s^gamma (herschel-bulkley)"),
+	WORD("time.end", end, parse_end, .flags = SS_OPTION_CASE_REQUIRED,
+	     .expected = "a time in s > 0, or steady", .help = "a time in s, or steady"),
+	NUMBER("time.output_every", output_every, .lo = 0.0, .hi = INFINITY,
+	       .flags = SS_OPTION_CASE_REQUIRED | SS_OPTION_LO_OPEN,
+	       .expected = "a finite number > 0", .help = "seconds between snapshots"),
+	WORD("boundary.west", boundary.side[SS_WEST], parse_side, .default_value = "wall",
+	     .expected = "wall, open or periodic"),
+	WORD("boundary.east", boundary.side[SS_EAST], parse_side, .default_value = "wall",
+	     .expected = "wall, open or periodic"),
+	WORD("boundary.south", boundary.side[SS_SOUTH], parse_side, .default_value = "wall",
+	     .expected = "wall, open or periodic"),
+	WORD("boundary.north", boundary.side[SS_NORTH], parse_side, .default_value = "wall",
+	     .expected = "wall, open or periodic"),
+	NUMBER("boundary.open_level", boundary.open_level, .default_value = "0", .lo = -INFINITY,
+	       .hi = INFINITY, .expected = "a finite number", .help = "m"),
+	WORD("initial.type", initial, parse_initial, .default_value = "flat",
+	     .expected = "flat, cone or file"),
+	NUMBER("initial.height", initial_height, .default_value = "0", .lo = -INFINITY,
+	       .hi = INFINITY, .expected = "a finite number", .help = "m"),
+	WORD("initial.center", cone_x, parse_pair, .expected = "two finite numbers 'X Y'",
+	     .help = "'X Y' in m"),
+	NUMBER("initial.radius", cone_radius, POSITIVE, .expected = "a finite number > 0",
+	       .help = "m, > 0"),
+	NUMBER("initial.angle", cone_angle_deg, .lo = 0.0, .hi = 90.0,
+	       .flags = SS_OPTION_LO_OPEN | SS_OPTION_HI_OPEN, .expected = "degrees in (0, 90)",
+	       .help = "degrees in (0, 90)"),
+	KEY("initial.file", SS_OPTION_TEXT, initial_file, .expected = "a file name",
+	    .help = "a raster of the grid's size"),
+	KEY("initial.bedrock", SS_OPTION_TEXT, bedrock_file, .expected = "a file name",
+	    .help = "a raster of the grid's size"),
 };
 #undef KEY
-enum { KEY_COUNT = sizeof keys / sizeof *keys };
+#undef NUMBER
+#undef WORD
+
+const struct ss_option_table ss_case_option_table = {
+	.command = "case", .options = keys, .count = sizeof keys / sizeof *keys,
+	.more = &ss_model_option_table, .more_offset = AT(model),
+};
+
+/* Every key of the table and of the model's, in order: an index for the
+ * parse state's bookkeeping. */
+enum { MAX_KEYS = 64 };
 
 static const char *const fixed_sections[] = {"grid", "model", "time", "boundary", "initial"};
 static const char *const region_prefix[] = {
@@ -112,6 +170,13 @@ static const char *const region_prefix[] = {
 };
 #define SECTIONS_ACCEPTED "grid, model, time, boundary, initial, wall NAME, open NAME, source NAME"
 #define MAX_REGIONS 256
+
+/* Where a key's value came from: the file (file:line) or an override. */
+struct key_state {
+	int set;                        /* given, and not unset since */
+	int by_override;                /* last given by --set */
+	char where[SS_CASE_WHERE_SIZE]; /* "file:line" or "--set ..." */
+};
 
 struct parse {
 	struct ss_case *c;
@@ -122,8 +187,7 @@ struct parse {
 	int overriding;            /* applying --set: later values replace */
 	int failed;
 	char where[SS_CASE_WHERE_SIZE];           /* location of the value being applied */
-	int key_set[KEY_COUNT];
-	char key_where[KEY_COUNT][SS_CASE_WHERE_SIZE];
+	struct key_state key[MAX_KEYS];
 	char last_region_key[16];  /* for polygon continuation lines */
 };
 
@@ -131,45 +195,45 @@ struct parse {
  * first error is the only one reported. */
 #define fail_at(p, ...) ((p)->failed = 1, ss_error_input_at((p)->where, __VA_ARGS__))
 
-/* ---- values ---------------------------------------------------------- */
-
-static int parse_double(const char *s, double *out)
+/* The option of key "section.key" and its index in the bookkeeping, or
+ * NULL. */
+static const struct ss_option *find_key(const char *key, int *index, size_t *offset)
 {
-	char *end;
-	errno = 0;
-	double v = strtod(s, &end);
-	if (end == s || errno == ERANGE)
-		return -1;
-	while (isspace((unsigned char)*end))
-		end++;
-	if (*end || !isfinite(v))
-		return -1;
-	*out = v;
-	return 0;
-}
-
-/* Up to max finite numbers separated by white space; returns the count or
- * -1 when something is not a number. */
-static int parse_numbers(const char *s, double *out, int max)
-{
+	const struct ss_option *o = ss_option_find_key(&ss_case_option_table, key, offset);
+	if (!o)
+		return NULL;
 	int n = 0;
-	for (;;) {
-		while (isspace((unsigned char)*s))
-			s++;
-		if (!*s)
-			return n;
-		char *end;
-		errno = 0;
-		double v = strtod(s, &end);
-		if (end == s || errno == ERANGE || !isfinite(v) ||
-		    (*end && !isspace((unsigned char)*end)))
-			return -1;
-		if (n < max)
-			out[n] = v;
-		n++;
-		s = end;
+	for (const struct ss_option_table *t = &ss_case_option_table; t; t = t->more) {
+		if (o >= t->options && o < t->options + t->count) {
+			*index = n + (int)(o - t->options);
+			return o;
+		}
+		n += t->count;
 	}
+	SS_BUG("case key '%s' in no table", key);
 }
+
+/* The bookkeeping of "section.key", which must exist. */
+static struct key_state *state_of(struct parse *p, const char *key)
+{
+	int index;
+	size_t offset;
+	if (!find_key(key, &index, &offset))
+		SS_BUG("no case key %s", key);
+	return &p->key[index];
+}
+
+static int is_set(struct parse *p, const char *key)
+{
+	return state_of(p, key)->set;
+}
+
+static const char *where_of(struct parse *p, const char *key)
+{
+	return state_of(p, key)->where;
+}
+
+/* ---- values ---------------------------------------------------------- */
 
 static char *dup_string(const char *s)
 {
@@ -194,94 +258,54 @@ static char *resolve_path(const char *case_path, const char *name)
 	return out;
 }
 
-static int store_value(struct parse *p, const struct key_spec *k, const char *value)
+/* The file keys' own copies: a path resolved and owned by the case. */
+static int store_path(struct parse *p, char **field, const char *value)
 {
-	void *field = (char *)p->c + k->offset;
-	double v[3];
-	switch (k->type) {
-	case V_COUNT:
-	case V_STAGES: {
-		char *end;
-		errno = 0;
-		long n = strtol(value, &end, 10);
-		while (isspace((unsigned char)*end))
-			end++;
-		if (end == value || *end || errno || n < (k->type == V_STAGES ? 2 : 1) ||
-		    n > INT_MAX / 4)
-			goto bad;
-		*(int *)field = (int)n;
+	char *s = resolve_path(p->path, value);
+	if (!s)
+		return ss_error_fail("out of memory reading '%s'", p->path);
+	free(*field);
+	*field = s;
+	char *where = field == &p->c->bedrock_file ? p->c->bedrock_where : p->c->initial_where;
+	snprintf(where, SS_CASE_WHERE_SIZE, "%s", p->where);
+	return SS_OK;
+}
+
+/* key (section.key) of the fixed sections = value */
+static int store_value(struct parse *p, const char *section, const char *name,
+                       const struct ss_option *o, size_t offset, const char *value)
+{
+	void *field = (char *)p->c + offset + o->offset;
+	if (o->kind == SS_OPTION_TEXT && *value)
+		return store_path(p, field, value);
+	if (o->kind != SS_OPTION_TEXT && ss_option_parse(o, value, field) == 0) {
+		if (field == &p->c->end)
+			p->c->steady = isinf(p->c->end);
 		return SS_OK;
 	}
-	case V_POSITIVE:
-	case V_NONNEG:
-	case V_REAL:
-	case V_ANGLE:
-	case V_CFL:
-		if (parse_double(value, v))
-			goto bad;
-		if ((k->type == V_POSITIVE && !(v[0] > 0.0)) ||
-		    (k->type == V_NONNEG && !(v[0] >= 0.0)) ||
-		    (k->type == V_ANGLE && !(v[0] > 0.0 && v[0] < 90.0)) ||
-		    (k->type == V_CFL && !(v[0] > 0.0 && v[0] <= 1.0)))
-			goto bad;
-		*(double *)field = v[0];
-		return SS_OK;
-	case V_PAIR:
-		if (parse_numbers(value, v, 3) != 2)
-			goto bad;
-		((double *)field)[0] = v[0];
-		((double *)field)[1] = v[1];
-		return SS_OK;
-	case V_CLOSURE:
-		if (ss_closure_parse(value, (enum ss_closure_kind *)field))
-			goto bad;
-		return SS_OK;
-	case V_SIDE:
-		if (ss_side_kind_parse(value, (enum ss_side_kind *)field))
-			goto bad;
-		return SS_OK;
-	case V_END:
-		if (strcmp(value, "steady") == 0) {
-			p->c->steady = 1;
-			*(double *)field = INFINITY;
-			return SS_OK;
-		}
-		if (parse_double(value, v) || !(v[0] > 0.0))
-			goto bad;
-		p->c->steady = 0;
-		*(double *)field = v[0];
-		return SS_OK;
-	case V_INTEGRATOR:
-		if (ss_integrator_parse(value, (enum ss_integrator *)field))
-			goto bad;
-		return SS_OK;
-	case V_INITIAL: {
-		static const char *const names[] = {"flat", "cone", "file"};
-		for (int m = 0; m < 3; m++) {
-			if (strcmp(value, names[m]) == 0) {
-				*(enum ss_initial_type *)field = (enum ss_initial_type)m;
-				return SS_OK;
-			}
-		}
-		goto bad;
-	}
-	case V_PATH: {
-		if (!*value)
-			goto bad;
-		char *s = resolve_path(p->path, value);
-		if (!s)
-			return ss_error_fail("out of memory reading '%s'", p->path);
+	return fail_at(p, "[%s] %s = '%s' is not valid: expected %s", section, name, value,
+	               o->expected);
+}
+
+/* key back to what it is when no one gives it: its default, or none */
+static void reset_value(struct parse *p, const struct ss_option *o, size_t offset)
+{
+	void *field = (char *)p->c + offset + o->offset;
+	if (o->kind == SS_OPTION_TEXT) {
 		free(*(char **)field);
-		*(char **)field = s;
-		char *where = field == &p->c->bedrock_file ? p->c->bedrock_where
-		                                           : p->c->initial_where;
-		snprintf(where, SS_CASE_WHERE_SIZE, "%s", p->where);
-		return SS_OK;
+		*(char **)field = NULL;
+		return;
 	}
-	}
-bad:
-	return fail_at(p, "[%s] %s = '%s' is not valid: expected %s", k->section,
-	               k->key, value, accepted[k->type]);
+	if (o->default_value)
+		ss_option_parse(o, o->default_value, field);
+	else if (o->kind == SS_OPTION_REAL)
+		*(double *)field = NAN;
+	else if (o->kind == SS_OPTION_WORD)
+		*(double *)field = 0.0;   /* end, a pair: as the case starts */
+	else
+		*(int *)field = 0;
+	if (field == &p->c->end)
+		p->c->steady = 0;
 }
 
 /* ---- regions --------------------------------------------------------- */
@@ -340,6 +364,13 @@ static struct ss_region *region_find(struct parse *p, enum ss_region_role role,
 	return r;
 }
 
+static void shape_clear(struct ss_shape *sh)
+{
+	free(sh->polygon);
+	free(sh->mask_path);
+	memset(sh, 0, sizeof *sh);
+}
+
 static int region_shape(struct parse *p, struct ss_region *r, const char *key,
                         const char *value, const char *section)
 {
@@ -347,11 +378,8 @@ static int region_shape(struct parse *p, struct ss_region *r, const char *key,
 	int polygon_more = p->continuation && strcmp(key, "polygon") == 0 &&
 	                   sh->kind == SS_SHAPE_POLYGON &&
 	                   strcmp(p->last_region_key, "polygon") == 0;
-	if (p->overriding && !polygon_more) {
-		free(sh->polygon);
-		free(sh->mask_path);
-		memset(sh, 0, sizeof *sh);
-	}
+	if (p->overriding && !polygon_more)
+		shape_clear(sh);
 	if (sh->kind != SS_SHAPE_NONE && !polygon_more)
 		return fail_at(p, "[%s] has two shapes (the first is at %s): give one of "
 		               "rect, disk, polygon, mask", section, sh->where);
@@ -367,32 +395,45 @@ static int region_shape(struct parse *p, struct ss_region *r, const char *key,
 			return ss_error_fail("out of memory");
 		return SS_OK;
 	}
-
-	int count = parse_numbers(value, NULL, 0);
-	if (strcmp(key, "rect") == 0) {
-		if (count != 4 || parse_numbers(value, sh->v, 4) != 4 ||
-		    !(sh->v[0] < sh->v[2] && sh->v[1] < sh->v[3]))
-			return fail_at(p, "[%s] rect = '%s': expected 'X0 Y0 X1 Y1' in m "
-			               "with X0 < X1 and Y0 < Y1", section, value);
-		sh->kind = SS_SHAPE_RECT;
-		return SS_OK;
-	}
-	if (strcmp(key, "disk") == 0) {
-		if (count != 3 || parse_numbers(value, sh->v, 3) != 3 || !(sh->v[2] > 0.0))
-			return fail_at(p, "[%s] disk = '%s': expected 'X Y R' in m with R > 0",
-			               section, value);
-		sh->kind = SS_SHAPE_DISK;
+	const enum ss_shape_kind kind = !strcmp(key, "rect") ? SS_SHAPE_RECT
+	                              : !strcmp(key, "disk") ? SS_SHAPE_DISK : SS_SHAPE_POLYGON;
+	if (kind != SS_SHAPE_POLYGON) {
+		if (ss_shape_parse_numbers(kind, value, sh))
+			return fail_at(p, "[%s] %s = '%s': expected %s", section, key, value,
+			               ss_shape_expected(kind));
 		return SS_OK;
 	}
 	/* polygon, possibly continued on indented lines */
+	double scratch;
+	int count = 0;
+	for (const char *s = value;; count++) {
+		while (isspace((unsigned char)*s))
+			s++;
+		if (!*s)
+			break;
+		char *end;
+		errno = 0;
+		scratch = strtod(s, &end);
+		if (end == s || errno == ERANGE || !isfinite(scratch) ||
+		    (*end && !isspace((unsigned char)*end))) {
+			count = -1;
+			break;
+		}
+		s = end;
+	}
 	if (count < 0 || count % 2)
-		return fail_at(p, "[%s] polygon = '%s': expected pairs of numbers 'X Y X Y ...' in m",
-		               section, value);
+		return fail_at(p, "[%s] polygon = '%s': expected %s", section, value,
+		               ss_shape_expected(SS_SHAPE_POLYGON));
 	double *pts = realloc(sh->polygon, (size_t)(2 * sh->polygon_points + count) * sizeof *pts);
 	if (!pts)
 		return ss_error_fail("out of memory");
 	sh->polygon = pts;
-	parse_numbers(value, pts + 2 * sh->polygon_points, count);
+	const char *s = value;
+	for (int k = 0; k < count; k++) {
+		char *end;
+		pts[2 * sh->polygon_points + k] = strtod(s, &end);
+		s = end;
+	}
 	sh->polygon_points += count / 2;
 	sh->kind = SS_SHAPE_POLYGON;
 	return SS_OK;
@@ -422,43 +463,83 @@ static int no_such_region(struct parse *p, enum ss_region_role role, const char 
 	               name, region_prefix[role], names);
 }
 
+/* The region an override names, or NULL after the message. */
+static struct ss_region *override_region(struct parse *p, const char *section)
+{
+	enum ss_region_role role;
+	const char *name;
+	if (region_section(section, &role, &name)) {
+		fail_at(p, "unknown section [%s]: expected " SECTIONS_ACCEPTED, section);
+		return NULL;
+	}
+	/* --set changes a section of the case; it does not make one up (an
+	 * --set of a misspelt name said the new section "has no shape") */
+	struct ss_region *r = region_find(p, role, name, 0);
+	if (!r)
+		no_such_region(p, role, name);
+	return r;
+}
+
+static int is_shape_key(const char *key)
+{
+	return !strcmp(key, "rect") || !strcmp(key, "disk") || !strcmp(key, "polygon") ||
+	       !strcmp(key, "mask");
+}
+
+static int is_source_key(const char *key)
+{
+	return !strcmp(key, "rate") || !strcmp(key, "start") || !strcmp(key, "stop");
+}
+
+static int unknown_region_key(struct parse *p, enum ss_region_role role, const char *section,
+                              const char *key)
+{
+	return fail_at(p, "unknown key '%s' in [%s]: expected %s", key, section,
+	               role == SS_REGION_SOURCE
+	               ? "rect, disk, polygon or mask, and rate, start, stop"
+	               : "one of rect, disk, polygon, mask");
+}
+
 static int apply_region_key(struct parse *p, const char *section, const char *key,
                             const char *value)
 {
 	enum ss_region_role role;
 	const char *name;
-	if (region_section(section, &role, &name))
-		return fail_at(p, "unknown section [%s]: expected " SECTIONS_ACCEPTED, section);
-	/* --set changes a section of the case; it does not make one up (an
-	 * --set of a misspelt name said the new section "has no shape") */
-	struct ss_region *r = region_find(p, role, name, !p->overriding);
-	if (!r && p->overriding && !p->failed)
-		return no_such_region(p, role, name);
-	if (!r)
-		return SS_ERR_INPUT;
+	struct ss_region *r;
+	if (p->overriding) {
+		if (!(r = override_region(p, section)))
+			return SS_ERR_INPUT;
+		role = r->role;
+	} else {
+		if (region_section(section, &role, &name))
+			return fail_at(p, "unknown section [%s]: expected " SECTIONS_ACCEPTED, section);
+		if (!(r = region_find(p, role, name, 1)))
+			return SS_ERR_INPUT;
+	}
 
 	int err;
-	if (!strcmp(key, "rect") || !strcmp(key, "disk") || !strcmp(key, "polygon") ||
-	    !strcmp(key, "mask")) {
+	if (is_shape_key(key)) {
 		err = region_shape(p, r, key, value, section);
-	} else if (role == SS_REGION_SOURCE &&
-	           (!strcmp(key, "rate") || !strcmp(key, "start") || !strcmp(key, "stop"))) {
+	} else if (role == SS_REGION_SOURCE && is_source_key(key)) {
 		const int is_rate = key[0] == 'r', is_start = key[2] == 'a';
 		char *where = is_rate ? r->rate_where : is_start ? r->start_where : r->stop_where;
 		double v;
+		char *end;
+		errno = 0;
+		v = strtod(value, &end);
+		while (isspace((unsigned char)*end))
+			end++;
 		if (where[0] && !p->overriding)
 			return fail_at(p, "[%s] %s is set twice (first at %s)", section, key, where);
-		if (parse_double(value, &v) || (is_rate ? !(v > 0.0) : !(v >= 0.0)))
+		if (end == value || *end || errno == ERANGE || !isfinite(v) ||
+		    (is_rate ? !(v > 0.0) : !(v >= 0.0)))
 			return fail_at(p, "[%s] %s = '%s': expected %s", section, key, value,
 			               is_rate ? "a finite number > 0 (m/s)" : "a time in s >= 0");
 		*(is_rate ? &r->rate : is_start ? &r->start : &r->stop) = v;
 		snprintf(where, SS_CASE_WHERE_SIZE, "%s", p->where);
 		err = SS_OK;
 	} else {
-		return fail_at(p, "unknown key '%s' in [%s]: expected %s", key, section,
-		               role == SS_REGION_SOURCE
-		               ? "rect, disk, polygon or mask, and rate, start, stop"
-		               : "one of rect, disk, polygon, mask");
+		return unknown_region_key(p, role, section, key);
 	}
 	snprintf(p->last_region_key, sizeof p->last_region_key, "%s", key);
 	return err;
@@ -466,13 +547,35 @@ static int apply_region_key(struct parse *p, const char *section, const char *ke
 
 /* ---- one key = value ------------------------------------------------- */
 
+static int is_fixed(const char *section)
+{
+	for (size_t s = 0; s < sizeof fixed_sections / sizeof *fixed_sections; s++)
+		if (!strcmp(section, fixed_sections[s]))
+			return 1;
+	return 0;
+}
+
+static int unknown_key(struct parse *p, const char *section, const char *key)
+{
+	char known[512] = "";
+	const size_t n = strlen(section);
+	for (const struct ss_option_table *t = &ss_case_option_table; t; t = t->more) {
+		for (int k = 0; k < t->count; k++) {
+			const char *ck = t->options[k].case_key;
+			if (!ck || strncmp(ck, section, n) || ck[n] != '.')
+				continue;
+			if (known[0])
+				strncat(known, ", ", sizeof known - strlen(known) - 1);
+			strncat(known, ck + n + 1, sizeof known - strlen(known) - 1);
+		}
+	}
+	return fail_at(p, "unknown key '%s' in [%s]: expected one of %s", key, section, known);
+}
+
 static int apply(struct parse *p, const char *section, const char *key,
                  const char *value)
 {
-	int fixed = 0;
-	for (size_t s = 0; s < sizeof fixed_sections / sizeof *fixed_sections; s++)
-		fixed |= strcmp(section, fixed_sections[s]) == 0;
-	if (!fixed) {
+	if (!is_fixed(section)) {
 		if (p->continuation && strcmp(key, "polygon") != 0)
 			return fail_at(p, "only polygon values may continue on an indented line");
 		return apply_region_key(p, section, key, value);
@@ -481,28 +584,78 @@ static int apply(struct parse *p, const char *section, const char *key,
 		return fail_at(p, "[%s] %s continues on an indented line: only polygon "
 		               "values may", section, key);
 
-	for (int k = 0; k < KEY_COUNT; k++) {
-		if (strcmp(keys[k].section, section) || strcmp(keys[k].key, key))
-			continue;
-		if (p->key_set[k] && !p->overriding)
-			return fail_at(p, "[%s] %s is set twice (first at %s)", section, key,
-			               p->key_where[k]);
-		int err = store_value(p, &keys[k], value);
-		if (err)
-			return err;
-		p->key_set[k] = 1;
-		snprintf(p->key_where[k], sizeof p->key_where[k], "%s", p->where);
+	char full[256];
+	int index;
+	size_t offset;
+	snprintf(full, sizeof full, "%s.%s", section, key);
+	const struct ss_option *o = find_key(full, &index, &offset);
+	if (!o)
+		return unknown_key(p, section, key);
+	struct key_state *k = &p->key[index];
+	if (k->set && !p->overriding)
+		return fail_at(p, "[%s] %s is set twice (first at %s)", section, key, k->where);
+	int err = store_value(p, section, key, o, offset, value);
+	if (err)
+		return err;
+	k->set = 1;
+	k->by_override = p->overriding;
+	snprintf(k->where, sizeof k->where, "%s", p->where);
+	return SS_OK;
+}
+
+/* --unset SECTION.KEY (as if the file did not give it) or --unset SECTION
+ * (a wall, open or source section removed). */
+static int unset(struct parse *p, char *lhs)
+{
+	char *dot = strrchr(lhs, '.');
+	if (!dot) {
+		if (is_fixed(lhs))
+			return fail_at(p, "[%s] cannot be removed: unset its keys (SECTION.KEY)", lhs);
+		struct ss_region *r = override_region(p, lhs);
+		if (!r)
+			return SS_ERR_INPUT;
+		struct ss_case *c = p->c;
+		shape_clear(&r->shape);
+		const ptrdiff_t at = r - c->regions;
+		memmove(r, r + 1, (size_t)(c->region_count - at - 1) * sizeof *r);
+		c->region_count--;
 		return SS_OK;
 	}
-	char known[512] = "";
-	for (int k = 0; k < KEY_COUNT; k++) {
-		if (strcmp(keys[k].section, section))
-			continue;
-		if (known[0])
-			strncat(known, ", ", sizeof known - strlen(known) - 1);
-		strncat(known, keys[k].key, sizeof known - strlen(known) - 1);
+	*dot = '\0';
+	const char *section = lhs, *key = dot + 1;
+	if (!is_fixed(section)) {
+		struct ss_region *r = override_region(p, section);
+		if (!r)
+			return SS_ERR_INPUT;
+		if (is_shape_key(key)) {
+			shape_clear(&r->shape);   /* finish() then says it has none */
+		} else if (r->role == SS_REGION_SOURCE && is_source_key(key)) {
+			const int is_rate = key[0] == 'r', is_start = key[2] == 'a';
+			if (is_rate) {
+				r->rate = 0.0;
+				r->rate_where[0] = '\0';
+			} else if (is_start) {
+				r->start = 0.0;
+				r->start_where[0] = '\0';
+			} else {
+				r->stop = INFINITY;
+				r->stop_where[0] = '\0';
+			}
+		} else {
+			return unknown_region_key(p, r->role, section, key);
+		}
+		return SS_OK;
 	}
-	return fail_at(p, "unknown key '%s' in [%s]: expected one of %s", key, section, known);
+	char full[256];
+	int index;
+	size_t offset;
+	snprintf(full, sizeof full, "%s.%s", section, key);
+	const struct ss_option *o = find_key(full, &index, &offset);
+	if (!o)
+		return unknown_key(p, section, key);
+	reset_value(p, o, offset);
+	memset(&p->key[index], 0, sizeof p->key[index]);
+	return SS_OK;
 }
 
 /* ---- inih glue ------------------------------------------------------- */
@@ -584,14 +737,9 @@ static int prescan(struct parse *p)
 			}
 			*close = '\0';
 			const char *name = t + 1;
-			int ok = 0;
-			for (size_t k = 0; k < sizeof fixed_sections / sizeof *fixed_sections; k++)
-				ok |= strcmp(name, fixed_sections[k]) == 0;
 			enum ss_region_role role;
 			const char *rname;
-			if (!ok && region_section(name, &role, &rname) == 0)
-				ok = 1;
-			if (!ok) {
+			if (!is_fixed(name) && region_section(name, &role, &rname) != 0) {
 				err = fail_at(p, "unknown section [%s]: expected " SECTIONS_ACCEPTED
 				              " (NAME of letters, digits, _ or -)", name);
 				break;
@@ -636,99 +784,143 @@ static int prescan(struct parse *p)
 
 /* ---- checks across keys ---------------------------------------------- */
 
-static int key_index(const char *section, const char *key)
+static int require(struct parse *p, const char *key, const char *meaning)
 {
-	for (int k = 0; k < KEY_COUNT; k++)
-		if (!strcmp(keys[k].section, section) && !strcmp(keys[k].key, key))
-			return k;
-	SS_BUG("no key [%s] %s", section, key);
-}
-
-static int require(struct parse *p, const char *section, const char *key,
-                   const char *meaning)
-{
-	if (p->key_set[key_index(section, key)])
+	if (is_set(p, key))
 		return SS_OK;
-	return ss_error_input("%s: [%s] is missing '%s' (%s)", p->path, section, key, meaning);
+	const char *dot = strchr(key, '.');
+	return ss_error_input("%s: [%.*s] is missing '%s' (%s)", p->path, (int)(dot - key), key,
+	                      dot + 1, meaning);
 }
 
-static int is_set(struct parse *p, const char *section, const char *key)
+/* Another sentence for the summary: what an override did to the file. */
+__attribute__((format(printf, 2, 3)))
+static void note(struct parse *p, const char *fmt, ...)
 {
-	return p->key_set[key_index(section, key)];
+	struct ss_case *c = p->c;
+	if (c->note_count == SS_CASE_MAX_NOTES)
+		return;
+	va_list ap;
+	va_start(ap, fmt);
+	vsnprintf(c->notes[c->note_count++], SS_CASE_NOTE_SIZE, fmt, ap);
+	va_end(ap);
 }
 
-static const char *where_of(struct parse *p, const char *section, const char *key)
+/* The file's key, made redundant by the override at why, is dropped. */
+static void drop(struct parse *p, const char *key, const char *why, const char *reason)
 {
-	return p->key_where[key_index(section, key)];
+	int index = 0;
+	size_t offset = 0;
+	const struct ss_option *o = find_key(key, &index, &offset);
+	const char *dot = strchr(key, '.');
+	if (!o || !dot)
+		SS_BUG("no case key %s", key);
+	note(p, "[%.*s] %s (%s) is dropped: %s %s", (int)(dot - key), key, dot + 1,
+	     p->key[index].where, why, reason);
+	reset_value(p, o, offset);
+	memset(&p->key[index], 0, sizeof p->key[index]);
 }
+
+/* The file gives key, and an override makes it redundant: dropped.  Else
+ * (both from the file, or both overrides) it is an error. */
+static int file_key(struct parse *p, const char *key)
+{
+	const struct key_state *k = state_of(p, key);
+	return k->set && !k->by_override;
+}
+
+static int by_override(struct parse *p, const char *key)
+{
+	const struct key_state *k = state_of(p, key);
+	return k->set && k->by_override;
+}
+
+static const char *const physical[] = {"model.delta", "model.density", "model.viscosity",
+                                       "model.consistency", "model.gravity"};
+enum { PHYSICAL = sizeof physical / sizeof *physical };
 
 static int finish_model(struct parse *p)
 {
 	struct ss_case *c = p->c;
-	int err = require(p, "model", "repose_angle", "degrees in (0, 90)");
+	struct ss_model_options *m = &c->model;
+	int err = require(p, "model.repose_angle", "degrees in (0, 90)");
 	if (err)
 		return err;
-	if (c->closure == SS_CLOSURE_HERSCHEL_BULKLEY) {
-		if ((err = require(p, "model", "gamma", "the herschel-bulkley exponent, > 0")))
-			return err;
-	} else {
-		c->gamma = 1.0;
-	}
+	if (m->closure != SS_CLOSURE_HERSCHEL_BULKLEY)
+		m->gamma = 1.0;   /* the others have no exponent (the output says 1) */
 
-	static const char *const physical[] = {"delta", "density", "viscosity", "consistency",
-	                                       "gravity"};
-	const char *given = NULL;
-	for (int k = 0; k < 5 && !given; k++)
-		if (is_set(p, "model", physical[k]))
+	/* nu, or the sliding layer it derives from: an override of one drops
+	 * the other from the file */
+	const char *given = NULL, *given_by_override = NULL;
+	for (int k = 0; k < PHYSICAL; k++) {
+		if (!given && is_set(p, physical[k]))
 			given = physical[k];
-	if (is_set(p, "model", "nu")) {
-		if (given)
-			return ss_error_input("%s: [model] gives both nu and %s: give nu, or the "
-			                      "physical parameters to derive it", where_of(p, "model", given),
-			                      given);
-		return SS_OK;
+		if (!given_by_override && by_override(p, physical[k]))
+			given_by_override = physical[k];
 	}
+	if (given && is_set(p, "model.nu")) {
+		if (by_override(p, "model.nu") && !given_by_override) {
+			for (int k = 0; k < PHYSICAL; k++)
+				if (is_set(p, physical[k]))
+					drop(p, physical[k], where_of(p, "model.nu"), "gives nu");
+			given = NULL;
+		} else if (given_by_override && file_key(p, "model.nu")) {
+			drop(p, "model.nu", where_of(p, given_by_override),
+			     "gives the sliding layer nu is derived from");
+		} else {
+			return ss_error_input("%s: [model] gives both nu and %s: give nu, or the "
+			                      "physical parameters to derive it", where_of(p, given),
+			                      strchr(given, '.') + 1);
+		}
+	}
+	if (is_set(p, "model.nu"))
+		return SS_OK;
 	if (!given)
 		return ss_error_input("%s: [model] is missing 'nu' (m^2/s, > 0) or the physical "
 		                      "parameters delta, density and viscosity (bingham, casson) "
 		                      "or consistency (herschel-bulkley)", p->path);
-	if (c->closure == SS_CLOSURE_COULOMB)
+	if (m->closure == SS_CLOSURE_COULOMB)
 		return ss_error_input("%s: [model] %s: the coulomb closure takes nu directly "
-		                      "(SPEC section 1 derives nu only for bingham, "
-		                      "herschel-bulkley and casson)", where_of(p, "model", given), given);
-	const char *law = c->closure == SS_CLOSURE_HERSCHEL_BULKLEY ? "consistency" : "viscosity";
-	const char *other = c->closure == SS_CLOSURE_HERSCHEL_BULKLEY ? "viscosity" : "consistency";
-	if (is_set(p, "model", other))
+		                      "(doc/model.md derives nu only for bingham, "
+		                      "herschel-bulkley and casson)%s",
+		                      by_override(p, "model.closure") ? where_of(p, "model.closure")
+		                                                      : where_of(p, given),
+		                      strchr(given, '.') + 1,
+		                      by_override(p, "model.closure") ? ": give model.nu too" : "");
+	const int hb = m->closure == SS_CLOSURE_HERSCHEL_BULKLEY;
+	const char *law = hb ? "model.consistency" : "model.viscosity";
+	const char *other = hb ? "model.viscosity" : "model.consistency";
+	if (file_key(p, other) && by_override(p, "model.closure"))
+		drop(p, other, where_of(p, "model.closure"), "takes the other law");
+	if (is_set(p, other))
 		return ss_error_input("%s: [model] %s does not apply to %s: expected %s",
-		                      where_of(p, "model", other), other,
-		                      ss_closure_name(c->closure), law);
-	if ((err = require(p, "model", "delta", "sliding layer thickness, m")) ||
-	    (err = require(p, "model", "density", "kg/m^3")) ||
-	    (err = require(p, "model", law, c->closure == SS_CLOSURE_HERSCHEL_BULKLEY
-	                                    ? "consistency k, Pa s^gamma" : "viscosity mu, Pa s")))
+		                      where_of(p, other), strchr(other, '.') + 1,
+		                      ss_closure_name(m->closure), strchr(law, '.') + 1);
+	if ((err = require(p, "model.delta", "sliding layer thickness, m")) ||
+	    (err = require(p, "model.density", "kg/m^3")) ||
+	    (err = require(p, law, hb ? "consistency k, Pa s^gamma" : "viscosity mu, Pa s")))
 		return err;
-	/* tau = rho g delta sin a_cr; SPEC section 1, [Paper] eqs. 8 and 12 */
-	const double tau = c->density * c->gravity * c->delta *
-	                   sin(c->repose_angle_deg * M_PI / 180.0);
+	/* tau = rho g delta sin a_cr; doc/model.md, [Paper] eqs. 8 and 12 */
+	const double tau = c->density * c->gravity * c->delta * sin(m->angle_deg * M_PI / 180.0);
 	const double d2 = c->delta * c->delta;
-	switch (c->closure) {
+	switch (m->closure) {
 	case SS_CLOSURE_BINGHAM:
-		c->nu = tau * d2 / (6.0 * c->viscosity);
+		m->nu = tau * d2 / (6.0 * c->viscosity);
 		break;
 	case SS_CLOSURE_CASSON:
-		c->nu = tau * d2 / (30.0 * c->viscosity);
+		m->nu = tau * d2 / (30.0 * c->viscosity);
 		break;
 	case SS_CLOSURE_HERSCHEL_BULKLEY: {
-		const double g = c->gamma;
-		c->nu = pow(tau / c->consistency, 1.0 / g) * g / ((1.0 + g) * (1.0 + 2.0 * g)) * d2;
+		const double g = m->gamma;
+		m->nu = pow(tau / c->consistency, 1.0 / g) * g / ((1.0 + g) * (1.0 + 2.0 * g)) * d2;
 		break;
 	}
 	default:
 		break;
 	}
-	if (!(c->nu > 0.0) || !isfinite(c->nu))
+	if (!(m->nu > 0.0) || !isfinite(m->nu))
 		return ss_error_input("%s: [model] the physical parameters give nu = %g m^2/s: "
-		                      "expected a finite value > 0", p->path, c->nu);
+		                      "expected a finite value > 0", p->path, m->nu);
 	return SS_OK;
 }
 
@@ -765,64 +957,51 @@ static int check_shape_extent(const struct ss_case *c, const struct ss_region *r
 	return SS_OK;
 }
 
-static int finish(struct parse *p)
+/* A key of [initial] that belongs to another type: dropped when the type
+ * came from an override and the key from the file, else an error. */
+static int initial_key_of_other_type(struct parse *p, const char *key, const char *applies)
+{
+	if (!is_set(p, key))
+		return SS_OK;
+	if (file_key(p, key) && by_override(p, "initial.type")) {
+		char reason[64];
+		snprintf(reason, sizeof reason, "(%s applies to type = %s)", strchr(key, '.') + 1,
+		         applies);
+		drop(p, key, where_of(p, "initial.type"), reason);
+		return SS_OK;
+	}
+	return ss_error_input("%s: [initial] %s applies to type = %s", where_of(p, key),
+	                      strchr(key, '.') + 1, applies);
+}
+
+static int finish_initial(struct parse *p)
+{
+	struct ss_case *c = p->c;
+	static const char *const cone_keys[] = {"initial.center", "initial.radius", "initial.angle"};
+	static const char *const cone_meaning[] = {"'X Y' in m", "m, > 0", "degrees in (0, 90)"};
+	int err;
+	for (int k = 0; k < 3; k++) {
+		if (c->initial != SS_INITIAL_CONE &&
+		    (err = initial_key_of_other_type(p, cone_keys[k], "cone")))
+			return err;
+		if (c->initial == SS_INITIAL_CONE && (err = require(p, cone_keys[k], cone_meaning[k])))
+			return err;
+	}
+	if (c->initial != SS_INITIAL_FILE &&
+	    (err = initial_key_of_other_type(p, "initial.file", "file")))
+		return err;
+	if (c->initial == SS_INITIAL_FILE) {
+		if ((err = require(p, "initial.file", "an ESRI ASCII .asc or sandslide .h5 file")) ||
+		    (err = initial_key_of_other_type(p, "initial.height", "flat or cone")))
+			return err;
+	}
+	return SS_OK;
+}
+
+static int finish_regions(struct parse *p)
 {
 	struct ss_case *c = p->c;
 	int err;
-	if ((err = require(p, "grid", "nx", "number of cells west to east, an integer >= 1")) ||
-	    (err = require(p, "grid", "ny", "number of cells south to north, an integer >= 1")) ||
-	    (err = require(p, "grid", "dx", "cell size in m, > 0")) ||
-	    (err = require(p, "time", "end", "a time in s, or steady")) ||
-	    (err = require(p, "time", "output_every", "seconds between snapshots, > 0")))
-		return err;
-	if (!is_set(p, "grid", "dy"))
-		c->dy = c->dx;
-	snprintf(c->grid_where, sizeof c->grid_where, "%s", where_of(p, "grid", "nx"));
-	/* shapes are checked against the far corner: it must be a number */
-	if (!isfinite(c->origin_x + c->nx * c->dx) || !isfinite(c->origin_y + c->ny * c->dy))
-		return ss_error_input("%s: [grid] the grid from (%g, %g) m over %d x %d cells of %g x "
-		                      "%g m ends beyond the largest number: expected a finite extent",
-		                      c->grid_where, c->origin_x, c->origin_y, c->nx, c->ny, c->dx,
-		                      c->dy);
-	if ((err = finish_model(p)))
-		return err;
-	if (is_set(p, "time", "max_time") && !c->steady)
-		return ss_error_input("%s: [time] max_time applies to end = steady: the run "
-		                      "already stops at end", where_of(p, "time", "max_time"));
-	static const char *const sides[] = {"west", "east", "south", "north"};
-	for (int side = 0; side < 4; side++) {
-		const int opposite = side ^ 1;
-		if ((c->boundary.side[side] == SS_SIDE_PERIODIC) !=
-		    (c->boundary.side[opposite] == SS_SIDE_PERIODIC) &&
-		    c->boundary.side[side] == SS_SIDE_PERIODIC)
-			return ss_error_input("%s: [boundary] %s = periodic needs %s = periodic too "
-			                      "(opposite sides wrap together)",
-			                      where_of(p, "boundary", sides[side]), sides[side],
-			                      sides[opposite]);
-	}
-
-	/* [initial]: keys that belong to another type are mistakes */
-	static const char *const cone_keys[] = {"center", "radius", "angle"};
-	for (int k = 0; k < 3; k++) {
-		if (c->initial != SS_INITIAL_CONE && is_set(p, "initial", cone_keys[k]))
-			return ss_error_input("%s: [initial] %s applies to type = cone",
-			                      where_of(p, "initial", cone_keys[k]), cone_keys[k]);
-		if (c->initial == SS_INITIAL_CONE &&
-		    (err = require(p, "initial", cone_keys[k],
-		                   k == 0 ? "'X Y' in m" : k == 1 ? "m, > 0" : "degrees in (0, 90)")))
-			return err;
-	}
-	if (c->initial != SS_INITIAL_FILE && is_set(p, "initial", "file"))
-		return ss_error_input("%s: [initial] file applies to type = file",
-		                      where_of(p, "initial", "file"));
-	if (c->initial == SS_INITIAL_FILE) {
-		if ((err = require(p, "initial", "file", "an ESRI ASCII .asc or sandslide .h5 file")))
-			return err;
-		if (is_set(p, "initial", "height"))
-			return ss_error_input("%s: [initial] height applies to type = flat or cone",
-			                      where_of(p, "initial", "height"));
-	}
-
 	for (int k = 0; k < c->region_count; k++) {
 		struct ss_region *r = &c->regions[k];
 		if (r->shape.kind == SS_SHAPE_NONE)
@@ -850,26 +1029,55 @@ static int finish(struct parse *p)
 	return SS_OK;
 }
 
-/* ---- entry points ---------------------------------------------------- */
-
-static void set_defaults(struct ss_case *c)
+static int finish(struct parse *p)
 {
-	c->closure = SS_CLOSURE_COULOMB;
-	c->gamma = 1.0;
-	c->gravity = 9.81;
-	c->cfl = 0.9;
-	c->steady_tol = 1e-9;
-	c->steady_slope_tol = 1e-6;
-	c->integrator = SS_INTEGRATOR_AUTO;
-	c->rkl2_max_stages = SS_RKL2_MAX_STAGES_DEFAULT;
-	c->rkl2_tol = SS_RKL2_TOL_DEFAULT;
-	c->max_time = INFINITY;
-	c->end = INFINITY;
-	for (int s = 0; s < 4; s++)
-		c->boundary.side[s] = SS_SIDE_WALL;
-	c->boundary.open_level = 0.0;
-	c->initial = SS_INITIAL_FLAT;
+	struct ss_case *c = p->c;
+	int err;
+	if ((err = require(p, "grid.nx", "number of cells west to east, an integer >= 1")) ||
+	    (err = require(p, "grid.ny", "number of cells south to north, an integer >= 1")) ||
+	    (err = require(p, "grid.dx", "cell size in m, > 0")) ||
+	    (err = require(p, "time.end", "a time in s, or steady")) ||
+	    (err = require(p, "time.output_every", "seconds between snapshots, > 0")))
+		return err;
+	if (!is_set(p, "grid.dy"))
+		c->dy = c->dx;
+	snprintf(c->grid_where, sizeof c->grid_where, "%s", where_of(p, "grid.nx"));
+	/* shapes are checked against the far corner: it must be a number */
+	if (!isfinite(c->origin_x + c->nx * c->dx) || !isfinite(c->origin_y + c->ny * c->dy))
+		return ss_error_input("%s: [grid] the grid from (%g, %g) m over %d x %d cells of %g x "
+		                      "%g m ends beyond the largest number: expected a finite extent",
+		                      c->grid_where, c->origin_x, c->origin_y, c->nx, c->ny, c->dx,
+		                      c->dy);
+	if ((err = finish_model(p)))
+		return err;
+	/* max_time limits a steady run; an override that gives the run an end
+	 * makes the file's max_time redundant */
+	if (is_set(p, "time.max_time") && !c->steady) {
+		if (file_key(p, "time.max_time") && by_override(p, "time.end"))
+			drop(p, "time.max_time", where_of(p, "time.end"),
+			     "gives the run its end (max_time applies to end = steady)");
+		else
+			return ss_error_input("%s: [time] max_time applies to end = steady: the run "
+			                      "already stops at end", where_of(p, "time.max_time"));
+	}
+	static const char *const sides[] = {"boundary.west", "boundary.east", "boundary.south",
+	                                    "boundary.north"};
+	for (int side = 0; side < 4; side++) {
+		const int opposite = side ^ 1;
+		if ((c->boundary.side[side] == SS_SIDE_PERIODIC) !=
+		    (c->boundary.side[opposite] == SS_SIDE_PERIODIC) &&
+		    c->boundary.side[side] == SS_SIDE_PERIODIC)
+			return ss_error_input("%s: [boundary] %s = periodic needs %s = periodic too "
+			                      "(opposite sides wrap together)",
+			                      where_of(p, sides[side]), sides[side] + 9,
+			                      sides[opposite] + 9);
+	}
+	if ((err = finish_initial(p)))
+		return err;
+	return finish_regions(p);
 }
+
+/* ---- entry points ---------------------------------------------------- */
 
 static char *trim(char *s)
 {
@@ -880,16 +1088,23 @@ static char *trim(char *s)
 	return s;
 }
 
+/* "SECTION.KEY=VALUE" sets a key; "SECTION.KEY" or "SECTION" unsets. */
 static int apply_override(struct parse *p, const char *arg)
 {
-	snprintf(p->where, sizeof p->where, "--set %s", arg);
 	const char *eq = strchr(arg, '=');
+	snprintf(p->where, sizeof p->where, "%s %s", eq ? "--set" : "--unset", arg);
 	char lhs[256];
-	size_t n = eq ? (size_t)(eq - arg) : 0;
-	if (!eq || n == 0 || n >= sizeof lhs)
-		return fail_at(p, "expected SECTION.KEY=VALUE, e.g. model.closure=casson");
+	const size_t n = eq ? (size_t)(eq - arg) : strlen(arg);
+	if (n == 0 || n >= sizeof lhs)
+		return fail_at(p, eq ? "expected SECTION.KEY=VALUE, e.g. model.closure=casson"
+		                     : "expected SECTION.KEY, e.g. time.max_time, or a section "
+		                       "such as 'source pour'");
 	memcpy(lhs, arg, n);
 	lhs[n] = '\0';
+	p->continuation = 0;
+	p->overriding = 1;
+	if (!eq)
+		return unset(p, trim(lhs));
 	char *dot = strrchr(lhs, '.');
 	if (!dot || dot == lhs || !dot[1])
 		return fail_at(p, "expected SECTION.KEY=VALUE, e.g. model.closure=casson");
@@ -897,8 +1112,6 @@ static int apply_override(struct parse *p, const char *arg)
 	char value[512];
 	snprintf(value, sizeof value, "%s", eq + 1);
 	/* the same trimming inih applies to file sections, keys and values */
-	p->continuation = 0;
-	p->overriding = 1;
 	return apply(p, trim(lhs), trim(dot + 1), trim(value));
 }
 
@@ -906,7 +1119,7 @@ int ss_case_parse(struct ss_case *c, const char *path, const char *text,
                   const char *const *overrides, int override_count)
 {
 	memset(c, 0, sizeof *c);
-	set_defaults(c);
+	ss_option_defaults(&ss_case_option_table, c);
 	c->path = dup_string(path);
 	c->text = dup_string(text);
 	if (!c->path || !c->text)
@@ -978,10 +1191,8 @@ int ss_case_load(struct ss_case *c, const char *path,
 
 void ss_case_release(struct ss_case *c)
 {
-	for (int k = 0; k < c->region_count; k++) {
-		free(c->regions[k].shape.polygon);
-		free(c->regions[k].shape.mask_path);
-	}
+	for (int k = 0; k < c->region_count; k++)
+		shape_clear(&c->regions[k].shape);
 	free(c->regions);
 	free(c->initial_file);
 	free(c->bedrock_file);

@@ -1,9 +1,13 @@
 /*
- * setup.c - from a case to a ready stepper (see setup.h).
+ * setup.c - from a case or a raster to a ready stepper (see setup.h).  Both
+ * go through start() (grid, integrator, memory, closure, stepper) and
+ * add_source() (a region's rates, and the check that it covers a cell), so
+ * that run and relax build their steppers one way.
  */
 #include "model/setup.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "sandslide/comm.h"
@@ -12,6 +16,86 @@
 #include "sandslide/shape.h"
 
 static const char *const role_names[] = {"wall", "open", "source"};
+
+/* What start() needs beyond the model, and how the messages name things. */
+struct start {
+	const struct ss_model_options *m;
+	int nx, ny;
+	double dx, dy, x0, y0;                /* m */
+	const struct ss_boundary *boundary;
+	int has_bedrock;
+	int relaxing;                         /* for ss_integrator_resolve */
+	int tile_nx, tile_ny;
+	enum ss_kernel kernel;
+	const char *integrator_what;          /* "--integrator rkl2" */
+	const char *bedrock_what;             /* "--bedrock" */
+	const char *grid_what;                /* "dem.asc: 60 x 40 cells" */
+	const char *memory_advice;            /* " (reduce nx and ny)", or "" */
+};
+
+/* The grid, the integrator auto resolves to, the memory check, the closure
+ * and the stepper (its grid then this rank's slab): what every set-up
+ * starts with.  On error st is released. */
+static int start(const struct start *s, struct ss_stepper *st)
+{
+	const struct ss_model_options *m = s->m;
+	struct ss_grid g;
+	struct ss_closure closure;
+	memset(st, 0, sizeof *st);
+	int err = ss_grid_init(&g, s->nx, s->ny, s->dx, s->dy, s->x0, s->y0);
+	if (err)
+		return err;
+	const enum ss_integrator integrator =
+		ss_integrator_resolve(m->integrator, s->has_bedrock, s->relaxing);
+	if (integrator == SS_INTEGRATOR_RKL2 && s->has_bedrock)
+		return ss_error_input("%s cannot be used with %s: its stages cannot keep the sand "
+		                      "above the rock (use euler or auto)", s->integrator_what,
+		                      s->bedrock_what);
+	/* the memory of one rank's slab, times the ranks on this node */
+	const double need = ss_stepper_memory_bytes(&g, integrator) / ss_comm_size() *
+	                    ss_comm_node_ranks();
+	const double have = ss_memory_available_bytes();
+	if (have > 0.0 && need > have) {
+		char nb[32], hb[32];
+		return ss_error_input("%s need%s %s of memory; this machine has %s available%s",
+		                      s->grid_what, strstr(s->grid_what, "cells") ? "" : "s",
+		                      ss_format_bytes(need, nb), ss_format_bytes(have, hb),
+		                      s->memory_advice);
+	}
+	err = ss_closure_init(&closure, m->closure, m->angle_deg, m->gamma, m->nu);
+	if (!err)
+		err = ss_stepper_init(st, &g, &closure, s->boundary, m->cfl, s->tile_nx, s->tile_ny);
+	if ((err = ss_comm_agree(err))) {
+		ss_stepper_release(st);   /* another rank's failure: ours is whole */
+		return err;
+	}
+	st->kernel = s->kernel;
+	st->integrator = integrator;
+	st->rkl2_max_stages = m->rkl2_max_stages;
+	st->rkl2_tol = m->rkl2_tol;
+	return SS_OK;
+}
+
+/* The cells of shape in mask (this rank's rows, cleared first); a shape
+ * that covers no cell centre of the whole grid is refused, naming what. */
+static int rasterize(const struct ss_shape *shape, const struct ss_grid *g, uint8_t *mask,
+                     const char *what)
+{
+	long long covered = 0;
+	memset(mask, 0, (size_t)g->nx * (size_t)g->ny);
+	int err = ss_shape_rasterize(shape, g, mask, &covered);
+	double covered_all = (double)covered, none = 0.0;
+	ss_comm_reduce(&none, 0, &covered_all, 1);
+	if (!err && covered_all == 0)
+		err = ss_error_input("%s covers no cell centre of the grid (x %g .. %g m, y %g .. %g m, "
+		                     "dx = %g m, dy = %g m): enlarge it or refine the grid", what,
+		                     g->origin_x, g->origin_x + (double)g->global_nx * g->dx,
+		                     g->origin_y, g->origin_y + (double)g->global_ny * g->dy,
+		                     g->dx, g->dy);
+	return err;
+}
+
+/* ---- from a case ------------------------------------------------------ */
 
 static int initial_heights(const struct ss_case *c, struct ss_stepper *st)
 {
@@ -91,41 +175,23 @@ static int load_bedrock(const struct ss_case *c, struct ss_stepper *st)
 int ss_setup_stepper(const struct ss_case *c, int tile_nx, int tile_ny,
                      enum ss_kernel kernel, struct ss_stepper *st)
 {
-	struct ss_grid g;
-	struct ss_closure closure;
-	memset(st, 0, sizeof *st);
-	int err = ss_grid_init(&g, c->nx, c->ny, c->dx, c->dy, c->origin_x, c->origin_y);
-	const enum ss_integrator integrator =
-		ss_integrator_resolve(c->integrator, c->bedrock_file != NULL);
-	if (integrator == SS_INTEGRATOR_RKL2 && c->bedrock_file)
-		return ss_error_input("%s: [time] integrator = rkl2 cannot be used with a "
-		                      "bedrock: its stages cannot keep the sand above the rock "
-		                      "(use euler or auto)", c->bedrock_where);
-	/* the memory of one rank's slab, times the ranks on this node */
-	const double need = ss_stepper_memory_bytes(&g, integrator) / ss_comm_size() *
-	                    ss_comm_node_ranks();
-	const double have = ss_memory_available_bytes();
-	if (!err && have > 0.0 && need > have) {
-		char nb[32], hb[32];
-		return ss_error_input("%s: [grid] nx = %d, ny = %d needs %s of memory; this "
-		                      "machine has %s available (reduce nx and ny)", c->grid_where,
-		                      c->nx, c->ny, ss_format_bytes(need, nb),
-		                      ss_format_bytes(have, hb));
-	}
-	if (!err)
-		err = ss_closure_init(&closure, c->closure, c->repose_angle_deg, c->gamma, c->nu);
-	if (!err)
-		err = ss_stepper_init(st, &g, &closure, &c->boundary, c->cfl, tile_nx, tile_ny);
-	if ((err = ss_comm_agree(err))) {
-		ss_stepper_release(st);   /* another rank's failure: ours is whole */
+	char integrator_what[SS_CASE_WHERE_SIZE + 64], grid_what[SS_CASE_WHERE_SIZE + 64];
+	snprintf(integrator_what, sizeof integrator_what,
+	         "%s: [time] integrator = rkl2", c->bedrock_where);
+	snprintf(grid_what, sizeof grid_what, "%s: [grid] nx = %d, ny = %d", c->grid_where,
+	         c->nx, c->ny);
+	const struct start s = {
+		.m = &c->model, .nx = c->nx, .ny = c->ny, .dx = c->dx, .dy = c->dy,
+		.x0 = c->origin_x, .y0 = c->origin_y, .boundary = &c->boundary,
+		.has_bedrock = c->bedrock_file != NULL, .relaxing = 0, .tile_nx = tile_nx,
+		.tile_ny = tile_ny, .kernel = kernel, .integrator_what = integrator_what,
+		.bedrock_what = "a bedrock", .grid_what = grid_what,
+		.memory_advice = " (reduce nx and ny)",
+	};
+	int err = start(&s, st);
+	if (err)
 		return err;
-	}
-	st->kernel = kernel;
-	/* from here on the grid is this rank's slab (stepper.h) */
-	g = st->grid;
-	st->integrator = integrator;
-	st->rkl2_max_stages = c->rkl2_max_stages;
-	st->rkl2_tol = c->rkl2_tol;
+	const struct ss_grid g = st->grid;   /* this rank's slab (stepper.h) */
 
 	/* a grid-sized mask only when there are regions to rasterise */
 	uint8_t *mask = c->region_count == 0 ? NULL
@@ -140,17 +206,10 @@ int ss_setup_stepper(const struct ss_case *c, int tile_nx, int tile_ny,
 			const struct ss_region *r = &c->regions[k];
 			if ((r->role == SS_REGION_SOURCE) != (pass == 1))
 				continue;
-			long long covered = 0;
-			memset(mask, 0, (size_t)g.nx * (size_t)g.ny);
-			err = ss_shape_rasterize(&r->shape, &g, mask, &covered);
-			double covered_all = (double)covered, none = 0.0;
-			ss_comm_reduce(&none, 0, &covered_all, 1);
-			if (!err && covered_all == 0)
-				err = ss_error_input("%s: [%s %s] covers no cell centre: enlarge it or "
-				                     "refine the grid (dx = %g m, dy = %g m)",
-				                     r->shape.where, role_names[r->role], r->name,
-				                     g.dx, g.dy);
-			if (err)
+			char what[SS_CASE_WHERE_SIZE + 96];
+			snprintf(what, sizeof what, "%s: [%s %s]", r->shape.where, role_names[r->role],
+			         r->name);
+			if ((err = rasterize(&r->shape, &g, mask, what)))
 				break;
 			if (r->role == SS_REGION_SOURCE) {
 				err = ss_stepper_add_source(st, mask, r->rate, r->start, r->stop);
@@ -173,6 +232,84 @@ int ss_setup_stepper(const struct ss_case *c, int tile_nx, int tile_ny,
 	/* failures of one rank (a file, an allocation) before the collective
 	 * calls of prepare */
 	err = ss_comm_agree(err);
+	if (!err)
+		err = ss_stepper_prepare(st);
+	if (err)
+		ss_stepper_release(st);
+	return err;
+}
+
+/* ---- from a raster ---------------------------------------------------- */
+
+/* The lowest height of the raster's cells with data: where sand leaves. */
+static int lowest_height(const struct ss_raster_setup *s, double *level)
+{
+	const struct ss_raster *r = s->heights;
+	*level = INFINITY;
+	for (size_t m = 0; m < (size_t)r->nx * r->ny; m++)
+		if (!r->nodata || !r->nodata[m])
+			*level = fmin(*level, r->values[m]);
+	if (isinf(*level))
+		return ss_error_input("%s: every cell is nodata: nothing to relax", s->name);
+	return SS_OK;
+}
+
+/* The raster's heights and nodata cells into st (this rank's rows), the
+ * bedrock, the poured sand. */
+static int fill_from_raster(const struct ss_raster_setup *s, struct ss_stepper *st)
+{
+	const struct ss_raster *r = s->heights;
+	const struct ss_grid g = st->grid;
+	const size_t first = (size_t)g.offset_j * g.nx;   /* every rank read the raster */
+	for (int j = 0; j < g.ny; j++) {
+		for (int i = 0; i < g.nx; i++) {
+			const size_t m = first + (size_t)j * g.nx + i;
+			const ptrdiff_t k = ss_grid_index(&g, i, j);
+			st->height[k] = r->values[m];
+			if (r->nodata && r->nodata[m])
+				ss_cell_type_set(st->cell_types, k, s->nodata_type);
+		}
+	}
+	/* agreed: the collective calls of prepare follow */
+	int err = ss_comm_agree(s->bedrock ? ss_stepper_set_bedrock(st, s->bedrock->values + first)
+	                                   : SS_OK);
+	if (err || !s->pour)
+		return err;
+	uint8_t *mask = ss_alloc((size_t)g.nx * g.ny, 1, "sand source mask");
+	if (!mask)
+		return ss_comm_agree(SS_ERR_FAIL);
+	err = rasterize(s->pour, &g, mask, "--add-sand");
+	if (!err)
+		err = ss_stepper_add_source(st, mask, s->pour_rate, 0.0, s->pour_duration);
+	ss_free(mask);
+	return ss_comm_agree(err);
+}
+
+int ss_setup_stepper_from_raster(const struct ss_raster_setup *s, struct ss_stepper *st)
+{
+	const struct ss_raster *r = s->heights;
+	memset(st, 0, sizeof *st);
+	const double dx = isnan(s->dx) ? r->cellsize : s->dx;
+	const double dy = isnan(r->cellsize_y) || !isnan(s->dx) ? dx : r->cellsize_y;
+	if (isnan(dx))
+		return ss_error_input("%s: the file gives no cell size: give it with --dx M", s->name);
+	double level = s->open_level;
+	int err = isnan(level) ? lowest_height(s, &level) : SS_OK;
+	if (err)
+		return err;
+	char grid_what[4200];
+	snprintf(grid_what, sizeof grid_what, "%s: %d x %d cells", s->name, r->nx, r->ny);
+	const struct ss_boundary sides = {{s->sides, s->sides, s->sides, s->sides}, level};
+	const struct start start_with = {
+		.m = s->model, .nx = r->nx, .ny = r->ny, .dx = dx, .dy = dy,
+		.x0 = isnan(r->x0) ? 0.0 : r->x0, .y0 = isnan(r->y0) ? 0.0 : r->y0,
+		.boundary = &sides, .has_bedrock = s->bedrock != NULL, .relaxing = 1,
+		.kernel = SS_KERNEL_FAST, .integrator_what = "--integrator rkl2",
+		.bedrock_what = "--bedrock", .grid_what = grid_what, .memory_advice = "",
+	};
+	if ((err = start(&start_with, st)))
+		return err;
+	err = fill_from_raster(s, st);
 	if (!err)
 		err = ss_stepper_prepare(st);
 	if (err)

@@ -1,20 +1,48 @@
 /*
- * setup.h - build the initial state of a run from a case: grid, closure,
- * cell types from the wall and open regions (in file order, a later region
- * overriding an earlier one), initial heights, sources.
+ * setup.h - the initial state of a run, prepared for stepping: from a case
+ * (run) or from a raster (relax), through the same steps: grid, integrator
+ * (ss_integrator_resolve), memory check, closure, stepper, cell types,
+ * heights, bedrock, sources.
  */
 #ifndef SANDSLIDE_SETUP_H
 #define SANDSLIDE_SETUP_H
 
 #include "sandslide/case.h"
+#include "sandslide/dem.h"
+#include "sandslide/model_options.h"
+#include "sandslide/shape.h"
 #include "sandslide/stepper.h"
 
 /* Initialise st for case c with tiles of tile_nx x tile_ny cells (<= 0:
- * defaults), the given kernel and the case's integrator.  SS_ERR_INPUT
- * names the key at fault (a region that covers no cell, an initial file
- * of the wrong size, too little memory, rkl2 with a bedrock).  On error st
- * is released. */
+ * defaults), the given kernel and the case's integrator: cell types from
+ * the wall and open regions (in file order, a later region overriding an
+ * earlier one), initial heights, bedrock, sources.  SS_ERR_INPUT names the
+ * key at fault (a region that covers no cell, an initial file of the wrong
+ * size, too little memory, rkl2 with a bedrock).  On error st is
+ * released. */
 int ss_setup_stepper(const struct ss_case *c, int tile_nx, int tile_ny,
                      enum ss_kernel kernel, struct ss_stepper *st);
+
+/* What relax builds its stepper from: a raster and the model. */
+struct ss_raster_setup {
+	const struct ss_model_options *model;
+	const char *name;                 /* the raster, for messages */
+	const struct ss_raster *heights;  /* the whole raster (each rank keeps
+	                                   * its rows) */
+	double dx;                        /* m; NaN: the raster's cell size */
+	enum ss_side_kind sides;          /* all four sides */
+	enum ss_cell_type nodata_type;    /* cells without data: wall or open */
+	double open_level;                /* m; NaN: the lowest height of the
+	                                   * raster (where an open side or cell
+	                                   * lets sand leave) */
+	const struct ss_raster *bedrock;  /* the same size, or NULL */
+	const struct ss_shape *pour;      /* sand poured from t = 0, or NULL: */
+	double pour_rate;                 /*   m/s */
+	double pour_duration;             /*   s */
+};
+
+/* st for the raster set-up s, as ss_setup_stepper (the fast kernel, the
+ * default tiles, auto as relax resolves it).  On error st is released. */
+int ss_setup_stepper_from_raster(const struct ss_raster_setup *s, struct ss_stepper *st);
 
 #endif

@@ -1,20 +1,19 @@
 /*
  * shape.c - rasterising case regions onto the grid (see shape.h).
  *
- * Mask images are read with libpng's simplified API as 8-bit grey; the
- * image's top row is the grid's north row.
+ * Mask images are decoded by io/png_mask.c; the image's top row is the
+ * grid's north row.
  */
 #include "sandslide/shape.h"
 
+#include <ctype.h>
 #include <errno.h>
-#include <stdio.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include <png.h>
-
+#include "io/png_mask.h"
 #include "sandslide/error.h"
-#include "io/png_check.h"
 
 /* Even-odd rule: count crossings of the ray from (x, y) towards +x. */
 static int polygon_contains(const double *xy, int n, double x, double y)
@@ -29,48 +28,16 @@ static int polygon_contains(const double *xy, int n, double x, double y)
 	return inside;
 }
 
+/* A mask image (io/png_mask.h decodes it): its top row is the grid's
+ * north row; a block (a rank's slab, grid.h) takes its own rows. */
 static int read_mask(const struct ss_shape *s, const struct ss_grid *g, uint8_t *mask,
                      long long *covered)
 {
-	FILE *f = fopen(s->mask_path, "rb");
-	if (!f)
-		return ss_error_input("%s: cannot open mask '%s': %s", s->where, s->mask_path,
-		                      strerror(errno));
-	char chunk[5];
-	unsigned long chunk_bytes;
-	const int bad = ss_png_check_chunks(f, chunk, &chunk_bytes);
-	fclose(f);
-	if (bad)
-		return ss_error_input("%s: mask '%s' is not a readable PNG: chunk %s claims %lu bytes, "
-		                      "more than the file holds (truncated or corrupt)", s->where,
-		                      s->mask_path, chunk, chunk_bytes);
-
-	png_image image;
-	memset(&image, 0, sizeof image);
-	image.version = PNG_IMAGE_VERSION;
-	if (!png_image_begin_read_from_file(&image, s->mask_path))
-		return ss_error_input("%s: mask '%s' is not a readable PNG: %s", s->where,
-		                      s->mask_path, image.message);
-	if (image.width != (png_uint_32)g->global_nx || image.height != (png_uint_32)g->global_ny) {
-		png_image_free(&image);
-		return ss_error_input("%s: mask '%s' is %u x %u pixels: expected the grid's "
-		                      "%lld x %lld (nx x ny)", s->where, s->mask_path,
-		                      (unsigned)image.width, (unsigned)image.height,
-		                      g->global_nx, g->global_ny);
-	}
-	image.format = PNG_FORMAT_GRAY;
-	uint8_t *pixels = ss_alloc(PNG_IMAGE_SIZE(image), 1, "mask pixels");
-	if (!pixels) {
-		png_image_free(&image);
-		return SS_ERR_FAIL;
-	}
-	if (!png_image_finish_read(&image, NULL, pixels, 0, NULL)) {
-		ss_free(pixels);
-		return ss_error_input("%s: cannot decode mask '%s': %s", s->where,
-		                      s->mask_path, image.message);
-	}
-	/* the image's top row is the grid's north row; a block (a rank's
-	 * slab, grid.h) takes its own rows */
+	uint8_t *pixels;
+	const int err = ss_png_read_mask(s->mask_path, s->where, g->global_nx, g->global_ny,
+	                                 &pixels);
+	if (err)
+		return err;
 	for (int j = 0; j < g->ny; j++) {
 		const uint8_t *row = pixels + (size_t)(g->global_ny - 1 - (g->offset_j + j)) * g->nx;
 		for (int i = 0; i < g->nx; i++) {
@@ -82,6 +49,58 @@ static int read_mask(const struct ss_shape *s, const struct ss_grid *g, uint8_t 
 	}
 	ss_free(pixels);
 	return SS_OK;
+}
+
+/* Up to max finite numbers separated by white space or commas; the count,
+ * or -1 when something is not a number. */
+static int numbers(const char *s, double *out, int max)
+{
+	int n = 0;
+	for (;;) {
+		while (isspace((unsigned char)*s) || (n > 0 && *s == ','))
+			s++;
+		if (!*s)
+			return n;
+		char *end;
+		errno = 0;
+		const double v = strtod(s, &end);
+		if (end == s || errno == ERANGE || !isfinite(v) ||
+		    (*end && *end != ',' && !isspace((unsigned char)*end)))
+			return -1;
+		if (n < max)
+			out[n] = v;
+		n++;
+		s = end;
+	}
+}
+
+int ss_shape_parse_numbers(enum ss_shape_kind kind, const char *value, struct ss_shape *s)
+{
+	double v[4];
+	const int want = kind == SS_SHAPE_RECT ? 4 : kind == SS_SHAPE_DISK ? 3 : 0;
+	if (!want || numbers(value, v, 4) != want)
+		return -1;
+	if (kind == SS_SHAPE_RECT && !(v[0] < v[2] && v[1] < v[3]))
+		return -1;
+	if (kind == SS_SHAPE_DISK && !(v[2] > 0.0))
+		return -1;
+	s->kind = kind;
+	memcpy(s->v, v, sizeof v);
+	return 0;
+}
+
+const char *ss_shape_expected(enum ss_shape_kind kind)
+{
+	switch (kind) {
+	case SS_SHAPE_RECT:
+		return "'X0 Y0 X1 Y1' in m with X0 < X1 and Y0 < Y1";
+	case SS_SHAPE_DISK:
+		return "'X Y R' in m with R > 0";
+	case SS_SHAPE_POLYGON:
+		return "pairs of numbers 'X Y X Y ...' in m, at least 3";
+	default:
+		return "rect, disk, polygon or mask";
+	}
 }
 
 int ss_shape_rasterize(const struct ss_shape *s, const struct ss_grid *g,

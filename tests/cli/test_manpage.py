@@ -295,6 +295,64 @@ def test_command_options_documented(page, command):
     assert not problems, "\n".join(problems)
 
 
+def help_defaults(text):
+    """{option name: its default} of `sandslide CMD --help`, where the help
+    gives one: "(default X)" at the end of its text, which the help adds
+    from the library's option tables (include/sandslide/option.h)."""
+    defaults, current, body = {}, None, []
+    for line in text.splitlines() + ["  --end-of-help"]:
+        if line.startswith("  -") or not line.startswith(" "):
+            if current:
+                m = re.search(r"\(default ([^\s();]+)\)$", " ".join(" ".join(body).split()))
+                if m:
+                    defaults[current] = m.group(1)
+            current, body = None, []
+            m = ENTRY.match(line, 2) if line.startswith("  -") else None
+            if m:
+                current = m.group(1).split(", ")[-1]
+        body.append(line)
+    return defaults
+
+
+def man_entry_texts(lines):
+    """{option name: the plain text of its .TP entry} of lines."""
+    texts, current = {}, None
+    for k, line in enumerate(lines):
+        if re.match(r"\.(TP|SS|SH|PP|LP|P)\b", line):
+            current = None
+            if re.match(r"\.TP\b", line):
+                tag = next((line_text(t) for t in lines[k + 1:] if line_text(t) is not None),
+                           None)
+                m = ENTRY.fullmatch(" ".join(tag.split())) if tag and tag.strip().startswith(
+                    "-") else None
+                if m:
+                    current = m.group(1).split(", ")[-1]
+                    texts[current] = []
+            continue
+        if current:
+            text = line_text(line)
+            if text is not None:
+                texts[current].append(text)
+    return {n: " ".join(" ".join(t).split()) for n, t in texts.items()}
+
+
+@pytest.mark.parametrize("command", COMMANDS)
+def test_defaults_documented(page, command):
+    """Each default `sandslide CMD --help` gives (from the option tables)
+    is the one the man page's entry states."""
+    _, subsections = page
+    if command not in subsections:
+        pytest.fail(f"the man page has no `.SS {command}`", pytrace=False)
+    texts = man_entry_texts(subsections[command])
+    problems = []
+    for name, default in help_defaults(help_text(command)).items():
+        text = texts.get(name, "")
+        if not re.search(rf"(?<![\w.-]){re.escape(default)}(?![\w-])(?!\.\d)", text):
+            problems.append(f"sandslide {command} {name}: --help gives the default {default}, "
+                            f"but the man page's entry does not say it: {text[:200]!r}")
+    assert not problems, "\n".join(problems)
+
+
 def test_global_options_documented(page):
     sections, _ = page
     assert "OPTIONS" in sections, \

@@ -24,13 +24,15 @@ static void check_case(const struct ss_case *c)
 	FUZZ_CHECK(c->dx > 0.0 && isfinite(c->dx) && c->dy > 0.0 && isfinite(c->dy));
 	FUZZ_CHECK(isfinite(c->origin_x) && isfinite(c->origin_y));
 	FUZZ_CHECK(isfinite(c->origin_x + c->nx * c->dx) && isfinite(c->origin_y + c->ny * c->dy));
-	FUZZ_CHECK(c->repose_angle_deg > 0.0 && c->repose_angle_deg < 90.0);
-	FUZZ_CHECK(c->nu > 0.0 && isfinite(c->nu));
-	FUZZ_CHECK(c->gamma > 0.0 && isfinite(c->gamma));
-	FUZZ_CHECK(c->cfl > 0.0 && c->cfl <= 1.0);
+	FUZZ_CHECK(c->model.angle_deg > 0.0 && c->model.angle_deg < 90.0);
+	FUZZ_CHECK(c->model.nu > 0.0 && isfinite(c->model.nu));
+	FUZZ_CHECK(c->model.gamma > 0.0 && isfinite(c->model.gamma));
+	FUZZ_CHECK(c->model.cfl > 0.0 && c->model.cfl <= 1.0);
 	FUZZ_CHECK(c->output_every > 0.0 && isfinite(c->output_every));
 	FUZZ_CHECK(c->steady ? isinf(c->end) : c->end > 0.0 && isfinite(c->end));
-	FUZZ_CHECK(c->steady_tol > 0.0);
+	FUZZ_CHECK(c->model.steady_tol > 0.0);
+	FUZZ_CHECK(c->steady || isnan(c->model.max_time));
+	FUZZ_CHECK(c->note_count >= 0 && c->note_count <= SS_CASE_MAX_NOTES);
 	FUZZ_CHECK(c->initial != SS_INITIAL_FILE || c->initial_file);
 	FUZZ_CHECK(c->region_count >= 0 && (c->region_count == 0 || c->regions));
 	for (int k = 0; k < c->region_count; k++) {

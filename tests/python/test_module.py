@@ -248,16 +248,62 @@ def test_bad_cell_size_and_bedrock_raise_input_errors():
         sandslide.relax(h0, -1.0)
     with pytest.raises(sandslide.InputError, match="shape"):
         sandslide.relax(h0, 1.0, bedrock=np.zeros((8, 7)))
+    # the library's checks (the module repeats none): cells named by column
+    # and row from the south, and by x and y in m; row 2 from the north of
+    # 8 rows is row 5 from the south
     rock = h0 - 1.0
     rock[2, 3] = np.nan
-    with pytest.raises(sandslide.InputError, match=r"bedrock\[2, 3\] is NaN"):
+    with pytest.raises(sandslide.InputError,
+                       match=r"bedrock of cell \(3, 5\) at x = 3.5 m, y = 5.5 m is nan"):
         sandslide.relax(h0, 1.0, bedrock=rock)
     rock = h0 - 1.0
     rock[1, 6] += 2.0
-    with pytest.raises(sandslide.InputError, match=r"bedrock\[1, 6\] = .* is above heights"):
+    with pytest.raises(sandslide.InputError,
+                       match=r"bedrock of cell \(6, 6\) at x = 6.5 m, y = 6.5 m is .* above"):
         sandslide.relax(h0, 1.0, bedrock=rock)
     with pytest.raises(sandslide.InputError, match="heights: every cell is nodata"):
         sandslide.relax(np.full((3, 4), np.nan), 1.0)
+
+
+def test_the_defaults_are_the_librarys():
+    """The module repeats no default: every keyword of relax is None, an
+    option of the library's table, and the docstring gives the library's
+    default; sandslide.options reads the table."""
+    import inspect
+    table = {o["name"].replace("-", "_"): o for o in sandslide.options("relax")}
+    assert table["angle"]["default"] == "35" and table["closure"]["default"] == "coulomb", \
+        "relax's table lost its defaults"
+    assert table["angle"]["case_key"] == "model.repose_angle", table["angle"]
+    params = inspect.signature(sandslide.relax).parameters
+    for name, p in params.items():
+        if name in ("heights", "dx"):
+            continue
+        assert p.default is None, f"relax({name}={p.default!r}): a default of its own"
+        if name not in ("dy", "bedrock"):
+            assert name in table and table[name]["by_name"], \
+                f"relax's keyword {name} is not an option of the library"
+            default = table[name]["default"] or "none"
+            assert f"{name} (default {default})" in sandslide.relax.__doc__, \
+                f"the docstring does not give {name}'s default {default}"
+    settable = {n for n, o in table.items() if o["by_name"] and o["kind"] not in ("text",)}
+    # what only a file has: its output, the PNG range, the cell size (dx
+    # is relax()'s own argument), the series' snapshots
+    files_only = {"force", "output_every", "zscale", "zoffset", "dx"}
+    missing = settable - set(params) - files_only
+    assert not missing, f"options of the library relax() does not take: {sorted(missing)}"
+    run_table = {o["name"] for o in sandslide.options("run")}
+    assert {"set", "unset", "threads", "force"} <= run_table, run_table
+    with pytest.raises(ValueError, match="no options of a command"):
+        sandslide.options("nosuch")
+
+
+def test_pouring_sand_by_name():
+    h0 = np.zeros((20, 20))
+    h, rep = sandslide.relax(h0, 1.0, add_sand="disk=10,10,3", sand_rate=0.01,
+                             sand_duration=20, threads=1)
+    assert rep["inflow"] > 0 and abs(np.nansum(h) - rep["inflow"]) < 1e-9 * rep["inflow"], rep
+    with pytest.raises(sandslide.InputError, match="go together"):
+        sandslide.relax(h0, 1.0, add_sand="disk=10,10,3")
 
 
 def test_error_classes():
@@ -322,6 +368,14 @@ def test_run_writes_the_series_with_overrides(tmp_path, case):
     assert s["snapshots"] == 2 and s["threads"] == 1, s
     with pytest.raises(sandslide.InputError, match="nonsense"):
         sandslide.run(case, tmp_path / "bad.h5", set={"model.nonsense": 1})
+    # an override wins; what it makes redundant is dropped, and said
+    s = sandslide.run(case, tmp_path / "layer.h5", set={"model.closure": "bingham",
+                      "model.delta": 0.01, "model.density": 1600, "model.viscosity": 5},
+                      threads=1)
+    assert any("[model] nu" in n and "dropped" in n for n in s["notes"]), s["notes"]
+    s = sandslide.run(case, tmp_path / "unset.h5", unset="time.cfl",
+                      set={"time.end": 0.5}, threads=1)
+    assert s["end"] == "done" and s["notes"] == [], s
 
 
 # Debian's netCDF4 warns that it was built against another numpy

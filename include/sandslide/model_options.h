@@ -1,0 +1,48 @@
+/*
+ * model_options.h - the options of the model and its time stepping that
+ * `run` and `relax` share: one table (ss_model_option_table), read as
+ * case-file keys by the case parser ([model] closure, [time] cfl, ...) and
+ * as command-line options by relax (--closure, --cfl, ...), so that each
+ * has one default, one range and one message wherever it is given.  A
+ * case must give repose_angle (SS_OPTION_CASE_REQUIRED) and nu or the
+ * sliding layer it derives from: a case states its physics, where relax's
+ * defaults suit a DEM whose time scale does not matter.
+ * doc/model.md gives the equations they enter; doc/case-file.md and
+ * `sandslide relax --help` list them.
+ */
+#ifndef SANDSLIDE_MODEL_OPTIONS_H
+#define SANDSLIDE_MODEL_OPTIONS_H
+
+#include "sandslide/closure.h"
+#include "sandslide/option.h"
+#include "sandslide/stepper.h"
+
+struct ss_model_options {
+	enum ss_closure_kind closure;     /* f_sl of doc/model.md */
+	double angle_deg;                 /* repose angle a_cr, degrees in (0, 90) */
+	double gamma;                     /* herschel-bulkley exponent, > 0 */
+	double nu;                        /* m^2/s, > 0 (a case may derive it
+	                                   * from the sliding layer: case.h) */
+	double cfl;                       /* fraction of forward Euler's stable
+	                                   * step, (0, 1] */
+	double steady_tol;                /* m/s: steady when max |dh/dt| is below */
+	double steady_slope_tol;          /* and no sand face steeper than
+	                                   * tan a_cr by more (stepper.h) */
+	double max_time;                  /* s: a steady run stops here anyway;
+	                                   * NaN: no such limit */
+	enum ss_integrator integrator;    /* auto: ss_integrator_resolve */
+	int rkl2_max_stages;              /* RKL2: stages per super-step */
+	double rkl2_tol;                  /* RKL2: error estimate per super-step,
+	                                   * in tan(a_cr) min(dx, dy) */
+};
+
+/* The table: name (relax's --NAME), case key, kind, default, range, help. */
+extern const struct ss_option_table ss_model_option_table;
+
+/* Every option at its default (the table's). */
+void ss_model_options_init(struct ss_model_options *m);
+
+/* max_time as a time limit: INFINITY when there is none. */
+double ss_model_time_limit(const struct ss_model_options *m);
+
+#endif

@@ -1,0 +1,139 @@
+/*
+ * option.h - a command's options as one table: for each option its name,
+ * kind, where its value goes, default, range, help, and the case-file key
+ * it also is.  Everything else is made from the tables: the command line's
+ * parser and --help (src/cli/), the options set by name of the library's
+ * foreign-function entry points (ss_relax_options_set, ss_run_options_set),
+ * the case file's keys that are the same options (model_options.h), the
+ * Python module's defaults (it asks ss_option_table_json), and the man
+ * page's check (tests/cli/test_manpage.py).  doc/options.md describes the
+ * rules.
+ *
+ * A value is always text, as a user types it ("35", "coulomb", "1e-9"), so
+ * that a default, a command-line word, a case-file value and a Python
+ * keyword are read by the same code and refused with the same message.
+ */
+#ifndef SANDSLIDE_OPTION_H
+#define SANDSLIDE_OPTION_H
+
+#include <stddef.h>
+
+enum ss_option_kind {
+	SS_OPTION_FLAG,    /* int 0 or 1: a bare --name on the command line,
+	                    * "1" or "0" by name */
+	SS_OPTION_INT,     /* int in lo..hi */
+	SS_OPTION_REAL,    /* finite double in lo..hi (each end open or closed) */
+	SS_OPTION_TEXT,    /* const char *, not empty (a path, a text) */
+	SS_OPTION_WORD,    /* parse(value, field) == 0: a name from a list, a
+	                    * shape, a pair of numbers */
+	SS_OPTION_LIST,    /* may be given many times; the owner of the options
+	                    * collects the values (run's --set) */
+	SS_OPTION_OPTIONAL_INT, /* int set to 1 when given; the next word, when
+	                    * an integer in lo..hi, goes to value_offset
+	                    * (render --bench [N]) */
+};
+
+/* Bits of ss_option.flags. */
+enum {
+	SS_OPTION_LO_OPEN = 1,     /* REAL: lo itself is not accepted */
+	SS_OPTION_HI_OPEN = 2,     /* REAL: hi itself is not accepted */
+	SS_OPTION_CLI_ONLY = 4,    /* not settable by name (foreign callers) */
+	SS_OPTION_NAMED_ONLY = 8,  /* not on the command line (e.g. history) */
+	SS_OPTION_CASE_REQUIRED = 16, /* a case file must give it (the
+	                            * command line's default does not apply
+	                            * there) */
+};
+
+struct ss_option {
+	const char *name;          /* "max-time": --max-time on the command line,
+	                            * "max-time" or "max_time" by name; NULL: a
+	                            * heading in the help (help holds it) */
+	const char *alias;         /* "-o", or NULL */
+	const char *case_key;      /* "time.max_time": the case file's key for the
+	                            * same option, or NULL */
+	const char *value_name;    /* "T" in "--max-time T"; NULL for a flag */
+	enum ss_option_kind kind;
+	size_t offset;             /* of the value in the table's struct */
+	const char *default_value; /* as a user would type it, or NULL: none
+	                            * (REAL: NaN, INT and FLAG: 0, TEXT: NULL;
+	                            * the help says what none means) */
+	double lo, hi;             /* INT, REAL */
+	unsigned flags;
+	const char *expected;      /* what a value must be, for messages */
+	const char *help;          /* lines separated by '\n', without the
+	                            * default (the help adds it) */
+	int (*parse)(const char *value, void *field); /* WORD: 0 when valid */
+	size_t value_offset;       /* OPTIONAL_INT: where its value goes */
+};
+
+/* A table, and another whose options continue it (relax's options go on
+ * with the model's, at the offset of its ss_model_options), or NULL. */
+struct ss_option_table {
+	const char *command;       /* "relax", for "unknown relax option" */
+	const struct ss_option *options;
+	int count;
+	const struct ss_option_table *more;
+	size_t more_offset;        /* of more's struct in this table's struct */
+};
+
+/* The tables are objects beside each command's options struct:
+ * ss_relax_option_table (relax.h), ss_run_option_table (run.h),
+ * ss_bench_option_table (bench.h), ss_render_option_table and
+ * ss_render_look_option_table (render.h), ss_model_option_table
+ * (model_options.h), ss_case_option_table (case.h). */
+
+/* The option named name ('_' may stand for '-': "max_time") of t or of the
+ * tables it continues in, with the offset of its table's struct in t's
+ * (*offset); NULL if none has that name. */
+const struct ss_option *ss_option_find(const struct ss_option_table *t, const char *name,
+                                       size_t *offset);
+
+/* The option whose case_key is key ("model.repose_angle"), as
+ * ss_option_find; NULL if none. */
+const struct ss_option *ss_option_find_key(const struct ss_option_table *t, const char *key,
+                                           size_t *offset);
+
+/* value read as o reads it into field (the option's place in its struct):
+ * 0, or -1 when it is not a value o accepts (field unchanged).  TEXT
+ * stores the pointer itself (its owner copies it if it must); LIST and
+ * FLAG by name ("1" or "0") are the caller's, as are an empty value. */
+int ss_option_parse(const struct ss_option *o, const char *value, void *field);
+
+/* Every option of t (and of the tables it continues in) that has a
+ * default set to it in base, the others to none (see default_value).
+ * SS_BUG when a default is not a value of its option: the tables are
+ * tested. */
+void ss_option_defaults(const struct ss_option_table *t, void *base);
+
+/* The copies of TEXT values that options set by name own (the caller's
+ * strings may not outlive the call). */
+enum { SS_OPTION_MAX_TEXTS = 16 };
+struct ss_option_texts {
+	void *field[SS_OPTION_MAX_TEXTS];   /* where each copy is pointed to */
+	char *copy[SS_OPTION_MAX_TEXTS];
+};
+void ss_option_texts_release(struct ss_option_texts *texts);
+
+/* Set option key of the struct at base to value, by name, for callers that
+ * cannot lay out the struct: SS_ERR_INPUT "unknown relax option 'x':
+ * expected one of ..." or "KEY 'VALUE': expected ...", base unchanged;
+ * SS_ERR_FAIL out of memory.  A TEXT value is copied into texts (the copy
+ * it replaces freed).  LIST options are their owner's (SS_BUG here), and an
+ * option flagged SS_OPTION_CLI_ONLY is unknown by name. */
+int ss_option_set(const struct ss_option_table *t, void *base, const char *key,
+                  const char *value, struct ss_option_texts *texts);
+
+/* "expected one of angle, closure, ..." of t and the tables it continues
+ * in (names settable by name), into buf. */
+void ss_option_names(const struct ss_option_table *t, char *buf, size_t size);
+
+/* The table as JSON into buf (size bytes, NUL-terminated): a list of
+ * {"name", "case_key", "kind", "default", "lo", "hi", "expected",
+ * "help"}, one per option of t and of the tables it continues in, for a
+ * foreign caller that takes its defaults and checks from the library (the
+ * Python module).  SS_ERR_INPUT when it does not fit (the message says how
+ * many bytes it needs). */
+int ss_option_table_json(const struct ss_option_table *t, char *buf, size_t size);
+
+
+#endif

@@ -1,0 +1,93 @@
+/*
+ * model_options.c - the options run and relax share (model_options.h):
+ * one table, one default and one range each.
+ */
+#include "sandslide/model_options.h"
+
+#include <math.h>
+#include <stddef.h>
+
+static int parse_closure(const char *value, void *field)
+{
+	return ss_closure_parse(value, field);
+}
+
+static int parse_integrator(const char *value, void *field)
+{
+	return ss_integrator_parse(value, field);
+}
+
+/* the core's defaults as the table's text */
+#define TEXT_OF(x) #x
+#define TEXT(x) TEXT_OF(x)
+
+#define AT(m) offsetof(struct ss_model_options, m)
+/* > 0, finite */
+#define POSITIVE .lo = 0.0, .hi = INFINITY, .flags = SS_OPTION_LO_OPEN
+
+static const struct ss_option options[] = {
+	{.help = "The model and its time stepping (also the case file's [model] and\n"
+	         "[time] keys: doc/model.md):\n"},
+	{.name = "closure", .case_key = "model.closure", .value_name = "NAME",
+	 .kind = SS_OPTION_WORD, .offset = AT(closure), .default_value = "coulomb",
+	 .parse = parse_closure, .expected = SS_CLOSURE_NAMES,
+	 .help = "the sliding law f_sl: coulomb, bingham,\n"
+	         "herschel-bulkley or casson"},
+	{.name = "angle", .case_key = "model.repose_angle", .value_name = "DEG",
+	 .kind = SS_OPTION_REAL, .offset = AT(angle_deg), .default_value = "35", .lo = 0.0,
+	 .hi = 90.0, .flags = SS_OPTION_LO_OPEN | SS_OPTION_HI_OPEN | SS_OPTION_CASE_REQUIRED,
+	 .expected = "degrees in (0, 90)", .help = "repose angle a_cr"},
+	{.name = "gamma", .case_key = "model.gamma", .value_name = "G", .kind = SS_OPTION_REAL,
+	 .offset = AT(gamma), .default_value = "1", POSITIVE, .expected = "a number > 0",
+	 .help = "herschel-bulkley exponent (1: bingham's law)"},
+	{.name = "nu", .case_key = "model.nu", .value_name = "V", .kind = SS_OPTION_REAL,
+	 .offset = AT(nu), .default_value = "1", POSITIVE, .expected = "m^2/s > 0",
+	 .help = "m^2/s: sets the time scale only (a case gives it,\n"
+	         "or the sliding layer it derives from)"},
+	{.name = "tol", .case_key = "time.steady_tol", .value_name = "X", .kind = SS_OPTION_REAL,
+	 .offset = AT(steady_tol), .default_value = "1e-9", POSITIVE, .expected = "m/s > 0",
+	 .help = "steady when max |dh/dt| < X m/s"},
+	{.name = "slope-tol", .case_key = "time.steady_slope_tol", .value_name = "E",
+	 .kind = SS_OPTION_REAL, .offset = AT(steady_slope_tol), .default_value = "1e-6",
+	 POSITIVE, .expected = "a number > 0",
+	 .help = "and no sand face steeper than tan(angle) + E\n"
+	         "(other closures: the same flux)"},
+	{.name = "integrator", .case_key = "time.integrator", .value_name = "NAME",
+	 .kind = SS_OPTION_WORD, .offset = AT(integrator), .default_value = "auto",
+	 .parse = parse_integrator, .expected = SS_INTEGRATOR_NAMES,
+	 .help = "euler, rkl2 (super-steps) or auto: rkl2 for run,\n"
+	         "euler for relax (DEMs come to rest faster, as\n"
+	         "measured) and with a bedrock (rkl2 cannot keep\n"
+	         "sand above it)"},
+	{.name = "rkl2-max-stages", .case_key = "time.rkl2_max_stages", .value_name = "S",
+	 .kind = SS_OPTION_INT, .offset = AT(rkl2_max_stages),
+	 .default_value = TEXT(SS_RKL2_MAX_STAGES_DEFAULT), .lo = 2, .hi = 100000,
+	 .expected = "an integer from 2 to 100000", .help = "rkl2: at most S stages a super-step"},
+	{.name = "rkl2-tol", .case_key = "time.rkl2_tol", .value_name = "E", .kind = SS_OPTION_REAL,
+	 .offset = AT(rkl2_tol), .default_value = TEXT(SS_RKL2_TOL_DEFAULT), POSITIVE,
+	 .expected = "a number > 0",
+	 .help = "rkl2: error estimate of a super-step at most\n"
+	         "E tan(angle) min(dx, dy)"},
+	{.name = "max-time", .case_key = "time.max_time", .value_name = "T", .kind = SS_OPTION_REAL,
+	 .offset = AT(max_time), POSITIVE, .expected = "s > 0",
+	 .help = "stop at T s even if not steady (default: no limit;\n"
+	         "a case: with end = steady)"},
+	{.name = "cfl", .case_key = "time.cfl", .value_name = "C", .kind = SS_OPTION_REAL,
+	 .offset = AT(cfl), .default_value = "0.9", .lo = 0.0, .hi = 1.0,
+	 .flags = SS_OPTION_LO_OPEN, .expected = "a number in (0, 1]",
+	 .help = "fraction of the stable forward-Euler step"},
+};
+
+const struct ss_option_table ss_model_option_table = {
+	.command = "model", .options = options, .count = sizeof options / sizeof *options,
+};
+
+void ss_model_options_init(struct ss_model_options *m)
+{
+	ss_option_defaults(&ss_model_option_table, m);
+}
+
+double ss_model_time_limit(const struct ss_model_options *m)
+{
+	return isnan(m->max_time) ? INFINITY : m->max_time;
+}
