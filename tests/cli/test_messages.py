@@ -88,3 +88,37 @@ def test_start_stop_error_blames_the_set_that_made_it(door):
     r = run(DOOR, cwd=door)
     line = text.splitlines().index("stop = 5") + 1
     assert r.stderr.startswith(f"sandslide: door.ini:{line}: [source room] stop = 5 s"), r.stderr
+
+
+# ---- an override wins (issue 23) ------------------------------------------
+
+@pytest.mark.parametrize("case", ["cone.ini", "table.ini"])
+def test_shortening_a_shipped_case_drops_its_max_time(tmp_path, case):
+    """`--set time.end=5` on a case that runs to steady with a max_time:
+    the override wins, the file's max_time is dropped, and the summary
+    says so (it was refused, blaming the file's line)."""
+    from conftest import CASES
+    r = run(["run", f"{CASES}/{case}", "-o", "x.h5", "--set", "time.end=5",
+             "--set", "time.output_every=5"], cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    notes = [line for line in r.stdout.splitlines() if line.startswith("note: ")]
+    assert len(notes) == 1 and "[time] max_time" in notes[0] and \
+        f"{case}:" in notes[0] and "--set time.end=5" in notes[0], r.stdout
+    assert "to t = 5 s" in r.stdout, r.stdout
+
+
+def test_unset_drops_a_key_and_a_section(door):
+    r = run(DOOR + ["--unset", "source room", "--set", "time.end=10"], cwd=door)
+    assert r.returncode == 0, r.stderr
+    import h5py
+    with h5py.File(door / "x.h5", "r") as f:
+        assert f["inflow"][-1] == 0.0, "the source was not removed"
+        assert "source room" in f.attrs["case_overrides"].decode(), \
+            "the unset is not stored for --restart"
+    r = run(DOOR + ["--force", "--unset", "model.nu"], cwd=door)
+    assert r.returncode == 2 and "[model] is missing 'nu'" in r.stderr, r.stderr
+    r = run(DOOR + ["--force", "--unset", "time.end=5"], cwd=door)
+    assert r.returncode == 2 and r.stderr.startswith("sandslide: --unset 'time.end=5': expected "
+                                                     "SECTION.KEY"), r.stderr
+    r = run(DOOR + ["--force", "--set", "time.end"], cwd=door)
+    assert r.returncode == 2 and "expected SECTION.KEY=VALUE" in r.stderr, r.stderr
