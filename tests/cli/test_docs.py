@@ -42,7 +42,7 @@ PAGES = ["README.md", "tests/README.md", "src/README.md", "render/README.md",
 OLD_SPEC = re.compile(r"\b" + "SP" + r"EC\b")
 OUTSIDE = re.compile(re.escape(".." + "/shared"))
 README_SECTION = re.compile(r"README(?:\.md)?(?:'s)?,?\s+(?:section\s+)?\"?[A-Z][a-z]|"
-                            r"README(?:'s)?\s+section|section of the README")
+                            r"README(?:'s)?\s+section|section of the README|\(README,?\s*$")
 # A root-relative path of a Markdown file, with an optional anchor.
 MD_PATH = re.compile(r"(?<![\w/.\-])((?:\.\./)*(?:[\w.\-]+/)*[\w\-]+\.md)(#[\w\-]*)?")
 # Citation keys: [Paper], [Horn], [Meyer2014]; not x[None] (indexing) and
