@@ -145,7 +145,7 @@ ifeq ($(MPI),1)
 endif
 # -fPIC: the same objects make the static and the shared library (on
 # x86-64 the kernel's loops make no calls through the PLT or GOT, so the
-# sweep runs as fast: README, Performance).
+# sweep runs as fast: doc/performance.md#how-the-figures-were-measured).
 ALL_CFLAGS  := $(BASE) -fPIC $(WARN) $(OMPFLAG) $(SANFLAG) $(MPIFLAG) -Iinclude -Isrc -DSS_VERSION='"$(VERSION)"' \
                $(DEP_CFLAGS) -MMD -MP $(CFLAGS)
 ALL_LDFLAGS := $(OMPFLAG) $(SANFLAG) $(LDFLAGS)
@@ -161,7 +161,7 @@ endif
 # command line in src/cli/ is the program around it.
 LIB_SRC  := $(filter-out src/cli/%,$(wildcard src/*/*.c))
 CLI_SRC  := $(wildcard src/cli/*.c)
-# The renderer (render/, SPEC section 6) is part of the library.
+# The renderer (render/, doc/rendering.md) is part of the library.
 RENDER_SRC := $(wildcard render/*.c)
 LIB_OBJ  := $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o) $(RENDER_SRC:render/%.c=$(BUILD)/obj/render/%.o)
 MAIN_OBJ := $(CLI_SRC:src/%.c=$(BUILD)/obj/%.o)
@@ -320,7 +320,7 @@ test check: all $(TEST_BIN) $(HOOK_BIN) headers-check check-layering $(FUZZ_REPL
 # tests/cli/test_mpi.py (which `make test` skips), which
 # compares every snapshot of build-mpi/sandslide under np = 1..4 with the
 # serial build/sandslide (built first).  Open MPI's settings for a root
-# user, more ranks than cores and a box without RDMA (notes: mpi.md).
+# user, more ranks than cores, no RDMA (doc/cluster.md#open-mpi-as-root-on-a-small-machine).
 MPI_ENV := OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 \
            OMPI_MCA_rmaps_base_oversubscribe=1 OMPI_MCA_mpi_yield_when_idle=1 \
            OMPI_MCA_btl_vader_single_copy_mechanism=none OMPI_MCA_pml=ob1 \

@@ -7,8 +7,8 @@ The terrain is fractal (spectral synthesis: random phases, amplitude
 k^-beta, beta = 1.6, i.e. a surface of fractal dimension about 2.2) scaled to
 a relief of 48 cells (--relief), then cut into 24 terraces 2 cells high:
 each terrace edge is a cliff of 63 degrees or more, which the repose angle
-brings down.  With N = 4096 this is the terrain of the DEM section of the
-README.  Needs numpy.
+brings down.  With N = 4096 this is the terrain of
+doc/performance.md#a-large-dem.  Needs numpy.
 """
 import argparse
 import sys

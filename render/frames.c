@@ -3,7 +3,7 @@
  * --frames DIR`, render.h).
  *
  * Each snapshot is read back from the output file the run has just
- * flushed: the renderer depends on the file format of SPEC section 5 only,
+ * flushed: the renderer depends on the file format of doc/output.md only,
  * never on the stepper's arrays.  (HDF5 shares one open file within a
  * process, so this sees exactly what the writer wrote.)
  *

@@ -2,7 +2,7 @@
  * shade.c - the two map styles (step 2 of a frame, render.h).
  *
  * shaded   colour = colour map of height x brightness.  The brightness is
- *          the hillshade of Horn's method [Horn] (README References): the gradient from
+ *          the hillshade of Horn's method [Horn] (doc/references.md): the gradient from
  *          the 3 x 3 neighbourhood with weights 1 2 1,
  *
  *            dh/dx = ((c + 2f + i) - (a + 2d + g)) / (8 dx)     a b c

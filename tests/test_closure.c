@@ -1,5 +1,5 @@
 /*
- * test_closure.c - the sliding closures of closure.h against SPEC section 1:
+ * test_closure.c - the sliding closures of closure.h against doc/model.md#closures:
  * f_sl of every closure against the table formulas written out here
  * independently, exact zeros at and below the critical slope, the degeneracy
  * power near a_cr, bingham == herschel-bulkley(gamma = 1), the derivative
@@ -50,7 +50,7 @@ static struct ss_closure make(const struct variant *v, double deg)
 	return c;
 }
 
-/* f_sl(s) straight from the table of SPEC section 1 (no shared code) */
+/* f_sl(s) straight from the table of doc/model.md#closures (no shared code) */
 static double spec_fsl(const struct variant *v, double deg, double s)
 {
 	const double a_cr = deg * DEG;
@@ -76,7 +76,7 @@ static double spec_fsl(const struct variant *v, double deg, double s)
 	return NAN;
 }
 
-/* 1. f_sl of every closure against the SPEC formulas */
+/* 1. f_sl of every closure against the formulas of doc/model.md#closures */
 static void test_eval_matches_spec(void)
 {
 	enum { N = 200 };
@@ -108,7 +108,7 @@ static void test_eval_matches_spec(void)
 				CHECK_NEAR(got, want,
 				           fmax(1e-13 * fmax(fabs(got), fabs(want)), 1e-15),
 				           "%s at %g deg: f_sl(s = %.17g) differs from "
-				           "the SPEC formula", v->label, deg, s);
+				           "the formula", v->label, deg, s);
 			}
 		}
 	}
@@ -164,7 +164,7 @@ static void test_exact_zero_subcritical(void)
 			      "f_sl != 0, first s = %.17g f = %g", v->label, deg,
 			      bad, bad_s, bad_f);
 			/* the 20000 doubles just above tan a_cr: rounding of
-			 * b - 1 (SPEC: max(b - 1, 0)) must never give a negative
+			 * b - 1 (doc/model.md#closures: max(b - 1, 0)) must never give a negative
 			 * or NaN f_sl, f_sl', lambda or flux */
 			int bad_d = 0, bad_l = 0, bad_fl = 0;
 			double bad_sd = 0.0, bad_vd = 0.0;
@@ -257,7 +257,7 @@ static double fit_slope(const double *x, const double *y, int n)
 	return sxy / sxx;
 }
 
-/* 3. f_sl ~ (a - a_cr)^p near a_cr with the power of the SPEC table */
+/* 3. f_sl ~ (a - a_cr)^p near a_cr with the power of the table in doc/model.md#closures */
 static void test_degeneracy_power(void)
 {
 	enum { N = 41 };
@@ -292,7 +292,7 @@ static void test_degeneracy_power(void)
 				continue;
 			const double slope = fit_slope(lx, ly, N);
 			CHECK_NEAR(slope, p, 0.02, "%s at %g deg: degeneracy power "
-			           "near a_cr is %.4f, SPEC says %g", v->label, deg,
+			           "near a_cr is %.4f, the model says %g", v->label, deg,
 			           slope, p);
 		}
 	}

@@ -1,5 +1,5 @@
 /*
- * test_physics.c - physical properties of the whole engine (SPEC sections 1-2),
+ * test_physics.c - physical properties of the whole engine (doc/model.md),
  * checked end to end through the stepper:
  *
  *   conservation     volume change = inflow - outflow to round-off, with wall
@@ -212,7 +212,7 @@ static void test_conservation(void)
 
 /* ---- 2. subcritical states do not move ------------------------------------ */
 
-/* The largest face slope as SPEC section 2 defines it, computed here
+/* The largest face slope as doc/model.md#face-flux defines it, computed here
  * independently: faces between two non-wall cells of which one flows, wall
  * neighbours mirrored, open cells and ghosts at their held height.  Only
  * faces whose cells both lie west of column i_limit count. */
@@ -309,7 +309,7 @@ static void test_subcritical_unchanged(void)
 	CHECK(s_test < 0.81 * tc && s_test > 0.79 * tc,
 	      "test set-up: steepest face %g is not 0.8 tan a_cr = %g", s_test, 0.8 * tc);
 	CHECK_NEAR(d0.max_slope_deg, atan(s_test) / DEG, 1e-9,
-	           "the library's steepest face differs from SPEC section 2's face slope "
+	           "the library's steepest face differs from doc/model.md's face slope "
 	           "(mirror ghosts at walls, held height at open cells)");
 
 	double *before = malloc((size_t)nx * ny * sizeof *before);

@@ -173,7 +173,7 @@ static int same_bits(const double *a, const double *b, size_t n)
 	return memcmp(a, b, n * sizeof *a) == 0;
 }
 
-/* The largest face slope as SPEC section 2 defines it, computed here
+/* The largest face slope as doc/model.md#face-flux defines it, computed here
  * independently (as in test_physics.c): faces between two non-wall cells of
  * which one flows, wall neighbours mirrored, open cells and ghosts at their
  * held height. */
@@ -1195,7 +1195,7 @@ static void test_cone(void)
  * comes to rest (steady stop: no face steeper than tan a_cr + 1e-6,
  * |dh/dt| < 1e-7 m/s) at some t_e with forward Euler after ev_e
  * evaluations; RKL2 must get there with at most 2.5 ev_e (on this small
- * grid its super-steps stay short; the Performance section of the README
+ * grid its super-steps stay short; doc/performance.md#time-to-solution-euler-against-rkl2
  * has the gains at scale), and at 3 t_e its
  * steepest face must be within 0.01 deg of the angle.  RKL2 damps the
  * grid-scale remainder of a face just above the angle only by R ~ a_s ~ 1/2

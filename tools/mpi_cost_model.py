@@ -4,7 +4,7 @@
     tools/mpi_cost_model.py [--cells-per-rank 1e8] [--rate 3e9] [--latency 2e-6]
                             [--bandwidth 1e10] [--io 1e10] [--open]
 
-A model, not a measurement: the README's "Running on a cluster" prints its
+A model, not a measurement: doc/performance.md#mpi-at-scale-the-cost-model prints its
 table and says how it compares with what was measured on one machine.
 
 What sandslide does per stencil evaluation (an Euler step or an RKL2 stage)

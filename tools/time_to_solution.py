@@ -2,7 +2,7 @@
 """time_to_solution.py - wall time to the same solution, euler against rkl2.
 
 A benchmark, never a test.  Runs `sandslide run` on two workloads with each
-integrator of `[time] integrator` (SPEC sections 2 and 4), interleaved
+integrator of `[time] integrator` (doc/model.md#rkl2-super-steps), interleaved
 (A B, then B A, ... over --rounds), and prints per workload and size the
 median wall time, steps, stencil evaluations, the simulated end time, the
 volume balance error and how far each integrator's heights are from the

@@ -1,6 +1,6 @@
 /*
  * boundary.h - the halo ring of a block: the four sides of the grid are
- * wall, open or periodic (SPEC section 1).
+ * wall, open or periodic (doc/model.md#cell-types-and-sides).
  *
  *   wall      ghost cells are walls: no flux, mirror ghost for gradients
  *   open      ghost cells are open cells held at open_level (Dirichlet)

@@ -5,7 +5,7 @@
  *   dh/dt = nu div[ f_sl(s) grad h / s ] + q,    s = |grad h|      [Paper eq. 1]
  *
  * With sin a = s / sqrt(1 + s^2), sc = sin a_cr and b = sin a / sc
- * (SPEC section 1, [Paper] sections 2.1-2.3, eqs. 2, 10-11, 13-14, 17-18):
+ * (doc/model.md#closures, [Paper] sections 2.1-2.3, eqs. 2, 10-11, 13-14, 17-18):
  *
  *   coulomb            max(s - tan a_cr, 0) / sqrt(1 + s^2)
  *   bingham            (1/b)(2 + 1/b) max(b - 1, 0)^2
@@ -64,7 +64,7 @@ static inline double ss_closure_eval_kind(enum ss_closure_kind kind,
 	case SS_CLOSURE_COULOMB:
 		return (s - c->tan_cr) / sqrt(1.0 + s * s);
 	/* s > tan a_cr can still round to b < 1 by an ulp at steep repose
-	 * angles: max(., 0) as in SPEC section 1 keeps pow() away from NaN */
+	 * angles: max(., 0) as in doc/model.md#closures keeps pow() away from NaN */
 	case SS_CLOSURE_BINGHAM: {
 		const double e = fmax(b - 1.0, 0.0);
 		return r * (2.0 + r) * (e * e);
@@ -86,7 +86,7 @@ static inline double ss_closure_eval(const struct ss_closure *c, double s)
 }
 
 /* f_sl'(s), the derivative with respect to the slope s (one-sided from above
- * at s = tan a_cr; 0 below).  Used for the CFL bound of SPEC section 2. */
+ * at s = tan a_cr; 0 below).  Used for the CFL bound, doc/model.md#the-cfl-bound. */
 static inline double ss_closure_derivative(const struct ss_closure *c, double s)
 {
 	if (!(s > c->tan_cr))
@@ -128,7 +128,7 @@ static inline double ss_closure_derivative(const struct ss_closure *c, double s)
 }
 
 /* The stability rate of a face at slope s, lambda/nu = max(f'(s), f(s)/s)
- * (SPEC section 2: dt = cfl / (2 lambda_max (1/dx^2 + 1/dy^2))). */
+ * (doc/model.md#forward-euler: dt = cfl / (2 lambda_max (1/dx^2 + 1/dy^2))). */
 static inline double ss_closure_lambda(const struct ss_closure *c, double s)
 {
 	if (!(s > c->tan_cr))
@@ -140,7 +140,7 @@ static inline double ss_closure_lambda(const struct ss_closure *c, double s)
 
 /* Flux across a face per unit face length and per unit nu:
  * -f_sl(s) g_n / s with s = sqrt(g_n^2 + g_t^2), g_n the gradient normal to
- * the face and g_t the tangential one (SPEC section 2).  Exactly 0 for
+ * the face and g_t the tangential one (doc/model.md#face-flux).  Exactly 0 for
  * s <= tan a_cr, including s = 0. */
 static inline double ss_closure_face_flux_kind(enum ss_closure_kind kind,
                                                const struct ss_closure *c,
@@ -159,7 +159,7 @@ static inline double ss_closure_face_flux(const struct ss_closure *c,
 }
 
 /*
- * The CFL rule every kernel uses (SPEC section 2 allows an upper bound of
+ * The CFL rule every kernel uses (doc/model.md#the-cfl-bound; any upper bound of
  * lambda_max): Lambda(S) = max of lambda(s)/nu over s in [0, S], tabulated
  * once per closure at angles k * (90 deg / SS_CFL_TABLE_SIZE), each entry the
  * maximum over 16 samples per interval up to that angle (and the one-sided

@@ -1,5 +1,5 @@
 /*
- * diagnostics.h - the per-snapshot record of a run (SPEC section 5) and the
+ * diagnostics.h - the per-snapshot record of a run (doc/output.md) and the
  * counters a restart needs: what the stepper measures and the snapshot
  * writer stores, shared by both without either knowing the other.
  */

@@ -1,5 +1,5 @@
 /*
- * face.h - the point-wise face flux that every sweep calls (SPEC section 2):
+ * face.h - the point-wise face flux that every sweep calls (doc/model.md#face-flux):
  *
  *   F = -nu f_sl(s) g_n / s,   s = sqrt(g_n^2 + g_t^2),   0 when s <= tan a_cr
  *
@@ -17,7 +17,7 @@
  * Newton steps (relative error below 1e-15 against 1/sqrt); elsewhere they
  * are 1/sqrt.  Herschel-Bulkley with gamma = 1/2 (e^3) and gamma = 2
  * (e sqrt e) avoids pow().  tests/test_sweep.c (test_face_formula) holds
- * these to the formulas of closure.h (SPEC section 1).
+ * these to the formulas of closure.h (doc/model.md#closures).
  *
  * The function is compiled once (face.c) and works on a row of faces, so the
  * reference sweep (one face per call) and the fast sweep (a row per call)

@@ -16,7 +16,7 @@
 
 #define SS_GRID_GHOST 1
 
-/* Cell types (the uint8 cell_type variable of SPEC section 5). */
+/* Cell types (the uint8 cell_type variable of doc/output.md#variables). */
 enum ss_cell_type {
 	SS_CELL_FLOW = 0,  /* sand evolves */
 	SS_CELL_WALL = 1,  /* solid: no sand, no flux through its faces */
@@ -64,7 +64,7 @@ static inline ptrdiff_t ss_grid_index(const struct ss_grid *g, int i, int j)
  * Cell types are stored packed, four cells to a byte (2 bits each, in
  * storage order: cell k in bits 2 (k mod 4) of byte k / 4), so that a cell
  * costs 8 B of height plus a quarter byte of type (the memory budget of
- * SPEC section 7).  Writers are single-threaded (set-up); two threads must
+ * doc/performance.md#memory).  Writers are single-threaded (set-up); two threads must
  * never set cells of the same byte.
  */
 static inline size_t ss_cell_types_bytes(size_t cells)

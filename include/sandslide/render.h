@@ -1,8 +1,8 @@
 /*
- * render.h - pictures of snapshots (SPEC section 6): PNG heightmaps, frame
+ * render.h - pictures of snapshots (doc/rendering.md): PNG heightmaps, frame
  * sequences and videos.  The code is in render/; `sandslide render` and
  * `sandslide run --frames` reach it.  The numerical kernel knows nothing of
- * it: the renderer reads the HDF5 output (SPEC section 5) itself.
+ * it: the renderer reads the HDF5 output (doc/output.md) itself.
  *
  * A frame is made in three steps, each its own function:
  *

@@ -1,6 +1,6 @@
 /*
  * rkl2.h - the coefficients of second-order Runge-Kutta-Legendre
- * super-time-stepping (RKL2; Meyer, Balsara & Aslam, J. Comput. Phys. 257,
+ * super-time-stepping (RKL2; [Meyer2014]: Meyer, Balsara & Aslam, J. Comput. Phys. 257,
  * 2014, section 3; the recurrence PLUTO, Idefix, Athena++ and SUNDIALS
  * LSRKStep use).
  *

@@ -1,5 +1,5 @@
 /*
- * snapshot.h - the HDF5 output of a run (SPEC section 5), its XDMF
+ * snapshot.h - the HDF5 output of a run (doc/output.md), its XDMF
  * sidecar, and the one reader of such files.  src/io/snapshot_write.c
  * (the writer) and src/io/snapshot_read.c (every read: `info`, restarts,
  * the renderer, .h5 DEMs) are the only code that includes <hdf5.h>; no

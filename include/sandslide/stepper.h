@@ -1,5 +1,5 @@
 /*
- * stepper.h - time integration of the DPSM on one block (SPEC section 2).
+ * stepper.h - time integration of the DPSM on one block (doc/model.md#forward-euler).
  *
  * Each substep: fill the halo -> the largest face slope S of the current
  * state -> dt from the CFL bound -> clip dt to the next event (target time,
@@ -9,7 +9,7 @@
  * every flux into two arrays, then updates (sweep.h).  Both give the same
  * bits.  The step is forward Euler with
  *
- *   dt = cfl / (2 nu Lambda(S) (1/dx^2 + 1/dy^2))              [SPEC 2]
+ *   dt = cfl / (2 nu Lambda(S) (1/dx^2 + 1/dy^2))    doc/model.md eq. (11)
  *
  * where Lambda(S) >= max(f_sl', f_sl/s) over [0, S] (closure.h).  While a
  * source is on, dt is also limited so that it raises a cell by at most

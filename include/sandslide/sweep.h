@@ -1,5 +1,5 @@
 /*
- * sweep.h - the finite-volume stencil of SPEC section 2, in two passes over
+ * sweep.h - the finite-volume stencil of doc/model.md#discretisation, in two passes over
  * cache-sized tiles (the reference kernel: simple, each face computed once
  * and stored).
  *

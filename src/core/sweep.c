@@ -53,8 +53,8 @@ static inline struct face_ends faces_of(const struct ss_grid *g, struct ss_tile_
 }
 
 /* Central difference of h at cell k along the direction with neighbour
- * offset `step`, a wall neighbour replaced by the cell itself (SPEC section
- * 2, mirror ghost), times 1/(2 spacing). */
+ * offset `step`, a wall neighbour replaced by the cell itself (doc/model.md
+ * #mirror-ghost-at-walls), times 1/(2 spacing). */
 static inline double central_difference(const double *restrict h,
                                         const uint8_t *restrict type,
                                         ptrdiff_t k, ptrdiff_t step,

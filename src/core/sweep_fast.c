@@ -1190,7 +1190,7 @@ static void stage_tile_start(const struct tile_ctx *c, const struct tile *t)
 
 /*
  * Sweep tile (tx, ty) in place: every flow cell advances by one forward
- * Euler step of SPEC section 2,
+ * Euler step of doc/model.md#forward-euler,
  *
  *     h += dt (-(F_e - F_w)/dx - (F_n - F_s)/dy + q),
  *     F = -nu f_sl(s) g_n / s,   s = sqrt(g_n^2 + g_t^2),

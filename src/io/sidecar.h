@@ -10,7 +10,7 @@
  * The XDMF sidecar OUT.xmf: a temporal
  * collection of one uniform grid per snapshot, so that ParaView opens the
  * series with its default reader (XDMF3, "Xdmf3ReaderS").  The layout it
- * describes is SPEC section 5: height (time, y, x) float64, cell_type (y, x)
+ * describes is doc/output.md#variables: height (time, y, x) float64, cell_type (y, x)
  * 8-bit, cell-centred, row 0 the south row.
  */
 #ifndef SANDSLIDE_IO_SIDECAR_H

@@ -1,6 +1,6 @@
 /*
  * snapshot_layout.h - what the HDF5 writer (snapshot_write.c) and reader
- * (snapshot_read.c) share of the file layout of SPEC section 5, without
+ * (snapshot_read.c) share of the file layout of doc/output.md, without
  * any HDF5 type: the diagnostic series and the constants of the
  * definition of a sandslide file.  Not installed; snapshot.h is the
  * public interface.

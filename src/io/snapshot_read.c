@@ -599,7 +599,7 @@ static int check_grid(struct ss_snapshot_file *f)
 	struct ss_snapshot_file_h5 *h = f->h5;
 	int err = var_open(&h->in, "height", &h->height);
 	if (err > 0 || (!err && h->height.rank != 3))
-		return not_sandslide(&h->in, "no /height (time, y, x) of numbers (SPEC section 5)");
+		return not_sandslide(&h->in, "no /height (time, y, x) of numbers (doc/output.md)");
 	if (err)
 		return err;
 	const hsize_t *hd = h->height.dims;
@@ -690,8 +690,8 @@ static int check_definition(struct ss_snapshot_file *f)
 	if (err)
 		return err;
 	if (strncmp(source, SS_SNAPSHOT_SOURCE, strlen(SS_SNAPSHOT_SOURCE)))
-		return not_sandslide(in, "no root attribute source = \"sandslide ...\" (SPEC "
-		                         "section 5)");
+		return not_sandslide(in, "no root attribute source = \"sandslide ...\" "
+		                         "(doc/output.md#the-one-reader)");
 	if ((err = check_grid(f)) || (err = read_times(f)))
 		return err;
 	f->dx = attr_double(in->file, "dx");

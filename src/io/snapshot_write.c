@@ -409,7 +409,7 @@ int ss_snapshot_named_netcdf(const char *path)
 	       (n > 4 && !strcasecmp(path + n - 4, ".nc4"));
 }
 
-/* "run.h5" -> "run.xmf" (SPEC section 5); any other name keeps its
+/* "run.h5" -> "run.xmf" (doc/output.md#sidecars); any other name keeps its
  * extension, "run.nc" -> "run.nc.xmf", so that run.h5 and run.nc beside it
  * do not share (and overwrite) one sidecar. */
 void ss_snapshot_sidecar_path(const char *path, char *out, size_t size)
@@ -474,7 +474,7 @@ static hid_t writer_access(void)
 	/* several ranks: every rank through MPI-IO, metadata read by one and
 	 * broadcast, and written collectively.  One rank keeps the POSIX
 	 * driver: MPI-IO wrote the 4096^2 cone's snapshots at half its speed
-	 * (README, Running on a cluster). */
+	 * (doc/performance.md#mpi-overhead). */
 	if (ss_comm_size() > 1) {
 		H5Pset_fapl_mpio(fapl, ss_comm_mpi(), MPI_INFO_NULL);
 		H5Pset_all_coll_metadata_ops(fapl, 1);

@@ -1,4 +1,4 @@
-"""Bad input (SPEC sections 3 and 4): exit status 2, one 'sandslide: ' line on
+"""Bad input (doc/case-file.md#errors): exit status 2, one 'sandslide: ' line on
 stderr naming file:line (or the --set argument) and what would be accepted,
 and nothing written: an existing output keeps its bytes, no new file appears.
 """

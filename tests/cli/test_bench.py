@@ -1,4 +1,4 @@
-"""`sandslide bench` (SPEC section 7): the JSON document parses, names every
+"""`sandslide bench` (doc/performance.md#the-sweep): the JSON document parses, names every
 case asked for, and its figures are positive and consistent; bad options
 exit 2.  Throughput itself is never asserted: the machines are shared."""
 import json

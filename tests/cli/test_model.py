@@ -1,4 +1,4 @@
-"""nu derived from the physical parameters of the sliding layer (SPEC section 1):
+"""nu from the sliding layer's parameters (doc/model.md#nu-from-the-sliding-layer):
 
     tau = density * gravity * delta * sin(a_cr)
     bingham           nu = tau delta^2 / (6 mu)
@@ -43,7 +43,7 @@ def test_nu_from_physical_parameters(tmp_path, base_case, closure, params, expec
     with h5open(out) as f:
         nu = float(f.attrs["nu"])
     assert nu == pytest.approx(expected, rel=1e-13), (
-        f"{closure} {params}: nu attribute {nu!r}, SPEC formula gives {expected!r}")
+        f"{closure} {params}: nu attribute {nu!r}, the formula gives {expected!r}")
 
 
 @pytest.mark.parametrize("closure, params, bad_key, words", [

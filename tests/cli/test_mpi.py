@@ -44,7 +44,7 @@ is conftest's SANDSLIDE.
                    mpirun -np 2
 
 Every run gets --threads 1 and --bind-to none, and the Open MPI settings of
-../shared/notes/mpi.md section 2 (root, oversubscription of 2 cores,
+doc/cluster.md#open-mpi-as-root-on-a-small-machine (root, oversubscription of 2 cores,
 yielding when idle, shared memory only).  A run that hangs (a deadlock) is
 killed, all its processes (and what they leave in /dev/shm and mpirun's
 session folder), after 60 s and fails the test.  About 60 mpirun starts:
@@ -79,7 +79,7 @@ pytestmark = [
     pytest.mark.skipif(MPIRUN is None, reason="mpirun not found (Debian package openmpi-bin)"),
 ]
 
-# Open MPI as root on a small machine (notes/mpi.md section 2)
+# Open MPI as root on a small machine (doc/cluster.md#open-mpi-as-root-on-a-small-machine)
 MPI_ENV = dict(
     os.environ,
     OMPI_ALLOW_RUN_AS_ROOT="1",

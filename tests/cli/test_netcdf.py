@@ -1,4 +1,4 @@
-"""SPEC section 5: the output opens as a netCDF-4 dataset, with time, y and x
+"""doc/output.md: the output opens as a netCDF-4 dataset, with time, y and x
 as dimensions (HDF5 dimension scales) and every variable on them."""
 import re
 import shutil

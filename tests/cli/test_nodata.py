@@ -62,7 +62,7 @@ def clipped_dem(ny=36, nx=44):
 
 
 def face_slopes(h, wall, dx=DX):
-    """Largest face slope of SPEC section 2 with walls where `wall` is True
+    """Largest face slope of doc/model.md#face-flux with walls where `wall` is True
     (and round the grid): faces touching a wall carry nothing, a wall
     neighbour along a face is replaced by the cell itself."""
     hp = np.pad(np.where(wall, 0.0, h), 1)

@@ -1,4 +1,4 @@
-"""The HDF5 output matches SPEC section 5, and the XDMF sidecar matches it."""
+"""The HDF5 output matches doc/output.md, and the XDMF sidecar matches it."""
 import math
 import xml.etree.ElementTree as ET
 

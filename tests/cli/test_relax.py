@@ -52,7 +52,7 @@ def _is_number(t):
 
 
 def face_slopes(h, dx):
-    """Largest slope of the faces as SPEC section 2 defines it (walls round
+    """Largest slope of the faces as doc/model.md#face-flux defines it (walls round
     the grid mirror; no interior walls): g_n across, g_t the mean of both
     cells' central differences along the face."""
     p = np.pad(h, 1, mode="edge")          # wall sides: mirror ghost
@@ -323,7 +323,7 @@ def test_bad_input_exits_2_and_leaves_the_input_alone(tmp_path, setup, args, mes
 
 def test_case_file_bedrock_is_used_and_stored(tmp_path):
     """[initial] bedrock = FILE in a case: the run keeps every cell on or
-    above it and the output carries /bedrock (SPEC section 5)."""
+    above it and the output carries /bedrock (doc/output.md#variables)."""
     ny, nx, dx = 8, 30, 0.05
     x = (np.arange(nx) + 0.5) * dx
     rock = np.tile(-1.0 * x, (ny, 1))

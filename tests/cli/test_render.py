@@ -1,5 +1,5 @@
 """`sandslide render` and `sandslide run --frames` through the command line
-(SPEC section 6): frames written in time order with their times, frame
+(doc/rendering.md): frames written in time order with their times, frame
 selection, bad input (exit 2, nothing written), the video with and without
 ffmpeg, and determinism.  Pixel-level properties are in tests/test_render.c.
 """

@@ -378,7 +378,7 @@ def read_asc(path):
 
 
 def face_slopes(h, dx):
-    """Steepest face of SPEC section 2 (wall sides mirrored): g_n across the
+    """Steepest face of doc/model.md#face-flux (wall sides mirrored): g_n across the
     face, g_t the mean of the two cells' central differences along it."""
     p = np.pad(h, 1, mode="edge")
     cy = (p[2:, 1:-1] - p[:-2, 1:-1]) / (2 * dx)

@@ -341,7 +341,7 @@ def test_sigkill_0_3_s_into_the_series(tmp_path):
 
 def test_sigkill_early_sweep(tmp_path):
     """Killed at any moment of its start-up (0 to 40 ms, every 2 ms), a run
-    leaves no output file or a readable one (SPEC section 5)."""
+    leaves no output file or a readable one (doc/output.md#written-as-the-run-goes)."""
     every = 0.02
     write(tmp_path, slow_case(1000, every))
     failures = []

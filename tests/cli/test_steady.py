@@ -1,4 +1,4 @@
-"""end = steady (SPEC section 2): stop when max |dh/dt| < steady_tol, but never
+"""end = steady (doc/model.md#the-steady-rule): stop when max |dh/dt| < steady_tol, but never
 while a source is still to switch on."""
 import numpy as np
 

@@ -83,7 +83,7 @@ def pile_on_ramp(ny=36, nx=44, dx=1.0, dy=1.0):
 
 def steepest_normal_gradient(h, dx, dy):
     """The largest |dh| / spacing across any face with data on both sides:
-    a lower bound of the face slope of SPEC section 2 (which adds the
+    a lower bound of the face slope of doc/model.md#face-flux (which adds the
     tangential part), so it too must not exceed tan(angle)."""
     gx = np.abs(np.diff(h, axis=1)) / dx
     gy = np.abs(np.diff(h, axis=0)) / dy
@@ -133,7 +133,7 @@ def test_threads_give_the_same_bits():
     h0 = pile_on_ramp(20, 24)
     one, _ = sandslide.relax(h0, 1.0, threads=1)
     two, _ = sandslide.relax(h0, 1.0, threads=2)
-    assert same_bits(one, two), "2 threads differ from 1 (README: same bits for any count)"
+    assert same_bits(one, two), "2 threads differ from 1 (doc/model.md#same-bits)"
 
 
 # ---- physics ---------------------------------------------------------------
