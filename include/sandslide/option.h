@@ -6,8 +6,8 @@
  * foreign-function entry points (ss_relax_options_set, ss_run_options_set),
  * the case file's keys that are the same options (model_options.h), the
  * Python module's defaults (it asks ss_option_table_json), and the man
- * page's check (tests/cli/test_manpage.py).  doc/options.md describes the
- * rules.
+ * page's check (tests/cli/test_manpage.py).  doc/running.md#options says
+ * what users see of it.
  *
  * A value is always text, as a user types it ("35", "coulomb", "1e-9"), so
  * that a default, a command-line word, a case-file value and a Python
