@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "base/strings.h"
 #include "sandslide/error.h"
 #include "sandslide/grid.h"
 
@@ -501,7 +502,8 @@ int ss_render_field(const struct ss_render_field *f, const struct ss_render_opti
 		return err;
 	if (f->nx < 1 || f->ny < 1 || f->stride < f->nx || !(f->dx > 0.0) || !(f->dy > 0.0))
 		return ss_error_input("cannot render a field of %d x %d cells (stride %td, "
-		                      "dx %g, dy %g)", f->nx, f->ny, f->stride, f->dx, f->dy);
+		                      "dx %s, dy %s)", f->nx, f->ny, f->stride, SS_REAL(f->dx),
+		                      SS_REAL(f->dy));
 	double zmin = o->zmin, zmax = o->zmax;
 	if (isnan(zmin) || isnan(zmax)) {
 		double lo, hi;

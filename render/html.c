@@ -52,6 +52,7 @@
 
 #include <zlib.h>
 
+#include "base/strings.h"
 #include "sandslide/error.h"
 #include "sandslide/grid.h"
 
@@ -176,11 +177,12 @@ static void put_js_string(struct page *p, const char *s)
 	put_bytes(p, "\"", 1);
 }
 
-/* A number that reads back exactly; null when it is not finite. */
+/* A number that reads back exactly (the shortest such text); null when it
+ * is not finite. */
 static void put_number(struct page *p, double x)
 {
 	if (isfinite(x))
-		putf(p, "%.17g", x);
+		putf(p, "%s", SS_REAL(x));
 	else
 		put(p, "null");
 }

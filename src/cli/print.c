@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "base/strings.h"
 #include "sandslide/comm.h"
 #include "sandslide/parallel.h"
 
@@ -204,8 +205,10 @@ void cli_print_info(const char *path, const struct ss_snapshot_summary *s)
 {
 	printf("file       %s (%s)\n", path, s->source);
 	printf("title      %s\n", s->title);
-	printf("grid       %d x %d cells, dx = %g m, dy = %g m, lower-left corner (%g, %g) m\n",
-	       s->nx, s->ny, s->dx, s->dy, s->origin_x, s->origin_y);
+	/* exact: %g would round a UTM northing of 5479330.25 m to 5.47933e+06 */
+	printf("grid       %d x %d cells, dx = %s m, dy = %s m, lower-left corner (%s, %s) m\n",
+	       s->nx, s->ny, SS_REAL(s->dx), SS_REAL(s->dy), SS_REAL(s->origin_x),
+	       SS_REAL(s->origin_y));
 	printf("cells      %lld flow, %lld wall, %lld open\n", s->flow_cells, s->wall_cells,
 	       s->open_cells);
 	printf("model      %s, repose angle %g deg, nu = %g m^2/s", s->closure,

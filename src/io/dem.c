@@ -16,6 +16,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "base/strings.h"
 #include "io/dem_internal.h"
 #include "sandslide/error.h"
 #include "sandslide/snapshot.h"
@@ -243,9 +244,10 @@ static int apply_cellsize(const struct ss_dem_read_options *o, const char *spec,
 	if (r->format != SS_DEM_PNG && !isnan(r->cellsize)) {
 		const double dy = ss_dem_dy(r);
 		if (fabs(r->cellsize - c) > 1e-9 * c || fabs(dy - c) > 1e-9 * c)
-			return ss_error_input_at(context, "'%s' has cell size %.17g x %.17g m: the given "
-			                         "cell size %.17g m disagrees (leave it out to use the "
-			                         "file's)", spec, r->cellsize, dy, c);
+			return ss_error_input_at(context, "'%s' has cell size %s x %s m: the given "
+			                         "cell size %s m disagrees (leave it out to use the "
+			                         "file's)", spec, SS_REAL(r->cellsize), SS_REAL(dy),
+			                         SS_REAL(c));
 		return SS_OK;
 	}
 	r->cellsize = r->cellsize_y = c;
@@ -260,9 +262,10 @@ static int check_extent(const char *spec, const char *context, const struct ss_r
 	const double x1 = r->x0 + r->nx * r->cellsize, y1 = r->y0 + r->ny * dy;
 	if ((!isnan(r->x0) && (!isfinite(r->x0) || (!isnan(x1) && !isfinite(x1)))) ||
 	    (!isnan(r->y0) && (!isfinite(r->y0) || (!isnan(y1) && !isfinite(y1)))))
-		return ss_error_input_at(context, "'%s': %d x %d cells of %g x %g m from (%g, %g) m "
+		return ss_error_input_at(context, "'%s': %d x %d cells of %s x %s m from (%s, %s) m "
 		                         "end beyond the largest number: expected a finite extent",
-		                         spec, r->nx, r->ny, r->cellsize, dy, r->x0, r->y0);
+		                         spec, r->nx, r->ny, SS_REAL(r->cellsize), SS_REAL(dy),
+		                         SS_REAL(r->x0), SS_REAL(r->y0));
 	return SS_OK;
 }
 

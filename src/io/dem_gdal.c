@@ -12,6 +12,7 @@
  */
 #include "io/dem_internal.h"
 
+#include "base/strings.h"
 #include "sandslide/error.h"
 
 #ifdef SS_HAVE_GDAL
@@ -119,9 +120,9 @@ static int read_dataset(GDALDatasetH ds, const char *path, const char *context,
 			                         "expected a north-up raster; resample it first, e.g. "
 			                         "gdalwarp", path, gt[2], gt[4]);
 		if (!(gt[1] > 0.0 && gt[5] < 0.0 && isfinite(gt[0]) && isfinite(gt[3])))
-			return ss_error_input_at(context, "'%s' has pixel size %g x %g: expected a north-up "
+			return ss_error_input_at(context, "'%s' has pixel size %s x %s: expected a north-up "
 			                         "raster (width > 0, height < 0 in the geotransform)", path,
-			                         gt[1], gt[5]);
+			                         SS_REAL(gt[1]), SS_REAL(gt[5]));
 		memcpy(r->geotransform, gt, sizeof gt);
 		r->has_geotransform = 1;
 		r->cellsize = gt[1];
