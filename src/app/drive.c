@@ -259,13 +259,18 @@ int ss_drive_run(struct ss_drive *d, enum ss_drive_end *end)
 		const enum ss_advance_end e = ss_stepper_advance(st, next_target(d, st->time, &k), &adv);
 		if (e == SS_ADVANCE_STALLED)
 			return stalled(d);
-		int err = e == SS_ADVANCE_NONFINITE ? STATE_NONFINITE : keep_state(d);
+		/* steady or stopped before the clock moved: that state is the
+		 * series' last snapshot already, and a second one at the same
+		 * time would make the time axis non-unique (xarray) */
+		const int kept = d->snapshot && ss_snapshot_count(d->snapshot) > 0 &&
+		                 ss_snapshot_last_time(d->snapshot) == st->time;
+		int err = e == SS_ADVANCE_NONFINITE ? STATE_NONFINITE : kept ? SS_OK : keep_state(d);
 		if (err == STATE_NONFINITE) {
 			keep_last_good_state(d);
 			*end = SS_DRIVE_NONFINITE;
 			return SS_OK;
 		}
-		if (err || (err = announce(d)))
+		if (err || (!kept && (err = announce(d))))
 			return err;
 		if (e == SS_ADVANCE_STEADY || e == SS_ADVANCE_INTERRUPTED) {
 			*end = e == SS_ADVANCE_STEADY ? SS_DRIVE_STEADY : SS_DRIVE_INTERRUPTED;

@@ -73,9 +73,10 @@ void cli_print_run_end(const struct ss_run_summary *s, int quiet)
 	}
 	if (quiet)
 		return;
-	printf("wrote %s: %lld snapshots to t = %g s, %lld %s%s\n", s->output, s->snapshots,
-	       s->time, s->steps, strcmp(s->integrator, "rkl2") ? "steps (euler)"
-	       : "super-steps (rkl2)", s->end == SS_RUN_STEADY ? " (steady)"
+	printf("wrote %s: %lld snapshot%s to t = %g s, %lld %s%s\n", s->output, s->snapshots,
+	       s->snapshots == 1 ? "" : "s", s->time, s->steps,
+	       strcmp(s->integrator, "rkl2") ? "steps (euler)" : "super-steps (rkl2)",
+	       s->end == SS_RUN_STEADY ? " (steady)"
 	       : s->end == SS_RUN_NOT_STEADY ? " (not steady by max_time)" : "");
 	/* with ranks: rank 0's phases, and its time in MPI calls */
 	char ranks[48] = "", mpi[48] = "";
