@@ -301,6 +301,9 @@ int ss_render_html_write(struct ss_render_html *h, const char *path, int fps, si
 /* ss_render_html_destroy(NULL) is a no-op. */
 void ss_render_html_destroy(struct ss_render_html *h);
 
+/* video.c: 1 when ffmpeg is on PATH (ss_render_video can make a video). */
+int ss_render_ffmpeg_found(void);
+
 /* series_render.c: dir must be a writable folder, or a missing one whose
  * parent is (created when `create`); SS_ERR_INPUT says which it is not. */
 int ss_render_check_dir(const char *dir, int create);

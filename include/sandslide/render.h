@@ -146,9 +146,15 @@ int ss_render_write_png(const struct ss_render_image *img, const char *path,
 struct ss_render_series_options {
 	const char *input;          /* the .h5 file */
 	const char *output_dir;     /* frames go here (created if missing); NULL:
-	                             * no frame files (only with html, no video) */
-	const char *frames;         /* "A:B:STEP" (B exclusive, as a Python slice;
-	                             * negative counts from the end), "A", or NULL: all */
+	                             * none are kept (with html or video: a video's
+	                             * frames go to a temporary folder beside it,
+	                             * removed once the video is made) */
+	const char *frames;         /* "A:B:STEP", a Python slice of the snapshots
+	                             * (B exclusive, negative counts from the end,
+	                             * parts optional, bounds clamped to the series,
+	                             * a negative STEP going backwards, STEP 0
+	                             * refused), drawn in its order; "A", one index;
+	                             * NULL: all, in time order */
 	double time;                /* s: the snapshot nearest this; NAN: unused */
 	const char *video;          /* FILE.mp4 to assemble with ffmpeg, or NULL */
 	int fps;                    /* frames per second of the video, and the
@@ -188,13 +194,15 @@ struct ss_render_series_report {
 
 /*
  * Render the chosen snapshots of o->input to output_dir/frame_00000.png,
- * frame_00001.png, ... in time order, then the video if asked for (without
- * ffmpeg on PATH the frames are kept, and that is success), and the
- * viewer o->html if asked for (the same frames, rendered once for both).
- * Everything is checked before the first frame is written.  Returns SS_OK
- * (*report filled), SS_ERR_INPUT (not a sandslide file, no snapshots, a
- * range outside the series, an unwritable folder, zmin >= zmax, frames, a
- * video or a viewer there already without force) or SS_ERR_FAIL.
+ * frame_00001.png, ... in the order chosen, then the video if asked for
+ * (without ffmpeg on PATH the frames in output_dir are kept, and that is
+ * success), and the viewer o->html if asked for (the same frames, rendered
+ * once for all).  Everything is checked before the first frame is
+ * written.  Returns SS_OK (*report filled), SS_ERR_INPUT (not a sandslide
+ * file, no snapshots, an index outside the series or an empty slice, an
+ * unwritable folder, zmin >= zmax, frames, a video or a viewer there
+ * already without force, a video without output_dir and without ffmpeg)
+ * or SS_ERR_FAIL.
  */
 int ss_render_series(const struct ss_render_series_options *o,
                      struct ss_render_series_report *report);

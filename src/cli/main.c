@@ -464,16 +464,18 @@ struct render_args {
 static const struct cli_option render_options[] = {
 	{.name = "--output", .alias = "-o", .value = "DIR", .kind = CLI_TEXT,
 	 .offset = RENDER(o.output_dir),
-	 .help = "folder of the frames (default frames/, created if\nmissing)"},
+	 .help = "folder of the frames (default frames/, created if\n"
+	         "missing; none for --html or --video alone)"},
 	{.name = "--frames", .value = "A:B:STEP", .kind = CLI_TEXT, .offset = RENDER(o.frames),
-	 .help = "snapshots A, A+STEP, ... before B, as a Python slice\n"
-	         "(negative counts from the end; parts may be left out)"},
+	 .help = "snapshots A, A+STEP, ... before B, a Python slice\n"
+	         "(negative counts from the end; parts may be left out;\n"
+	         "bounds clamped; ::-1 reverses), or one index A"},
 	{.name = "--time", .value = "T", .kind = CLI_REAL, .offset = RENDER(o.time),
 	 .lo = -INFINITY, .hi = INFINITY, .expected = "a time in s",
 	 .help = "only the snapshot nearest T seconds"},
 	{.name = "--video", .value = "FILE.mp4", .kind = CLI_TEXT, .offset = RENDER(o.video),
-	 .help = "assemble the frames with ffmpeg (H.264, yuv420p) if it\n"
-	         "is on PATH; without it the frames are kept"},
+	 .help = "assemble the frames with ffmpeg (H.264, yuv420p); with\n"
+	         "-o the frames are kept (also when ffmpeg is missing)"},
 	{.name = "--fps", .value = "N", .kind = CLI_INT, .offset = RENDER(o.fps), .lo = 1,
 	 .hi = 240, .expected = "1 to 240",
 	 .help = "frames per second of the video, and the speed the\n"
@@ -484,8 +486,8 @@ static const struct cli_option render_options[] = {
 	 .help = "no colour bar on a video's frames (--video adds one)"},
 	{.name = "--html", .value = "FILE.html", .kind = CLI_TEXT, .offset = RENDER(o.html),
 	 .help = "write a self-contained viewer (frames, slider, play,\n"
-	         "height under the mouse) to FILE.html; alone, no\n"
-	         "frame folder is written (with -o or --video, both)"},
+	         "height under the mouse) to FILE.html; without -o,\n"
+	         "no frame folder is written"},
 	FORCE(RENDER(o.force), "replace existing frames, video or viewer"),
 	THREADS(RENDER(threads)),
 	QUIET(RENDER(quiet), "no summary"),
@@ -536,8 +538,8 @@ static int cmd_render(int argc, char **argv)
 		a.o.look.label = 0;
 	if (a.no_colorbar)
 		a.o.look.colorbar = 0;
-	/* the viewer alone needs no frame files; a video is made from them */
-	if (a.o.html && !cli_given(&cmd, "--output") && !a.o.video)
+	/* a viewer or a video needs no frame folder: -o keeps the frames */
+	if ((a.o.html || a.o.video) && !cli_given(&cmd, "--output"))
 		a.o.output_dir = NULL;
 	struct ss_render_series_report report;
 	const int err = ss_render_series(&a.o, &report);
