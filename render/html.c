@@ -32,6 +32,10 @@
  *   scale    the colour map's 256 colours (ss_render_cmap_table), zmin and
  *            zmax, so the page's colour bar is the frames' exactly.
  *
+ * The page opens on the last frame: what a run made, where the first is
+ * often an empty room (a pouring case) or the very start of a slide; Home
+ * and the slider go back, and play starts again from the first frame.
+ *
  * The oblique style has no map from the picture to the cells: its page has
  * the frames and the controls but no height readout.
  *
@@ -497,7 +501,7 @@ static const char *const page_script[] = {
 	"});",
 	"window.addEventListener('resize', drawBar);",
 	"pic.addEventListener('load', drawBar, {once: true});",
-	"show(0);",
+	"show(n - 1);   // the end: what the run made (a pouring case starts empty)",
 	"drawBar();",
 	"})();",
 	"</script>",

@@ -271,7 +271,7 @@ def browser():
 
 @pytest.fixture
 def page(browser, viewer):
-    """The viewer freshly loaded, its first frame shown."""
+    """The viewer freshly loaded, its last frame shown."""
     path, _, _ = viewer
     browser.get_log("browser")    # what an earlier test left
     browser.get(path.as_uri())
@@ -316,7 +316,7 @@ def test_screenshot_is_not_blank(page):
     from PIL import Image
     from selenium.webdriver.common.by import By
     from selenium.webdriver.common.keys import Keys
-    page.find_element(By.TAG_NAME, "body").send_keys(Keys.ARROW_RIGHT)   # frame 1
+    page.find_element(By.TAG_NAME, "body").send_keys(Keys.HOME, Keys.ARROW_RIGHT)   # frame 1
     time.sleep(0.2)
     shot = Image.open(io.BytesIO(page.get_screenshot_as_png())).convert("RGB")
     colours = shot.getcolors(maxcolors=1 << 20)
@@ -335,17 +335,25 @@ def test_screenshot_is_not_blank(page):
 def test_slider_and_keys_change_the_frame(page, series):
     _, data = series
     times = data["time"]
+    # the page opens on the last frame: what the run made (a pouring case
+    # starts empty)
+    k4 = shown(page)
+    assert k4[0] == 4 and time_of(k4[1]) == pytest.approx(times[4], rel=1e-5), \
+        f"the page opened on {k4[:3]}, not the last frame"
+    assert k4[2].startswith("frame 5 / 5") and "snapshot 4" in k4[2], k4[2]
+    from selenium.webdriver.common.by import By
+    from selenium.webdriver.common.keys import Keys
+    page.find_element(By.TAG_NAME, "body").send_keys(Keys.HOME)
     k0 = shown(page)
     assert k0[0] == 0 and time_of(k0[1]) == pytest.approx(times[0], rel=1e-5, abs=1e-9)
     assert k0[2].startswith("frame 1 / 5")
+    assert k0[3:] != k4[3:], "Home shows another picture"
     page.execute_script("const s = document.getElementById('slider');"
                         "s.value = 3; s.dispatchEvent(new Event('input', {bubbles: true}));")
     k3 = shown(page)
     assert k3[0] == 3 and k3[2].startswith("frame 4 / 5") and "snapshot 3" in k3[2]
     assert time_of(k3[1]) == pytest.approx(times[3], rel=1e-5)
     assert k3[3:] != k0[3:], "the picture changed"
-    from selenium.webdriver.common.by import By
-    from selenium.webdriver.common.keys import Keys
     body = page.find_element(By.TAG_NAME, "body")
     body.send_keys(Keys.ARROW_RIGHT)
     assert shown(page)[0] == 4 and time_of(shown(page)[1]) == pytest.approx(times[4], rel=1e-5)
