@@ -10,12 +10,17 @@
  *                 area averaging when the picture is smaller than the grid
  *                 (--max-size), bilinear between cell centres when it is
  *                 larger (small grids are drawn at K pixels per cell); wall
- *                 cells never enter an average.
+ *                 cells and cells without data never enter an average.
  *   2. colour     shaded:  colour map of height x hillshade (Horn's method),
  *                          walls dark, open cells light, optional contours;
  *                 gray16:  16-bit grey, linear between zmin and zmax;
  *                 oblique: a perspective view, z-buffered triangles, walls
  *                          as raised blocks.
+ *                 Cells without data (SS_RENDER_CELL_NODATA) are absent in
+ *                 every style: the background (white) in shaded and
+ *                 oblique, transparent in gray16, as if the grid ended
+ *                 there; a wall side of the grid with no data all along it
+ *                 is not drawn either.
  *                 Then the optional time label and colour bar.
  *   3. encode     libpng, to a temporary name renamed into place, with the
  *                 time, the height scale and the snapshot in text chunks.
@@ -41,6 +46,11 @@ enum ss_render_cmap {
 	SS_RENDER_CMAP_TERRAIN,  /* blue - green - sand - brown - white */
 	SS_RENDER_CMAP_GRAY,     /* black to white */
 };
+
+/* A cell_type (struct ss_render_field) of a cell without data, such as
+ * the nodata cells of a DEM: /cell_type 3 of a sandslide file
+ * (SS_SNAPSHOT_CELL_NODATA, snapshot.h). */
+#define SS_RENDER_CELL_NODATA 3
 
 /* Colours of the shaded style for cells that are not sand, and for
  * heights that are not numbers (R, G, B). */
@@ -93,7 +103,8 @@ struct ss_render_field {
 	ptrdiff_t stride;           /* elements between rows, >= nx */
 	const double *height;       /* m: cell (i, j) at height[j * stride + i],
 	                             * i west to east, j = 0 the south row */
-	const uint8_t *cell_type;   /* enum ss_cell_type (grid.h), same layout;
+	const uint8_t *cell_type;   /* enum ss_cell_type (grid.h) or
+	                             * SS_RENDER_CELL_NODATA, same layout;
 	                             * NULL: every cell is a flow cell */
 	double time;                /* s */
 	unsigned wall_sides;        /* bit 1 << enum ss_side (boundary.h) for each

@@ -334,6 +334,7 @@ static int open_output(struct relax *x, const struct ss_relax_report *rep)
 		.integrator = ss_integrator_name(x->st.integrator),
 		.repose_angle_deg = o->angle_deg, .nu = o->nu, .gamma = o->gamma,
 		.bedrock = x->st.bedrock, .crs_wkt = x->dem.crs_wkt, .boundary = &x->st.boundary,
+		.nodata = x->dem.nodata,
 	};
 	return ss_drive_create(d, &meta);
 }

@@ -210,8 +210,11 @@ void cli_print_info(const char *path, const struct ss_snapshot_summary *s)
 	printf("grid       %d x %d cells, dx = %s m, dy = %s m, lower-left corner (%s, %s) m\n",
 	       s->nx, s->ny, SS_REAL(s->dx), SS_REAL(s->dy), SS_REAL(s->origin_x),
 	       SS_REAL(s->origin_y));
-	printf("cells      %lld flow, %lld wall, %lld open\n", s->flow_cells, s->wall_cells,
+	printf("cells      %lld flow, %lld wall, %lld open", s->flow_cells, s->wall_cells,
 	       s->open_cells);
+	if (s->nodata_cells > 0)
+		printf(", %lld without data", s->nodata_cells);
+	printf("\n");
 	printf("model      %s, repose angle %g deg, nu = %g m^2/s", s->closure,
 	       s->repose_angle_deg, s->nu);
 	if (!strcmp(s->closure, "herschel-bulkley"))

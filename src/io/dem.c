@@ -149,7 +149,28 @@ static int gdal_unavailable(const char *path, const char *context)
 /* ------------------------------------------------------------------ */
 /* reading                                                              */
 
-/* The last snapshot of a sandslide file, with its cell size and corner. */
+/* The cells without data of a sandslide file (relax's nodata,
+ * SS_SNAPSHOT_CELL_NODATA) as r->nodata, left NULL when there are none;
+ * their values are 0 already (read as walls). */
+static int read_h5_nodata(struct ss_snapshot_file *f, struct ss_raster *r)
+{
+	const size_t n = (size_t)f->nx * (size_t)f->ny;
+	uint8_t *flags = ss_alloc(n, 1, "cell types");
+	if (!flags)
+		return SS_ERR_FAIL;
+	int err = ss_snapshot_file_read_cell_flags(f, 0, f->ny, flags);
+	size_t none = 0;
+	for (size_t k = 0; k < n && !err; k++)
+		none += (flags[k] = flags[k] == SS_SNAPSHOT_CELL_NODATA);
+	if (!err && none > 0)
+		r->nodata = flags;
+	else
+		ss_free(flags);
+	return err;
+}
+
+/* The last snapshot of a sandslide file, with its cell size and corner,
+ * and its cells without data. */
 static int read_h5_output(const char *path, struct ss_raster *r)
 {
 	struct ss_snapshot_file f;
@@ -161,6 +182,8 @@ static int read_h5_output(const char *path, struct ss_raster *r)
 		err = SS_ERR_FAIL;
 	if (!err)
 		err = ss_snapshot_file_read_rows(&f, f.count - 1, 0, f.ny, r->values);
+	if (!err)
+		err = read_h5_nodata(&f, r);
 	if (!err) {
 		r->nx = f.nx;
 		r->ny = f.ny;
