@@ -10,6 +10,8 @@ subcritical DEM at its edges: the check that the first test can fail.
 """
 import json
 import math
+import os
+import subprocess
 
 import numpy as np
 import pytest
@@ -257,3 +259,34 @@ def test_render_draws_the_cells_without_data_as_absent(tmp_path):
         f"white pixels at {np.argwhere(white != nodata)[:5]} differ from the nodata cells"
     gray = read_png(tmp_path / "gray" / "frame_00000.png", pixels=True)["pixels"][::-1]
     assert np.array_equal(gray == 0, nodata), "gray16: 0 exactly on the nodata cells"
+
+
+def test_the_guards_snapshot_keeps_the_cells_without_data(tmp_path):
+    """relax to .h5 with --nodata open (the solver's open cells, at the open
+    level), a NaN put into a height after step 40 (tests/hooks/nan_step.c):
+    the guard reopens the series and appends the last good state, which has
+    NaN on the nodata cells and nowhere else, like every snapshot before it:
+    the reopened series knows its cells without data."""
+    from conftest import SANDSLIDE_NAN
+    if not os.access(SANDSLIDE_NAN, os.X_OK):
+        pytest.fail(f"{SANDSLIDE_NAN} is missing: make builds it (build/tests/sandslide-nan)")
+    h0, nodata = clipped_dem()
+    y, x = (np.mgrid[0:h0.shape[0], 0:h0.shape[1]] + 0.5) * DX
+    h0 = h0 + np.maximum(0.0, math.tan(math.radians(60)) * (0.6 - np.hypot(x - 2.2, y - 1.8)))
+    assert not nodata[h0.shape[0] // 2, h0.shape[1] // 2], "test bug: the NaN cell has no data"
+    write_asc(tmp_path / "pile.asc", h0, nodata)
+    p = subprocess.run([SANDSLIDE_NAN, "relax", "pile.asc", "-o", "out.h5", "-q",
+                        "--nodata", "open", "--output-every", "0.01", "--threads", "1"],
+                       cwd=tmp_path,
+                       capture_output=True, text=True, timeout=300,
+                       env=dict(os.environ, SANDSLIDE_TEST_NAN_STEP="40"))
+    assert p.returncode == 1 and "last good state" in p.stderr, (p.returncode, p.stderr)
+    with h5open(tmp_path / "out.h5") as f:
+        steps = f["steps"][()]
+        heights = f["height"][()]
+        types = f["cell_type"][()]
+    assert steps[-1] == 39 and len(steps) >= 3, f"snapshots after steps {list(steps)}"
+    assert np.array_equal(types == 3, nodata), "cell_type 3 is the nodata cells"
+    for k, h in enumerate(heights):
+        assert np.array_equal(np.isnan(h), nodata), \
+            f"snapshot {k} (step {steps[k]}): NaN at {np.argwhere(np.isnan(h) != nodata)[:5]}"
