@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "base/strings.h"
 #include "sandslide/error.h"
 #include "sandslide/grid.h"
 
@@ -134,6 +135,23 @@ static double view_azimuth(const struct ss_render_plan *p)
 	return bearing < 0.0 ? bearing + 360.0 : bearing;
 }
 
+/* Has a cell along grid side `side` data?  A wall side along cells that
+ * all lack it (a DEM's outline) holds no sand and is not drawn: the data
+ * would stand in a box of walls. */
+static int side_has_data(const uint8_t *cell_type, ptrdiff_t stride, int nx, int ny, int side)
+{
+	if (!cell_type)
+		return 1;
+	const int along_x = side == SS_SOUTH || side == SS_NORTH, n = along_x ? nx : ny;
+	for (int k = 0; k < n; k++) {
+		const int i = along_x ? k : side == SS_WEST ? 0 : nx - 1;
+		const int j = along_x ? (side == SS_SOUTH ? 0 : ny - 1) : k;
+		if (ss_render_type_of(cell_type[(ptrdiff_t)j * stride + i]) != SS_RENDER_CELL_NODATA)
+			return 1;
+	}
+	return 0;
+}
+
 int ss_render_plan_init(struct ss_render_plan *p, const struct ss_render_options *look,
                         int nx, int ny, double dx, double dy, const uint8_t *cell_type,
                         ptrdiff_t type_stride, unsigned wall_sides, double zmin,
@@ -160,7 +178,9 @@ int ss_render_plan_init(struct ss_render_plan *p, const struct ss_render_options
 	/* gray16's pixels are data, one per cell: nothing is drawn round them */
 	const int border = look->style == SS_RENDER_GRAY16 ? 0 : border_px(&p->rs);
 	for (int side = 0; side < 4; side++) {
-		p->border[side] = wall_sides & 1u << side ? border : 0;
+		const int drawn = wall_sides & 1u << side &&
+		                  side_has_data(cell_type, type_stride, nx, ny, side);
+		p->border[side] = drawn ? border : 0;
 		p->wall_m[side] = p->border[side] * (side < 2 ? p->rs.px_dx : p->rs.px_dy);
 	}
 	p->pic_w = w + p->border[SS_WEST] + p->border[SS_EAST];
@@ -222,7 +242,7 @@ int ss_render_plan_gradients(const struct ss_render_plan *p, const double *h,
 			for (int x = 0; x < nx; x++) {
 				const int t = cell_type ? cell_type[(ptrdiff_t)(ny - 1 - y) * type_stride + x]
 				                        : SS_CELL_FLOW;
-				types[(size_t)y * nx + x] = (uint8_t)(t <= SS_CELL_OPEN ? t : SS_CELL_WALL);
+				types[(size_t)y * nx + x] = ss_render_type_of(t);
 			}
 		const struct ss_render_raster cr = {
 			nx, ny, p->rs.px_dx * p->rs.width / nx, p->rs.px_dy * p->rs.height / ny,
@@ -235,7 +255,7 @@ int ss_render_plan_gradients(const struct ss_render_plan *p, const double *h,
 				const size_t k = (size_t)(ny - 1 - y) * nx + x;
 				const double v = ss_render_raster_h(&cr, x, y);
 				cgx[k] = cgy[k] = 0.0;
-				if (types[(size_t)y * nx + x] != SS_CELL_WALL && !isnan(v))
+				if (!ss_render_no_sand(types[(size_t)y * nx + x]) && !isnan(v))
 					ss_render_gradient(&cr, x, y, &cgx[k], &cgy[k]);
 			}
 		resample_to_float(p, cgx, nx, cell_type, type_stride, acc_hw, acc_w, *gx, parallel);
@@ -469,7 +489,8 @@ static void field_range(const struct ss_render_field *f, double *lo, double *hi)
 		for (int i = 0; i < f->nx; i++) {
 			const ptrdiff_t k = (ptrdiff_t)j * f->stride + i;
 			const double v = f->height[k];
-			if ((!f->cell_type || f->cell_type[k] != SS_CELL_WALL) && isfinite(v)) {
+			if ((!f->cell_type || !ss_render_no_sand(ss_render_type_of(f->cell_type[k]))) &&
+			    isfinite(v)) {
 				a = v < a ? v : a;
 				b = v > b ? v : b;
 			}
@@ -487,7 +508,8 @@ int ss_render_field(const struct ss_render_field *f, const struct ss_render_opti
 		return err;
 	if (f->nx < 1 || f->ny < 1 || f->stride < f->nx || !(f->dx > 0.0) || !(f->dy > 0.0))
 		return ss_error_input("cannot render a field of %d x %d cells (stride %td, "
-		                      "dx %g, dy %g)", f->nx, f->ny, f->stride, f->dx, f->dy);
+		                      "dx %s, dy %s)", f->nx, f->ny, f->stride, SS_REAL(f->dx),
+		                      SS_REAL(f->dy));
 	double zmin = o->zmin, zmax = o->zmax;
 	if (isnan(zmin) || isnan(zmax)) {
 		double lo, hi;

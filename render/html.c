@@ -15,7 +15,8 @@
  *            the picture was coloured from (area means of cells, under
  *            --max-size).  Quantised to uint16:
  *                0       wall
- *                1       no data (a height that is not a number)
+ *                1       no data (a cell without data, or a height that
+ *                        is not a number)
  *                v >= 2  height qlo + (v - 2) * step,
  *                        step = (qhi - qlo) / 65533,
  *            [qlo, qhi] the height scale widened to the heights of the
@@ -28,9 +29,13 @@
  *            (checked from file:// in Chromium 156 and Firefox 153 ESR;
  *            it needs no network);
  *   types    the cell (or pixel) types once, the same way: 0 flow, 1 wall,
- *            2 open;
+ *            2 open, 3 no data (a DEM's nodata, drawn as background);
  *   scale    the colour map's 256 colours (ss_render_cmap_table), zmin and
  *            zmax, so the page's colour bar is the frames' exactly.
+ *
+ * The page opens on the last frame: what a run made, where the first is
+ * often an empty room (a pouring case) or the very start of a slide; Home
+ * and the slider go back, and play starts again from the first frame.
  *
  * The oblique style has no map from the picture to the cells: its page has
  * the frames and the controls but no height readout.
@@ -52,6 +57,7 @@
 
 #include <zlib.h>
 
+#include "base/strings.h"
 #include "sandslide/error.h"
 #include "sandslide/grid.h"
 
@@ -71,6 +77,7 @@ struct ss_render_html {
 	const struct ss_render_plan *plan;
 	struct ss_render_source *source;
 	int cells;                  /* the data are the cells (else the pixels) */
+	int any_nodata;             /* some data cell has no data: a key for it */
 	int gw, gh;                 /* the data grid (0 x 0: no readout) */
 	double gdx, gdy;            /* m per data cell */
 	double qlo, qhi;            /* m, the quantisation's range */
@@ -176,11 +183,12 @@ static void put_js_string(struct page *p, const char *s)
 	put_bytes(p, "\"", 1);
 }
 
-/* A number that reads back exactly; null when it is not finite. */
+/* A number that reads back exactly (the shortest such text); null when it
+ * is not finite. */
 static void put_number(struct page *p, double x)
 {
 	if (isfinite(x))
-		putf(p, "%.17g", x);
+		putf(p, "%s", SS_REAL(x));
 	else
 		put(p, "null");
 }
@@ -257,6 +265,7 @@ static const char *const page_head[] = {
 	"<canvas id='bar' width='80' height='300' aria-label='height scale'></canvas>",
 	"<div class='key'><span class='swatch' id='wallkey'></span>wall</div>",
 	"<div class='key'><span class='swatch' id='openkey'></span>open</div>",
+	"<div class='key'><span class='swatch' id='nodatakey'></span>no data</div>",
 	"</div>",
 	"</div>",
 	NULL,
@@ -290,7 +299,7 @@ static const char *const page_script[] = {
 	"    .pipeThrough(new DecompressionStream('deflate'));",
 	"  return new Uint8Array(await new Response(stream).arrayBuffer());",
 	"}",
-	"const types = readable ? inflate(S.types) : null;   // 0 flow, 1 wall, 2 open",
+	"const types = readable ? inflate(S.types) : null;   // 0 flow, 1 wall, 2 open, 3 no data",
 	"const cache = new Map();",
 	"function heights(k) {",
 	"  let p = cache.get(k);",
@@ -454,6 +463,8 @@ static const char *const page_script[] = {
 	"$('wallkey').style.background = S.wall;",
 	"if (S.open) $('openkey').style.background = S.open;",
 	"else $('openkey').parentNode.style.display = 'none';",
+	"if (S.absent) $('nodatakey').style.background = S.absent;",
+	"else $('nodatakey').parentNode.style.display = 'none';",
 	"const zoom = Math.max(S.imageW, S.imageH) < 400 ?",
 	"  Math.ceil(400 / Math.max(S.imageW, S.imageH)) : 1;",
 	"pic.width = S.imageW * zoom;",
@@ -495,7 +506,7 @@ static const char *const page_script[] = {
 	"});",
 	"window.addEventListener('resize', drawBar);",
 	"pic.addEventListener('load', drawBar, {once: true});",
-	"show(0);",
+	"show(n - 1);   // the end: what the run made (a pouring case starts empty)",
 	"drawBar();",
 	"})();",
 	"</script>",
@@ -564,10 +575,12 @@ static int make_types(struct ss_render_html *h)
 	if (!t)
 		return ss_error_fail("out of memory");
 	for (int row = 0; row < h->gh; row++)
-		for (int col = 0; col < h->gw; col++)
-			t[(size_t)row * h->gw + col] =
-				h->cells ? h->source->cell_type[(size_t)(h->gh - 1 - row) * h->gw + col]
-				         : p->pixel_type[(size_t)row * h->gw + col];
+		for (int col = 0; col < h->gw; col++) {
+			const size_t k = (size_t)row * h->gw + col;
+			t[k] = h->cells ? h->source->cell_type[(size_t)(h->gh - 1 - row) * h->gw + col]
+			                : p->pixel_type[k];
+			h->any_nodata |= t[k] == SS_RENDER_CELL_NODATA;
+		}
 	const int err = deflate_bytes(t, count, &h->types, &h->types_size);
 	free(t);
 	return err;
@@ -662,7 +675,7 @@ static int quantise(struct ss_render_html *h, long long t, const double *pixel_h
 			unsigned code;
 			if (type == SS_CELL_WALL)
 				code = CODE_WALL;
-			else if (!isfinite(z))
+			else if (type == SS_RENDER_CELL_NODATA || !isfinite(z))
 				code = CODE_NODATA;
 			else {
 				const double q = round((z - h->qlo) / step);
@@ -745,9 +758,15 @@ static void put_data(struct page *pg, const struct ss_render_html *h, const char
 	put(pg, ",\n");
 	if (p->look.style == SS_RENDER_GRAY16) {   /* walls transparent, open cells grey */
 		put(pg, "  wall: 'transparent', open: null,\n");
+		put(pg, h->any_nodata ? "  absent: 'transparent',\n" : "  absent: null,\n");
 	} else {
 		put_color(pg, "wall", SS_RENDER_WALL_RGB);
 		put_color(pg, "open", SS_RENDER_OPEN_RGB);
+		if (h->any_nodata)
+			put_color(pg, "absent", SS_RENDER_BACKGROUND, SS_RENDER_BACKGROUND,
+			          SS_RENDER_BACKGROUND);   /* the key of cells without data */
+		else
+			put(pg, "  absent: null,\n");
 	}
 	put(pg, "  cmap: '");
 	for (int k = 0; k < 256; k++)

@@ -10,10 +10,29 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "sandslide/grid.h"
 #include "sandslide/render.h"
 #include "sandslide/snapshot.h"
 
-#define SS_RENDER_BACKGROUND 0xff               /* white: oblique sky, colour bar */
+#define SS_RENDER_BACKGROUND 0xff               /* white: oblique sky, colour bar,
+                                                 * cells without data */
+
+/* Cell and pixel types: enum ss_cell_type (flow 0, wall 1, open 2) and
+ * SS_RENDER_CELL_NODATA (3); anything else is taken for a wall. */
+static inline uint8_t ss_render_type_of(int t)
+{
+	return (uint8_t)(t >= 0 && t <= SS_RENDER_CELL_NODATA ? t : SS_CELL_WALL);
+}
+
+/* Walls and cells without data hold no sand: no height of theirs enters
+ * a mean, a gradient or the height scale (bit 0 is set in both, 1 and 3). */
+_Static_assert(SS_CELL_FLOW == 0 && SS_CELL_WALL == 1 && SS_CELL_OPEN == 2 &&
+               SS_RENDER_CELL_NODATA == 3 && SS_SNAPSHOT_CELL_NODATA == 3,
+               "the renderer's types are the file's, and bit 0 marks no sand");
+static inline int ss_render_no_sand(int t)
+{
+	return t & 1;
+}
 
 /* ---- resample.c: cells -> pixels ------------------------------------- */
 
@@ -48,7 +67,8 @@ static inline int ss_render_resampler_is_identity(const struct ss_render_resampl
 
 /* Pixel types (width * height, north row first) from the cell types
  * (nx * ny with row stride `stride`, south row first; NULL: all flow): the
- * type covering most of the pixel, ties going to walls, then open cells. */
+ * type covering most of the pixel, ties going to walls, then cells without
+ * data, then open cells. */
 void ss_render_resample_types(const struct ss_render_resampler *r, const uint8_t *cell_type,
                               ptrdiff_t stride, uint8_t *pixel_type, int parallel);
 
@@ -180,7 +200,8 @@ struct ss_render_source {
 };
 
 /* Open and check a sandslide output file (SS_ERR_INPUT with a message if
- * it is not one or is damaged) and read its cell types. */
+ * it is not one or is damaged) and read its cell types, with the cells
+ * without data as SS_RENDER_CELL_NODATA. */
 int ss_render_source_open(struct ss_render_source *s, const char *path);
 void ss_render_source_close(struct ss_render_source *s);
 
@@ -300,6 +321,9 @@ int ss_render_html_write(struct ss_render_html *h, const char *path, int fps, si
 
 /* ss_render_html_destroy(NULL) is a no-op. */
 void ss_render_html_destroy(struct ss_render_html *h);
+
+/* video.c: 1 when ffmpeg is on PATH (ss_render_video can make a video). */
+int ss_render_ffmpeg_found(void);
 
 /* series_render.c: dir must be a writable folder, or a missing one whose
  * parent is (created when `create`); SS_ERR_INPUT says which it is not. */

@@ -19,7 +19,11 @@
  *     of a video, while a room fills, and a column among low sand would
  *     hide what lies behind it;
  *   - a skirt down to a base 8 % of the range below zmin along the edges
- *     of the grid, so the sand reads as a solid slab.
+ *     of the grid, so the sand reads as a solid slab;
+ *   - cells without data (a DEM's outline, its holes) are absent: no
+ *     triangle with a vertex on one is drawn, the skirt runs along the
+ *     edge of the triangles that are, and a grid side that is a wall is
+ *     drawn only if some cell along it has data (frame.c).
  * Camera: at compass bearing view_azimuth and elevation view_elevation
  * from the centre of the scene's box (the grid with its wall sides, up to
  * the scale's top plus WALL_RISE), far enough that the box's bounding
@@ -227,12 +231,13 @@ static int outside_band(const struct target *t, float y_lo, float y_hi)
 	return y_hi < t->y0 - 1 || y_lo > t->y1 + 1;
 }
 
-/* Height of the surface mesh at raster pixel k: walls and NaN take the mean
- * of their sand neighbours (or the base if they have none). */
+/* Height of the surface mesh at raster pixel k: walls, cells without data
+ * and NaN take the mean of their sand neighbours (or the base if they have
+ * none). */
 static double mesh_height(const struct ss_render_raster *r, int x, int y, double base)
 {
 	const size_t k = (size_t)y * r->width + x;
-	if (r->type[k] != SS_CELL_WALL && !isnan(ss_render_raster_h(r, x, y)))
+	if (!ss_render_no_sand(r->type[k]) && !isnan(ss_render_raster_h(r, x, y)))
 		return ss_render_raster_h(r, x, y);
 	double sum = 0.0;
 	int n = 0;
@@ -242,7 +247,7 @@ static double mesh_height(const struct ss_render_raster *r, int x, int y, double
 			if (xn < 0 || yn < 0 || xn >= r->width || yn >= r->height)
 				continue;
 			const size_t m = (size_t)yn * r->width + xn;
-			if (r->type[m] != SS_CELL_WALL && !isnan(ss_render_raster_h(r, xn, yn))) {
+			if (!ss_render_no_sand(r->type[m]) && !isnan(ss_render_raster_h(r, xn, yn))) {
 				sum += ss_render_raster_h(r, xn, yn);
 				n++;
 			}
@@ -271,10 +276,12 @@ static void surface_vertices(const struct ss_render_raster *r, const struct came
 			const double h = mesh_height(r, x, y, base);
 			const double wx = (x + 0.5) * r->px_dx, wy = (H - y - 0.5) * r->px_dy;
 			double b = 1.0;
-			const uint8_t *rgb = wall_rgb;
-			if (r->type[k] != SS_CELL_WALL && isnan(ss_render_raster_h(r, x, y))) {
+			const uint8_t *rgb = wall_rgb;   /* under a block, or not drawn */
+			if (ss_render_no_sand(r->type[k])) {
+				rgb = wall_rgb;
+			} else if (isnan(ss_render_raster_h(r, x, y))) {
 				rgb = nodata;
-			} else if (r->type[k] != SS_CELL_WALL) {
+			} else {
 				double gx, gy;
 				ss_render_gradient(r, x, y, &gx, &gy);
 				b = ss_render_hillshade(&light, gx, gy);
@@ -284,11 +291,27 @@ static void surface_vertices(const struct ss_render_raster *r, const struct came
 		}
 }
 
+/* Is pixel (x, y) a vertex of the surface, a cell with data? */
+static inline int has_data(const struct ss_render_raster *r, int x, int y)
+{
+	return r->type[(size_t)y * r->width + x] != SS_RENDER_CELL_NODATA;
+}
+
+/* Is triangle `half` (0: a b e, north-east; 1: a e d, south-west) of the
+ * square with north-west corner (x, y) drawn?  Outside the grid: no. */
+static int triangle_drawn(const struct ss_render_raster *r, int x, int y, int half)
+{
+	if (x < 0 || y < 0 || x + 1 >= r->width || y + 1 >= r->height)
+		return 0;
+	return has_data(r, x, y) && has_data(r, x + 1, y + 1) &&
+	       has_data(r, half ? x : x + 1, half ? y + 1 : y);
+}
+
 /* The sides of the slab along the grid's edges, between neighbouring
- * edge vertices. */
+ * edge vertices (with cells without data: under the drawn triangles). */
 static void draw_skirt(struct target *t, const struct ss_render_raster *r,
                        const struct camera *c, const struct ss_render_light *light,
-                       const struct vtx *v)
+                       const struct vtx *v, int any_nodata)
 {
 	const int W = r->width, H = r->height;
 	/* edges: south (y = H-1, normal -y), north (y = 0, +y), west, east */
@@ -303,6 +326,12 @@ static void draw_skirt(struct target *t, const struct ss_render_raster *r,
 			const int x1 = along_x ? s + 1 : x0, y1 = along_x ? y0 : s + 1;
 			const size_t k0 = (size_t)y0 * W + x0, k1 = (size_t)y1 * W + x1;
 			if (r->type[k0] == SS_CELL_WALL && r->type[k1] == SS_CELL_WALL)
+				continue;
+			/* the triangle on the edge: south and west ones are the
+			 * south-west halves of their squares */
+			if (any_nodata && !triangle_drawn(r, along_x ? s : side == 2 ? 0 : W - 2,
+			                                  along_x ? (side == 0 ? H - 2 : 0) : s,
+			                                  side == 0 || side == 2))
 				continue;
 			const struct vtx *a = &v[k0], *d = &v[k1];
 			const struct vtx b0 = make_vtx(c, (x0 + 0.5) * r->px_dx, (H - y0 - 0.5) * r->px_dy,
@@ -472,9 +501,61 @@ static void draw_wall_side(struct target *t, const struct ss_render_raster *r,
 	}
 }
 
+/* The slab's side under the surface edge from vertex (x0, y0) to (x1, y1),
+ * its outer normal (nx, ny) on the map (x east, y north). */
+static void draw_skirt_edge(struct target *t, const struct ss_render_raster *r,
+                            const struct camera *c, const struct ss_render_light *light,
+                            const struct vtx *v, int x0, int y0, int x1, int y1, double nx,
+                            double ny)
+{
+	const int W = r->width, H = r->height;
+	const double b = face_light(light, nx, ny, 0.0);
+	struct vtx ta = v[(size_t)y0 * W + x0], td = v[(size_t)y1 * W + x1];
+	for (int ch = 0; ch < 3; ch++)
+		ta.c[ch] = td.c[ch] = (uint8_t)(skirt_rgb[ch] * b + 0.5);
+	const struct vtx b0 = make_vtx(c, (x0 + 0.5) * r->px_dx, (H - y0 - 0.5) * r->px_dy,
+	                               c->z_floor, skirt_rgb, b);
+	const struct vtx b1 = make_vtx(c, (x1 + 0.5) * r->px_dx, (H - y1 - 0.5) * r->px_dy,
+	                               c->z_floor, skirt_rgb, b);
+	if (outside_band(t, fminf(fminf(ta.y, td.y), fminf(b0.y, b1.y)),
+	                 fmaxf(fmaxf(ta.y, td.y), fmaxf(b0.y, b1.y))))
+		return;
+	draw_quad(t, &ta, &td, &b1, &b0);
+}
+
+/* The skirt along the edges between drawn triangles and cells without
+ * data inside the grid (draw_skirt does the grid's own edges): each edge
+ * of a drawn triangle whose neighbour across it is not drawn. */
+static void draw_outline_skirt(struct target *t, const struct ss_render_raster *r,
+                               const struct camera *c, const struct ss_render_light *light,
+                               const struct vtx *v)
+{
+	const int W = r->width, H = r->height;
+	const double s = sqrt(0.5);
+	for (int y = 0; y + 1 < H; y++)
+		for (int x = 0; x + 1 < W; x++) {
+			if (triangle_drawn(r, x, y, 0)) {   /* a b e: north, east, diagonal */
+				if (y > 0 && !triangle_drawn(r, x, y - 1, 1))
+					draw_skirt_edge(t, r, c, light, v, x, y, x + 1, y, 0.0, 1.0);
+				if (x + 2 < W && !triangle_drawn(r, x + 1, y, 1))
+					draw_skirt_edge(t, r, c, light, v, x + 1, y, x + 1, y + 1, 1.0, 0.0);
+				if (!triangle_drawn(r, x, y, 1))
+					draw_skirt_edge(t, r, c, light, v, x, y, x + 1, y + 1, -s, -s);
+			}
+			if (triangle_drawn(r, x, y, 1)) {   /* a e d: south, west, diagonal */
+				if (y + 2 < H && !triangle_drawn(r, x, y + 1, 0))
+					draw_skirt_edge(t, r, c, light, v, x, y + 1, x + 1, y + 1, 0.0, -1.0);
+				if (x > 0 && !triangle_drawn(r, x - 1, y, 0))
+					draw_skirt_edge(t, r, c, light, v, x, y, x, y + 1, -1.0, 0.0);
+				if (!triangle_drawn(r, x, y, 0))
+					draw_skirt_edge(t, r, c, light, v, x, y, x + 1, y + 1, s, s);
+			}
+		}
+}
+
 static void draw_band(struct target *t, const struct ss_render_raster *r,
                       const struct camera *c, const struct ss_render_light *light,
-                      const struct vtx *v, const struct wall_tops *tops)
+                      const struct vtx *v, const struct wall_tops *tops, int any_nodata)
 {
 	const int W = r->width, H = r->height;
 	for (int y = 0; y + 1 < H; y++)
@@ -485,9 +566,18 @@ static void draw_band(struct target *t, const struct ss_render_raster *r,
 			const float hi = fmaxf(fmaxf(a->y, b->y), fmaxf(d->y, e->y));
 			if (outside_band(t, lo, hi))
 				continue;
-			draw_quad(t, a, b, e, d);
+			if (!any_nodata) {
+				draw_quad(t, a, b, e, d);
+				continue;
+			}
+			if (triangle_drawn(r, x, y, 0))
+				draw_triangle(t, a, b, e);
+			if (triangle_drawn(r, x, y, 1))
+				draw_triangle(t, a, e, d);
 		}
-	draw_skirt(t, r, c, light, v);
+	draw_skirt(t, r, c, light, v, any_nodata);
+	if (any_nodata)
+		draw_outline_skirt(t, r, c, light, v);
 	for (int y = 0; y < H; y++)
 		for (int x = 0; x < W; x++) {
 			const size_t k = (size_t)y * W + x;
@@ -584,7 +674,7 @@ static int wall_tops_init(struct wall_tops *w, const struct ss_render_raster *r,
 	for (int y = 0; y < H; y++)
 		for (int x = 0; x < W; x++) {
 			const size_t k = (size_t)y * W + x;
-			if (r->type[k] == SS_CELL_WALL)
+			if (ss_render_no_sand(r->type[k]))
 				continue;
 			const double v = ss_render_raster_h(r, x, y);
 			for (int b = -1; b <= 1; b++)
@@ -629,6 +719,9 @@ int ss_render_oblique(const struct ss_render_raster *r, const struct ss_render_o
 		memset(img->pixels + (size_t)y * img->row_bytes, SS_RENDER_BACKGROUND,
 		       3 * (size_t)c.width);
 	surface_vertices(r, &c, o, zmin, zmax, v, parallel);
+	int any_nodata = 0;
+	for (size_t k = 0; k < n && !any_nodata; k++)
+		any_nodata = r->type[k] == SS_RENDER_CELL_NODATA;
 	struct ss_render_light light;
 	ss_render_light_init(&light, o->azimuth_deg, o->altitude_deg, o->zscale);
 
@@ -642,7 +735,7 @@ int ss_render_oblique(const struct ss_render_raster *r, const struct ss_render_o
 		if (t.y1 > img->height)
 			t.y1 = img->height;
 		if (t.y0 < t.y1)
-			draw_band(&t, r, &c, &light, v, &tops);
+			draw_band(&t, r, &c, &light, v, &tops, any_nodata);
 	}
 	ss_free(depth);
 	ss_free(v);

@@ -84,18 +84,20 @@ static const struct ss_option series[] = {
 	 .help = "the sandslide file (the command line's argument)"},
 	{.name = "output", .alias = "-o", .value_name = "DIR", .kind = SS_OPTION_TEXT,
 	 .offset = AT(output_dir), .default_value = "frames", .expected = "a folder",
-	 .help = "folder of the frames (created if missing)"},
+	 .help = "folder of the frames (created if missing; none\n"
+	         "for --html or --video alone)"},
 	{.name = "frames", .value_name = "A:B:STEP", .kind = SS_OPTION_TEXT, .offset = AT(frames),
 	 .expected = "A:B:STEP or A",
-	 .help = "snapshots A, A+STEP, ... before B, as a Python slice\n"
-	         "(negative counts from the end; parts may be left out)"},
+	 .help = "snapshots A, A+STEP, ... before B, a Python slice\n"
+	         "(negative counts from the end; parts may be left out;\n"
+	         "bounds clamped; ::-1 reverses), or one index A"},
 	{.name = "time", .value_name = "T", .kind = SS_OPTION_REAL, .offset = AT(time),
 	 .lo = -INFINITY, .hi = INFINITY, .expected = "a time in s",
 	 .help = "only the snapshot nearest T seconds"},
 	{.name = "video", .value_name = "FILE.mp4", .kind = SS_OPTION_TEXT, .offset = AT(video),
 	 .expected = "a path",
-	 .help = "assemble the frames with ffmpeg (H.264, yuv420p) if it\n"
-	         "is on PATH; without it the frames are kept"},
+	 .help = "assemble the frames with ffmpeg (H.264, yuv420p); with\n"
+	         "-o the frames are kept (also when ffmpeg is missing)"},
 	{.name = "fps", .value_name = "N", .kind = SS_OPTION_INT, .offset = AT(fps),
 	 .default_value = "24", .lo = 1, .hi = 240, .expected = "1 to 240",
 	 .help = "frames per second of the video, and the speed the\n"
@@ -103,8 +105,8 @@ static const struct ss_option series[] = {
 	{.name = "html", .value_name = "FILE.html", .kind = SS_OPTION_TEXT, .offset = AT(html),
 	 .expected = "a path",
 	 .help = "write a self-contained viewer (frames, slider, play,\n"
-	         "height under the mouse) to FILE.html; alone, no\n"
-	         "frame folder is written (with -o or --video, both)"},
+	         "height under the mouse) to FILE.html; without -o,\n"
+	         "no frame folder is written"},
 	{.name = "force", .kind = SS_OPTION_FLAG, .offset = AT(force), .expected = "1 or 0",
 	 .help = "replace existing frames, video or viewer"},
 };

@@ -23,6 +23,7 @@
 
 #include <png.h>
 
+#include "base/strings.h"
 #include "sandslide/error.h"
 
 int ss_render_image_init(struct ss_render_image *img, int width, int height,
@@ -105,16 +106,17 @@ static void add_text(struct png_texts *x, const char *key, const char *value)
 	t->text_length = strlen(value);
 }
 
-/* Two numbers that go together ("%.17g": they read back exactly), both or
- * neither: a known NaN of either leaves both out. */
+/* Two numbers that go together (ss_real_text: the shortest text that
+ * reads back exactly), both or neither: a known NaN of either leaves both
+ * out. */
 static void add_pair(struct png_texts *x, const char *key_a, double a, const char *key_b,
                      double b)
 {
 	if (isnan(a) || isnan(b))
 		return;
 	char *text_a = x->number[x->numbers++], *text_b = x->number[x->numbers++];
-	snprintf(text_a, NUMBER_SIZE, "%.17g", a);
-	snprintf(text_b, NUMBER_SIZE, "%.17g", b);
+	snprintf(text_a, NUMBER_SIZE, "%s", SS_REAL(a));
+	snprintf(text_b, NUMBER_SIZE, "%s", SS_REAL(b));
 	add_text(x, key_a, text_a);
 	add_text(x, key_b, text_b);
 }
@@ -129,7 +131,7 @@ static void fill_texts(struct png_texts *x, const struct ss_render_image *img)
 		add_text(x, "Source", img->source);
 	add_text(x, "style", ss_render_style_name(img->style));
 	if (!isnan(img->time)) {
-		snprintf(x->number[x->numbers++], NUMBER_SIZE, "%.17g", img->time);
+		snprintf(x->number[x->numbers++], NUMBER_SIZE, "%s", SS_REAL(img->time));
 		add_text(x, "time_s", x->number[x->numbers - 1]);
 	}
 	add_pair(x, "zmin_m", img->zmin, "zmax_m", img->zmax);

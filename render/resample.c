@@ -13,9 +13,9 @@
  *                       smooth hillshading and contour lines rather than
  *                       flat squares.
  *
- * Both are separable weights, w(x) w(y), and wall cells get none: a pixel's
- * height is sum(w h) / sum(w) over its flow and open cells, so walls never
- * pull the sand surface down.  Cell types are resampled with the area
+ * Both are separable weights, w(x) w(y), and wall cells and cells without
+ * data get none: a pixel's height is sum(w h) / sum(w) over its flow and
+ * open cells, so walls never pull the sand surface down.  Cell types are resampled with the area
  * weights in both cases: a pixel takes the type covering most of it, so
  * walls keep their cell-sharp edges when a small grid is enlarged.
  *
@@ -143,7 +143,7 @@ void ss_render_resample_types(const struct ss_render_resampler *r, const uint8_t
 			for (int px = 0; px < W; px++) {
 				const int t = cell_type ? cell_type[(ptrdiff_t)(H - 1 - py) * stride + px]
 				                        : SS_CELL_FLOW;
-				pixel_type[(size_t)py * W + px] = (uint8_t)(t <= SS_CELL_OPEN ? t : SS_CELL_WALL);
+				pixel_type[(size_t)py * W + px] = ss_render_type_of(t);
 			}
 		return;
 	}
@@ -152,21 +152,23 @@ void ss_render_resample_types(const struct ss_render_resampler *r, const uint8_t
 	for (int py = 0; py < H; py++) {
 		const int q = H - 1 - py;   /* pixel rows from the south, like cells */
 		for (int px = 0; px < W; px++) {
-			double area[3] = {0.0, 0.0, 0.0};   /* flow, wall, open */
+			double area[4] = {0.0, 0.0, 0.0, 0.0};   /* flow, wall, open, no data */
 			for (int m = 0; m < by->count[q]; m++) {
 				const int j = by->first[q] + m;
 				const double wy = by->w[(size_t)q * by->span + m];
 				for (int n = 0; n < bx->count[px]; n++) {
 					const int i = bx->first[px] + n;
 					const int t = cell_type ? cell_type[(ptrdiff_t)j * stride + i] : SS_CELL_FLOW;
-					area[t <= SS_CELL_OPEN ? t : SS_CELL_WALL] +=
-						wy * bx->w[(size_t)px * bx->span + n];
+					area[ss_render_type_of(t)] += wy * bx->w[(size_t)px * bx->span + n];
 				}
 			}
 			uint8_t t = SS_CELL_WALL;
-			if (area[SS_CELL_OPEN] > area[SS_CELL_WALL])
-				t = SS_CELL_OPEN;
-			if (area[SS_CELL_FLOW] > fmax(area[SS_CELL_WALL], area[SS_CELL_OPEN]))
+			double most = area[SS_CELL_WALL];
+			if (area[SS_RENDER_CELL_NODATA] > most)
+				t = SS_RENDER_CELL_NODATA, most = area[SS_RENDER_CELL_NODATA];
+			if (area[SS_CELL_OPEN] > most)
+				t = SS_CELL_OPEN, most = area[SS_CELL_OPEN];
+			if (area[SS_CELL_FLOW] > most)
 				t = SS_CELL_FLOW;
 			pixel_type[(size_t)py * W + px] = t;
 		}
@@ -200,7 +202,7 @@ void ss_render_resample_rows(const struct ss_render_resampler *r, const double *
 				const double *wx = ix->w + (size_t)px * ix->span;
 				double s_hw = 0.0, s_w = 0.0;
 				for (int k = 0; k < n; k++) {
-					if (tr && tr[i0 + k] == SS_CELL_WALL)
+					if (tr && ss_render_no_sand(tr[i0 + k]))
 						continue;
 					s_hw += wx[k] * hr[i0 + k];
 					s_w += wx[k];

@@ -2,7 +2,8 @@
  * series.c - a sandslide output file (doc/output.md) as the renderer
  * reads it: the file through the one reader of src/io/snapshot_read.c
  * (snapshot.h), which checks it and serialises HDF5 between the threads
- * that render frames, and its cell types (one byte per cell), read once.
+ * that render frames, and its cell types (one byte per cell, the file's
+ * own: a cell without data is one, not a wall), read once.
  * Heights are read a block of whole chunks of rows at a time, so a
  * 16384^2 snapshot never needs to be in memory at once.
  */
@@ -34,7 +35,7 @@ int ss_render_source_open(struct ss_render_source *s, const char *path)
 	const int block = ss_snapshot_file_block_rows(f);
 	for (int j0 = 0; j0 < f->ny && !err; j0 += block) {
 		const int rows = f->ny - j0 < block ? f->ny - j0 : block;
-		err = ss_snapshot_file_read_cell_types(&s->file, j0, rows,
+		err = ss_snapshot_file_read_cell_flags(&s->file, j0, rows,
 		                                       s->cell_type + (size_t)j0 * f->nx);
 	}
 	if (err)
@@ -63,7 +64,7 @@ int ss_render_source_range(struct ss_render_source *s, long long first, long lon
 				for (int i = 0; i < nx; i++) {
 					const size_t k = (size_t)j * nx + i;
 					const double v = buf[k];
-					if (ct[k] != SS_CELL_WALL && isfinite(v)) {
+					if (!ss_render_no_sand(ct[k]) && isfinite(v)) {
 						lo = v < lo ? v : lo;
 						hi = v > hi ? v : hi;
 					}

@@ -1,6 +1,7 @@
 /*
- * series_render.c - `sandslide render`: the frames of a file, in time
- * order, and the video (render.h).
+ * series_render.c - `sandslide render`: the chosen snapshots of a file as
+ * frames (all of them in time order, or a Python slice of them in its
+ * order), a video of them and a viewer (render.h).
  *
  * Everything that can be checked is checked before the first frame is
  * written: the file, the frame selection, the output folder, the video's
@@ -32,13 +33,14 @@
 /* Frames up to this size are rendered one per thread. */
 #define FRAME_PARALLEL_MAX_PIXELS (16ll << 20)
 
-/* One integer of a frame range; empty gives `def`.  -1 if malformed. */
-static int parse_index(const char *s, size_t len, long long def, long long *out)
+/* One integer of a frame range into *out, *given 0 when it is empty;
+ * -1 if malformed. */
+static int parse_index(const char *s, size_t len, long long *out, int *given)
 {
-	if (len == 0) {
-		*out = def;
+	*given = len > 0;
+	*out = 0;
+	if (len == 0)
 		return 0;
-	}
 	char buf[32], *end;
 	if (len >= sizeof buf)
 		return -1;
@@ -49,36 +51,67 @@ static int parse_index(const char *s, size_t len, long long def, long long *out)
 	return *end || errno || end == buf ? -1 : 0;
 }
 
-/* The snapshots named by "A:B:STEP" (a Python slice without clamping:
- * negative counts from the end, B exclusive) or "A"; SS_ERR_INPUT if the
- * range leaves the series or is empty. */
+/* A bound of a slice as Python's slice.indices() takes it: negative
+ * counts from the end, then clamped to [lo, hi]. */
+static long long slice_bound(long long v, long long count, long long lo, long long hi)
+{
+	if (v < 0)
+		v = v < -count ? lo : v + count;   /* no overflow for any v */
+	return v < lo ? lo : v > hi ? hi : v;
+}
+
+/*
+ * The snapshots named by "A", one index (negative counts from the end; it
+ * must be in the series), or by "A:B:STEP", a Python slice of the count
+ * snapshots: A, A+STEP, ... up to B exclusive, each part optional, bounds
+ * counted from the end when negative and clamped to the series, a negative
+ * STEP going backwards (from the last snapshot by default, so "::-1" is
+ * every snapshot in reverse), STEP 0 refused.  In that order; SS_ERR_INPUT
+ * if the selection is empty.
+ */
 static int select_range(const char *spec, long long count, long long **out, long long *n)
 {
 	const char *c1 = strchr(spec, ':'), *c2 = c1 ? strchr(c1 + 1, ':') : NULL;
 	long long a, b, step = 1;
-	int bad;
+	int has_a, has_b, has_step = 0, bad;
 	if (!c1) {
-		bad = parse_index(spec, strlen(spec), 0, &a) || strlen(spec) == 0;
-		b = a < 0 ? a + count + 1 : a + 1;
+		bad = parse_index(spec, strlen(spec), &a, &has_a) || !has_a;
+		if (!bad && (a < -count || a >= count))
+			return ss_error_input("--frames '%s' is outside the series: it has %lld snapshots, "
+			                      "0 to %lld (or -%lld to -1 from the end)", spec, count,
+			                      count - 1, count);
+		a = a < 0 ? a + count : a;
+		b = a + 1;
 	} else {
-		bad = parse_index(spec, (size_t)(c1 - spec), 0, &a) ||
-		      parse_index(c1 + 1, c2 ? (size_t)(c2 - c1 - 1) : strlen(c1 + 1), count, &b) ||
-		      (c2 && (parse_index(c2 + 1, strlen(c2 + 1), 1, &step) || strchr(c2 + 1, ':')));
-		if (!bad && b < 0)
-			b += count;
+		bad = parse_index(spec, (size_t)(c1 - spec), &a, &has_a) ||
+		      parse_index(c1 + 1, c2 ? (size_t)(c2 - c1 - 1) : strlen(c1 + 1), &b, &has_b) ||
+		      (c2 && (strchr(c2 + 1, ':') ||
+		              parse_index(c2 + 1, strlen(c2 + 1), &step, &has_step)));
+		step = has_step ? step : 1;
+		if (!bad && step == 0)
+			return ss_error_input("--frames '%s': STEP is 0; expected a step of 1 or more, or "
+			                      "-1 or less to go backwards", spec);
+		if (!bad && step > 0) {
+			a = has_a ? slice_bound(a, count, 0, count) : 0;
+			b = has_b ? slice_bound(b, count, 0, count) : count;
+		} else if (!bad) {
+			a = has_a ? slice_bound(a, count, -1, count - 1) : count - 1;
+			b = has_b ? slice_bound(b, count, -1, count - 1) : -1;
+		}
 	}
-	if (bad || step < 1)
-		return ss_error_input("--frames '%s': expected A:B:STEP (snapshots A, A+STEP, ... "
-		                      "before B; negative counts from the end) or one index A", spec);
-	if (a < 0)
-		a += count;
-	if (a < 0 || a >= count || b < 0 || b > count)
-		return ss_error_input("--frames '%s' is outside the series: it has %lld snapshots, "
-		                      "0 to %lld", spec, count, count - 1);
-	if (b <= a)
-		return ss_error_input("--frames '%s' selects no snapshot (the end %lld is not after "
-		                      "the start %lld)", spec, b, a);
-	*n = (b - a + step - 1) / step;
+	if (bad)
+		return ss_error_input("--frames '%s': expected A:B:STEP, a Python slice (snapshots "
+		                      "A, A+STEP, ... before B; negative counts from the end; parts "
+		                      "may be left out) or one index A", spec);
+	/* a step longer than the series takes one snapshot however long it is:
+	 * bounded, so that nothing below overflows */
+	step = step > count ? count : step < -count ? -count : step;
+	/* the count of range(a, b, step) */
+	*n = step > 0 ? (b > a ? (b - a - 1) / step + 1 : 0)
+	              : (a > b ? (a - b - 1) / -step + 1 : 0);
+	if (*n == 0)
+		return ss_error_input("--frames '%s' selects no snapshot of the %lld (0 to %lld): "
+		                      "the slice is empty", spec, count, count - 1);
 	*out = malloc((size_t)*n * sizeof **out);
 	if (!*out)
 		return ss_error_fail("out of memory");
@@ -107,34 +140,6 @@ static int select_time(const struct ss_render_source *s, double t, long long **o
 		return ss_error_fail("out of memory");
 	(*out)[0] = best;
 	*n = 1;
-	return SS_OK;
-}
-
-/* Frames go out in time order, whatever order the file has. */
-struct timed {
-	double t;
-	long long k;
-};
-
-static int by_time(const void *pa, const void *pb)
-{
-	const struct timed *a = pa, *b = pb;
-	if (a->t != b->t)
-		return a->t < b->t ? -1 : 1;
-	return a->k < b->k ? -1 : a->k > b->k;
-}
-
-static int sort_by_time(const struct ss_render_source *s, long long *sel, long long n)
-{
-	struct timed *v = malloc((size_t)n * sizeof *v);
-	if (!v)
-		return ss_error_fail("out of memory");
-	for (long long k = 0; k < n; k++)
-		v[k] = (struct timed){s->file.time[sel[k]], sel[k]};
-	qsort(v, (size_t)n, sizeof *v, by_time);
-	for (long long k = 0; k < n; k++)
-		sel[k] = v[k].k;
-	free(v);
 	return SS_OK;
 }
 
@@ -194,6 +199,36 @@ static int check_video_path(const char *video)
 	return SS_OK;
 }
 
+/*
+ * The frames of a video that no -o keeps: a folder made for them beside
+ * the video (its folder is writable, which was checked; /tmp may be a
+ * small tmpfs), hidden and unique, removed with them once the video is
+ * made or has failed.
+ */
+static int make_frame_folder(const char *video, char *dir, size_t size)
+{
+	char parent[4096];
+	parent_of(video, parent, sizeof parent);
+	snprintf(dir, size, "%s/.sandslide-frames-XXXXXX", parent);
+	if (!mkdtemp(dir))
+		return ss_error_fail("cannot make a folder for the frames of the video '%s' in "
+		                     "'%s': %s", video, parent, strerror(errno));
+	return SS_OK;
+}
+
+/* Remove the frames 0 .. n - 1 in dir and dir itself.  Best effort: the
+ * video is made (or its failure reported) by then, and a folder that
+ * will not go away is left, hidden, rather than turned into a failure. */
+static void remove_frame_folder(const char *dir, long long n)
+{
+	char path[4200];
+	for (long long k = 0; k < n; k++) {
+		ss_render_frame_path(dir, k, path, sizeof path);
+		remove(path);
+	}
+	rmdir(dir);
+}
+
 /* Without force, nothing that exists is replaced: not the frames about
  * to be written (frame_00000.png .. of the n chosen) nor the video. */
 static int check_not_there(const struct ss_render_series_options *o, long long n)
@@ -223,7 +258,8 @@ static int check_not_there(const struct ss_render_series_options *o, long long n
 	return SS_OK;
 }
 
-/* The chosen snapshots, in time order. */
+/* The chosen snapshots, in the order they are drawn: --frames', else all
+ * in the file's order, which is time order (a series' times increase). */
 static int select_frames(const struct ss_render_series_options *o,
                          const struct ss_render_source *s, long long **sel, long long *n)
 {
@@ -236,7 +272,7 @@ static int select_frames(const struct ss_render_series_options *o,
 		err = select_time(s, o->time, sel, n);
 	else
 		err = select_range("0:", s->file.count, sel, n);
-	return err ? err : sort_by_time(s, *sel, *n);
+	return err;
 }
 
 /* One frame: its PNG to the folder (dir, or NULL) and to the viewer (html,
@@ -340,15 +376,21 @@ int ss_render_series(const struct ss_render_series_options *o,
                      struct ss_render_series_report *report)
 {
 	const double started = ss_parallel_wall_seconds();
+	char tmp_dir[4200] = "";    /* the frames of a video alone */
 	memset(report, 0, sizeof *report);
 	int err = ss_render_options_check(&o->look);
 	if (err)
 		return err;
 	if ((o->video || o->html) && (o->fps < 1 || o->fps > 240))
 		return ss_error_input("--fps %d: expected 1 to 240 frames per second", o->fps);
-	if (!o->output_dir && (o->video || !o->html))
-		return ss_error_input("no folder for the frames: %s", o->video ? "--video needs one"
-		                      : "give one, or --html to put the frames in a viewer");
+	if (!o->output_dir && !o->video && !o->html)
+		return ss_error_input("no folder for the frames: give one, or --html to put the "
+		                      "frames in a viewer, or --video to make a video of them");
+	/* a video alone keeps no frames: without ffmpeg there would be nothing */
+	if (o->video && !o->output_dir && !ss_render_ffmpeg_found())
+		return ss_error_input("cannot make the video '%s': ffmpeg is not on PATH (Debian: "
+		                      "apt-get install ffmpeg); give -o DIR to keep the frames "
+		                      "instead", o->video);
 
 	struct ss_render_source s;
 	if ((err = ss_render_source_open(&s, o->input)))
@@ -373,11 +415,18 @@ int ss_render_series(const struct ss_render_series_options *o,
 	if (o->html && (err = ss_render_html_create(&html, &plan, &s, sel, n,
 	                                            !isnan(o->look.zmin) || !isnan(o->look.zmax))))
 		goto out_plan;
+	/* the frames' folder: -o's, or for a video alone a temporary one */
+	const char *dir = o->output_dir;
 	if (o->output_dir && (err = ss_render_check_dir(o->output_dir, 1)))
 		goto out_html;
+	if (!dir && o->video) {
+		if ((err = make_frame_folder(o->video, tmp_dir, sizeof tmp_dir)))
+			goto out_html;
+		dir = tmp_dir;
+	}
 
 	const double t0 = ss_parallel_wall_seconds();
-	if ((err = render_frames(&plan, &s, sel, n, o->output_dir, html)))
+	if ((err = render_frames(&plan, &s, sel, n, dir, html)))
 		goto out_html;
 	report->render_seconds = ss_parallel_wall_seconds() - t0;
 	report_frames(o, &s, &plan, sel, n, report);
@@ -389,9 +438,11 @@ int ss_render_series(const struct ss_render_series_options *o,
 	}
 	report->seconds = ss_parallel_wall_seconds() - started;
 	if (o->video)
-		err = ss_render_video(o->output_dir, n, o->fps, o->video, &report->video);
+		err = ss_render_video(dir, n, o->fps, o->video, &report->video);
 
 out_html:
+	if (tmp_dir[0])
+		remove_frame_folder(tmp_dir, n);
 	ss_render_html_destroy(html);
 out_plan:
 	ss_render_plan_release(&plan);

@@ -16,14 +16,16 @@
  *          vector L towards the light.  40 % ambient keeps faces turned
  *          away from the light readable in colour.  Walls are one dark
  *          colour and open cells one light colour, unshaded, so they read
- *          as "not sand" at a glance.  Contour lines every dz metres are
+ *          as "not sand" at a glance; cells without data are the
+ *          background, white, as if the map ended there.  Contour lines every dz metres are
  *          drawn on the pixel below each level: pixel p is on the line of
  *          level k dz when p lies below it and a 4-neighbour at or above
  *          it, so lines are one pixel wide and flat ground lying exactly on
  *          a level draws none.
  *
- * gray16   16-bit grey: 0 is "no sand here" (walls, NaN; marked transparent
- *          by the PNG's tRNS chunk) and heights map linearly onto 1..65535,
+ * gray16   16-bit grey: 0 is "no sand here" (walls, cells without data,
+ *          NaN; marked transparent by the PNG's tRNS chunk) and heights map
+ *          linearly onto 1..65535,
  *
  *            v = 1 + round((h - zmin) / (zmax - zmin) * 65534)   (clamped)
  *
@@ -44,7 +46,7 @@ static inline int has_sand(const struct ss_render_raster *r, int x, int y)
 {
 	if (x < 0 || y < 0 || x >= r->width || y >= r->height)
 		return 0;
-	return r->type[(size_t)y * r->width + x] != SS_CELL_WALL &&
+	return !ss_render_no_sand(r->type[(size_t)y * r->width + x]) &&
 	       !isnan(ss_render_raster_h(r, x, y));
 }
 
@@ -101,8 +103,8 @@ static inline int gradient_inside(const struct ss_render_raster *r, int x, int y
 	const size_t w = (size_t)r->width;
 	const uint8_t *tn = r->type + (size_t)(y - v) * w + x, *tc = r->type + (size_t)y * w + x,
 	              *ts = r->type + (size_t)(y + v) * w + x;
-	if ((tn[-u] | tn[0] | tn[u] | tc[-u] | tc[u] | ts[-u] | ts[0] | ts[u]) & SS_CELL_WALL)
-		return 0;   /* flow 0, wall 1, open 2: any wall sets bit 0 */
+	if (ss_render_no_sand(tn[-u] | tn[0] | tn[u] | tc[-u] | tc[u] | ts[-u] | ts[0] | ts[u]))
+		return 0;   /* a wall (1) or no data (3) sets bit 0 (internal.h) */
 	const double *hn = r->h + (ptrdiff_t)(y - v) * r->stride + x;
 	const double *hc = r->h + (ptrdiff_t)y * r->stride + x;
 	const double *hs = r->h + (ptrdiff_t)(y + v) * r->stride + x;
@@ -173,7 +175,9 @@ void ss_render_shaded(const struct ss_render_raster *r, const struct ss_render_o
 	struct ss_render_light light;
 	ss_render_light_init(&light, o->azimuth_deg, o->altitude_deg, o->zscale);
 	const uint8_t wall[3] = {SS_RENDER_WALL_RGB}, open[3] = {SS_RENDER_OPEN_RGB},
-	              nodata[3] = {SS_RENDER_NODATA_RGB};
+	              nodata[3] = {SS_RENDER_NODATA_RGB},
+	              absent[3] = {SS_RENDER_BACKGROUND, SS_RENDER_BACKGROUND,
+	                           SS_RENDER_BACKGROUND};
 	const double dz = o->contour;
 	const int W = r->width, H = r->height;
 
@@ -186,6 +190,7 @@ void ss_render_shaded(const struct ss_render_raster *r, const struct ss_render_o
 			const double v = hrow[x];
 			const uint8_t *c = types[x] == SS_CELL_WALL ? wall
 			                 : types[x] == SS_CELL_OPEN ? open
+			                 : types[x] == SS_RENDER_CELL_NODATA ? absent
 			                 : isnan(v) ? nodata : NULL;
 			uint8_t *p = row + 3 * (size_t)x;
 			if (c) {
@@ -219,7 +224,7 @@ void ss_render_gray16(const struct ss_render_raster *r, double zmin, double zmax
 		const double *hrow = r->h + (ptrdiff_t)y * r->stride;
 		for (int x = 0; x < W; x++) {
 			const double v = hrow[x];
-			if (types[x] == SS_CELL_WALL || isnan(v)) {
+			if (ss_render_no_sand(types[x]) || isnan(v)) {
 				row[x] = 0;
 				continue;
 			}

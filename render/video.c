@@ -73,6 +73,12 @@ static int has_mp4_container(const char *video)
 	return !dot || !strcmp(dot, ".mp4") || !strcmp(dot, ".mov") || !strcmp(dot, ".m4v");
 }
 
+int ss_render_ffmpeg_found(void)
+{
+	char ffmpeg[4096];
+	return find_on_path("ffmpeg", ffmpeg, sizeof ffmpeg) == 0;
+}
+
 int ss_render_video(const char *dir, long long count, int fps, const char *video,
                     enum ss_render_video_made *made)
 {

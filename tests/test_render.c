@@ -959,6 +959,123 @@ static void test_write_failure_leaves_nothing(void)
 	ss_render_image_release(&img);
 }
 
+/* ---- cells without data ------------------------------------------------ */
+
+/* Is p a lit face of an oblique wall: 8c 8c 96 (oblique.c) times a
+ * brightness, red and green equal and blue a little above? */
+static int wall_grey(const uint8_t *p)
+{
+	return p[0] == p[1] && p[2] > p[1] && p[2] - p[1] <= 12;
+}
+
+/*
+ * Cells without data (SS_RENDER_CELL_NODATA: a DEM's nodata round its
+ * outline) are absent in every style: the background (white) in shaded
+ * and oblique, 0 (transparent) in gray16, never a wall; their heights
+ * (1000 m here) reach no colour, no gradient and not the height scale; a
+ * wall side with no data all along it is not drawn.  The same field with
+ * walls there instead is the check that each property can fail.
+ */
+static void test_nodata_cells_are_absent(void)
+{
+	const int n = 40;
+	struct field t, w;
+	field_init(&t, n, n);
+	field_init(&w, n, n);
+	int cells_without = 0;
+	for (int j = 0; j < n; j++)
+		for (int i = 0; i < n; i++) {
+			const int inside = hypot(i + 0.5 - 20.0, j + 0.5 - 20.0) < 15.0;
+			*H(&t, i, j) = *H(&w, i, j) = inside ? 1.0 : 1000.0;
+			*T(&t, i, j) = inside ? SS_CELL_FLOW : SS_RENDER_CELL_NODATA;
+			*T(&w, i, j) = inside ? SS_CELL_FLOW : SS_CELL_WALL;
+			cells_without += !inside;
+		}
+	t.f.wall_sides = w.f.wall_sides = 0xf;   /* relax's sides are walls */
+	struct ss_render_options o;
+	ss_render_options_default(&o);
+	struct ss_render_image a, b;
+
+	/* shaded: white where there is no data, one colour on the flat sand */
+	CHECK(ss_render_field(&t.f, &o, &a) == SS_OK && ss_render_field(&w.f, &o, &b) == SS_OK,
+	      "render shaded");
+	int pw, ph;
+	ss_render_picture_size(n, n, t.f.dx, t.f.dy, &o, &pw, &ph);
+	CHECK(a.width == pw && a.height == ph, "no wall side drawn along sides without data: "
+	      "%d x %d px, the map is %d x %d", a.width, a.height, pw, ph);
+	CHECK(b.width > pw && b.height > ph, "with walls there, the wall sides are drawn");
+	CHECK(a.zmin == 0.5 && a.zmax == 1.5, "the scale is the flat sand's, widened: %g .. %g "
+	      "(1000 m of the cells without data must not enter it)", a.zmin, a.zmax);
+	const uint8_t *sand = rgb_at(&a, a.width / 2, a.height / 2), *corner = rgb_at(&a, 0, 0);
+	CHECK(corner[0] == 255 && corner[1] == 255 && corner[2] == 255,
+	      "a cell without data is the white background: (%d, %d, %d)", corner[0], corner[1],
+	      corner[2]);
+	int white = 0, other = 0;
+	for (int y = 0; y < a.height; y++)
+		for (int x = 0; x < a.width; x++) {
+			const uint8_t *p = rgb_at(&a, x, y);
+			if (p[0] == 255 && p[1] == 255 && p[2] == 255)
+				white++;
+			else
+				other += memcmp(p, sand, 3) != 0;
+		}
+	CHECK(other == 0, "%d pixels of the flat sand differ from its colour: the cells without "
+	      "data leaked into the shading", other);
+	CHECK(white > 0.3 * a.width * a.height, "cells without data are white: %d px", white);
+	ss_render_image_release(&a);
+	ss_render_image_release(&b);
+
+	/* gray16: 0, transparent, as walls are */
+	o.style = SS_RENDER_GRAY16;
+	CHECK(ss_render_field(&t.f, &o, &a) == SS_OK, "render gray16");
+	int zeros = 0;
+	for (int y = 0; y < a.height; y++)
+		for (int x = 0; x < a.width; x++)
+			zeros += ((const uint16_t *)(a.pixels + (size_t)y * a.row_bytes))[x] == 0;
+	CHECK(a.width == n && zeros == cells_without, "gray16: %d zero (transparent) pixels, "
+	      "%d cells without data", zeros, cells_without);
+	ss_render_image_release(&a);
+
+	/* oblique: no grey wall anywhere, where the walls make plenty */
+	ss_render_options_default(&o);
+	o.style = SS_RENDER_OBLIQUE;
+	o.zmin = 0.0;
+	o.zmax = 2.0;
+	o.view_azimuth_deg = 200.0;
+	CHECK(ss_render_field(&t.f, &o, &a) == SS_OK && ss_render_field(&w.f, &o, &b) == SS_OK,
+	      "render oblique");
+	int grey_a = 0, grey_b = 0, white_a = 0, white_b = 0;
+	for (int y = 0; y < a.height; y++)
+		for (int x = 0; x < a.width; x++) {
+			const uint8_t *p = rgb_at(&a, x, y);
+			grey_a += wall_grey(p);
+			white_a += p[0] == 255 && p[1] == 255 && p[2] == 255;
+		}
+	for (int y = 0; y < b.height; y++)
+		for (int x = 0; x < b.width; x++) {
+			const uint8_t *p = rgb_at(&b, x, y);
+			grey_b += wall_grey(p);
+			white_b += p[0] == 255 && p[1] == 255 && p[2] == 255;
+		}
+	CHECK(grey_a == 0, "oblique: %d grey wall pixels where cells have no data", grey_a);
+	CHECK(grey_b > 1000, "oblique: the same cells as walls make grey blocks: %d px", grey_b);
+	CHECK(white_a > white_b + 1000, "oblique: the cells without data show the background: "
+	      "%d white px, %d with walls there", white_a, white_b);
+	struct ss_render_image again;
+	const int threads = ss_parallel_max_threads();
+	ss_parallel_set_threads(1);
+	CHECK(ss_render_field(&t.f, &o, &again) == SS_OK, "render");
+	ss_parallel_set_threads(threads);
+	CHECK(again.width == a.width && again.height == a.height &&
+	      !memcmp(again.pixels, a.pixels, a.row_bytes * a.height),
+	      "oblique with cells without data: same bits on 1 and %d threads", threads);
+	ss_render_image_release(&again);
+	ss_render_image_release(&a);
+	ss_render_image_release(&b);
+	field_release(&t);
+	field_release(&w);
+}
+
 int main(void)
 {
 	const char *base = getenv("TMPDIR");
@@ -983,6 +1100,7 @@ int main(void)
 	RUN(test_oblique_wall_sides_follow_sand);
 	RUN(test_oblique_view_from_open_side);
 	RUN(test_dune_lightness_linear);
+	RUN(test_nodata_cells_are_absent);
 	RUN(test_bad_options);
 	RUN(test_write_failure_leaves_nothing);
 	char cmd[600];

@@ -10,12 +10,17 @@
  *                 area averaging when the picture is smaller than the grid
  *                 (--max-size), bilinear between cell centres when it is
  *                 larger (small grids are drawn at K pixels per cell); wall
- *                 cells never enter an average.
+ *                 cells and cells without data never enter an average.
  *   2. colour     shaded:  colour map of height x hillshade (Horn's method),
  *                          walls dark, open cells light, optional contours;
  *                 gray16:  16-bit grey, linear between zmin and zmax;
  *                 oblique: a perspective view, z-buffered triangles, walls
  *                          as raised blocks.
+ *                 Cells without data (SS_RENDER_CELL_NODATA) are absent in
+ *                 every style: the background (white) in shaded and
+ *                 oblique, transparent in gray16, as if the grid ended
+ *                 there; a wall side of the grid with no data all along it
+ *                 is not drawn either.
  *                 Then the optional time label and colour bar.
  *   3. encode     libpng, to a temporary name renamed into place, with the
  *                 time, the height scale and the snapshot in text chunks.
@@ -42,6 +47,11 @@ enum ss_render_cmap {
 	SS_RENDER_CMAP_TERRAIN,  /* blue - green - sand - brown - white */
 	SS_RENDER_CMAP_GRAY,     /* black to white */
 };
+
+/* A cell_type (struct ss_render_field) of a cell without data, such as
+ * the nodata cells of a DEM: /cell_type 3 of a sandslide file
+ * (SS_SNAPSHOT_CELL_NODATA, snapshot.h). */
+#define SS_RENDER_CELL_NODATA 3
 
 /* Colours of the shaded style for cells that are not sand, and for
  * heights that are not numbers (R, G, B). */
@@ -99,7 +109,8 @@ struct ss_render_field {
 	ptrdiff_t stride;           /* elements between rows, >= nx */
 	const double *height;       /* m: cell (i, j) at height[j * stride + i],
 	                             * i west to east, j = 0 the south row */
-	const uint8_t *cell_type;   /* enum ss_cell_type (grid.h), same layout;
+	const uint8_t *cell_type;   /* enum ss_cell_type (grid.h) or
+	                             * SS_RENDER_CELL_NODATA, same layout;
 	                             * NULL: every cell is a flow cell */
 	double time;                /* s */
 	unsigned wall_sides;        /* bit 1 << enum ss_side (boundary.h) for each
@@ -152,9 +163,15 @@ int ss_render_write_png(const struct ss_render_image *img, const char *path,
 struct ss_render_series_options {
 	const char *input;          /* the .h5 file */
 	const char *output_dir;     /* frames go here (created if missing); NULL:
-	                             * no frame files (only with html, no video) */
-	const char *frames;         /* "A:B:STEP" (B exclusive, as a Python slice;
-	                             * negative counts from the end), "A", or NULL: all */
+	                             * none are kept (with html or video: a video's
+	                             * frames go to a temporary folder beside it,
+	                             * removed once the video is made) */
+	const char *frames;         /* "A:B:STEP", a Python slice of the snapshots
+	                             * (B exclusive, negative counts from the end,
+	                             * parts optional, bounds clamped to the series,
+	                             * a negative STEP going backwards, STEP 0
+	                             * refused), drawn in its order; "A", one index;
+	                             * NULL: all, in time order */
 	double time;                /* s: the snapshot nearest this; NAN: unused */
 	const char *video;          /* FILE.mp4 to assemble with ffmpeg, or NULL */
 	int fps;                    /* frames per second of the video, and the
@@ -201,13 +218,15 @@ struct ss_render_series_report {
 
 /*
  * Render the chosen snapshots of o->input to output_dir/frame_00000.png,
- * frame_00001.png, ... in time order, then the video if asked for (without
- * ffmpeg on PATH the frames are kept, and that is success), and the
- * viewer o->html if asked for (the same frames, rendered once for both).
- * Everything is checked before the first frame is written.  Returns SS_OK
- * (*report filled), SS_ERR_INPUT (not a sandslide file, no snapshots, a
- * range outside the series, an unwritable folder, zmin >= zmax, frames, a
- * video or a viewer there already without force) or SS_ERR_FAIL.
+ * frame_00001.png, ... in the order chosen, then the video if asked for
+ * (without ffmpeg on PATH the frames in output_dir are kept, and that is
+ * success), and the viewer o->html if asked for (the same frames, rendered
+ * once for all).  Everything is checked before the first frame is
+ * written.  Returns SS_OK (*report filled), SS_ERR_INPUT (not a sandslide
+ * file, no snapshots, an index outside the series or an empty slice, an
+ * unwritable folder, zmin >= zmax, frames, a video or a viewer there
+ * already without force, a video without output_dir and without ffmpeg)
+ * or SS_ERR_FAIL.
  */
 int ss_render_series(const struct ss_render_series_options *o,
                      struct ss_render_series_report *report);

@@ -9,7 +9,9 @@
  *   /height      float64 (time, y, x), chunked, extendible in time
  *   /time        float64 (time), s
  *   /x, /y       float64 cell centres, m
- *   /cell_type   uint8 (y, x), flag_values 0 1 2, "flow wall open"
+ *   /cell_type   int8 (y, x), flag_values 0 1 2, "flow wall open"; with
+ *                cells without data (relax of a DEM with nodata) 0 1 2 3,
+ *                "flow wall open nodata"
  *   /bedrock     float64 (y, x), m, only with a bedrock (NaN off flow cells)
  *   /volume /inflow /outflow /max_height /max_slope_deg /steps
  *   /active_fraction /wall_seconds      float64 (time)
@@ -31,6 +33,15 @@
 
 struct ss_snapshot;   /* opaque: owns the HDF5 handles */
 
+/* /cell_type of a cell without data (a nodata cell of relax's DEM).  Not a
+ * cell type of the stepper (grid.h), which holds such a cell as a wall, or
+ * as open with --nodata open: the file says that it has no data, so that
+ * the renderer draws it as absent rather than as a wall, and a DEM read
+ * from the file has it as nodata again.  /height is NaN there, as at
+ * walls.  Every other reader takes it for a wall (ss_snapshot_file_read_
+ * cell_types). */
+#define SS_SNAPSHOT_CELL_NODATA 3
+
 struct ss_snapshot_meta {
 	const char *title;
 	const char *history;     /* the command line */
@@ -49,6 +60,12 @@ struct ss_snapshot_meta {
 	                          * CF grid mapping variable /crs */
 	const struct ss_boundary *boundary; /* the grid's sides (root attribute
 	                          * boundary), or NULL: not written */
+	const uint8_t *nodata;   /* the whole grid's cells without data (nx x
+	                          * global_ny bytes, south row first, nonzero: no
+	                          * data, as struct ss_raster holds them), or
+	                          * NULL: none.  Written as /cell_type
+	                          * SS_SNAPSHOT_CELL_NODATA and NaN in /height,
+	                          * whatever the stepper's type of the cell */
 };
 
 /* Call first in a program: HDF5 quiet (errors are reported by the callers)
@@ -63,17 +80,19 @@ int ss_snapshot_create(struct ss_snapshot **out, const char *path,
                        const struct ss_grid *g, const uint8_t *cell_types,
                        const struct ss_snapshot_meta *meta);
 
-/* Append one snapshot (height with the grid's halo layout; walls are
- * written as NaN, the _FillValue, so cell_types in the same layout) and,
+/* Append one snapshot (height with the grid's halo layout; walls and
+ * cells without data are written as NaN, the _FillValue, so cell_types in
+ * the same layout) and,
  * when state is not NULL, the restart state (root attribute
  * restart_state), flush the file and rewrite the XDMF sidecar. */
 int ss_snapshot_append(struct ss_snapshot *s, double time_s, const double *height,
                        const uint8_t *cell_types, const struct ss_diagnostics *d,
                        const struct ss_restart_state *state);
 
-/* Reopen an output of grid g to append snapshots to it (a restart).
- * SS_ERR_INPUT if it is not a sandslide output (ss_snapshot_file_open) of
- * that grid with at least one snapshot. */
+/* Reopen an output of grid g to append snapshots to it (a restart, or the
+ * guard of drive.h), with the cells without data it has.  SS_ERR_INPUT if
+ * it is not a sandslide output (ss_snapshot_file_open) of that grid with
+ * at least one snapshot. */
 int ss_snapshot_open_append(struct ss_snapshot **out, const char *path,
                             const struct ss_grid *g);
 
@@ -140,6 +159,8 @@ struct ss_snapshot_summary {
 	double *time;
 	struct ss_diagnostics *diag;
 	long long flow_cells, wall_cells, open_cells;
+	long long nodata_cells;  /* without data (SS_SNAPSHOT_CELL_NODATA), not
+	                          * counted in wall_cells */
 };
 
 /* Read the summary of a sandslide file; SS_ERR_INPUT if it is not one or
@@ -216,9 +237,15 @@ int ss_snapshot_file_read_rows(struct ss_snapshot_file *f, long long t, int j0, 
                                double *out);
 
 /* Rows j0 .. j0 + rows - 1 of /cell_type into out (rows * nx, south row
- * first); SS_ERR_INPUT if a value is not a cell type (0 flow, 1 wall,
- * 2 open) or the rows cannot be read.  Thread-safe as read_rows. */
+ * first) as the stepper's cell types (enum ss_cell_type): a cell without
+ * data is a wall, as the stepper held it by default.  SS_ERR_INPUT if a
+ * value is not one of the file's (0 flow, 1 wall, 2 open, 3 no data) or
+ * the rows cannot be read.  Thread-safe as read_rows. */
 int ss_snapshot_file_read_cell_types(struct ss_snapshot_file *f, int j0, int rows,
+                                     uint8_t *out);
+/* The same as the file has them: SS_SNAPSHOT_CELL_NODATA for a cell
+ * without data (the renderer, and a DEM read from the file). */
+int ss_snapshot_file_read_cell_flags(struct ss_snapshot_file *f, int j0, int rows,
                                      uint8_t *out);
 
 /* Rows per read that take whole chunks of /height, about 8 MB of them. */

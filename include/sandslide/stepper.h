@@ -26,15 +26,17 @@
  *              state), so no state a stage can reach is unstable;
  *   accuracy   s <= rkl2_max_stages, and the embedded error estimate of
  *              RKC and SUNDIALS (sweep.h, ss_sweep_stage_estimate) at most
- *              rkl2_tol tan(a_cr) min(dx, dy) in the max norm: the estimate
- *              of a super-step is made by the next one's first stage, and
- *              sets the limit of the one after, tau 0.9 sqrt(tol / est),
- *              growing by at most 2x a super-step, from 4 stages at the
- *              start.  A limit on the change per super-step was tried
- *              first: it let super-steps grow without end as a state comes
- *              to rest, where RKL2 damps the stiff remainder only by its
- *              a_s ~ 1/2 a super-step (a relaxing cone took 150 times
- *              Euler's simulated time and 3 times its evaluations);
+ *              rkl2_tol tan(a_cr) min(dx, dy) in the max norm.  One more
+ *              evaluation after the last stage, at Y_s, writing nothing,
+ *              makes the estimate of a super-step, which sets the limit of
+ *              the next, tau 0.9 sqrt(tol / est), growing by at most 2x a
+ *              super-step, from 4 stages at the start.  The limit is
+ *              known when a super-step ends and is saved with each
+ *              snapshot (restart state), so a restart from a snapshot
+ *              takes the same super-steps.  The estimate, not
+ *              the size of the change, bounds the super-steps as a state
+ *              comes to rest, where RKL2 damps the stiff remainder only by
+ *              its a_s ~ 1/2 a super-step;
  *   events     super-steps end on target times and source switches, so a
  *              source is constant over a super-step (its value at every
  *              stage time), and the source rule above holds for tau;

@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "base/strings.h"
 #include "sandslide/comm.h"
 #include "sandslide/error.h"
 #include "sandslide/parallel.h"
@@ -176,8 +177,9 @@ static void keep_last_good_state(struct ss_drive *d)
 	snprintf(t->cell, sizeof t->cell, "a cell");
 	const struct ss_grid *g = &st->grid;
 	if (ss_stepper_first_nonfinite(st, &i, &j))   /* global (i, j) */
-		snprintf(t->cell, sizeof t->cell, "cell (%d, %d) at x = %g m, y = %g m", i, j,
-		         g->origin_x + (i + 0.5) * g->dx, g->origin_y + (j + 0.5) * g->dy);
+		snprintf(t->cell, sizeof t->cell, "cell (%d, %d) at x = %s m, y = %s m", i, j,
+		         SS_REAL(g->origin_x + (i + 0.5) * g->dx),
+		         SS_REAL(g->origin_y + (j + 0.5) * g->dy));
 	t->step = st->steps;
 	t->time = st->time;
 	t->snapshots = ss_drive_snapshots(d);
@@ -257,13 +259,18 @@ int ss_drive_run(struct ss_drive *d, enum ss_drive_end *end)
 		const enum ss_advance_end e = ss_stepper_advance(st, next_target(d, st->time, &k), &adv);
 		if (e == SS_ADVANCE_STALLED)
 			return stalled(d);
-		int err = e == SS_ADVANCE_NONFINITE ? STATE_NONFINITE : keep_state(d);
+		/* steady or stopped before the clock moved: that state is the
+		 * series' last snapshot already, and a second one at the same
+		 * time would make the time axis non-unique (xarray) */
+		const int kept = d->snapshot && ss_snapshot_count(d->snapshot) > 0 &&
+		                 ss_snapshot_last_time(d->snapshot) == st->time;
+		int err = e == SS_ADVANCE_NONFINITE ? STATE_NONFINITE : kept ? SS_OK : keep_state(d);
 		if (err == STATE_NONFINITE) {
 			keep_last_good_state(d);
 			*end = SS_DRIVE_NONFINITE;
 			return SS_OK;
 		}
-		if (err || (err = announce(d)))
+		if (err || (!kept && (err = announce(d))))
 			return err;
 		if (e == SS_ADVANCE_STEADY || e == SS_ADVANCE_INTERRUPTED) {
 			*end = e == SS_ADVANCE_STEADY ? SS_DRIVE_STEADY : SS_DRIVE_INTERRUPTED;

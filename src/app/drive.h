@@ -5,7 +5,9 @@
  * clipped to `end`, until the end, a steady state (max |dh/dt| < steady_tol
  * with no source still to switch on) or a stop signal.  At each target the
  * state is checked and, with a series, appended to the output as a snapshot
- * (which first checks that it fits, snapshot.h).  The driver owns the
+ * (which first checks that it fits, snapshot.h), unless the clock has not
+ * moved since the last snapshot (steady or stopped before a step), so that
+ * no two snapshots share a time.  The driver owns the
  * output: it claims it (io/output.h) before creating or appending to it and
  * holds the claim until ss_drive_finish.
  *

@@ -238,6 +238,7 @@ static int open_output(struct relax *x, const struct ss_relax_report *rep)
 		.integrator = ss_integrator_name(x->st.integrator),
 		.repose_angle_deg = o->model.angle_deg, .nu = o->model.nu, .gamma = o->model.gamma,
 		.bedrock = x->st.bedrock, .crs_wkt = x->dem.crs_wkt, .boundary = &x->st.boundary,
+		.nodata = x->dem.nodata,
 	};
 	return ss_drive_create(d, &meta);
 }

@@ -99,10 +99,33 @@ void ss_strbuf_json_string(struct ss_strbuf *b, const char *s)
 	ss_strbuf_printf(b, "\"");
 }
 
+/* The fewest digits from `least` to `most` with which x reads back as
+ * itself, printed into buf; `most` digits if none does. */
+static void shortest(double x, int least, int most, char *buf, size_t size)
+{
+	for (int digits = least; digits < most; digits++) {
+		snprintf(buf, size, "%.*g", digits, x);
+		if (strtod(buf, NULL) == x)
+			return;
+	}
+	snprintf(buf, size, "%.*g", most, x);
+}
+
+const char *ss_real_text(double x, char buf[SS_REAL_TEXT_SIZE])
+{
+	shortest(x, 15, 17, buf, SS_REAL_TEXT_SIZE);
+	return buf;
+}
+
 void ss_strbuf_json_number(struct ss_strbuf *b, double x, int digits)
 {
-	if (isfinite(x))
-		ss_strbuf_printf(b, "%.*g", digits, x);
-	else
+	if (!isfinite(x)) {
 		ss_strbuf_printf(b, "null");
+		return;
+	}
+	/* from 15 digits up (or `digits`, if fewer): a decimal of fewer
+	 * digits prints as itself at 15 too, %g dropping the trailing zeros */
+	char text[SS_REAL_TEXT_SIZE];
+	shortest(x, digits < 15 ? digits : 15, digits, text, sizeof text);
+	ss_strbuf_printf(b, "%s", text);
 }

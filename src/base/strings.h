@@ -34,8 +34,23 @@ void ss_strbuf_printf(struct ss_strbuf *b, const char *fmt, ...)
 /* s in double quotes with '"', '\\' and control characters escaped: a
  * path may hold any of them and the JSON must still parse. */
 void ss_strbuf_json_string(struct ss_strbuf *b, const char *s);
-/* x with `digits` significant digits (17: read back bit for bit); null when
- * x is NaN or infinite, which JSON cannot write. */
+/* x with at most `digits` significant digits, and no more than it takes
+ * to read back as x: 17 gives the shortest text that reads back bit for
+ * bit (1e-09, not 1.0000000000000001e-09; ss_real_text); null when x is
+ * NaN or infinite, which JSON cannot write. */
 void ss_strbuf_json_number(struct ss_strbuf *b, double x, int digits);
+
+/* x as the shortest of "%.15g", "%.16g" and "%.17g" that reads back as x
+ * (strtod): 5479330.25, not %g's 5.47933e+06; 1e-09, not %.17g's
+ * 1.0000000000000001e-09.  15 digits print any decimal of up to 15
+ * significant digits as written (DBL_DIG), so a number that came from
+ * such a decimal prints as it did; "nan", "inf", "-inf" otherwise.
+ * Returns buf.  For numbers people read that must be exact: coordinates,
+ * cell sizes, tolerances. */
+#define SS_REAL_TEXT_SIZE 32
+const char *ss_real_text(double x, char buf[SS_REAL_TEXT_SIZE]);
+/* ss_real_text into a buffer that lives to the end of the enclosing
+ * block, for printf's arguments: printf("x = %s m", SS_REAL(x)). */
+#define SS_REAL(x) ss_real_text((x), (char[SS_REAL_TEXT_SIZE]){0})
 
 #endif

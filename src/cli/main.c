@@ -309,8 +309,8 @@ static int cmd_render(int argc, char **argv)
 		o.look.label = 0;
 	if (cli.no_colorbar)
 		o.look.colorbar = 0;
-	/* the viewer alone needs no frame files; a video is made from them */
-	if (o.html && !cli_given(&cmd, "--output") && !o.video)
+	/* a viewer or a video needs no frame folder: -o keeps the frames */
+	if ((o.html || o.video) && !cli_given(&cmd, "--output"))
 		o.output_dir = NULL;
 	struct ss_render_series_report report;
 	const int err = ss_render_series(&o, &report);

@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "base/strings.h"
 #include "sandslide/comm.h"
 #include "sandslide/parallel.h"
 
@@ -74,9 +75,10 @@ void cli_print_run_end(const struct ss_run_summary *s, int quiet)
 		return;
 	for (int k = 0; k < s->note_count; k++)
 		printf("note: %s\n", s->notes[k]);
-	printf("wrote %s: %lld snapshots to t = %g s, %lld %s%s\n", s->output, s->snapshots,
-	       s->time, s->steps, strcmp(s->integrator, "rkl2") ? "steps (euler)"
-	       : "super-steps (rkl2)", s->end == SS_RUN_STEADY ? " (steady)"
+	printf("wrote %s: %lld snapshot%s to t = %g s, %lld %s%s\n", s->output, s->snapshots,
+	       s->snapshots == 1 ? "" : "s", s->time, s->steps,
+	       strcmp(s->integrator, "rkl2") ? "steps (euler)" : "super-steps (rkl2)",
+	       s->end == SS_RUN_STEADY ? " (steady)"
 	       : s->end == SS_RUN_NOT_STEADY ? " (not steady by max_time)" : "");
 	/* with ranks: rank 0's phases, and its time in MPI calls */
 	char ranks[48] = "", mpi[48] = "";
@@ -206,10 +208,15 @@ void cli_print_info(const char *path, const struct ss_snapshot_summary *s)
 {
 	printf("file       %s (%s)\n", path, s->source);
 	printf("title      %s\n", s->title);
-	printf("grid       %d x %d cells, dx = %g m, dy = %g m, lower-left corner (%g, %g) m\n",
-	       s->nx, s->ny, s->dx, s->dy, s->origin_x, s->origin_y);
-	printf("cells      %lld flow, %lld wall, %lld open\n", s->flow_cells, s->wall_cells,
+	/* exact: %g would round a UTM northing of 5479330.25 m to 5.47933e+06 */
+	printf("grid       %d x %d cells, dx = %s m, dy = %s m, lower-left corner (%s, %s) m\n",
+	       s->nx, s->ny, SS_REAL(s->dx), SS_REAL(s->dy), SS_REAL(s->origin_x),
+	       SS_REAL(s->origin_y));
+	printf("cells      %lld flow, %lld wall, %lld open", s->flow_cells, s->wall_cells,
 	       s->open_cells);
+	if (s->nodata_cells > 0)
+		printf(", %lld without data", s->nodata_cells);
+	printf("\n");
 	printf("model      %s, repose angle %g deg, nu = %g m^2/s", s->closure,
 	       s->repose_angle_deg, s->nu);
 	if (!strcmp(s->closure, "herschel-bulkley"))

@@ -16,6 +16,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "base/strings.h"
 #include "io/dem_internal.h"
 #include "sandslide/error.h"
 #include "sandslide/snapshot.h"
@@ -148,7 +149,28 @@ static int gdal_unavailable(const char *path, const char *context)
 /* ------------------------------------------------------------------ */
 /* reading                                                              */
 
-/* The last snapshot of a sandslide file, with its cell size and corner. */
+/* The cells without data of a sandslide file (relax's nodata,
+ * SS_SNAPSHOT_CELL_NODATA) as r->nodata, left NULL when there are none;
+ * their values are 0 already (read as walls). */
+static int read_h5_nodata(struct ss_snapshot_file *f, struct ss_raster *r)
+{
+	const size_t n = (size_t)f->nx * (size_t)f->ny;
+	uint8_t *flags = ss_alloc(n, 1, "cell types");
+	if (!flags)
+		return SS_ERR_FAIL;
+	int err = ss_snapshot_file_read_cell_flags(f, 0, f->ny, flags);
+	size_t none = 0;
+	for (size_t k = 0; k < n && !err; k++)
+		none += (flags[k] = flags[k] == SS_SNAPSHOT_CELL_NODATA);
+	if (!err && none > 0)
+		r->nodata = flags;
+	else
+		ss_free(flags);
+	return err;
+}
+
+/* The last snapshot of a sandslide file, with its cell size and corner,
+ * and its cells without data. */
 static int read_h5_output(const char *path, struct ss_raster *r)
 {
 	struct ss_snapshot_file f;
@@ -160,6 +182,8 @@ static int read_h5_output(const char *path, struct ss_raster *r)
 		err = SS_ERR_FAIL;
 	if (!err)
 		err = ss_snapshot_file_read_rows(&f, f.count - 1, 0, f.ny, r->values);
+	if (!err)
+		err = read_h5_nodata(&f, r);
 	if (!err) {
 		r->nx = f.nx;
 		r->ny = f.ny;
@@ -243,9 +267,10 @@ static int apply_cellsize(const struct ss_dem_read_options *o, const char *spec,
 	if (r->format != SS_DEM_PNG && !isnan(r->cellsize)) {
 		const double dy = ss_dem_dy(r);
 		if (fabs(r->cellsize - c) > 1e-9 * c || fabs(dy - c) > 1e-9 * c)
-			return ss_error_input_at(context, "'%s' has cell size %.17g x %.17g m: the given "
-			                         "cell size %.17g m disagrees (leave it out to use the "
-			                         "file's)", spec, r->cellsize, dy, c);
+			return ss_error_input_at(context, "'%s' has cell size %s x %s m: the given "
+			                         "cell size %s m disagrees (leave it out to use the "
+			                         "file's)", spec, SS_REAL(r->cellsize), SS_REAL(dy),
+			                         SS_REAL(c));
 		return SS_OK;
 	}
 	r->cellsize = r->cellsize_y = c;
@@ -260,9 +285,10 @@ static int check_extent(const char *spec, const char *context, const struct ss_r
 	const double x1 = r->x0 + r->nx * r->cellsize, y1 = r->y0 + r->ny * dy;
 	if ((!isnan(r->x0) && (!isfinite(r->x0) || (!isnan(x1) && !isfinite(x1)))) ||
 	    (!isnan(r->y0) && (!isfinite(r->y0) || (!isnan(y1) && !isfinite(y1)))))
-		return ss_error_input_at(context, "'%s': %d x %d cells of %g x %g m from (%g, %g) m "
+		return ss_error_input_at(context, "'%s': %d x %d cells of %s x %s m from (%s, %s) m "
 		                         "end beyond the largest number: expected a finite extent",
-		                         spec, r->nx, r->ny, r->cellsize, dy, r->x0, r->y0);
+		                         spec, r->nx, r->ny, SS_REAL(r->cellsize), SS_REAL(dy),
+		                         SS_REAL(r->x0), SS_REAL(r->y0));
 	return SS_OK;
 }
 

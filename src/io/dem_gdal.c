@@ -12,6 +12,7 @@
  */
 #include "io/dem_internal.h"
 
+#include "base/strings.h"
 #include "sandslide/error.h"
 
 #ifdef SS_HAVE_GDAL
@@ -79,26 +80,64 @@ static int geographic(const char *wkt, char *name, size_t size)
 	return g;
 }
 
-/* The refusal of a DEM in degrees, with the gdalwarp command that puts it
- * in metres: the UTM zone (WGS 84) of its centre when the geotransform
- * gives one. */
+/* x (> 0) rounded to two significant digits: 82.4 -> 82, 772 -> 770,
+ * 0.927 -> 0.93 (divided by a power of ten, not multiplied by its
+ * inexact inverse, so that the text is short). */
+static double two_digits(double x)
+{
+	const int e = (int)floor(log10(x)) - 1;
+	return e >= 0 ? round(x / pow(10.0, e)) * pow(10.0, e)
+	              : round(x * pow(10.0, -e)) / pow(10.0, -e);
+}
+
+/*
+ * The refusal of a DEM in degrees, with the gdalwarp command that puts it
+ * in metres: the UTM zone (WGS 84) of its centre, and cells about as large
+ * as the source's there, when the geotransform gives them.  At latitude
+ * phi a degree is (WGS 84 ellipsoid, the series of the NGA's
+ * "length of a degree")
+ *
+ *   north   111132.92 - 559.82 cos 2 phi + 1.175 cos 4 phi - 0.0023 cos 6 phi  m
+ *   east    111412.84 cos phi - 93.5 cos 3 phi + 0.118 cos 5 phi               m
+ *
+ * and the square cell suggested has the area of the source's, sqrt(cx cy),
+ * to two digits: about as many cells, where gdalwarp's own default gave a
+ * small raster cells of 772 m.  -ot Float32 keeps the interpolated heights
+ * of an integer raster (an Int16 DEM would stay Int16, rounded), and
+ * -dstnodata marks what lies outside the source after the rotation of the
+ * projection, which would otherwise be 0 m: a cliff all round.
+ */
 static int refuse_degrees(const char *path, const char *context, const char *crs,
                           const struct ss_raster *r, int nx, int ny)
 {
 	char target[64] = "EPSG:<a projected CRS in metres, e.g. your UTM zone>";
+	char cells[160] = "", size[96] = "";
 	if (r->has_geotransform) {
 		/* x is longitude, y latitude: GDAL's traditional GIS order */
-		const double lon = r->geotransform[0] + 0.5 * nx * r->geotransform[1];
-		const double lat = r->geotransform[3] + 0.5 * ny * r->geotransform[5];
+		const double *gt = r->geotransform;
+		const double lon = gt[0] + 0.5 * nx * gt[1];
+		const double lat = gt[3] + 0.5 * ny * gt[5];
 		if (lon >= -180.0 && lon <= 180.0 && lat >= -90.0 && lat <= 90.0) {
 			int zone = (int)floor((lon + 180.0) / 6.0) + 1;
 			zone = zone < 1 ? 1 : zone > 60 ? 60 : zone;
 			snprintf(target, sizeof target, "EPSG:%d", (lat >= 0.0 ? 32600 : 32700) + zone);
+			const double phi = lat * (M_PI / 180.0);
+			const double north = 111132.92 - 559.82 * cos(2.0 * phi) + 1.175 * cos(4.0 * phi) -
+			                     0.0023 * cos(6.0 * phi);
+			const double east = 111412.84 * cos(phi) - 93.5 * cos(3.0 * phi) +
+			                     0.118 * cos(5.0 * phi);
+			const double cx = gt[1] * east, cy = -gt[5] * north, c = sqrt(cx * cy);
+			if (isfinite(c) && c > 0.0) {
+				const double t = two_digits(c);
+				snprintf(cells, sizeof cells, " (about %.3g x %.3g m there)", cx, cy);
+				snprintf(size, sizeof size, "-tr %s %s ", SS_REAL(t), SS_REAL(t));
+			}
 		}
 	}
-	return ss_error_input_at(context, "'%s' is in %s: its cells are degrees, not metres; "
-	                         "reproject it first, e.g. gdalwarp -t_srs %s -r bilinear '%s' "
-	                         "dem-m.tif", path, crs, target, path);
+	return ss_error_input_at(context, "'%s' is in %s: its cells are degrees, not metres%s; "
+	                         "reproject it first, e.g. gdalwarp -t_srs %s %s-r bilinear "
+	                         "-ot Float32 -dstnodata -9999 '%s' dem-m.tif", path, crs, cells,
+	                         target, size, path);
 }
 
 static int read_dataset(GDALDatasetH ds, const char *path, const char *context,
@@ -119,9 +158,9 @@ static int read_dataset(GDALDatasetH ds, const char *path, const char *context,
 			                         "expected a north-up raster; resample it first, e.g. "
 			                         "gdalwarp", path, gt[2], gt[4]);
 		if (!(gt[1] > 0.0 && gt[5] < 0.0 && isfinite(gt[0]) && isfinite(gt[3])))
-			return ss_error_input_at(context, "'%s' has pixel size %g x %g: expected a north-up "
+			return ss_error_input_at(context, "'%s' has pixel size %s x %s: expected a north-up "
 			                         "raster (width > 0, height < 0 in the geotransform)", path,
-			                         gt[1], gt[5]);
+			                         SS_REAL(gt[1]), SS_REAL(gt[5]));
 		memcpy(r->geotransform, gt, sizeof gt);
 		r->has_geotransform = 1;
 		r->cellsize = gt[1];

@@ -782,8 +782,10 @@ static void check_rows(const struct ss_snapshot_file *f, int j0, int rows)
 
 /* Walls are stored as NaN (the _FillValue, snapshot_write.c) and held at
  * 0 m by the stepper: give them 0 m again, so that a restart, a frame or a
- * DEM read from the file sees what the run had.  A NaN anywhere else is
- * left for the caller's checks to find. */
+ * DEM read from the file sees what the run had; so are cells without data
+ * (read as walls), and a DEM read from the file has them as nodata, whose
+ * value is 0 (dem.h).  A NaN anywhere else is left for the caller's checks
+ * to find. */
 static int walls_to_zero(struct ss_snapshot_file *f, int j0, int rows, double *out)
 {
 	const size_t n = (size_t)rows * (size_t)f->nx;
@@ -824,7 +826,7 @@ int ss_snapshot_file_read_rows(struct ss_snapshot_file *f, long long t, int j0, 
 	return err ? err : walls_to_zero(f, j0, rows, out);
 }
 
-int ss_snapshot_file_read_cell_types(struct ss_snapshot_file *f, int j0, int rows,
+int ss_snapshot_file_read_cell_flags(struct ss_snapshot_file *f, int j0, int rows,
                                      uint8_t *out)
 {
 	check_rows(f, j0, rows);
@@ -840,10 +842,24 @@ int ss_snapshot_file_read_cell_types(struct ss_snapshot_file *f, int j0, int row
 	}
 	const size_t n = (size_t)rows * (size_t)f->nx;
 	for (size_t k = 0; k < n && !err; k++)
-		if (out[k] > SS_CELL_OPEN)
+		if (out[k] > SS_SNAPSHOT_CELL_NODATA)
 			err = damaged(&f->h5->in, "/cell_type holds %d at column %zu, row %zu (from the "
-			              "south): expected 0 (flow), 1 (wall) or 2 (open)", out[k],
-			              k % (size_t)f->nx + 1, j0 + k / (size_t)f->nx + 1);
+			              "south): expected 0 (flow), 1 (wall), 2 (open) or 3 (no data)",
+			              out[k], k % (size_t)f->nx + 1, j0 + k / (size_t)f->nx + 1);
+	return err;
+}
+
+/* A cell without data is a wall to every reader but the renderer's: the
+ * stepper held it as one (or as open, which left it at the open level),
+ * and its height is stored as NaN like a wall's. */
+int ss_snapshot_file_read_cell_types(struct ss_snapshot_file *f, int j0, int rows,
+                                     uint8_t *out)
+{
+	const int err = ss_snapshot_file_read_cell_flags(f, j0, rows, out);
+	const size_t n = (size_t)rows * (size_t)f->nx;
+	for (size_t k = 0; k < n && !err; k++)
+		if (out[k] == SS_SNAPSHOT_CELL_NODATA)
+			out[k] = SS_CELL_WALL;
 	return err;
 }
 
@@ -873,11 +889,12 @@ static int count_cells(struct ss_snapshot_file *f, struct ss_snapshot_summary *s
 	int err = SS_OK;
 	for (int j0 = 0; j0 < f->ny && !err; j0 += block) {
 		const int rows = f->ny - j0 < block ? f->ny - j0 : block;
-		err = ss_snapshot_file_read_cell_types(f, j0, rows, types);
+		err = ss_snapshot_file_read_cell_flags(f, j0, rows, types);
 		for (size_t k = 0; k < (size_t)rows * (size_t)f->nx && !err; k++) {
 			sum->flow_cells += types[k] == SS_CELL_FLOW;
 			sum->wall_cells += types[k] == SS_CELL_WALL;
 			sum->open_cells += types[k] == SS_CELL_OPEN;
+			sum->nodata_cells += types[k] == SS_SNAPSHOT_CELL_NODATA;
 		}
 	}
 	ss_free(types);

@@ -4,9 +4,12 @@
  *
  * File types are explicit little-endian IEEE (H5T_IEEE_F64LE, H5T_STD_I8LE),
  * memory types native.  Heights are copied a band of chunk rows at a time,
- * with NaN (the CF _FillValue) at walls, so that netCDF readers, GDAL and
- * ParaView show walls as missing rather than as floor at 0 m; the reader
- * (snapshot_read.c) gives walls 0 m again.  HDF5's own error stack
+ * with NaN (the CF _FillValue) at walls and at cells without data, so
+ * that netCDF readers, GDAL and ParaView show them as missing rather than
+ * as floor at 0 m; the reader (snapshot_read.c) gives them 0 m again.
+ * Cells without data (meta.nodata, relax's DEM) are /cell_type 3
+ * (SS_SNAPSHOT_CELL_NODATA), whatever the stepper made of them; only then
+ * does flag_values have a fourth value, so a run's file is as before.  HDF5's own error stack
  * printing is off: each failure prints one sandslide message.
  *
  * Beside the file: the XDMF sidecar (run.xmf, for ParaView) and GDAL's
@@ -65,6 +68,8 @@ struct ss_snapshot {
 	int band_rows;          /* rows of a chunk of /height */
 	char *crs_wkt;          /* for the .aux.xml; NULL: none */
 	int has_bedrock;        /* /bedrock written */
+	uint8_t *nodata;        /* this rank's rows of the cells without data
+	                           (nx x ny, south row first), NULL: none */
 };
 
 static void quiet_hdf5(void)
@@ -215,9 +220,11 @@ static int write_rows(hid_t dataset, hid_t file_space, int j0, int n, int nx, hi
 }
 
 /* The packed cell types (grid.h) as bytes, a block of rows at a time: a
- * full unpacked copy would cost a byte per cell, 4 times the packed array. */
+ * full unpacked copy would cost a byte per cell, 4 times the packed array.
+ * Cells without data (nodata: this rank's rows, or NULL) are
+ * SS_SNAPSHOT_CELL_NODATA. */
 static int write_cell_types(hid_t dataset, hid_t file_space, const struct ss_grid *g,
-                            const uint8_t *cell_types)
+                            const uint8_t *cell_types, const uint8_t *nodata)
 {
 	const int rows = g->ny < 64 ? g->ny : 64;
 	uint8_t *block = ss_alloc((size_t)rows * (size_t)g->nx, 1, "cell type rows");
@@ -229,6 +236,10 @@ static int write_cell_types(hid_t dataset, hid_t file_space, const struct ss_gri
 		for (int j = 0; j < n; j++)
 			ss_cell_types_unpack(cell_types, ss_grid_index(g, 0, j0 + j), (size_t)g->nx,
 			                     block + (size_t)j * g->nx);
+		const uint8_t *none = nodata ? nodata + (size_t)j0 * g->nx : NULL;
+		for (size_t k = 0; none && k < (size_t)n * g->nx; k++)
+			if (none[k])
+				block[k] = SS_SNAPSHOT_CELL_NODATA;
 		bad = write_rows(dataset, file_space, (int)g->offset_j + j0, n, g->nx,
 		                 H5T_NATIVE_UINT8, block);   /* converted to int8 */
 	}
@@ -349,15 +360,17 @@ static int write_static(struct ss_snapshot *s, const uint8_t *cell_types,
 	space = H5Screate_simple(2, dims2, NULL);
 	hid_t ct = bad ? -1 : H5Dcreate2(f, "cell_type", H5T_STD_I8LE, space, H5P_DEFAULT,
 	                                 H5P_DEFAULT, H5P_DEFAULT);
-	bad = bad || ct < 0 || write_cell_types(ct, space, g, cell_types) ||
+	bad = bad || ct < 0 || write_cell_types(ct, space, g, cell_types, s->nodata) ||
 	      attr_units(ct, "1", "cell type") ||
-	      attr_string(ct, "flag_meanings", "flow wall open") ||
+	      attr_string(ct, "flag_meanings", meta->nodata ? "flow wall open nodata"
+	                                                    : "flow wall open") ||
 	      (crs && attr_string(ct, "grid_mapping", "crs")) ||
 	      H5DSattach_scale(ct, y, 0) < 0 || H5DSattach_scale(ct, x, 1) < 0;
 	if (!bad) {
 		/* an attribute: every rank writes the same values */
-		const int8_t flags[3] = {SS_CELL_FLOW, SS_CELL_WALL, SS_CELL_OPEN};
-		hsize_t n = 3;
+		const int8_t flags[4] = {SS_CELL_FLOW, SS_CELL_WALL, SS_CELL_OPEN,
+		                         SS_SNAPSHOT_CELL_NODATA};
+		hsize_t n = meta->nodata ? 4 : 3;
 		hid_t as = H5Screate_simple(1, &n, NULL);
 		hid_t a = H5Acreate2(ct, "flag_values", H5T_STD_I8LE, as, H5P_DEFAULT, H5P_DEFAULT);
 		bad = a < 0 || H5Awrite(a, H5T_NATIVE_INT8, flags) < 0;
@@ -441,6 +454,7 @@ int ss_snapshot_destroy(struct ss_snapshot *s)
 	if (s->count == 0 && s->partial_path && is_root())
 		remove(s->partial_path);   /* never complete: leave nothing */
 	free(s->times);
+	ss_free(s->nodata);
 	ss_free(s->band);
 	ss_free(s->band_types);
 	free(s->crs_wkt);
@@ -533,6 +547,14 @@ int ss_snapshot_create(struct ss_snapshot **out, const char *path,
 		return ss_error_fail("out of memory");
 	}
 	s->has_bedrock = meta->bedrock != NULL;
+	if (meta->nodata) {   /* this rank's rows */
+		const size_t cells = (size_t)g->ny * (size_t)g->nx;
+		if (!(s->nodata = ss_alloc(cells, 1, "cells without data"))) {
+			ss_snapshot_destroy(s);
+			return SS_ERR_FAIL;
+		}
+		memcpy(s->nodata, meta->nodata + (size_t)g->offset_j * g->nx, cells);
+	}
 	if (write_static(s, cell_types, meta) || H5Fflush(s->file, H5F_SCOPE_GLOBAL) < 0) {
 		ss_snapshot_destroy(s);
 		return ss_error_fail("cannot write the static variables of '%s'", path);
@@ -623,7 +645,8 @@ static int check_snapshot_space(struct ss_snapshot *s)
 
 /*
  * Snapshot k of /height: this rank's rows of height (halo layout), NaN at
- * walls, one band of chunk rows of the whole grid at a time.  Every rank
+ * walls and cells without data, one band of chunk rows of the whole grid
+ * at a time.  Every rank
  * makes the same writes, one per band, selecting its rows of the band
  * (maybe none): a write per band keeps the copy small (band_rows x nx),
  * and each chunk of the filtered dataset is written once, by one
@@ -652,8 +675,11 @@ static int write_heights(struct ss_snapshot *s, long long k, const double *heigh
 				const ptrdiff_t row = ss_grid_index(g, 0, (int)(j - first));
 				double *out = s->band + (size_t)(j - lo) * (size_t)g->nx;
 				ss_cell_types_unpack(cell_types, row, (size_t)g->nx, s->band_types);
+				const uint8_t *none = s->nodata ? s->nodata + (size_t)(j - first) * g->nx
+				                                : NULL;
 				for (int i = 0; i < g->nx; i++)
-					out[i] = s->band_types[i] == SS_CELL_WALL ? NAN : height[row + i];
+					out[i] = s->band_types[i] == SS_CELL_WALL || (none && none[i])
+					         ? NAN : height[row + i];
 			}
 			const hsize_t start[3] = {(hsize_t)k, (hsize_t)lo, 0};
 			const hsize_t count[3] = {1, (hsize_t)(hi - lo), (hsize_t)g->nx};
@@ -756,6 +782,21 @@ double ss_snapshot_last_time(const struct ss_snapshot *s)
 	return s->count > 0 ? s->times[s->count - 1] : NAN;
 }
 
+/* This rank's rows of the cells without data of f into s->nodata: the
+ * snapshots appended mark them as the first ones did. */
+static int read_nodata(struct ss_snapshot *s, struct ss_snapshot_file *f,
+                       const struct ss_grid *g)
+{
+	const size_t cells = (size_t)g->ny * (size_t)g->nx;
+	if (!(s->nodata = ss_alloc(cells ? cells : 1, 1, "cells without data")))
+		return SS_ERR_FAIL;
+	const int err = g->ny > 0 ? ss_snapshot_file_read_cell_flags(f, (int)g->offset_j, g->ny,
+	                                                             s->nodata) : SS_OK;
+	for (size_t k = 0; k < cells && !err; k++)
+		s->nodata[k] = s->nodata[k] == SS_SNAPSHOT_CELL_NODATA;
+	return err;
+}
+
 /* A file to continue must be a sandslide file (ss_snapshot_file_open) of
  * grid g with at least one snapshot, and every series and cell type in it
  * must read (the summary): the appends that follow extend them all.  Its
@@ -779,6 +820,8 @@ static int check_append(struct ss_snapshot *s, const char *path, const struct ss
 		else
 			memcpy(s->times, f.time, (size_t)f.count * sizeof *s->times);
 	}
+	if (!err && sum.nodata_cells > 0)
+		err = read_nodata(s, &f, g);
 	ss_snapshot_summary_release(&sum);
 	ss_snapshot_file_close(&f);
 	return err;

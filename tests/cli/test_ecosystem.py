@@ -201,11 +201,12 @@ def test_dem_in_degrees_refused_with_the_gdalwarp_that_fixes_it(tmp_path):
     and gives the gdalwarp command to the UTM zone of its centre, which
     then gives a DEM relax takes."""
     g = gdal()
-    rows = [[(i * j) % 7 + 0.1 * i for i in range(12)] for j in range(10)]
+    rows = [[40 * ((i * j) % 7) + 3 * i for i in range(12)] for j in range(10)]
     (tmp_path / "dem.asc").write_text(asc_text(rows, cellsize=1.0))
-    # around Zurich (8.5 E, 47.4 N): UTM zone 32 north, EPSG:32632
+    # around Zurich (8.5 E, 47.4 N): UTM zone 32 north, EPSG:32632; whole
+    # metres in Int16, as real DEMs (SRTM, ...) come
     g.Translate(str(tmp_path / "deg.tif"), str(tmp_path / "dem.asc"), outputSRS="EPSG:4326",
-                outputBounds=[8.5, 47.4, 8.5108, 47.391])
+                outputBounds=[8.5, 47.4, 8.5108, 47.391], outputType=g.GDT_Int16)
     r = run(["relax", "deg.tif", "-o", "out.asc"], cwd=tmp_path)
     assert r.returncode == 2, r.stderr
     assert r.stderr.count("\n") == 1 and "degrees, not metres" in r.stderr, r.stderr
@@ -217,12 +218,28 @@ def test_dem_in_degrees_refused_with_the_gdalwarp_that_fixes_it(tmp_path):
                 outputSRS="EPSG:4326", outputBounds=[-70.5, -33.4, -70.49, -33.41])
     r = run(["relax", "south.tif", "-o", "out.asc"], cwd=tmp_path)
     assert r.returncode == 2 and "EPSG:32719" in r.stderr, r.stderr
-    # the suggested command works
-    if shutil.which("gdalwarp"):
-        cmd = m.group(1).replace("'", "").split()
-        subprocess.run(cmd, cwd=tmp_path, check=True, capture_output=True)
-        r = run(["relax", "dem-m.tif", "-o", "m.tif", "-q"], cwd=tmp_path)
-        assert r.returncode == 0, f"the reprojected DEM is refused: {r.stderr}"
+    # the suggested command works: float heights, cells like the source's
+    # 0.0009 deg (67.9 m east x 100 m north at 47.4 N: 82 m of the same
+    # area), nodata outside the source, a DEM relax takes
+    cmd = m.group(1).replace("'", "").split()
+    assert "-ot Float32" in m.group(1) and "-tr 82 82" in m.group(1), m.group(1)
+    assert "(about 67.9 x 100 m there)" in m.string, m.string
+    assert shutil.which("gdalwarp"), "gdalwarp is not installed (Debian: gdal-bin)"
+    subprocess.run(cmd, cwd=tmp_path, check=True, capture_output=True)
+    warped = g.Open(str(tmp_path / "dem-m.tif"))
+    band = warped.GetRasterBand(1)
+    assert g.GetDataTypeName(band.DataType) == "Float32", \
+        f"the suggested gdalwarp wrote {g.GetDataTypeName(band.DataType)} heights"
+    gt = warped.GetGeoTransform()
+    assert gt[1] == 82 and gt[5] == -82, f"cells of {gt[1]} x {-gt[5]} m, expected 82"
+    assert band.GetNoDataValue() == -9999, band.GetNoDataValue()
+    h = band.ReadAsArray()
+    data = h[h != -9999]
+    assert data.size > 0.5 * h.size and (data != np.round(data)).any(), \
+        "bilinear heights should not be whole metres (Float32, not Int16)"
+    assert data.min() >= 0 and data.max() <= 40 * 6 + 3 * 11, "heights outside the source's"
+    r = run(["relax", "dem-m.tif", "-o", "m.tif", "-q"], cwd=tmp_path)
+    assert r.returncode == 0, f"the reprojected DEM is refused: {r.stderr}"
 
 
 @pytest.mark.skipif("GDAL: on" not in run(["--version"]).stdout,

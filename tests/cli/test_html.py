@@ -271,7 +271,7 @@ def browser():
 
 @pytest.fixture
 def page(browser, viewer):
-    """The viewer freshly loaded, its first frame shown."""
+    """The viewer freshly loaded, its last frame shown."""
     path, _, _ = viewer
     browser.get_log("browser")    # what an earlier test left
     browser.get(path.as_uri())
@@ -316,7 +316,7 @@ def test_screenshot_is_not_blank(page):
     from PIL import Image
     from selenium.webdriver.common.by import By
     from selenium.webdriver.common.keys import Keys
-    page.find_element(By.TAG_NAME, "body").send_keys(Keys.ARROW_RIGHT)   # frame 1
+    page.find_element(By.TAG_NAME, "body").send_keys(Keys.HOME, Keys.ARROW_RIGHT)   # frame 1
     time.sleep(0.2)
     shot = Image.open(io.BytesIO(page.get_screenshot_as_png())).convert("RGB")
     colours = shot.getcolors(maxcolors=1 << 20)
@@ -335,17 +335,25 @@ def test_screenshot_is_not_blank(page):
 def test_slider_and_keys_change_the_frame(page, series):
     _, data = series
     times = data["time"]
+    # the page opens on the last frame: what the run made (a pouring case
+    # starts empty)
+    k4 = shown(page)
+    assert k4[0] == 4 and time_of(k4[1]) == pytest.approx(times[4], rel=1e-5), \
+        f"the page opened on {k4[:3]}, not the last frame"
+    assert k4[2].startswith("frame 5 / 5") and "snapshot 4" in k4[2], k4[2]
+    from selenium.webdriver.common.by import By
+    from selenium.webdriver.common.keys import Keys
+    page.find_element(By.TAG_NAME, "body").send_keys(Keys.HOME)
     k0 = shown(page)
     assert k0[0] == 0 and time_of(k0[1]) == pytest.approx(times[0], rel=1e-5, abs=1e-9)
     assert k0[2].startswith("frame 1 / 5")
+    assert k0[3:] != k4[3:], "Home shows another picture"
     page.execute_script("const s = document.getElementById('slider');"
                         "s.value = 3; s.dispatchEvent(new Event('input', {bubbles: true}));")
     k3 = shown(page)
     assert k3[0] == 3 and k3[2].startswith("frame 4 / 5") and "snapshot 3" in k3[2]
     assert time_of(k3[1]) == pytest.approx(times[3], rel=1e-5)
     assert k3[3:] != k0[3:], "the picture changed"
-    from selenium.webdriver.common.by import By
-    from selenium.webdriver.common.keys import Keys
     body = page.find_element(By.TAG_NAME, "body")
     body.send_keys(Keys.ARROW_RIGHT)
     assert shown(page)[0] == 4 and time_of(shown(page)[1]) == pytest.approx(times[4], rel=1e-5)
@@ -466,3 +474,45 @@ def test_play_and_pause(page):
     button.send_keys(Keys.SPACE)
     assert button.text == "Play"
     assert_no_js_errors(page)
+
+
+# ---- a DEM with cells without data ---------------------------------------------
+
+def test_cells_without_data_read_no_data(browser, tmp_path):
+    """A relaxed DEM with nodata round it: the readout over a nodata cell
+    says "no data" (not "wall"), a cell with data its height, and the key
+    names "no data"."""
+    nx, ny = 14, 10
+    y, x = np.mgrid[0:ny, 0:nx] + 0.5
+    h = 2.0 + 0.05 * x + 0.02 * y
+    nodata = np.hypot(x - 7, y - 5) > 4.5
+    rows = [" ".join("-9999" if nodata[j, i] else repr(float(h[j, i])) for i in range(nx))
+            for j in range(ny - 1, -1, -1)]
+    (tmp_path / "dem.asc").write_text(
+        f"ncols {nx}\nnrows {ny}\nxllcorner 0\nyllcorner 0\ncellsize 1\n"
+        "NODATA_value -9999\n" + "\n".join(rows) + "\n")
+    run_ok(["relax", "dem.asc", "-o", "dem.h5", "-q"], cwd=tmp_path)
+    run_ok(["render", "dem.h5", "--html", "view.html", "-q"], cwd=tmp_path)
+    browser.get_log("browser")
+    browser.get((tmp_path / "view.html").as_uri())
+    wait(browser, lambda: browser.execute_script(
+        "const p = document.getElementById('pic'); return p.complete && p.naturalWidth > 0;"),
+        "the frame to load")
+    key = browser.execute_script(
+        "const k = document.getElementById('nodatakey');"
+        "return [k.parentNode.style.display, getComputedStyle(k).backgroundColor];")
+    assert key[0] != "none" and key[1] == "rgb(255, 255, 255)", \
+        f"the 'no data' key: {key} (shown, white like the cells without data)"
+    with h5open(tmp_path / "dem.h5") as f:
+        last = f["height"][-1]
+    frame = len(browser.execute_script("return SS.times;")) - 1
+    for i, j in [(0, 0), (7, 5)]:
+        move_to_cell(browser, i, j, nx, ny)
+        text, d = readout(browser, "hover", frame, i, j)
+        if nodata[j, i]:
+            assert d["kind"] == "nodata" and text.endswith("no data"), \
+                f"cell ({i}, {j}) has no data: {text}"
+        else:
+            assert d["kind"] == "flow" and abs(float(d["h"]) - last[j, i]) < 1e-3, \
+                (text, last[j, i])
+    assert_no_js_errors(browser)

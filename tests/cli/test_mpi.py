@@ -556,6 +556,38 @@ def test_relax_h5_under_3_ranks_is_the_serial_series(tmp_path, serial_relax):
                        "relax (.h5, open sides, rkl2) under np = 3")
 
 
+def write_clipped_cliff(path):
+    """The cliff with nodata (-9999) round a disk that crosses every rank's
+    rows, and a hole: the cells relax writes as /cell_type 3."""
+    rng = np.random.default_rng(11)
+    h = 0.02 * rng.random((26, 32))
+    h[:, :10] += 0.2
+    y, x = np.mgrid[0:26, 0:32] + 0.5
+    nodata = np.hypot(x - 14, y - 13) > 12.5
+    nodata[12, 20] = True
+    path.write_text(asc_text(np.where(nodata, -9999.0, h), dx=0.1)
+                    .replace("cellsize", "NODATA_value -9999\ncellsize"))
+    return nodata
+
+
+@pytest.mark.parametrize("nodata", ["wall", "open"])
+def test_relax_h5_with_nodata_under_3_ranks_is_the_serial_series(tmp_path, nodata):
+    """The cells without data (cell_type 3, NaN heights) are written by
+    each rank for its rows: the same bits as the serial file."""
+    for d in ("serial", "mpi"):
+        (tmp_path / d).mkdir()
+        mask = write_clipped_cliff(tmp_path / d / "dem.asc")
+    args = ["relax", "dem.asc", "-o", "relaxed.h5", "-q", "--nodata", nodata,
+            "--output-every", "1", *RELAX_FAST]
+    serial_run_ok(args, tmp_path / "serial")
+    mpi_run_ok(3, args, tmp_path / "mpi")
+    with h5open(tmp_path / "serial" / "relaxed.h5") as f:
+        assert np.array_equal(f["cell_type"][()] == 3, mask), \
+            "test set-up: the serial file's cells without data are not the DEM's"
+    assert_same_output(tmp_path / "serial" / "relaxed.h5", tmp_path / "mpi" / "relaxed.h5",
+                       f"relax (.h5, nodata {nodata}) under np = 3")
+
+
 # ---- c. cut, restarted under another rank count, interrupted, killed ------------------------
 
 

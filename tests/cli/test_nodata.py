@@ -10,11 +10,13 @@ subcritical DEM at its edges: the check that the first test can fail.
 """
 import json
 import math
+import os
+import subprocess
 
 import numpy as np
 import pytest
 
-from conftest import run, same_bits
+from conftest import h5open, run, run_ok, same_bits
 
 TAN35 = math.tan(math.radians(35.0))
 NODATA = -9999.0
@@ -184,3 +186,107 @@ def test_pile_against_the_nodata_edge_keeps_its_volume(tmp_path):
     assert math.tan(math.radians(rep["max_slope_after_deg"])) <= TAN35 + 1e-6, rep
     s = face_slopes(np.where(nodata, 0.0, h), nodata)
     assert s <= TAN35 + 1e-6, f"steepest face {s!r} above tan 35 = {TAN35!r}"
+
+
+# ---- the cells without data in the HDF5 output (issue 23) --------------------------
+
+def test_h5_output_marks_the_cells_without_data(tmp_path):
+    """relax to .h5: /cell_type is 3 ("nodata", a fourth flag) exactly on the
+    DEM's nodata cells and /height NaN there, whether the solver held them
+    as walls or as open cells; `info` counts them; read back as a DEM
+    (.h5 in, .asc out) they are nodata again, the other cells their
+    heights bit for bit."""
+    h0, nodata = clipped_dem()
+    write_asc(tmp_path / "dem.asc", h0, nodata, x0=512000.5, y0=4100000.25)
+    for how in ("wall", "open"):
+        relax(["dem.asc", "--nodata", how, "-o", f"{how}.h5"], tmp_path)
+        with h5open(tmp_path / f"{how}.h5") as f:
+            ct = f["cell_type"]
+            assert list(ct.attrs["flag_values"]) == [0, 1, 2, 3], ct.attrs["flag_values"]
+            meanings = ct.attrs["flag_meanings"]
+            meanings = meanings.decode() if isinstance(meanings, bytes) else meanings
+            assert meanings == "flow wall open nodata", meanings
+            types = ct[()]
+            assert np.array_equal(types == 3, nodata), \
+                f"--nodata {how}: cell_type 3 at {np.argwhere((types == 3) != nodata)[:5]}, " \
+                "not exactly the nodata cells"
+            assert set(np.unique(types[~nodata])) == {0}, "the cells with data are flow cells"
+            heights = f["height"][()]
+            assert np.isnan(heights[:, nodata]).all(), f"--nodata {how}: a height where no data"
+            assert np.isfinite(heights[:, ~nodata]).all()
+        r = run_ok(["info", f"{how}.h5"], cwd=tmp_path)
+        line = [l for l in r.stdout.splitlines() if l.startswith("cells")][0]
+        assert line.split(None, 1)[1] == (f"{(~nodata).sum()} flow, 0 wall, 0 open, "
+                                          f"{nodata.sum()} without data"), line
+    # the .h5 as a DEM: the nodata cells come back as nodata
+    relax(["wall.h5", "-o", "back.asc"], tmp_path)
+    head, h = read_asc(tmp_path / "back.asc")
+    assert np.array_equal(h == float(head["nodata_value"]), nodata), \
+        "nodata cells of the .h5 did not come back as the .asc's nodata"
+    assert same_bits(np.where(nodata, 0.0, h), np.where(nodata, 0.0, h0)), "heights changed"
+
+
+def test_a_run_keeps_three_cell_types(tmp_path):
+    """Without cells without data (a run, a DEM without nodata), /cell_type
+    keeps its three flags, as before."""
+    h0, _ = clipped_dem()
+    write_asc(tmp_path / "dem.asc", h0, np.zeros_like(h0, dtype=bool))
+    relax(["dem.asc", "-o", "out.h5"], tmp_path)
+    with h5open(tmp_path / "out.h5") as f:
+        assert list(f["cell_type"].attrs["flag_values"]) == [0, 1, 2]
+        assert "without data" not in run_ok(["info", "out.h5"], cwd=tmp_path).stdout
+
+
+def test_render_draws_the_cells_without_data_as_absent(tmp_path):
+    """One pixel per cell: shaded draws the nodata cells white (the
+    background), not the wall colour, and no wall border round a grid whose
+    edge has no data; gray16 makes them 0 (transparent), like walls."""
+    from test_render import read_png
+    h0, nodata = clipped_dem()
+    write_asc(tmp_path / "dem.asc", h0, nodata)
+    relax(["dem.asc", "-o", "out.h5"], tmp_path)
+    run_ok(["render", "out.h5", "-o", "shaded", "--scale", "1", "--frames", "-1", "-q"],
+           cwd=tmp_path)
+    run_ok(["render", "out.h5", "-o", "gray", "--style", "gray16", "--frames", "-1", "-q"],
+           cwd=tmp_path)
+    ny, nx = nodata.shape
+    shaded = read_png(tmp_path / "shaded" / "frame_00000.png", pixels=True)
+    px = shaded["pixels"][::-1]      # row 0 south, as the cells
+    assert px.shape == (ny, nx, 3), \
+        f"{px.shape}: one pixel per cell and no wall border (every edge cell lacks data)"
+    white = (px == 255).all(axis=2)
+    assert np.array_equal(white, nodata), \
+        f"white pixels at {np.argwhere(white != nodata)[:5]} differ from the nodata cells"
+    gray = read_png(tmp_path / "gray" / "frame_00000.png", pixels=True)["pixels"][::-1]
+    assert np.array_equal(gray == 0, nodata), "gray16: 0 exactly on the nodata cells"
+
+
+def test_the_guards_snapshot_keeps_the_cells_without_data(tmp_path):
+    """relax to .h5 with --nodata open (the solver's open cells, at the open
+    level), a NaN put into a height after step 40 (tests/hooks/nan_step.c):
+    the guard reopens the series and appends the last good state, which has
+    NaN on the nodata cells and nowhere else, like every snapshot before it:
+    the reopened series knows its cells without data."""
+    from conftest import SANDSLIDE_NAN
+    if not os.access(SANDSLIDE_NAN, os.X_OK):
+        pytest.fail(f"{SANDSLIDE_NAN} is missing: make builds it (build/tests/sandslide-nan)")
+    h0, nodata = clipped_dem()
+    y, x = (np.mgrid[0:h0.shape[0], 0:h0.shape[1]] + 0.5) * DX
+    h0 = h0 + np.maximum(0.0, math.tan(math.radians(60)) * (0.6 - np.hypot(x - 2.2, y - 1.8)))
+    assert not nodata[h0.shape[0] // 2, h0.shape[1] // 2], "test bug: the NaN cell has no data"
+    write_asc(tmp_path / "pile.asc", h0, nodata)
+    p = subprocess.run([SANDSLIDE_NAN, "relax", "pile.asc", "-o", "out.h5", "-q",
+                        "--nodata", "open", "--output-every", "0.01", "--threads", "1"],
+                       cwd=tmp_path,
+                       capture_output=True, text=True, timeout=300,
+                       env=dict(os.environ, SANDSLIDE_TEST_NAN_STEP="40"))
+    assert p.returncode == 1 and "last good state" in p.stderr, (p.returncode, p.stderr)
+    with h5open(tmp_path / "out.h5") as f:
+        steps = f["steps"][()]
+        heights = f["height"][()]
+        types = f["cell_type"][()]
+    assert steps[-1] == 39 and len(steps) >= 3, f"snapshots after steps {list(steps)}"
+    assert np.array_equal(types == 3, nodata), "cell_type 3 is the nodata cells"
+    for k, h in enumerate(heights):
+        assert np.array_equal(np.isnan(h), nodata), \
+            f"snapshot {k} (step {steps[k]}): NaN at {np.argwhere(np.isnan(h) != nodata)[:5]}"

@@ -6,6 +6,7 @@ ESRI ASCII, 16-bit PNG and HDF5, the report, and bad input.
 import json
 import math
 import os
+import re
 import struct
 import zlib
 
@@ -439,3 +440,32 @@ def test_geotiff_round_trip_keeps_georeferencing_and_nodata(tmp_path):
     valid = h0 != -9999.0
     assert face_slopes(np.where(valid, h, h[valid].min()), 0.1) < 2.0   # the cliff came down
     assert h[valid].max() < h0[valid].max()
+
+
+def test_numbers_print_exactly_and_shortest(tmp_path):
+    """The report's tolerances are 1e-09 and 1e-06, not 17 digits that
+    merely read back (1.0000000000000001e-09), and every number in it reads
+    back as the double relax had; `info` gives a UTM corner exactly, not
+    rounded by 2 m (5.47933e+06), and the cell size as written."""
+    y, x = (np.mgrid[0:12, 0:14] + 0.5) * 0.3
+    write_asc(tmp_path / "dem.asc", 1.0 + 0.2 * x + 0.1 * y, cellsize=0.3, x0=263811.5,
+              y0=5479330.25)
+    r = run(["relax", "dem.asc", "-o", "out.h5", "-q", "--report", "r.json",
+             "--tol", "1e-9", "--slope-tol", "1e-6"], cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    text = (tmp_path / "r.json").read_text()
+    assert '"tol": 1e-09,' in text and '"slope_tol": 1e-06,' in text, text
+    def significant(token):
+        mantissa = token.lower().split("e")[0].lstrip("-").replace(".", "")
+        return len(mantissa.strip("0"))
+    for token in re.findall(r"(?<![\w.])-?\d[\d.]*(?:e[-+]?\d+)?", text):
+        # Python's repr is the shortest text that reads back
+        assert significant(token) <= significant(repr(float(token))), \
+            f"{token} has more digits than it takes ({repr(float(token))}):\n{text}"
+    rep = json.loads(text)
+    assert rep["tol"] == 1e-9 and rep["slope_tol"] == 1e-6 and rep["dx"] == 0.3, rep
+    r = run(["info", "out.h5"], cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    grid = [line for line in r.stdout.splitlines() if line.startswith("grid")][0]
+    assert grid.endswith("dx = 0.3 m, dy = 0.3 m, lower-left corner (263811.5, 5479330.25) m"), \
+        grid

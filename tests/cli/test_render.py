@@ -129,6 +129,50 @@ def test_frames_slice_and_time(series, tmp_path):
     assert read_png(tmp_path / "c" / "frame_00000.png")["text"]["snapshot"] == "2"
 
 
+def python_slice(spec, count):
+    """The indices Python's list(range(count))[A:B:STEP] (or [A]) gives."""
+    parts = [int(p) if p else None for p in spec.split(":")]
+    if len(parts) == 1:
+        return [list(range(count))[parts[0]]]
+    return list(range(count))[slice(*parts)]
+
+
+@pytest.mark.parametrize("spec", ["0:100:9", "0:100:2", "::-1", "-1", "-5", "4", "-100:2",
+                                  "3:-100:-1", "::-2", "10:-10:-3", "1:", ":-1", "-2::-1",
+                                  "::999999999999999999", "::-9223372036854775808"])
+def test_frames_as_a_python_slice(series, tmp_path, spec):
+    """--frames is a Python slice of the snapshots: bounds clamped to the
+    series, negative steps in reverse, frames numbered in the order drawn."""
+    d, _ = series
+    want = python_slice(spec, 5)
+    assert want, "test bug: a spec that selects nothing"
+    r = run(["render", d / "out.h5", "-o", tmp_path, "--frames", spec, "--max-size", "16"])
+    assert r.returncode == 0, f"--frames {spec} on 5 snapshots: {r.stderr}"
+    names = frames_in(tmp_path)
+    assert names == [f"frame_{k:05d}.png" for k in range(len(want))], \
+        f"--frames {spec}: {names}, expected {len(want)} frames"
+    got = [int(read_png(tmp_path / n)["text"]["snapshot"]) for n in names]
+    assert got == want, f"--frames {spec} drew snapshots {got}, Python's slice gives {want}"
+
+
+@pytest.mark.parametrize("spec, expect", [
+    ("5:9", "selects no snapshot"), ("3:1", "selects no snapshot"),
+    ("-1:0", "selects no snapshot"), ("0:3:-1", "selects no snapshot"),
+    ("::0", "STEP is 0"), ("1:4:0", "STEP is 0"),
+    ("5", "outside the series"), ("-6", "outside the series"),
+    ("1:2:3:4", "expected A:B:STEP"), ("1.5:", "expected A:B:STEP"), ("a", "expected A:B:STEP"),
+])
+def test_frames_that_select_nothing(series, tmp_path, spec, expect):
+    """An empty slice, a step of 0 and an index outside the series exit 2,
+    saying which, and write nothing."""
+    d, _ = series
+    r = run(["render", d / "out.h5", "-o", tmp_path / "f", f"--frames={spec}"])
+    assert r.returncode == 2 and expect in r.stderr, \
+        f"--frames {spec!r}: exit {r.returncode}, expected 2 and {expect!r}: {r.stderr}"
+    assert r.stderr.count("\n") == 1, r.stderr
+    assert not (tmp_path / "f").exists(), "nothing written"
+
+
 def test_gray16_heights_and_range(series, tmp_path):
     d, times = series
     run_ok(["render", d / "out.h5", "-o", tmp_path, "--style", "gray16", "--frames", "4",
@@ -289,7 +333,7 @@ def test_bad_files(tmp_path, what):
 
 
 @pytest.mark.parametrize("args, expect", [
-    (["--frames", "5:9"], "outside the series"),
+    (["--frames", "5:9"], "selects no snapshot"),
     (["--frames", "7"], "outside the series"),
     (["--frames", "3:1"], "selects no snapshot"),
     (["--frames", "a:b"], "expected A:B:STEP"),
@@ -346,6 +390,42 @@ def test_video_without_ffmpeg_keeps_frames(series, tmp_path):
     assert "ffmpeg is not on PATH" in r.stderr
     assert len(frames_in(tmp_path / "frames")) == 5, "the frames are kept"
     assert not (tmp_path / "v.mp4").exists()
+
+
+@pytest.mark.skipif(not (shutil.which("ffmpeg") and shutil.which("ffprobe")),
+                    reason="ffmpeg/ffprobe not installed")
+def test_video_alone_keeps_no_frames(series, tmp_path):
+    """--video without -o: the video, and no frames/ nor the temporary
+    folder its frames went to, in the working folder or the video's."""
+    d, _ = series
+    (tmp_path / "work").mkdir()
+    (tmp_path / "films").mkdir()
+    r = run_ok(["render", d / "out.h5", "--video", tmp_path / "films" / "v.mp4",
+                "--frames", "::-1", "--max-size", "64"], cwd=tmp_path / "work")
+    assert os.listdir(tmp_path / "work") == [], \
+        f"the working folder got {os.listdir(tmp_path / 'work')} (a frames/ folder?)"
+    assert os.listdir(tmp_path / "films") == ["v.mp4"], \
+        f"beside the video: {os.listdir(tmp_path / 'films')} (frames left behind?)"
+    assert r.stdout == "wrote %s: 5 frames at 24 frames/s\n" % (tmp_path / "films" / "v.mp4"), \
+        r.stdout
+    probe = subprocess.run(["ffprobe", "-v", "error", "-count_frames", "-select_streams", "v:0",
+                            "-show_entries", "stream=nb_read_frames", "-of", "csv=p=0",
+                            str(tmp_path / "films" / "v.mp4")],
+                           capture_output=True, text=True, timeout=60)
+    assert probe.stdout.strip() == "5", probe.stdout + probe.stderr
+
+
+def test_video_alone_without_ffmpeg_is_refused(series, tmp_path):
+    """--video without -o and without ffmpeg would make nothing: exit 2
+    before anything is written, saying -o keeps the frames."""
+    d, _ = series
+    empty = tmp_path / "bin"
+    empty.mkdir()
+    r = run(["render", d / "out.h5", "--video", "v.mp4"], cwd=tmp_path,
+            env={**os.environ, "PATH": str(empty)})
+    assert r.returncode == 2, r.stderr
+    assert "ffmpeg is not on PATH" in r.stderr and "-o DIR" in r.stderr, r.stderr
+    assert sorted(os.listdir(tmp_path)) == ["bin"], "something was written"
 
 
 @pytest.mark.skipif(not (shutil.which("ffmpeg") and shutil.which("ffprobe")),

@@ -28,7 +28,8 @@ static int fuzz_status(int err)
 	return err == SS_OK || err == SS_ERR_INPUT || err == SS_ERR_FAIL;
 }
 
-/* The cell types in blocks of `block` rows: each 0, 1 or 2. */
+/* The cell types in blocks of `block` rows: each 0, 1 or 2 (a cell
+ * without data, 3 in the file, is read as a wall). */
 static void read_types(struct ss_snapshot_file *f, int block)
 {
 	uint8_t *t = malloc((size_t)block * (size_t)f->nx);
@@ -85,7 +86,8 @@ static int check_summary(struct ss_snapshot_file *f, struct ss_snapshot_summary 
 	FUZZ_CHECK(fuzz_status(err));
 	if (!err) {
 		FUZZ_CHECK(s->nx == f->nx && s->ny == f->ny && s->count == f->count);
-		FUZZ_CHECK(s->flow_cells + s->wall_cells + s->open_cells == (long long)f->nx * f->ny);
+		FUZZ_CHECK(s->flow_cells + s->wall_cells + s->open_cells + s->nodata_cells ==
+		           (long long)f->nx * f->ny);
 		FUZZ_CHECK(!memcmp(s->time, f->time, (size_t)f->count * sizeof *s->time));
 		FUZZ_CHECK(memchr(s->source, 0, sizeof s->source) && !strncmp(s->source, "sandslide", 9));
 	}
@@ -100,7 +102,7 @@ static void same_summary(const struct ss_snapshot_summary *a, const struct ss_sn
 	FUZZ_CHECK(!memcmp(a->time, b->time, (size_t)a->count * sizeof *a->time));
 	FUZZ_CHECK(!memcmp(a->diag, b->diag, (size_t)a->count * sizeof *a->diag));
 	FUZZ_CHECK(a->flow_cells == b->flow_cells && a->wall_cells == b->wall_cells &&
-	           a->open_cells == b->open_cells);
+	           a->open_cells == b->open_cells && a->nodata_cells == b->nodata_cells);
 	FUZZ_CHECK(!strcmp(a->title, b->title) && !strcmp(a->closure, b->closure));
 }
 
