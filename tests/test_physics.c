@@ -947,12 +947,9 @@ static double timed(void (*fn)(void))
 
 #define RUN_TIMED(fn)                                                         \
 	do {                                                                  \
-		double secs_ = 0.0;                                           \
-		const int before_ = check_failed;                             \
-		check_current = #fn;                                          \
-		secs_ = timed(fn);                                            \
-		printf("%s %s (%.2f s)\n", check_failed == before_ ? "ok  " : "FAIL", \
-		       #fn, secs_);                                           \
+		const struct check_mark mark_ = check_begin(#fn);             \
+		const double secs_ = timed(fn);                               \
+		printf("%s %s (%.2f s)\n", check_end(mark_), #fn, secs_);     \
 		fflush(stdout);                                               \
 	} while (0)
 

@@ -1354,12 +1354,11 @@ static void test_restart(void)
 /* RUN with the wall time of the test */
 #define RUN_TIMED(fn)                                                         \
 	do {                                                                  \
-		const int before_ = check_failed;                             \
+		const struct check_mark mark_ = check_begin(#fn);             \
 		const double t0_ = check_now();                               \
-		check_current = #fn;                                          \
 		fn();                                                         \
-		printf("%s %s (%.2f s)\n", check_failed == before_ ? "ok  " : "FAIL", \
-		       #fn, check_now() - t0_);                               \
+		const double secs_ = check_now() - t0_;                       \
+		printf("%s %s (%.2f s)\n", check_end(mark_), #fn, secs_);     \
 		fflush(stdout);                                               \
 	} while (0)
 
