@@ -305,7 +305,8 @@ endif
 # (each ends with "N passed, M failed", or with ", K skipped" after it
 # when something was skipped, each skip saying why; a program or test
 # function that made no check fails), the fuzz corpora replayed, then the
-# CLI/file tests and the Python module's with pytest.
+# CLI/file tests and the Python module's with pytest (-rs: every skip
+# prints its reason).  test_mpi.py is left to test-mpi.
 test check: all $(TEST_BIN) $(HOOK_BIN) headers-check check-layering $(FUZZ_REPLAY)
 	@fail=0; for t in $(TEST_BIN); do \
 	  echo "== $$t"; OMP_NUM_THREADS=$${OMP_NUM_THREADS:-2} ./$$t || fail=1; \
@@ -316,16 +317,16 @@ test check: all $(TEST_BIN) $(HOOK_BIN) headers-check check-layering $(FUZZ_REPL
 	  SANDSLIDE_PAUSE=$(abspath $(HOOK_PAUSE)) \
 	  SANDSLIDE_MAKEFLAGS="BUILD=$(BUILD) SANITIZE=$(SANITIZE) MPI=$(MPI) OPENMP=$(OPENMP) GDAL=$(GDAL)" \
 	  SANDSLIDE_CC="$(CC)" SANDSLIDE_LDFLAGS="$(ALL_LDFLAGS)" SANDSLIDE_PY_PRELOAD="$(PY_PRELOAD)" \
-	  $(PYTHON) -m pytest -q tests/cli || fail=1; \
+	  $(PYTHON) -m pytest -q -rs tests/cli --ignore=tests/cli/test_mpi.py || fail=1; \
 	echo "== tests/python (pytest)"; \
 	$(PY_SAN_ENV) SANDSLIDE=$(abspath $(BUILD)/sandslide) \
 	  SANDSLIDE_LIBRARY=$(abspath $(BUILD)/$(SONAME)) PYTHONPATH=python \
-	  $(PYTHON) -m pytest -q tests/python || fail=1; \
+	  $(PYTHON) -m pytest -q -rs tests/python || fail=1; \
 	exit $$fail
 
 # The distributed tests (make MPI=1 test-mpi): the C test of the halo and
 # the ordered sums alone and under mpirun -np 1 .. 4, then
-# tests/cli/test_mpi.py (which `make test` skips), which
+# tests/cli/test_mpi.py (which `make test` leaves out), which
 # compares every snapshot of build-mpi/sandslide under np = 1..4 with the
 # serial build/sandslide (built first).  Open MPI's settings for a root
 # user, more ranks than cores and a box without RDMA (notes: mpi.md).
@@ -344,7 +345,7 @@ test-mpi: all $(BUILD)/tests/test_comm $(HOOK_PAUSE)
 	  done
 	@echo "== tests/cli/test_mpi.py (pytest)"; \
 	  $(MPI_ENV) SANDSLIDE_MPI=$(abspath $(BUILD)/sandslide) SANDSLIDE=$(abspath build/sandslide) \
-	  SANDSLIDE_MPI_PAUSE=$(abspath $(HOOK_PAUSE)) $(PYTHON) -m pytest -q tests/cli/test_mpi.py
+	  SANDSLIDE_MPI_PAUSE=$(abspath $(HOOK_PAUSE)) $(PYTHON) -m pytest -q -rs tests/cli/test_mpi.py
 
 # The tiers of src/README.md, checked by the #includes of each file: the
 # kernel knows nothing of files, printing or the command line, I/O nothing

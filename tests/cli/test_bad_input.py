@@ -6,13 +6,14 @@ import os
 import re
 import shutil
 import struct
+import subprocess
 
 import h5py
 import numpy as np
 import pytest
 
-from conftest import (BASE, asc_text, drop_line, edit, files_under, line_of, png_bytes,
-                      run)
+from conftest import (BASE, SANDSLIDE, asc_text, drop_line, edit, files_under, line_of,
+                      png_bytes, run)
 
 CASE = "case.ini"
 SENTINEL = b"SENTINEL: sandslide must not touch this file\n" + bytes(range(256))
@@ -398,15 +399,33 @@ def test_missing_case_file(tmp_path):
     assert files_under(tmp_path) == set()
 
 
+def without_reading_any_file():
+    """For root, who reads a file of mode 000 (CAP_DAC_OVERRIDE,
+    CAP_DAC_READ_SEARCH): a prefix that runs a program without those two
+    capabilities (setpriv, of util-linux); [] for anyone else."""
+    if os.geteuid() != 0:
+        return []
+    prefix = [shutil.which("setpriv") or "setpriv",
+              "--bounding-set=-dac_override,-dac_read_search"]
+    try:
+        ok = subprocess.run(prefix + ["true"], capture_output=True, timeout=60).returncode == 0
+    except OSError:
+        ok = False
+    if not ok:
+        pytest.skip("running as root, and setpriv (Debian package util-linux) cannot drop "
+                    "the capability of reading any file: chmod 000 hides nothing from root")
+    return prefix
+
+
 def test_unreadable_case_file(tmp_path):
     case = tmp_path / CASE
     case.write_text(BASE)
     os.chmod(case, 0)
     try:
-        if os.access(case, os.R_OK):
-            pytest.skip("running as root: chmod 000 does not make the file unreadable")
-        r = run(["run", CASE, "-o", "o.h5"], cwd=tmp_path)
+        r = subprocess.run(without_reading_any_file() + [SANDSLIDE, "run", CASE, "-o", "o.h5"],
+                           cwd=tmp_path, capture_output=True, text=True, timeout=120)
         assert_input_error(r, CASE)
+        assert "ermission denied" in r.stderr, r.stderr
         assert not (tmp_path / "o.h5").exists()
     finally:
         os.chmod(case, 0o644)

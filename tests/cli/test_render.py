@@ -349,7 +349,7 @@ def test_video_without_ffmpeg_keeps_frames(series, tmp_path):
 
 
 @pytest.mark.skipif(not (shutil.which("ffmpeg") and shutil.which("ffprobe")),
-                    reason="ffmpeg/ffprobe not installed")
+                    reason="ffmpeg or ffprobe not on PATH (Debian package ffmpeg)")
 def test_video_frame_count(series, tmp_path):
     d, _ = series
     # a frame left over from a longer earlier series must not get in
