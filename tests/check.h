@@ -16,6 +16,11 @@
  *                                      test's own RUN (timed, every rank)
  *   check_report()                     prints "N passed, M failed" (with
  *                                      ", K skipped" when K > 0), exit code
+ *   CHECK_OPENMP                       1 if the tests (and the library) are
+ *                                      built with OpenMP: without, a run
+ *                                      "on 2 threads" runs on 1, and a test
+ *                                      comparing thread counts says so with
+ *                                      CHECK_SKIP
  *   check_now()                        monotonic clock, s (for timings)
  *   struct rng, rng_next/uniform/int   splitmix64: reproducible random states
  *   check_scratch_make(name)           a mkdtemp folder /tmp/NAME.XXXXXX for files
@@ -103,6 +108,13 @@ static inline int rng_int(struct rng *r, int n)
 {
 	return (int)(rng_next(r) % (uint64_t)n);
 }
+
+/* The tests are compiled with the library's flags, -fopenmp or not. */
+#ifdef _OPENMP
+enum { CHECK_OPENMP = 1 };
+#else
+enum { CHECK_OPENMP = 0 };
+#endif
 
 static int check_passed, check_failed, check_skipped;
 static const char *check_current = "";
