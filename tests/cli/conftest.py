@@ -9,6 +9,7 @@ signalled); `make test` builds all three.  Every test writes its files
 under pytest's tmp_path.
 """
 import os
+import shutil
 import struct
 import subprocess
 import time
@@ -158,6 +159,28 @@ def files_under(path):
         for name in dirnames + filenames:
             out.add(os.path.relpath(os.path.join(dirpath, name), path))
     return out
+
+
+def without_root_powers():
+    """A command prefix that runs a program without root's power over file
+    modes (CAP_DAC_OVERRIDE, CAP_DAC_READ_SEARCH: root reads a file of mode
+    000 and writes into a folder of mode 555), so that a test of an
+    unreadable file or a folder it may not write tests something when run
+    as root, as CI does: setpriv (util-linux) with the two out of the
+    bounding set.  [] for anyone but root; a skip, saying why, where setpriv
+    cannot."""
+    if os.geteuid() != 0:
+        return []
+    prefix = [shutil.which("setpriv") or "setpriv",
+              "--bounding-set=-dac_override,-dac_read_search"]
+    try:
+        ok = subprocess.run(prefix + ["true"], capture_output=True, timeout=60).returncode == 0
+    except OSError:
+        ok = False
+    if not ok:
+        pytest.skip("running as root, and setpriv (Debian package util-linux) cannot drop "
+                    "root's power over file modes: chmod hides nothing from root")
+    return prefix
 
 
 def wait_for(predicate, timeout, interval=0.02):

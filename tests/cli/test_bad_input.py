@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from conftest import (BASE, SANDSLIDE, asc_text, drop_line, edit, files_under, line_of,
-                      png_bytes, run)
+                      png_bytes, run, without_root_powers)
 
 CASE = "case.ini"
 SENTINEL = b"SENTINEL: sandslide must not touch this file\n" + bytes(range(256))
@@ -399,30 +399,12 @@ def test_missing_case_file(tmp_path):
     assert files_under(tmp_path) == set()
 
 
-def without_reading_any_file():
-    """For root, who reads a file of mode 000 (CAP_DAC_OVERRIDE,
-    CAP_DAC_READ_SEARCH): a prefix that runs a program without those two
-    capabilities (setpriv, of util-linux); [] for anyone else."""
-    if os.geteuid() != 0:
-        return []
-    prefix = [shutil.which("setpriv") or "setpriv",
-              "--bounding-set=-dac_override,-dac_read_search"]
-    try:
-        ok = subprocess.run(prefix + ["true"], capture_output=True, timeout=60).returncode == 0
-    except OSError:
-        ok = False
-    if not ok:
-        pytest.skip("running as root, and setpriv (Debian package util-linux) cannot drop "
-                    "the capability of reading any file: chmod 000 hides nothing from root")
-    return prefix
-
-
 def test_unreadable_case_file(tmp_path):
     case = tmp_path / CASE
     case.write_text(BASE)
     os.chmod(case, 0)
     try:
-        r = subprocess.run(without_reading_any_file() + [SANDSLIDE, "run", CASE, "-o", "o.h5"],
+        r = subprocess.run(without_root_powers() + [SANDSLIDE, "run", CASE, "-o", "o.h5"],
                            cwd=tmp_path, capture_output=True, text=True, timeout=120)
         assert_input_error(r, CASE)
         assert "ermission denied" in r.stderr, r.stderr
