@@ -199,12 +199,15 @@ def test_file_size_limit_gives_exit_1_and_keeps_earlier_snapshots(tmp_path):
 
 
 def test_full_disk_gives_exit_1_and_keeps_earlier_snapshots(tmp_path):
-    """On a 3 MiB tmpfs (root only; skipped elsewhere)."""
+    """On a 3 MiB tmpfs (root only, with the right to mount; skipped
+    elsewhere, saying why)."""
     disk = tmp_path / "small"
     disk.mkdir()
-    if subprocess.run(["mount", "-t", "tmpfs", "-o", "size=3m", "tmpfs", str(disk)],
-                      capture_output=True).returncode != 0:
-        pytest.skip("cannot mount a small tmpfs here (needs root)")
+    m = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=3m", "tmpfs", str(disk)],
+                       capture_output=True, text=True)
+    if m.returncode != 0:
+        pytest.skip("cannot mount a 3 MiB tmpfs here (needs root and CAP_SYS_ADMIN): mount "
+                    f"said {(m.stderr.strip().splitlines() or [''])[0]!r}")
     try:
         case = write_case(disk, edit(edit(POUR, "nx = 40\n", "nx = 200\n"),
                                      "ny = 30\n", "ny = 200\n"))
