@@ -707,8 +707,8 @@ static void geotiff_round_trip(void)
 		ss_raster_release(&b);
 		CHECK(err == SS_ERR_INPUT && strstr(msg, "unavailable in this build") &&
 		      strstr(msg, ".asc"), "reading too: %s", msg);
-		CHECK_SKIP("the GeoTIFF round trip: this build has no GDAL (made with GDAL=0, "
-		           "or without Debian package libgdal-dev)");
+		CHECK_SKIP("the GeoTIFF round trip: this build has no GDAL (made with GDAL=0 or "
+		           "MPI=1, or without Debian package libgdal-dev)");
 		ss_raster_release(&a);
 		return;
 	}
