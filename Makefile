@@ -278,14 +278,19 @@ $(FUZZ_BUILD)/replay/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/replay.c $(FUZZ_BUIL
 # replay/render/x.d and replay/src/io/x.d: the tiers are one level deeper
 -include $(wildcard $(FUZZ_BUILD)/*/*/*.d $(FUZZ_BUILD)/*/*/*/*.d)
 
-# The test hook of the non-finite guard (tests/hooks/nan_step.c): the
-# command line linked again with the stepper's advance wrapped, so that a
-# test can put a NaN into a height; the real sandslide has no such hook.
-HOOK_BIN := $(BUILD)/tests/sandslide-nan
-$(HOOK_BIN): tests/hooks/nan_step.c $(MAIN_OBJ) $(BUILD)/libsandslide.a $(BUILD)/.flags
+# The test hooks (tests/hooks/NAME_step.c): the command line linked again
+# with the stepper's advance wrapped, as $(BUILD)/tests/sandslide-NAME, so
+# that a test can put a NaN into a height (nan: the non-finite guard), or
+# stop a run at a known substep until it is signalled (pause: the
+# interrupt, without racing the run); the real sandslide has no hook.
+HOOK_NAN   := $(BUILD)/tests/sandslide-nan
+HOOK_PAUSE := $(BUILD)/tests/sandslide-pause
+HOOK_BIN   := $(HOOK_NAN) $(HOOK_PAUSE)
+$(HOOK_BIN): $(BUILD)/tests/sandslide-%: tests/hooks/%_step.c $(MAIN_OBJ) $(BUILD)/libsandslide.a \
+             $(BUILD)/.flags
 	@mkdir -p $(@D)
 	@$(if $(Q),echo '  LINK    $@')
-	$(Q)$(CC) $(filter-out -MMD -MP,$(ALL_CFLAGS)) tests/hooks/nan_step.c $(MAIN_OBJ) \
+	$(Q)$(CC) $(filter-out -MMD -MP,$(ALL_CFLAGS)) $< $(MAIN_OBJ) \
 	  $(BUILD)/libsandslide.a $(ALL_LDFLAGS) -Wl,--wrap=ss_stepper_advance $(LIBS) -o $@
 
 # The Python module's tests load the library into python3: a sanitized one
@@ -297,27 +302,31 @@ ifeq ($(SANITIZE),1)
 endif
 
 # The README's test command.  The layering check, the C test programs
-# (each prints "N passed, M failed"), the fuzz corpora replayed, then the
-# CLI/file tests and the Python module's with pytest.
+# (each ends with "N passed, M failed", or with ", K skipped" after it
+# when something was skipped, each skip saying why; a program or test
+# function that made no check fails), the fuzz corpora replayed, then the
+# CLI/file tests and the Python module's with pytest (-rs: every skip
+# prints its reason).  test_mpi.py is left to test-mpi.
 test check: all $(TEST_BIN) $(HOOK_BIN) headers-check check-layering $(FUZZ_REPLAY)
 	@fail=0; for t in $(TEST_BIN); do \
 	  echo "== $$t"; OMP_NUM_THREADS=$${OMP_NUM_THREADS:-2} ./$$t || fail=1; \
 	done; \
 	echo "== tests/fuzz (corpora and regressions replayed)"; ( $(FUZZ_REPLAY_RUN) ) || fail=1; \
 	echo "== tests/cli (pytest)"; \
-	SANDSLIDE_MPI= SANDSLIDE=$(abspath $(BUILD)/sandslide) SANDSLIDE_NAN=$(abspath $(HOOK_BIN)) \
+	SANDSLIDE_MPI= SANDSLIDE=$(abspath $(BUILD)/sandslide) SANDSLIDE_NAN=$(abspath $(HOOK_NAN)) \
+	  SANDSLIDE_PAUSE=$(abspath $(HOOK_PAUSE)) \
 	  SANDSLIDE_MAKEFLAGS="BUILD=$(BUILD) SANITIZE=$(SANITIZE) MPI=$(MPI) OPENMP=$(OPENMP) GDAL=$(GDAL)" \
 	  SANDSLIDE_CC="$(CC)" SANDSLIDE_LDFLAGS="$(ALL_LDFLAGS)" SANDSLIDE_PY_PRELOAD="$(PY_PRELOAD)" \
-	  $(PYTHON) -m pytest -q tests/cli || fail=1; \
+	  $(PYTHON) -m pytest -q -rs tests/cli --ignore=tests/cli/test_mpi.py || fail=1; \
 	echo "== tests/python (pytest)"; \
 	$(PY_SAN_ENV) SANDSLIDE=$(abspath $(BUILD)/sandslide) \
 	  SANDSLIDE_LIBRARY=$(abspath $(BUILD)/$(SONAME)) PYTHONPATH=python \
-	  $(PYTHON) -m pytest -q tests/python || fail=1; \
+	  $(PYTHON) -m pytest -q -rs tests/python || fail=1; \
 	exit $$fail
 
 # The distributed tests (make MPI=1 test-mpi): the C test of the halo and
 # the ordered sums alone and under mpirun -np 1 .. 4, then
-# tests/cli/test_mpi.py (which `make test` skips), which
+# tests/cli/test_mpi.py (which `make test` leaves out), which
 # compares every snapshot of build-mpi/sandslide under np = 1..4 with the
 # serial build/sandslide (built first).  Open MPI's settings for a root
 # user, more ranks than cores, no RDMA (doc/cluster.md#open-mpi-as-root-on-a-small-machine).
@@ -326,7 +335,7 @@ MPI_ENV := OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 \
            OMPI_MCA_btl_vader_single_copy_mechanism=none OMPI_MCA_pml=ob1 \
            OMPI_MCA_btl=self,vader OMPI_MCA_btl_base_warn_component_unused=0 OMP_NUM_THREADS=1
 .PHONY: test-mpi
-test-mpi: all $(BUILD)/tests/test_comm
+test-mpi: all $(BUILD)/tests/test_comm $(HOOK_PAUSE)
 	@[ "$(MPI)" = 1 ] || { echo "test-mpi: run it as make MPI=1 test-mpi"; exit 2; }
 	$(MAKE) MPI=0 all
 	@echo "== $(BUILD)/tests/test_comm (alone, then mpirun -np 1 .. 4)"; \
@@ -336,7 +345,7 @@ test-mpi: all $(BUILD)/tests/test_comm
 	  done
 	@echo "== tests/cli/test_mpi.py (pytest)"; \
 	  $(MPI_ENV) SANDSLIDE_MPI=$(abspath $(BUILD)/sandslide) SANDSLIDE=$(abspath build/sandslide) \
-	  $(PYTHON) -m pytest -q tests/cli/test_mpi.py
+	  SANDSLIDE_MPI_PAUSE=$(abspath $(HOOK_PAUSE)) $(PYTHON) -m pytest -q -rs tests/cli/test_mpi.py
 
 # The tiers of src/README.md, checked by the #includes of each file: the
 # kernel knows nothing of files, printing or the command line, I/O nothing

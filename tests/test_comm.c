@@ -34,10 +34,11 @@
  *                of the first failing rank in rank order
  *
  * Run as a plain program (one rank: `make test`) or under mpirun -np N in the
- * MPI build (make MPI=1).  Only rank 0 prints "ok"/"FAIL" per test and the
- * closing "N passed, M failed" (the totals of every rank); a failed check
- * prints its rank.  Every rank exits with the agreed status.  Each test is
- * collective: every rank makes the same calls whatever its checks found.
+ * MPI build (make MPI=1).  Only rank 0 prints "ok"/"FAIL" per test (a test
+ * that made no check on any rank fails) and the closing "N passed, M
+ * failed" (the totals of every rank); a failed check prints its rank.
+ * Every rank exits with the agreed status.  Each test is collective: every
+ * rank makes the same calls whatever its checks found.
  */
 #include <math.h>
 #include <stdint.h>
@@ -68,27 +69,32 @@ static void *zalloc(size_t bytes)
 	return p;
 }
 
-/* The failures of every rank in one test, summed (exact: integers). */
-static int failures_everywhere(int mine)
+/* The counts of every rank, summed in place (exact: integers). */
+static void sum_everywhere(int *counts, int n)
 {
-	double sum = mine, unused = 0.0;
-	ss_comm_reduce(&unused, 0, &sum, 1);
-	return (int)sum;
+	double sum[3], unused = 0.0;
+	for (int k = 0; k < n; k++)
+		sum[k] = counts[k];
+	ss_comm_reduce(&unused, 0, sum, n);
+	for (int k = 0; k < n; k++)
+		counts[k] = (int)sum[k];
 }
 
 /* RUN of check.h for every rank: the test's name carries the rank into the
- * FAIL lines, and rank 0 prints the verdict of all. */
+ * FAIL lines, and rank 0 prints the verdict of all, judged on the checks
+ * of every rank (a test may check on rank 0 alone what all sent it). */
 static char current[160];
 #define RUN_ALL(fn)                                                               \
 	do {                                                                      \
-		const int before_ = check_failed;                                 \
 		snprintf(current, sizeof current, "%s (rank %d of %d)", #fn, rank, ranks); \
-		check_current = current;                                          \
+		const struct check_mark mark_ = check_begin(current);             \
 		fn();                                                             \
 		fflush(stderr);                                                   \
-		const int failed_ = failures_everywhere(check_failed - before_);  \
+		int made_[3] = {check_passed + check_failed - mark_.passed - mark_.failed, \
+		                check_failed - mark_.failed, check_skipped - mark_.skipped}; \
+		sum_everywhere(made_, 3);                                         \
 		if (rank == 0) {                                                  \
-			printf("%s %s\n", failed_ == 0 ? "ok  " : "FAIL", #fn);   \
+			printf("%s %s\n", check_verdict(made_[0], made_[1], made_[2]), #fn); \
 			fflush(stdout);                                           \
 		}                                                                 \
 	} while (0)
@@ -579,10 +585,11 @@ int main(int argc, char **argv)
 	RUN_ALL(test_agree);
 
 	/* the totals of every rank, printed once, and one exit status */
-	double max_unused = 0.0, totals[2] = {check_passed, check_failed};
-	ss_comm_reduce(&max_unused, 0, totals, 2);
-	check_passed = (int)totals[0];
-	check_failed = (int)totals[1];
+	int totals[3] = {check_passed, check_failed, check_skipped};
+	sum_everywhere(totals, 3);
+	check_passed = totals[0];
+	check_failed = totals[1];
+	check_skipped = totals[2];
 	int status = 0;
 	if (rank == 0)
 		status = check_report();

@@ -1,12 +1,15 @@
 """Shared helpers for the sandslide command-line and file-format tests.
 
 The binary is found through the environment variable SANDSLIDE (an
-absolute path); it defaults to build/sandslide of this checkout.  The one
-with the test hook of the non-finite guard, SANDSLIDE_NAN, defaults to
-tests/sandslide-nan beside it (`make test` builds both).  Every
-test writes its files under pytest's tmp_path.
+absolute path); it defaults to build/sandslide of this checkout.  The ones
+with a test hook (tests/hooks/) default to tests/ beside it: SANDSLIDE_NAN,
+tests/sandslide-nan (the non-finite guard), and SANDSLIDE_PAUSE,
+tests/sandslide-pause (a run that stops at a known substep until it is
+signalled); `make test` builds all three.  Every test writes its files
+under pytest's tmp_path.
 """
 import os
+import shutil
 import struct
 import subprocess
 import time
@@ -22,6 +25,9 @@ SANDSLIDE = os.environ.get("SANDSLIDE", os.path.join(ROOT, "build", "sandslide")
 # sandslide with the test hook of the non-finite guard (tests/hooks/nan_step.c)
 SANDSLIDE_NAN = os.environ.get("SANDSLIDE_NAN", os.path.join(os.path.dirname(SANDSLIDE),
                                                               "tests", "sandslide-nan"))
+# sandslide with the test hook of the interrupt (tests/hooks/pause_step.c)
+SANDSLIDE_PAUSE = os.environ.get("SANDSLIDE_PAUSE", os.path.join(os.path.dirname(SANDSLIDE),
+                                                                  "tests", "sandslide-pause"))
 CASES = os.path.join(ROOT, "cases")
 
 # A small valid case: 20 x 16 cells of 0.1 m, grid [0, 2] x [0, 1.6] m.
@@ -155,6 +161,28 @@ def files_under(path):
     return out
 
 
+def without_root_powers():
+    """A command prefix that runs a program without root's power over file
+    modes (CAP_DAC_OVERRIDE, CAP_DAC_READ_SEARCH: root reads a file of mode
+    000 and writes into a folder of mode 555), so that a test of an
+    unreadable file or a folder it may not write tests something when run
+    as root, as CI does: setpriv (util-linux) with the two out of the
+    bounding set.  [] for anyone but root; a skip, saying why, where setpriv
+    cannot."""
+    if os.geteuid() != 0:
+        return []
+    prefix = [shutil.which("setpriv") or "setpriv",
+              "--bounding-set=-dac_override,-dac_read_search"]
+    try:
+        ok = subprocess.run(prefix + ["true"], capture_output=True, timeout=60).returncode == 0
+    except OSError:
+        ok = False
+    if not ok:
+        pytest.skip("running as root, and setpriv (Debian package util-linux) cannot drop "
+                    "root's power over file modes: chmod hides nothing from root")
+    return prefix
+
+
 def wait_for(predicate, timeout, interval=0.02):
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
@@ -168,3 +196,39 @@ def wait_for(predicate, timeout, interval=0.02):
 @pytest.fixture
 def base_case():
     return BASE
+
+
+# ---- signals at a known substep (tests/hooks/pause_step.c) ---------------------
+# A test that signals a running sandslide would race it: on a fast machine
+# the run may end first.  sandslide-pause stops after substep `step`,
+# creates a marker file and waits for the stop signal, so that the signal
+# arrives there every time and the run stops after substep step + 1.
+
+
+def hook_binary(path):
+    """path, which must be a hook binary that was built: a test that needs it
+    fails (it is not skipped) when it is missing."""
+    assert os.path.isfile(path) and os.access(path, os.X_OK), \
+        f"{path} not found: `make test` builds it (or set the variable naming it)"
+    return path
+
+
+def pause_env(step, marker, env=None):
+    """The environment that makes sandslide-pause stop after substep `step`
+    and create `marker` until a stop signal comes."""
+    return dict(os.environ if env is None else env, SANDSLIDE_TEST_PAUSE_STEP=str(step),
+                SANDSLIDE_TEST_PAUSE_FILE=str(marker))
+
+
+def wait_paused(p, marker, step, timeout=120):
+    """Wait until process p, started with pause_env(step, marker), is paused
+    after that substep; fails (p left running for the caller to end) if it
+    ended first or did not get there within timeout seconds."""
+    wait_for(lambda: os.path.exists(marker) or p.poll() is not None, timeout)
+    if os.path.exists(marker):
+        return
+    if p.poll() is not None:
+        out, err = p.communicate()
+        raise AssertionError(f"test set-up: the run ended (exit {p.returncode}) before "
+                             f"substep {step}, where it should pause\nstderr:\n{err}")
+    raise AssertionError(f"the run did not reach substep {step} within {timeout} s")

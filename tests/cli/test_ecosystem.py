@@ -146,7 +146,8 @@ def test_cdo_reads_elapsed_time_and_missing_walls(run_files):
 
 
 @pytest.mark.skipif("GDAL: on" not in run(["--version"]).stdout,
-                    reason="this build reads no GeoTIFF (make GDAL=0, or the MPI build)")
+                    reason="this build reads no GeoTIFF (made with GDAL=0 or MPI=1, or without "
+                           "Debian package libgdal-dev)")
 def test_crs_kept_from_geotiff_to_h5_and_back(tmp_path):
     """relax of a GeoTIFF with a CRS into .h5 writes the CF grid mapping
     /crs; relax of that .h5 into GeoTIFF gives the CRS, geotransform and
@@ -194,7 +195,8 @@ def test_crs_kept_from_geotiff_to_h5_and_back(tmp_path):
 
 
 @pytest.mark.skipif("GDAL: on" not in run(["--version"]).stdout,
-                    reason="this build reads no GeoTIFF (make GDAL=0, or the MPI build)")
+                    reason="this build reads no GeoTIFF (made with GDAL=0 or MPI=1, or without "
+                           "Debian package libgdal-dev)")
 def test_dem_in_degrees_refused_with_the_gdalwarp_that_fixes_it(tmp_path):
     """A DEM in a geographic CRS would be taken as metres (every face ~90
     deg, a run that crawls for ever): exit 2, one line that says degrees
@@ -243,7 +245,8 @@ def test_dem_in_degrees_refused_with_the_gdalwarp_that_fixes_it(tmp_path):
 
 
 @pytest.mark.skipif("GDAL: on" not in run(["--version"]).stdout,
-                    reason="this build reads no GeoTIFF (make GDAL=0, or the MPI build)")
+                    reason="this build reads no GeoTIFF (made with GDAL=0 or MPI=1, or without "
+                           "Debian package libgdal-dev)")
 def test_relax_of_a_format_it_does_not_write_defaults_to_geotiff(tmp_path):
     """relax dem.img without -o: out/dem-relaxed.tif with the .img's
     georeferencing (it blamed an -o that was never given)."""

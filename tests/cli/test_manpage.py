@@ -391,7 +391,7 @@ def test_commands_match(page):
 def test_groff_renders_without_warnings():
     groff = shutil.which("groff")
     if groff is None:
-        pytest.skip("groff is not installed (Debian package groff): cannot check that "
+        pytest.skip("groff is not installed (Debian package groff-base): cannot check that "
                     "the man page renders without warnings")
     r = subprocess.run([groff, "-man", "-Tutf8", "-ww", "-z", MANPAGE],
                        capture_output=True, text=True, timeout=60)

@@ -3,8 +3,10 @@ serial build/sandslide, bit for bit.
 
 Skipped unless the MPI build exists: SANDSLIDE_MPI (default
 build-mpi/sandslide of this checkout, `make MPI=1`; set but empty: skipped)
-and Open MPI's mpirun (MPIRUN, default mpirun.openmpi).  The serial binary
-is conftest's SANDSLIDE.
+and Open MPI's mpirun (MPIRUN, default mpirun.openmpi); each skip says
+which.  The serial binary is conftest's SANDSLIDE; the MPI build's pause
+hook is SANDSLIDE_MPI_PAUSE (default tests/sandslide-pause beside
+SANDSLIDE_MPI; `make MPI=1 test-mpi` builds it).
 
   bit identity     six small cases (64 x 45..48 cells, tiles 16 x 8: six tile
                    rows, the last one short when ny is 45 or 47) covering wall,
@@ -26,11 +28,14 @@ is conftest's SANDSLIDE.
                    snapshots before it complete), continued by run --restart
                    under np = 3 to the end: every snapshot and the final
                    restart_state are those of the serial run never cut
-  SIGTERM          to mpirun -np 3 mid-run: one message from rank 0, a
-                   readable file (h5py, ncdump) ending with a complete
-                   snapshot; run --restart under np = 2 from it, interrupted
-                   again: every snapshot on the output times has the serial
-                   run's bits
+  SIGTERM          to mpirun -np 3 mid-run, its ranks paused after a
+                   known substep (build-mpi/tests/sandslide-pause,
+                   tests/hooks/pause_step.c: no race with a fast machine):
+                   one message from rank 0, every rank stops after the next
+                   substep, a readable file (h5py, ncdump) ending with a
+                   complete snapshot of that substep; run --restart under
+                   np = 2 from it, interrupted again the same way: every
+                   snapshot on the output times has the serial run's bits
   killed job       SIGKILL to every process of the job (mpirun puts each rank
                    in its own process group, so the test kills the session)
                    leaves a file that h5py and ncdump -h read, with every
@@ -64,10 +69,14 @@ import numpy as np
 import pytest
 
 import conftest
-from conftest import ROOT, SANDSLIDE, h5open, same_bits, wait_for
+from conftest import (ROOT, SANDSLIDE, h5open, hook_binary, pause_env, same_bits, wait_for,
+                      wait_paused)
 
 SANDSLIDE_MPI = os.environ.get("SANDSLIDE_MPI", os.path.join(ROOT, "build-mpi", "sandslide"))
 MPIRUN = os.environ.get("MPIRUN") or shutil.which("mpirun.openmpi") or shutil.which("mpirun")
+# the MPI build with the pause hook (tests/hooks/pause_step.c)
+SANDSLIDE_MPI_PAUSE = os.environ.get(
+    "SANDSLIDE_MPI_PAUSE", os.path.join(os.path.dirname(SANDSLIDE_MPI), "tests", "sandslide-pause"))
 
 pytestmark = [
     # SANDSLIDE_MPI= (empty): not here; `make MPI=1 test-mpi` runs these
@@ -172,16 +181,19 @@ def with_threads(args):
     return args + ["--threads", "1"] if args and args[0] in ("run", "relax") else args
 
 
-def mpi_command(np_, args):
-    """mpirun -np np_ ... sandslide args; np_ None: the MPI binary alone."""
+def mpi_command(np_, args, binary=None):
+    """mpirun -np np_ ... sandslide args; np_ None: the MPI binary alone;
+    binary: another build of it (default SANDSLIDE_MPI)."""
+    binary = binary or SANDSLIDE_MPI
     if np_ is None:
-        return [SANDSLIDE_MPI] + with_threads(args)
-    return [MPIRUN, "-np", str(np_), "--bind-to", "none", SANDSLIDE_MPI] + with_threads(args)
+        return [binary] + with_threads(args)
+    return [MPIRUN, "-np", str(np_), "--bind-to", "none", binary] + with_threads(args)
 
 
-def start_mpi(np_, args, cwd):
+def start_mpi(np_, args, cwd, binary=None, env=None):
     """Start a distributed run in its own session (see kill_session)."""
-    return subprocess.Popen(mpi_command(np_, args), cwd=cwd, env=MPI_ENV, text=True,
+    return subprocess.Popen(mpi_command(np_, args, binary), cwd=cwd,
+                            env=MPI_ENV if env is None else env, text=True,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             stdin=subprocess.DEVNULL, start_new_session=True)
 
@@ -298,9 +310,8 @@ CASES = {
     # cut by a file-size limit: about 4800 steps, 301 snapshots of 24 kB
     "long-euler": dict(end=60.0, every=0.2),
     # interrupted and killed: about 240000 steps, several seconds under
-    # mpirun even on a quiet machine (mpirun passes SIGTERM on to the ranks
-    # only after 1 s, and the run must still be going then); a snapshot
-    # every 160 steps
+    # mpirun even on a quiet machine (the killed job must still be going
+    # when it is killed); a snapshot every 160 steps
     "signal-euler": dict(end=3000.0, every=2.0),
 }
 BIT_CASES = [c for c in CASES if c not in ("long-euler", "signal-euler")]
@@ -684,67 +695,75 @@ def test_cut_under_2_ranks_continued_under_3_is_the_uninterrupted_run(tmp_path, 
                  f"{f.attrs.get(k)!r}, uninterrupted serial {w.attrs[k]!r}")
 
 
-def interrupt(p, out, what, count, end):
-    """SIGTERM to mpirun once out holds `count` snapshots.  mpirun passes it
-    on to the ranks after odls_base_sigkill_timeout (1 s) and SIGKILLs them
-    1 s later: a run that reaches its end within that second is skipped.
-    Returns the snapshots seen before the signal."""
+def start_paused(np_, args, cwd, step):
+    """mpirun -np np_ of the pause hook's build with args, every rank paused
+    after substep `step` until its stop signal (interrupt sends it)."""
+    marker = cwd / "paused"
+    marker.unlink(missing_ok=True)   # left by an earlier run
+    return start_mpi(np_, args, cwd, binary=hook_binary(SANDSLIDE_MPI_PAUSE),
+                     env=pause_env(step, marker, MPI_ENV))
+
+
+def interrupt(p, out, what, step):
+    """SIGTERM to mpirun (start_paused) once its ranks are paused after
+    substep `step`.  mpirun passes it on to the ranks and SIGKILLs them
+    after odls_base_sigkill_timeout (1 s); every rank stops after substep
+    step + 1, however fast the machine, and rank 0 says so once."""
     try:
-        ok = wait_for(lambda: snapshot_count(out) >= count or p.poll() is not None, 60)
-        assert p.poll() is None, f"{what} ended before the signal: {p.communicate()}"
-        assert ok, f"{what} wrote no {count} snapshots within 60 s"
-        seen = max(count, snapshot_count(out))
+        wait_paused(p, out.parent / "paused", step, 60)
         files = shared_memory_of(p.pid)
         p.send_signal(signal.SIGTERM)
-        sent = time.monotonic()
         r = finish(p, f"{what}, interrupted", 60)
-        took = time.monotonic() - sent
         remove_leftovers(p.pid, files)   # mpirun ends the ranks with SIGKILL
     finally:
         kill_session(p.pid)
-    with h5open(out) as f:
-        t_last = float(f["time"][-1])
-    if t_last == end:
-        if took < 1.0:
-            pytest.skip(f"{what} reached its end {took:.2f} s after SIGTERM, before mpirun "
-                        f"passed it on (machine too fast)")
-        raise AssertionError(f"{what} ran on to its end (t = {end}) {took:.2f} s after SIGTERM: "
-                             f"the ranks did not stop\nstderr:\n{r.stderr}")
     assert r.returncode != 0, f"{what}, interrupted, exited 0\nstderr:\n{r.stderr}"
     ours = [line for line in r.stderr.splitlines() if line.startswith("sandslide:")]
-    assert len(ours) == 1 and "interrupted" in ours[0], \
-        f"{what}: one message from rank 0 expected:\n{r.stderr}"
+    assert len(ours) == 1 and "interrupted" in ours[0] and f"(step {step + 1})" in ours[0], \
+        f"{what}: one message from rank 0, stopped in step {step + 1}, expected:\n{r.stderr}"
     assert f"sandslide run --restart {out.name}" in r.stderr, \
         f"{what}: the message does not say how to continue:\n{r.stderr}"
-    return seen
+    with h5open(out) as f:
+        assert f["steps"][-1] == step + 1, \
+            f"{what}: signalled after step {step}, the last snapshot is after step " \
+            f"{f['steps'][-1]}, not {step + 1}"
+
+
+def mid_interval(whole, k):
+    """A substep between the serial run's snapshots k and k + 1."""
+    with h5open(whole) as w:
+        return int(w["steps"][k] + w["steps"][k + 1]) // 2
 
 
 def test_sigterm_leaves_a_complete_last_snapshot_that_continues_bit_for_bit(tmp_path, serial):
-    """SIGTERM to mpirun -np 3 after 3 snapshots: within Open MPI's grace
-    period every rank stops at the same substep and the file ends with a
-    complete snapshot (readable by h5py and ncdump).  run --restart under
-    np = 2 continues from it and is interrupted again 2 snapshots later:
-    every snapshot on the output times, before and after the first cut, has
-    the bits of the serial run (so the interrupt's snapshot, restart_state
-    and all, was the state of the run)."""
+    """SIGTERM to mpirun -np 3 paused after substep mid-way between
+    snapshots 3 and 4: every rank stops after the next substep and the file
+    ends with its complete snapshot (readable by h5py and ncdump).  run
+    --restart under np = 2 continues from it and is interrupted again 2
+    snapshots later: every snapshot on the output times, before and after
+    the first cut, has the bits of the serial run (so the interrupt's
+    snapshot, restart_state and all, was the state of the run)."""
     write_case(tmp_path, "signal-euler")
     out = tmp_path / "cut.h5"
     every = CASES["signal-euler"]["every"]
-    p = start_mpi(3, ["run", "case.ini", "-o", out.name, "-q", "--tile", TILE], tmp_path)
-    end = CASES["signal-euler"]["end"]
-    seen = interrupt(p, out, "mpirun -np 3", 3, end)
-    nt = assert_consistent(out, "after SIGTERM", seen, every)
+    whole = serial("signal-euler")
+    step = mid_interval(whole, 3)
+    p = start_paused(3, ["run", "case.ini", "-o", out.name, "-q", "--tile", TILE], tmp_path,
+                     step)
+    interrupt(p, out, "mpirun -np 3", step)
+    nt = assert_consistent(out, "after SIGTERM", 4, every)
+    assert nt == 5, f"snapshots 0 .. 3 and the interrupt's expected, not {nt}"
     with h5open(out) as f:
         t_cut = float(f["time"][-1])
     ncdump_header(out)
-    whole = serial("signal-euler")
-    assert assert_snapshots_are_serial(out, whole, "cut under np = 3") >= seen
+    assert assert_snapshots_are_serial(out, whole, "cut under np = 3") == 4
 
-    p = start_mpi(2, ["run", "--restart", out.name, "-q"], tmp_path)
-    interrupt(p, out, "run --restart under mpirun -np 2", nt + 2, end)
+    step = mid_interval(whole, 6)
+    p = start_paused(2, ["run", "--restart", out.name, "-q"], tmp_path, step)
+    interrupt(p, out, "run --restart under mpirun -np 2", step)
     matched = assert_snapshots_are_serial(out, whole, "cut under np = 3, continued under np = 2")
     with h5open(out) as f:
-        assert f["time"][-1] > t_cut and matched >= nt + 1, \
+        assert f["time"][-1] > t_cut and matched == 7, \
             f"continued from t = {t_cut}: times {f['time'][()]}"
 
 

@@ -136,7 +136,7 @@ def test_nodata_open_drains_the_same_dem(tmp_path):
 
 def gdal():
     if "GDAL: on" not in run(["--version"]).stdout:
-        pytest.skip("this build has no GDAL (make GDAL=0)")
+        pytest.skip("this build has no GDAL (made with GDAL=0 or MPI=1, or without Debian package libgdal-dev)")
     g = pytest.importorskip("osgeo.gdal", reason="GDAL's Python bindings (python3-gdal) "
                             "are not installed")
     g.UseExceptions()

@@ -421,7 +421,8 @@ def gdal_built():
     return "GDAL: on" in r.stdout
 
 
-@pytest.mark.skipif(not gdal_built(), reason="this build has no GDAL (make GDAL=0)")
+@pytest.mark.skipif(not gdal_built(), reason="this build has no GDAL (made with GDAL=0 or "
+                    "MPI=1, or without Debian package libgdal-dev)")
 def test_geotiff_round_trip_keeps_georeferencing_and_nodata(tmp_path):
     h0 = cliff(30, 20)
     h0[2:4, 25:28] = -9999.0

@@ -1,17 +1,21 @@
 """Nothing lost, nothing crashes (issue 6): overwrite refusal, interrupts and
-restarts bit for bit, write failures, the non-finite guard."""
+restarts bit for bit, write failures, the non-finite guard.
+
+The interrupts are sent to sandslide-pause (tests/hooks/pause_step.c),
+paused after a chosen substep: they arrive there whatever the speed of the
+machine, and the run stops after the next substep."""
 import os
 import re
 import resource
 import signal
 import subprocess
-import time
 
 import numpy as np
 import pytest
 
 import conftest
-from conftest import BASE, SANDSLIDE, SANDSLIDE_NAN, edit, h5open, run, wait_for
+from conftest import (BASE, SANDSLIDE, SANDSLIDE_NAN, SANDSLIDE_PAUSE, edit, h5open, hook_binary,
+                      pause_env, run, wait_paused)
 
 # 40 x 30 cells poured by a source next to an open side: about 10^4 steps
 # over 40 s of simulated time, a snapshot every 2 s
@@ -33,9 +37,20 @@ def write_case(tmp_path, text=POUR, name="pour.ini"):
     return name
 
 
-def start(args, cwd, env=None):
-    return subprocess.Popen([SANDSLIDE] + args, cwd=cwd, stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, env=env)
+def start_paused(args, cwd, step):
+    """sandslide-pause with args, paused after substep `step` until a stop
+    signal comes (wait_paused waits for that)."""
+    marker = cwd / "paused"
+    marker.unlink(missing_ok=True)   # left by an earlier run
+    p = subprocess.Popen([hook_binary(SANDSLIDE_PAUSE)] + args, cwd=cwd, stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True, env=pause_env(step, marker))
+    try:
+        wait_paused(p, marker, step)
+    except BaseException:
+        p.kill()
+        p.communicate()
+        raise
+    return p
 
 
 def snapshots(path):
@@ -76,29 +91,29 @@ def test_relax_refuses_to_replace_an_output_without_force(tmp_path):
 
 @pytest.mark.parametrize("sig, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
 def test_signal_mid_run_then_restart_matches_an_uninterrupted_run(tmp_path, sig, code):
-    # Euler: with RKL2 (the default) this case ends before the signal
-    # arrives; RKL2 cut between output times and continued is
-    # test_rkl2.py's test_restart_of_a_cut_rkl2_run_matches_an_uninterrupted_run
+    # Euler: about 290 substeps between snapshots (RKL2 cut between output
+    # times and continued is test_rkl2.py's
+    # test_restart_of_a_cut_rkl2_run_matches_an_uninterrupted_run)
     case = write_case(tmp_path, POUR.replace("[time]\n", "[time]\nintegrator = euler\n"))
-    p = start(["run", case, "-o", "cut.h5", "-q", "--threads", "2"], tmp_path)
-    # wait until a couple of snapshots are out, then interrupt mid-interval
-    assert wait_for(lambda: (tmp_path / "cut.h5").exists() and
-                    len(snapshots(tmp_path / "cut.h5")) >= 3, 60), "the run wrote nothing"
-    time.sleep(0.05)
+    r = run(["run", case, "-o", "whole.h5", "-q"], cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    with h5open(tmp_path / "whole.h5") as f:
+        steps, times = f["steps"][:], f["time"][:]
+    # the signal comes mid-interval, after 4 snapshots
+    pause = int(steps[3] + steps[4]) // 2
+    p = start_paused(["run", case, "-o", "cut.h5", "-q", "--threads", "2"], tmp_path, pause)
     p.send_signal(sig)
     out, err = p.communicate(timeout=60)
-    if p.returncode == 0:
-        pytest.skip("the run ended before the signal arrived (machine too fast)")
     assert p.returncode == code, (p.returncode, err)
-    assert "sandslide run --restart cut.h5" in err, err
-    t_cut = snapshots(tmp_path / "cut.h5")
-    assert t_cut[-1] < 40.0, "interrupted, yet the last snapshot is the end"
+    assert f"(step {pause + 1})" in err and "sandslide run --restart cut.h5" in err, err
+    with h5open(tmp_path / "cut.h5") as f:
+        assert list(f["steps"][:]) == list(steps[:4]) + [pause + 1], \
+            f"signalled after step {pause}: snapshots after steps {list(f['steps'][:])}"
+        assert times[3] < f["time"][-1] < times[4], f"the interrupt's snapshot at {f['time'][-1]}"
 
     r = run(["run", "--restart", "cut.h5", "-q", "--threads", "1"], cwd=tmp_path)
     assert r.returncode == 0, r.stderr
     assert snapshots(tmp_path / "cut.h5")[-1] == 40.0
-    r = run(["run", case, "-o", "whole.h5", "-q"], cwd=tmp_path)
-    assert r.returncode == 0, r.stderr
     assert_same_snapshots(tmp_path / "cut.h5", tmp_path / "whole.h5")
 
 
@@ -184,12 +199,15 @@ def test_file_size_limit_gives_exit_1_and_keeps_earlier_snapshots(tmp_path):
 
 
 def test_full_disk_gives_exit_1_and_keeps_earlier_snapshots(tmp_path):
-    """On a 3 MiB tmpfs (root only; skipped elsewhere)."""
+    """On a 3 MiB tmpfs (root only, with the right to mount; skipped
+    elsewhere, saying why)."""
     disk = tmp_path / "small"
     disk.mkdir()
-    if subprocess.run(["mount", "-t", "tmpfs", "-o", "size=3m", "tmpfs", str(disk)],
-                      capture_output=True).returncode != 0:
-        pytest.skip("cannot mount a small tmpfs here (needs root)")
+    m = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=3m", "tmpfs", str(disk)],
+                       capture_output=True, text=True)
+    if m.returncode != 0:
+        pytest.skip("cannot mount a 3 MiB tmpfs here (needs root and CAP_SYS_ADMIN): mount "
+                    f"said {(m.stderr.strip().splitlines() or [''])[0]!r}")
     try:
         case = write_case(disk, edit(edit(POUR, "nx = 40\n", "nx = 200\n"),
                                      "ny = 30\n", "ny = 200\n"))
@@ -211,7 +229,9 @@ def test_full_disk_gives_exit_1_and_keeps_earlier_snapshots(tmp_path):
 
 def test_the_real_sandslide_has_no_test_hook(tmp_path):
     case = write_case(tmp_path, BASE, "case.ini")
-    env = dict(os.environ, SANDSLIDE_TEST_NAN_STEP="3")
+    # nor the pause's: paused, it would wait 300 s for a signal
+    env = dict(os.environ, SANDSLIDE_TEST_NAN_STEP="3", SANDSLIDE_TEST_PAUSE_STEP="3",
+               SANDSLIDE_TEST_PAUSE_SECONDS="300")
     p = subprocess.run([SANDSLIDE, "run", case, "-o", "o.h5", "-q"], cwd=tmp_path,
                        capture_output=True, text=True, env=env, timeout=120)
     assert p.returncode == 0, (p.returncode, p.stderr)
@@ -298,43 +318,48 @@ def read_asc_values(path):
     return np.array([float(t) for t in tokens[10:10 + nx * ny]]).reshape(ny, nx)[::-1]
 
 
-@pytest.mark.parametrize("sig, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
-def test_relax_signal_keeps_the_input_and_every_snapshot(tmp_path, sig, code):
-    write_cliff(tmp_path / "cliff.asc", 160, 120)
-    before = (tmp_path / "cliff.asc").read_bytes()
-    p = start(["relax", "cliff.asc", "-o", "cut.h5", "--output-every", "0.02", "-q"],
-              tmp_path)
-    assert wait_for(lambda: (tmp_path / "cut.h5").exists() and
-                    len(snapshots(tmp_path / "cut.h5")) >= 3, 60), "relax wrote nothing"
+# The cliff of 40 x 30 cells takes thousands of substeps to relax, a
+# snapshot every 8 with --output-every 0.02: relax is signalled after
+# substep 30 (4 snapshots out) or 200.
+
+
+def relax_cut(tmp_path, out, pause, sig, extra=()):
+    """relax cliff.asc -o out, signalled after substep `pause`: its stderr."""
+    p = start_paused(["relax", "cliff.asc", "-o", out, *extra], tmp_path, pause)
     p.send_signal(sig)
-    out, err = p.communicate(timeout=60)
-    if p.returncode == 0:
-        pytest.skip("relax ended before the signal arrived (machine too fast)")
-    assert p.returncode == code, (p.returncode, err)
-    assert "interrupted" in err and "cut.h5" in err, err
+    _, err = p.communicate(timeout=60)
+    assert p.returncode == 128 + sig, (p.returncode, err)
+    assert "interrupted at t = " in err and f"(step {pause + 1})" in err and out in err, err
+    return err
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+def test_relax_signal_keeps_the_input_and_every_snapshot(tmp_path, sig):
+    write_cliff(tmp_path / "cliff.asc", 40, 30)
+    before = (tmp_path / "cliff.asc").read_bytes()
+    relax_cut(tmp_path, "cut.h5", 30, sig, ["--output-every", "0.02", "-q"])
     assert (tmp_path / "cliff.asc").read_bytes() == before, "the input was modified"
     with h5open(tmp_path / "cut.h5") as f:
         n = len(f["time"])
-        assert n >= 3 and f["height"].shape[0] == n
+        assert n >= 4 and f["height"].shape[0] == n, f"{n} snapshots"
+        assert f["steps"][-1] == 31 and np.all(np.diff(f["steps"][:]) > 0), f["steps"][:]
         assert np.isfinite(f["height"][:]).all()
-        assert np.all(np.diff(f["steps"][:]) >= 0)
     assert not list(tmp_path.glob(".*.lock")), "the claim of the output was left behind"
 
 
 def test_relax_signal_with_a_raster_output_writes_the_surface_then(tmp_path):
-    write_cliff(tmp_path / "cliff.asc", 160, 120)
+    write_cliff(tmp_path / "cliff.asc", 40, 30)
     before = (tmp_path / "cliff.asc").read_bytes()
-    p = start(["relax", "cliff.asc", "-o", "cut.asc"], tmp_path)
-    time.sleep(1.0)
-    p.send_signal(signal.SIGTERM)
-    out, err = p.communicate(timeout=60)
-    if p.returncode == 0:
-        pytest.skip("relax ended before the signal arrived (machine too fast)")
-    assert p.returncode == 143, (p.returncode, err)
+    err = relax_cut(tmp_path, "cut.asc", 200, signal.SIGTERM)
     assert "not relaxed" in err, err
     assert (tmp_path / "cliff.asc").read_bytes() == before, "the input was modified"
     h = read_asc_values(tmp_path / "cut.asc")
-    assert h.shape == (120, 160) and np.isfinite(h).all()
+    assert h.shape == (30, 40) and np.isfinite(h).all()
+    # "then": the surface after substep 201, as a series cut there holds it
+    relax_cut(tmp_path, "cut.h5", 200, signal.SIGTERM, ["--output-every", "1", "-q"])
+    with h5open(tmp_path / "cut.h5") as f:
+        assert f["steps"][-1] == 201
+        assert np.array_equal(h, f["height"][-1]), "the raster is not the state after step 201"
 
 
 def test_relax_non_finite_height_keeps_the_last_good_state(tmp_path):

@@ -345,7 +345,7 @@ def case(tmp_path):
 
 
 def test_run_writes_the_series_with_overrides(tmp_path, case):
-    h5py = pytest.importorskip("h5py")
+    h5py = pytest.importorskip("h5py", reason="python3-h5py is not installed")
     out = tmp_path / "tiny.h5"
     s = sandslide.run(case, out, set={"time.end": 0.75, "time.output_every": 0.25,
                                       "model.repose_angle": 30}, threads=1)
@@ -381,7 +381,7 @@ def test_run_writes_the_series_with_overrides(tmp_path, case):
 # Debian's netCDF4 warns that it was built against another numpy
 @pytest.mark.filterwarnings("ignore:numpy.ndarray size changed")
 def test_open_gives_a_dataset(tmp_path, case):
-    pytest.importorskip("xarray")
+    pytest.importorskip("xarray", reason="python3-xarray is not installed")
     out = tmp_path / "tiny.h5"
     sandslide.run(case, out, threads=1)
     with sandslide.open(out) as ds:
@@ -427,7 +427,8 @@ def test_missing_library_says_what_was_tried(tmp_path):
     assert "SANDSLIDE_LIBRARY" in r.stderr and "nowhere" in r.stderr, r.stderr
     import ctypes.util
     if ctypes.util.find_library("sandslide"):
-        pytest.skip("a libsandslide is installed where the loader looks")
+        pytest.skip("a libsandslide is installed where the loader looks (make uninstall): "
+                    "the search without SANDSLIDE_LIBRARY cannot be shown to fail")
     r = import_in(package_copy(tmp_path / "b"), None)
     assert r.returncode != 0 and "ImportError" in r.stderr, r.stderr
     for tried in ("SANDSLIDE_LIBRARY", "_library.PATH", "build tree", "find_library"):
