@@ -18,6 +18,7 @@
 #include "sandslide/error.h"
 #include "sandslide/parallel.h"
 #include "sandslide/comm.h"
+#include "sandslide/cpu.h"
 
 #include "sandslide/grid.h"
 #include "sandslide/boundary.h"
