@@ -30,8 +30,10 @@
  *                    1/sqrt over 1e-300 .. 1e300; a row of faces gives the
  *                    bits of single faces
  *
- * About 10 s on 2 idle cores (the reference kernel of the active-tile case is
- * most of it); the seed is fixed (SANDSLIDE_TEST_SEED overrides it).
+ * About 16 s on 2 idle cores (the identity cases, the active-tile case and
+ * the three paths' sweeps, 3-5 s each); the seed is fixed
+ * (SANDSLIDE_TEST_SEED overrides it).  The path main() starts on is the
+ * default one, or the one SANDSLIDE_CPU forces.
  * SANDSLIDE_TEST_SCALE in (0, 1] (tests/scale.h; 0.5 under `make SANITIZE=1
  * test` and `make race`) shrinks the box of the active-tile case, with
  * every check kept.
