@@ -11,6 +11,8 @@
 #                   PREFIX (/usr/local), staged in DESTDIR; make uninstall
 #   make demo       run the default case (cases/door.ini -> out/door.h5)
 #   make OPENMP=0   build without OpenMP (pragmas must still compile)
+#   make NATIVE=1   build for this machine's processor (-march=native); the
+#                   default build runs on any x86-64 (AVX-512 chosen at run time)
 #   make SANITIZE=1 AddressSanitizer + UndefinedBehaviorSanitizer, in build-san/
 #                   (`make SANITIZE=1 test` runs every test with them)
 #   make race       data-race check of the OpenMP code: ThreadSanitizer + Archer
@@ -118,9 +120,35 @@ ifeq ($(GDAL),1)
 endif
 
 WARN     := -Wall -Wextra -Wpedantic -Wstrict-prototypes -Wshadow
+# The instruction set.  By default the baseline of the compiler's target
+# (x86-64: SSE2), so that a build, `make install` and the library Python
+# loads run on any x86-64 machine of the distribution.  The kernel's hot
+# loops (KERNEL_SRC) are compiled twice more, for AVX2 and for AVX-512, and
+# the best copy the processor runs is chosen at run time
+# (include/sandslide/cpu.h; SANDSLIDE_CPU=generic|avx2|avx512 forces one).
+# NATIVE=1: everything for this machine (-march=native), a program that may
+# die of SIGILL on another; the copies and the choice stay.
+# The path decides the bits, not -march: the AVX-512 copy of the face flux
+# has its own reciprocal square root (face.h); otherwise each operation is
+# rounded once whichever instructions do it, with no a * b + c contracted
+# into an FMA (-ffp-contract=off: gcc's ISO C mode implies it, clang's
+# does not).
+NATIVE   ?= 0
+ifeq ($(NATIVE),1)
+  ARCHFLAG := -march=native
+endif
+ifneq ($(filter x86_64-%,$(shell $(CC) -dumpmachine 2>/dev/null)),)
+  KERNEL_PATHS := avx2 avx512
+  PATHDEF      := -DSS_KERNEL_PATHS
+endif
+KERNEL_SRC        := src/core/face.c src/core/sweep_fast.c
+# each copy's instruction set: what ss_cpu_path_supported checks (cpu.c)
+PATHFLAGS_avx2    := -DSS_PATH=SS_PATH_AVX2 -mavx2
+PATHFLAGS_avx512  := -DSS_PATH=SS_PATH_AVX512 -mavx2 -mavx512f -mavx512cd -mavx512vl \
+                     -mavx512bw -mavx512dq
 # -fno-math-errno lets sqrt() vectorise (errno is never read); it changes
 # no result.  Never -ffast-math: it breaks determinism and the NaN checks.
-BASE     := -std=c11 -D_XOPEN_SOURCE=700 -O3 -march=native -fno-math-errno -g
+BASE     := -std=c11 -D_XOPEN_SOURCE=700 -O3 $(ARCHFLAG) -ffp-contract=off -fno-math-errno -g
 ifeq ($(OPENMP),1)
   OMPFLAG := -fopenmp
 else
@@ -146,7 +174,8 @@ endif
 # -fPIC: the same objects make the static and the shared library (on
 # x86-64 the kernel's loops make no calls through the PLT or GOT, so the
 # sweep runs as fast: doc/performance.md#how-the-figures-were-measured).
-ALL_CFLAGS  := $(BASE) -fPIC $(WARN) $(OMPFLAG) $(SANFLAG) $(MPIFLAG) -Iinclude -Isrc -DSS_VERSION='"$(VERSION)"' \
+ALL_CFLAGS  := $(BASE) -fPIC $(WARN) $(OMPFLAG) $(SANFLAG) $(MPIFLAG) $(PATHDEF) -Iinclude -Isrc \
+               -DSS_VERSION='"$(VERSION)"' \
                $(DEP_CFLAGS) -MMD -MP $(CFLAGS)
 ALL_LDFLAGS := $(OMPFLAG) $(SANFLAG) $(LDFLAGS)
 LIBS        := $(DEP_LIBS) -lm
@@ -164,6 +193,9 @@ CLI_SRC  := $(wildcard src/cli/*.c)
 # The renderer (render/, doc/rendering.md) is part of the library.
 RENDER_SRC := $(wildcard render/*.c)
 LIB_OBJ  := $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o) $(RENDER_SRC:render/%.c=$(BUILD)/obj/render/%.o)
+# the kernel's copies per instruction-set path: FILE-avx2.o, FILE-avx512.o
+KERNEL_OBJ := $(foreach p,$(KERNEL_PATHS),$(KERNEL_SRC:src/%.c=$(BUILD)/obj/%-$(p).o))
+LIB_OBJ  += $(KERNEL_OBJ)
 MAIN_OBJ := $(CLI_SRC:src/%.c=$(BUILD)/obj/%.o)
 TEST_SRC := $(wildcard tests/test_*.c)
 TEST_BIN := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
@@ -176,15 +208,26 @@ SHLIB    := libsandslide.so.$(VERSION)
 all: $(BUILD)/sandslide $(BUILD)/libsandslide.a $(BUILD)/libsandslide.so
 
 # A flags stamp: objects rebuild when the flags change (git's GIT-CFLAGS).
+STAMP := $(ALL_CFLAGS) $(PATHFLAGS_avx2) $(PATHFLAGS_avx512) $(ALL_LDFLAGS) $(LIBS)
 $(BUILD)/.flags: FORCE
 	@mkdir -p $(@D)
-	@echo '$(ALL_CFLAGS) $(ALL_LDFLAGS) $(LIBS)' | cmp -s - $@ || echo '$(ALL_CFLAGS) $(ALL_LDFLAGS) $(LIBS)' > $@
+	@echo '$(STAMP)' | cmp -s - $@ || echo '$(STAMP)' > $@
 FORCE:
 
 $(BUILD)/obj/%.o: src/%.c $(BUILD)/.flags
 	@mkdir -p $(@D)
 	@$(if $(Q),echo '  CC      $<')
 	$(Q)$(CC) $(ALL_CFLAGS) -c $< -o $@
+
+$(BUILD)/obj/%-avx2.o: src/%.c $(BUILD)/.flags
+	@mkdir -p $(@D)
+	@$(if $(Q),echo '  CC      $< (avx2)')
+	$(Q)$(CC) $(ALL_CFLAGS) $(PATHFLAGS_avx2) -c $< -o $@
+
+$(BUILD)/obj/%-avx512.o: src/%.c $(BUILD)/.flags
+	@mkdir -p $(@D)
+	@$(if $(Q),echo '  CC      $< (avx512)')
+	$(Q)$(CC) $(ALL_CFLAGS) $(PATHFLAGS_avx512) -c $< -o $@
 
 $(BUILD)/obj/render/%.o: render/%.c $(BUILD)/.flags
 	@mkdir -p $(@D)

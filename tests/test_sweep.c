@@ -15,6 +15,12 @@
  *                    unchanged and falls asleep after its first step
  *   max slope        ss_sweep_max_slope is exactly the slope ss_sweep_fluxes
  *                    returns (and the fast sweep's first measure)
+ *   paths            on every instruction-set path the processor runs (cpu.h;
+ *                    the others are skipped with a note): a row of faces
+ *                    gives the bits of single faces, the face accuracy
+ *                    checks below hold, the fast sweep gives the reference
+ *                    sweep's bits; the generic and AVX2 paths give the same
+ *                    bits, the AVX-512 path other bits in some faces
  *   face function    ss_face_fluxes against nu * ss_closure_face_flux: within
  *                    K eps (1 + kappa) relative everywhere (kappa the
  *                    cancellation factor of e = b - 1, see bound_scale; this
@@ -24,8 +30,10 @@
  *                    1/sqrt over 1e-300 .. 1e300; a row of faces gives the
  *                    bits of single faces
  *
- * About 10 s on 2 idle cores (the reference kernel of the active-tile case is
- * most of it); the seed is fixed (SANDSLIDE_TEST_SEED overrides it).
+ * About 16 s on 2 idle cores (the identity cases, the active-tile case and
+ * the three paths' sweeps, 3-5 s each); the seed is fixed
+ * (SANDSLIDE_TEST_SEED overrides it).  The path main() starts on is the
+ * default one, or the one SANDSLIDE_CPU forces.
  * SANDSLIDE_TEST_SCALE in (0, 1] (tests/scale.h; 0.5 under `make SANITIZE=1
  * test` and `make race`) shrinks the box of the active-tile case, with
  * every check kept.
@@ -42,6 +50,7 @@
 #include "scale.h"
 #include "sandslide/boundary.h"
 #include "sandslide/closure.h"
+#include "sandslide/cpu.h"
 #include "sandslide/diagnostics.h"
 #include "sandslide/face.h"
 #include "sandslide/grid.h"
@@ -1036,49 +1045,215 @@ static void test_face_rsqrt(void)
 	       ss_face_rsqrt_method(), worst, worst / DBL_EPSILON);
 }
 
+/* ---- the instruction-set paths (cpu.h) ---------------------------------- */
+
+static const enum ss_cpu_path all_paths[] = {SS_CPU_GENERIC, SS_CPU_AVX2, SS_CPU_AVX512};
+#define N_PATHS ((int)(sizeof all_paths / sizeof *all_paths))
+
+/* Use path p for what follows.  0 when this processor (or build) cannot
+ * run it: then prints why `what` is skipped there, which is not a pass. */
+static int use_path(enum ss_cpu_path p, const char *what)
+{
+	if (!ss_cpu_path_supported(p)) {
+		CHECK_SKIP("%s on the %s path: this processor (or this build) cannot run it", what,
+		           ss_cpu_path_name(p));
+		return 0;
+	}
+	const int err = ss_cpu_select(ss_cpu_path_name(p));
+	CHECK(err == 0 && ss_cpu_path() == p, "ss_cpu_select(\"%s\") refused or ignored: "
+	      "the path in use is %s", ss_cpu_path_name(p), ss_cpu_path_name(ss_cpu_path()));
+	return err == 0 && ss_cpu_path() == p;
+}
+
+/* The path in use when main() started: what a test that changes it puts back. */
+static enum ss_cpu_path default_path;
+
+static void restore_path(void)
+{
+	const int err = ss_cpu_select(ss_cpu_path_name(default_path));
+	CHECK(err == 0, "ss_cpu_select(\"%s\") refused: cannot restore the default path",
+	      ss_cpu_path_name(default_path));
+}
+
+/* The faces of test_face_lanes: sub- and supercritical faces mixed, some
+ * exactly 0; n + PAD of them (see there). */
+static void lane_faces(struct rng *r, const struct ss_closure *c, int n, double *gn,
+                       double *gt)
+{
+	for (int k = 0; k < n; k++) {
+		const double s = k % 17 == 0 ? 0.0 : 3.0 * c->tan_cr * rng_uniform(r);
+		random_gradient(r, s, &gn[k], &gt[k]);
+	}
+}
+
 /* A row of n faces gives the same bits as n calls with n = 1, wherever a
- * face sits in the row (vector lanes, masked tails, chunk boundaries). */
+ * face sits in the row (vector lanes, masked tails, chunk boundaries): on
+ * every path this processor runs. */
 static void test_face_lanes(void)
 {
-	struct rng r = {seed + 7};
 	/* rows of up to N faces from offsets up to 4: PAD more inputs than
 	 * faces, so that no row reads past them */
 	enum { N = 300, PAD = 4 };
 	double gn[N + PAD], gt[N + PAD], row[N];
-	int differ = 0, total = 0;
+	for (int pi = 0; pi < N_PATHS; pi++) {
+		const enum ss_cpu_path path = all_paths[pi];
+		if (!use_path(path, "face lanes"))
+			continue;
+		struct rng r = {seed + 7};
+		int differ = 0, total = 0;
+		for (int ci = 0; ci < N_CLOSURES; ci++) {
+			struct ss_closure c;
+			struct ss_face_rule rule;
+			const int err = ss_closure_init(&c, closures[ci].kind, REPOSE,
+			                                closures[ci].gamma, 0.02);
+			CHECK(err == 0, "test set-up: closure %s refused", closures[ci].name);
+			if (err)
+				continue;
+			ss_face_rule_init(&rule, &c);
+			lane_faces(&r, &c, N + PAD, gn, gt);
+			const int lengths[] = {100, N, 129, 7};
+			for (size_t li = 0; li < sizeof lengths / sizeof *lengths; li++) {
+				const int n = lengths[li];
+				const int off = (int)li * 3 % (PAD + 1);   /* shift the lanes */
+				ss_face_fluxes(&rule, n, gn + off, gt + off, row);
+				int d = 0;
+				for (int k = 0; k < n; k++) {
+					double one;
+					ss_face_fluxes(&rule, 1, gn + off + k, gt + off + k, &one);
+					d += !same_bits(one, row[k]);
+					total++;
+				}
+				CHECK(d == 0, "%s path, %s: a row of %d faces (offset %d) differs from "
+				      "single calls in %d faces", ss_cpu_path_name(path),
+				      closures[ci].name, n, off, d);
+				differ += d;
+			}
+		}
+		printf("  face lanes, %s path: %d faces in rows of 100, 300, 129, 7: %d differ "
+		       "from single calls\n", ss_cpu_path_name(path), total, differ);
+	}
+	restore_path();
+}
+
+/*
+ * The paths against each other.  Faces: the generic and AVX2 paths give
+ * the same bits (both take 1/sqrt); the AVX-512 path (vrsqrt14pd) differs
+ * in some faces, so that a forced path is seen to be the one that runs,
+ * and passes the accuracy checks of the face function (test_face_rsqrt,
+ * test_face_formula, run here on each path main() did not run them on).
+ * Sweeps: on each path the fast sweep gives the reference sweep's bits
+ * (1 and 2 threads, two tile sizes, every closure), and the generic and
+ * AVX2 paths give the same bits.  A path this processor cannot run is
+ * skipped with a note.
+ */
+enum { PATH_FACES = 2000 };
+
+/* Fluxes of PATH_FACES random faces of every closure on the path in use,
+ * into out[closure][face]. */
+static void path_faces(double out[][PATH_FACES])
+{
+	static double gn[PATH_FACES], gt[PATH_FACES];
+	struct rng r = {seed + 8};
 	for (int ci = 0; ci < N_CLOSURES; ci++) {
 		struct ss_closure c;
 		struct ss_face_rule rule;
 		const int err = ss_closure_init(&c, closures[ci].kind, REPOSE, closures[ci].gamma,
 		                                0.02);
 		CHECK(err == 0, "test set-up: closure %s refused", closures[ci].name);
-		if (err)
-			continue;
+		lane_faces(&r, &c, PATH_FACES, gn, gt);
 		ss_face_rule_init(&rule, &c);
-		for (int k = 0; k < N + PAD; k++) {
-			/* sub- and supercritical faces mixed, some exactly 0 */
-			const double s = k % 17 == 0 ? 0.0 : 3.0 * c.tan_cr * rng_uniform(&r);
-			random_gradient(&r, s, &gn[k], &gt[k]);
-		}
-		const int lengths[] = {100, N, 129, 7};
-		for (size_t li = 0; li < sizeof lengths / sizeof *lengths; li++) {
-			const int n = lengths[li];
-			const int off = (int)li * 3 % (PAD + 1);   /* shift the lanes */
-			ss_face_fluxes(&rule, n, gn + off, gt + off, row);
-			int d = 0;
-			for (int k = 0; k < n; k++) {
-				double one;
-				ss_face_fluxes(&rule, 1, gn + off + k, gt + off + k, &one);
-				d += !same_bits(one, row[k]);
-				total++;
-			}
-			CHECK(d == 0, "%s: a row of %d faces (offset %d) differs from single "
-			      "calls in %d faces", closures[ci].name, n, off, d);
-			differ += d;
-		}
+		ss_face_fluxes(&rule, PATH_FACES, gn, gt, out[ci]);
 	}
-	printf("  face lanes: %d faces in rows of 100, 300, 129, 7: %d differ from single calls\n",
-	       total, differ);
+}
+
+/* The heights of sc after T s on the path in use (fast sweep, tiles 16x8,
+ * 2 threads), by storage index, in a new array (free it) of *n; NULL if
+ * the stepper could not be built. */
+static double *path_heights(const struct scenario *sc, double T, size_t *n_out)
+{
+	struct ss_stepper st;
+	if (build(&st, sc, SS_KERNEL_FAST, 16, 8, 2))
+		return NULL;
+	advance_to(&st, T, sc->name);
+	const size_t n = ss_grid_storage_cells(&st.grid);
+	double *h = malloc(n * sizeof *h);
+	if (h)
+		memcpy(h, st.height, n * sizeof *h);
+	*n_out = n;
+	CHECK(h != NULL, "test set-up: out of memory");
+	ss_stepper_release(&st);
+	return h;
+}
+
+static void test_paths(void)
+{
+	const double T = 0.12;
+	static double faces[N_PATHS][N_CLOSURES][PATH_FACES];
+	double *heights[N_PATHS][N_CLOSURES] = {{NULL}};
+	int ran[N_PATHS] = {0};
+	size_t cells = 0;
+	for (int pi = 0; pi < N_PATHS; pi++) {
+		const enum ss_cpu_path path = all_paths[pi];
+		if (!use_path(path, "the face function and both sweeps"))
+			continue;
+		ran[pi] = 1;
+		path_faces(faces[pi]);
+		if (path != default_path) {
+			printf("  %s path:\n", ss_cpu_path_name(path));
+			test_face_rsqrt();
+			test_face_formula();
+		}
+		const long long before = identity_steps;
+		for (int c = 0; c < N_CLOSURES; c++) {
+			struct rng r = {seed * 53u + (uint64_t)c};
+			struct scenario sc;
+			char name[160];
+			random_scenario(&sc, &r, closures[c], sides4(SS_SIDE_WALL, SS_SIDE_OPEN,
+			                SS_SIDE_WALL, SS_SIDE_WALL, 0.0), c % 2, T);
+			snprintf(name, sizeof name, "%s path, %s", ss_cpu_path_name(path),
+			         closures[c].name);
+			sc.name = name;
+			static const int some[2] = {0, 3};   /* 7x5 and the default */
+			identity_case(&sc, T, some, 2);
+			heights[pi][c] = path_heights(&sc, T, &cells);
+			scenario_free(&sc);
+		}
+		printf("  %s path: the fast sweep gives the reference's bits, %d closures x 2 tile "
+		       "sizes x 1, 2 threads, %lld reference steps\n", ss_cpu_path_name(path),
+		       N_CLOSURES, identity_steps - before);
+	}
+	/* across paths: generic (index 0) against avx2 (1) and avx512 (2) */
+	for (int pi = 1; pi < N_PATHS && ran[0]; pi++) {
+		if (!ran[pi])
+			continue;
+		long face_differ = 0, cell_differ = 0;
+		for (int c = 0; c < N_CLOSURES; c++) {
+			for (int k = 0; k < PATH_FACES; k++)
+				face_differ += !same_bits(faces[pi][c][k], faces[0][c][k]);
+			for (size_t k = 0; heights[pi][c] && heights[0][c] && k < cells; k++)
+				cell_differ += !same_bits(heights[pi][c][k], heights[0][c][k]);
+		}
+		const char *name = ss_cpu_path_name(all_paths[pi]);
+		if (all_paths[pi] == SS_CPU_AVX2) {
+			CHECK(face_differ == 0, "the avx2 path's face fluxes differ from the generic "
+			      "path's in %ld of %d faces: they must be the same bits", face_differ,
+			      N_CLOSURES * PATH_FACES);
+			CHECK(cell_differ == 0, "the avx2 path's sweeps differ from the generic "
+			      "path's in %ld cells after %g s: they must be the same bits",
+			      cell_differ, T);
+		} else {
+			CHECK(face_differ > 0, "the avx512 path gives the generic path's bits in "
+			      "all %d faces: is it running 1/sqrt, not vrsqrt14pd?",
+			      N_CLOSURES * PATH_FACES);
+		}
+		printf("  %s against generic: %ld of %d faces and %ld cells (%d closures after "
+		       "%g s) differ\n", name, face_differ, N_CLOSURES * PATH_FACES, cell_differ,
+		       N_CLOSURES, T);
+	}
+	for (int pi = 0; pi < N_PATHS; pi++)
+		for (int c = 0; c < N_CLOSURES; c++)
+			free(heights[pi][c]);
+	restore_path();
 }
 
 /* Packed cell types (grid.h): every set is read back, no set disturbs
@@ -1120,8 +1295,10 @@ int main(void)
 		seed = strtoull(env, NULL, 10);
 	const double t0 = check_now();
 	ss_parallel_set_threads(2);
-	printf("test_sweep: seed %llu, rsqrt %s, scale %g\n", (unsigned long long)seed,
-	       ss_face_rsqrt_method(), test_scale());
+	default_path = ss_cpu_path();
+	printf("test_sweep: seed %llu, %s path (rsqrt %s), scale %g\n",
+	       (unsigned long long)seed, ss_cpu_path_name(default_path), ss_face_rsqrt_method(),
+	       test_scale());
 	RUN(test_packed_types);
 	{
 		const double t_ = check_now();
@@ -1136,6 +1313,11 @@ int main(void)
 	{
 		const double t_ = check_now();
 		RUN(test_face_formula);
+		printf("    (%.2f s)\n", check_now() - t_);
+	}
+	{
+		const double t_ = check_now();
+		RUN(test_paths);
 		printf("    (%.2f s)\n", check_now() - t_);
 	}
 	{

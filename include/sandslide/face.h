@@ -13,15 +13,18 @@
  *   casson       f/s = (1/b)^2 (10 b q + 6 b + 3 q + 1) e^3 / s, q = sqrt b,
  *                                                                e = max(q - 1, 0)
  *
- * With AVX-512 the reciprocal square roots are vrsqrt14pd refined by two
- * Newton steps (relative error below 1e-15 against 1/sqrt); elsewhere they
- * are 1/sqrt.  Herschel-Bulkley with gamma = 1/2 (e^3) and gamma = 2
- * (e sqrt e) avoids pow().  tests/test_sweep.c (test_face_formula) holds
- * these to the formulas of closure.h (doc/model.md#closures).
+ * On the AVX-512 path (cpu.h) the reciprocal square roots are vrsqrt14pd
+ * refined by two Newton steps (relative error below 1e-15 against 1/sqrt);
+ * on the generic and AVX2 paths they are 1/sqrt, so those two give the same
+ * bits and the AVX-512 path bits of its own.  Herschel-Bulkley with
+ * gamma = 1/2 (e^3) and gamma = 2 (e sqrt e) avoids pow().
+ * tests/test_sweep.c (test_face_formula) holds every path to the formulas
+ * of closure.h (doc/model.md#closures).
  *
- * The function is compiled once (face.c) and works on a row of faces, so the
- * reference sweep (one face per call) and the fast sweep (a row per call)
- * run the same instructions on every face: the same bits.
+ * The function works on a row of faces and is compiled once per path
+ * (face.c, core/cpu_paths.h); ss_face_fluxes runs the copy of the path in
+ * use, so the reference sweep (one face per call) and the fast sweep (a
+ * row per call) run the same instructions on every face: the same bits.
  */
 #ifndef SANDSLIDE_FACE_H
 #define SANDSLIDE_FACE_H
@@ -76,10 +79,12 @@ static inline double ss_face_limit(double flux, double thick_a, double thick_b, 
 	return flux < out_b ? out_b : flux;
 }
 
-/* y[k] = 1/sqrt(x[k]) for x[k] > 0, k < n, as the face flux computes it. */
+/* y[k] = 1/sqrt(x[k]) for x[k] > 0, k < n, as the face flux computes it on
+ * the path in use. */
 void ss_face_rsqrt(int n, const double *restrict x, double *restrict y);
 
-/* "vrsqrt14pd + 2 Newton steps (AVX-512)" or "1/sqrt", for reports. */
+/* "vrsqrt14pd + 2 Newton steps (AVX-512)" or "1/sqrt": the path in use
+ * (cpu.h), for reports. */
 const char *ss_face_rsqrt_method(void);
 
 #endif

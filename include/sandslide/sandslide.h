@@ -19,6 +19,7 @@
 #include "sandslide/parallel.h"
 #include "sandslide/option.h"
 #include "sandslide/comm.h"
+#include "sandslide/cpu.h"
 
 #include "sandslide/grid.h"
 #include "sandslide/boundary.h"

@@ -21,6 +21,7 @@
 #include "sandslide/bench.h"
 #include "sandslide/dem.h"
 #include "sandslide/comm.h"
+#include "sandslide/cpu.h"
 #include "sandslide/error.h"
 #include "sandslide/parallel.h"
 #include "sandslide/relax.h"
@@ -407,6 +408,8 @@ static int command(int argc, char **argv)
 		{"render", cmd_render}, {"relax", cmd_relax},
 	};
 	ss_snapshot_library_init();
+	if (ss_cpu_init())   /* SANDSLIDE_CPU, on every rank before anything runs */
+		return 2;
 	if (argc < 2)
 		return main_usage_error("%s", "no command given");
 	const char *cmd = argv[1];
@@ -424,14 +427,15 @@ static int command(int argc, char **argv)
 		return 0;
 	}
 	if (!strcmp(cmd, "--version") || !strcmp(cmd, "version")) {
-		printf("sandslide %s (OpenMP: %s, %d processors; GDAL: %s; MPI: %s)\n", ss_version(),
+		printf("sandslide %s (OpenMP: %s, %d processors; GDAL: %s; MPI: %s; kernel: %s)\n",
+		       ss_version(),
 #ifdef _OPENMP
 		       "on",
 #else
 		       "off",
 #endif
 		       ss_parallel_processors(), ss_dem_gdal_available() ? "on" : "off",
-		       ss_comm_library() ? ss_comm_library() : "off");
+		       ss_comm_library() ? ss_comm_library() : "off", ss_cpu_path_name(ss_cpu_path()));
 		return 0;
 	}
 	/* the distributed commands: the others work on one block */

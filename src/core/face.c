@@ -6,13 +6,21 @@
  * square roots, one the closure.  Every loop is branch-free so that the
  * compiler vectorises it; a face below the critical slope is evaluated at
  * s^2 = 1 (where every formula is finite) and its result replaced by 0.
+ *
+ * Compiled once per instruction-set path (core/cpu_paths.h): the AVX-512
+ * copy computes the reciprocal square roots with vrsqrt14pd, the others
+ * with 1/sqrt; the rest is the same source, vectorised for each path.  The
+ * rule's set-up and the public functions, which call the copy of the path
+ * in use, are in the generic copy only.
  */
 #include "sandslide/face.h"
 
 #include <math.h>
 #include <stdint.h>
 
-#ifdef __AVX512F__
+#include "core/cpu_paths.h"
+
+#if SS_PATH == SS_PATH_AVX512
 #include <immintrin.h>
 #endif
 
@@ -25,6 +33,7 @@ static inline double positive_part(double x)
 	return x > 0.0 ? x : 0.0;
 }
 
+#if SS_PATH == SS_PATH_GENERIC
 void ss_face_rule_init(struct ss_face_rule *r, const struct ss_closure *c)
 {
 	r->nu = c->nu;
@@ -59,8 +68,9 @@ void ss_face_rule_init(struct ss_face_rule *r, const struct ss_closure *c)
 		break;
 	}
 }
+#endif
 
-#ifdef __AVX512F__
+#if SS_PATH == SS_PATH_AVX512
 /* vrsqrt14pd has a relative error below 2^-14; each Newton step
  * y <- y (3/2 - x/2 y^2) squares it, so two give full double precision up
  * to a few roundings.  The last partial vector is masked, so a face gets
@@ -80,7 +90,7 @@ static inline __mmask8 tail_mask(int left)
 	return left >= 8 ? (__mmask8)0xFF : (__mmask8)((1u << left) - 1u);
 }
 
-void ss_face_rsqrt(int n, const double *restrict x, double *restrict y)
+void SS_PATH_FN(ss_face_rsqrt)(int n, const double *restrict x, double *restrict y)
 {
 	for (int k = 0; k < n; k += 8) {
 		const __mmask8 m = tail_mask(n - k);
@@ -113,13 +123,8 @@ static int slopes_and_rsqrt(int m, double tan_cr2, const double *restrict gn,
 	}
 	return any != 0;
 }
-
-const char *ss_face_rsqrt_method(void)
-{
-	return "vrsqrt14pd + 2 Newton steps (AVX-512)";
-}
 #else
-void ss_face_rsqrt(int n, const double *restrict x, double *restrict y)
+void SS_PATH_FN(ss_face_rsqrt)(int n, const double *restrict x, double *restrict y)
 {
 	for (int k = 0; k < n; k++)
 		y[k] = 1.0 / sqrt(x[k]);
@@ -143,11 +148,6 @@ static int slopes_and_rsqrt(int m, double tan_cr2, const double *restrict gn,
 		inv_w[k] = 1.0 / sqrt(1.0 + s2[k]);
 	}
 	return any;
-}
-
-const char *ss_face_rsqrt_method(void)
-{
-	return "1/sqrt";
 }
 #endif
 
@@ -209,9 +209,9 @@ static inline void f_over_s(enum ss_face_form form, const struct ss_face_rule *r
 	}
 }
 
-int ss_face_fluxes(const struct ss_face_rule *r, int n,
-                   const double *restrict g_n, const double *restrict g_t,
-                   double *restrict flux)
+int SS_PATH_FN(ss_face_fluxes)(const struct ss_face_rule *r, int n,
+                               const double *restrict g_n, const double *restrict g_t,
+                               double *restrict flux)
 {
 	double s2[CHUNK], inv_s[CHUNK], inv_w[CHUNK], fos[CHUNK], slides[CHUNK];
 	const double nu = r->nu;
@@ -237,3 +237,28 @@ int ss_face_fluxes(const struct ss_face_rule *r, int n,
 	}
 	return any;
 }
+
+#if SS_PATH == SS_PATH_GENERIC
+/* The path is read for each call: each row of faces of the fast sweep (a
+ * load and a branch against a row's hundreds of operations), each face of
+ * the reference sweep. */
+int ss_face_fluxes(const struct ss_face_rule *r, int n,
+                   const double *restrict g_n, const double *restrict g_t,
+                   double *restrict flux)
+{
+	const enum ss_cpu_path p = ss_cpu_path();
+	return SS_PATH_CALL(p, ss_face_fluxes, r, n, g_n, g_t, flux);
+}
+
+void ss_face_rsqrt(int n, const double *restrict x, double *restrict y)
+{
+	const enum ss_cpu_path p = ss_cpu_path();
+	SS_PATH_CALL(p, ss_face_rsqrt, n, x, y);
+}
+
+const char *ss_face_rsqrt_method(void)
+{
+	return ss_cpu_path() == SS_CPU_AVX512 ? "vrsqrt14pd + 2 Newton steps (AVX-512)"
+	                                      : "1/sqrt";
+}
+#endif

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "sandslide/comm.h"
+#include "sandslide/cpu.h"
 #include "sandslide/error.h"
 #include "sandslide/parallel.h"
 #include "sandslide/rkl2.h"
@@ -57,7 +58,13 @@ int ss_stepper_init(struct ss_stepper *st, const struct ss_grid *g,
 	memset(st, 0, sizeof *st);
 	if (!(cfl > 0.0 && cfl <= 1.0))
 		return ss_error_input("cfl %g is outside (0, 1]", cfl);
-	int err = ss_boundary_check(b);
+	/* the kernel path SANDSLIDE_CPU names (cpu.h), for a program of one
+	 * process that did not check it first as the command line does (in a
+	 * distributed run ss_cpu_init is collective: the program calls it) */
+	int err = ss_comm_size() == 1 ? ss_cpu_init() : SS_OK;
+	if (err)
+		return err;
+	err = ss_boundary_check(b);
 	if (err)
 		return err;
 

@@ -8,12 +8,19 @@
  * above cell x.  The arithmetic of every face and cell is that of the
  * reference sweep (sweep.c): the same gradients in the same order, the same
  * face function (face.c), the same update expression.
+ *
+ * Compiled once per instruction-set path (core/cpu_paths.h): the functions
+ * with loops over cells in every copy, named with the copy's suffix
+ * (SS_PATH_FN); the set-up, and the public functions that call the copy of
+ * the path in use once per call, in the generic copy only.  A copy calls
+ * its own path's face flux.
  */
 #include "sandslide/sweep.h"
 
 #include <math.h>
 #include <string.h>
 
+#include "core/cpu_paths.h"
 #include "sandslide/error.h"
 #include "sandslide/parallel.h"
 
@@ -328,8 +335,8 @@ static double slope2_all(const struct ss_grid *g, const double *h,
 	return m;
 }
 
-double ss_sweep_max_slope(const struct ss_grid *g, const double *restrict height,
-                          const uint8_t *restrict cell_types)
+double SS_PATH_FN(ss_sweep_max_slope)(const struct ss_grid *g, const double *restrict height,
+                                      const uint8_t *restrict cell_types)
 {
 	int bad = 0;
 	const double m = slope2_all(g, height, cell_types, &bad);
@@ -351,9 +358,10 @@ static inline int stencil_in_sand(const double *h, const double *b, const uint8_
 	return in_sand;
 }
 
-double ss_sweep_max_sand_slope(const struct ss_grid *g, const double *restrict height,
-                               const uint8_t *restrict cell_types,
-                               const double *restrict bedrock, double bare)
+double SS_PATH_FN(ss_sweep_max_sand_slope)(const struct ss_grid *g,
+                                           const double *restrict height,
+                                           const uint8_t *restrict cell_types,
+                                           const double *restrict bedrock, double bare)
 {
 	const ptrdiff_t s = g->stride;
 	const double inv_dx = 1.0 / g->dx, inv_dy = 1.0 / g->dy;
@@ -388,6 +396,7 @@ static size_t row_doubles(const struct ss_tiling *t)
 	return ((size_t)t->tile_nx + 2 + 7) / 8 * 8;   /* 64 B aligned rows */
 }
 
+#if SS_PATH == SS_PATH_GENERIC
 /* The per-tile flags, ring rows, row buffers and open-face tables of f
  * (f->tiling, f->tiles and f->threads set). */
 static int alloc_tables(struct ss_sweep_fast *f, const struct ss_grid *g,
@@ -554,9 +563,10 @@ void ss_sweep_fast_release(struct ss_sweep_fast *f)
 	ss_free(f->sweep);
 	memset(f, 0, sizeof *f);
 }
+#endif
 
-void ss_sweep_fast_wake_all(struct ss_sweep_fast *f, const struct ss_grid *g,
-                            const double *height, const uint8_t *cell_types)
+void SS_PATH_FN(ss_sweep_fast_wake_all)(struct ss_sweep_fast *f, const struct ss_grid *g,
+                                        const double *height, const uint8_t *cell_types)
 {
 	int bad = 0;
 	memset(f->sweep, 1, (size_t)f->tiles);
@@ -566,6 +576,7 @@ void ss_sweep_fast_wake_all(struct ss_sweep_fast *f, const struct ss_grid *g,
 	f->nonfinite = bad;
 }
 
+#if SS_PATH == SS_PATH_GENERIC
 void ss_sweep_fast_mark_sources(struct ss_sweep_fast *f, const struct ss_grid *g,
                                 const double *source_rate)
 {
@@ -592,6 +603,7 @@ double ss_sweep_fast_awake(const struct ss_sweep_fast *f)
 		n += f->sweep[k];
 	return n;
 }
+#endif
 
 /* Tile rows holding a tile to sweep, into f->row_list; returns the count. */
 static int list_rows(struct ss_sweep_fast *f)
@@ -609,8 +621,8 @@ static int list_rows(struct ss_sweep_fast *f)
 	return n;
 }
 
-double ss_sweep_fast_begin(struct ss_sweep_fast *f, const struct ss_grid *g,
-                           const double *height, const uint8_t *cell_types)
+double SS_PATH_FN(ss_sweep_fast_begin)(struct ss_sweep_fast *f, const struct ss_grid *g,
+                                       const double *height, const uint8_t *cell_types)
 {
 	const struct ss_tiling *t = &f->tiling;
 	const int rows = list_rows(f);
@@ -790,7 +802,7 @@ static inline int face_row(const struct ss_face_rule *rule, int n,
                            double *restrict flux)
 {
 	const double tan_cr2 = rule->tan_cr2;
-	const int any = ss_face_fluxes(rule, n, gn, gt, flux);
+	const int any = SS_PATH_FN(ss_face_fluxes)(rule, n, gn, gt, flux);
 	int sliding = 0;
 	if (!ta)
 		return any;
@@ -1291,6 +1303,7 @@ static void plan_next_from(struct ss_sweep_fast *f, const uint8_t *swept,
 	f->sweep_next = tmp;
 }
 
+#if SS_PATH == SS_PATH_GENERIC
 void ss_sweep_fast_wake_across(struct ss_sweep_fast *f, const uint8_t *from_south,
                                const uint8_t *from_north)
 {
@@ -1319,6 +1332,7 @@ void ss_sweep_fast_wake_across(struct ss_sweep_fast *f, const uint8_t *from_sout
 		}
 	}
 }
+#endif
 
 static void plan_next(struct ss_sweep_fast *f)
 {
@@ -1416,12 +1430,12 @@ static struct tile_ctx context_of(struct ss_sweep_fast *f, const struct ss_grid 
 	};
 }
 
-double ss_sweep_fast_step(struct ss_sweep_fast *f, const struct ss_grid *g,
-                          const struct ss_face_rule *rule, double dt,
-                          const double *restrict source_rate,
-                          const double *restrict bedrock,
-                          const uint8_t *restrict cell_types,
-                          double *restrict height, double *restrict open_flux)
+double SS_PATH_FN(ss_sweep_fast_step)(struct ss_sweep_fast *f, const struct ss_grid *g,
+                                      const struct ss_face_rule *rule, double dt,
+                                      const double *restrict source_rate,
+                                      const double *restrict bedrock,
+                                      const uint8_t *restrict cell_types,
+                                      double *restrict height, double *restrict open_flux)
 {
 	const struct tile_ctx ctx = context_of(f, g, rule, dt, source_rate, bedrock,
 	                                       cell_types, height, open_flux);
@@ -1430,12 +1444,12 @@ double ss_sweep_fast_step(struct ss_sweep_fast *f, const struct ss_grid *g,
 	return rate_max;
 }
 
-double ss_sweep_fast_stage(struct ss_sweep_fast *f, const struct ss_grid *g,
-                           const struct ss_face_rule *rule,
-                           const struct ss_sweep_stage *stage, int last,
-                           const double *restrict source_rate,
-                           const uint8_t *restrict cell_types,
-                           double *restrict height, double *restrict open_flux)
+double SS_PATH_FN(ss_sweep_fast_stage)(struct ss_sweep_fast *f, const struct ss_grid *g,
+                                       const struct ss_face_rule *rule,
+                                       const struct ss_sweep_stage *stage, int last,
+                                       const double *restrict source_rate,
+                                       const uint8_t *restrict cell_types,
+                                       double *restrict height, double *restrict open_flux)
 {
 	struct tile_ctx ctx = context_of(f, g, rule, 1.0, source_rate, NULL, cell_types,
 	                                 height, open_flux);
@@ -1445,3 +1459,60 @@ double ss_sweep_fast_stage(struct ss_sweep_fast *f, const struct ss_grid *g,
 		plan_next_stage(f, last);
 	return change_max;
 }
+
+#if SS_PATH == SS_PATH_GENERIC
+/* ---- the public functions: the copy of the path in use ---------------- */
+
+double ss_sweep_max_slope(const struct ss_grid *g, const double *restrict height,
+                          const uint8_t *restrict cell_types)
+{
+	const enum ss_cpu_path p = ss_cpu_path();
+	return SS_PATH_CALL(p, ss_sweep_max_slope, g, height, cell_types);
+}
+
+double ss_sweep_max_sand_slope(const struct ss_grid *g, const double *restrict height,
+                               const uint8_t *restrict cell_types,
+                               const double *restrict bedrock, double bare)
+{
+	const enum ss_cpu_path p = ss_cpu_path();
+	return SS_PATH_CALL(p, ss_sweep_max_sand_slope, g, height, cell_types, bedrock, bare);
+}
+
+void ss_sweep_fast_wake_all(struct ss_sweep_fast *f, const struct ss_grid *g,
+                            const double *height, const uint8_t *cell_types)
+{
+	const enum ss_cpu_path p = ss_cpu_path();
+	SS_PATH_CALL(p, ss_sweep_fast_wake_all, f, g, height, cell_types);
+}
+
+double ss_sweep_fast_begin(struct ss_sweep_fast *f, const struct ss_grid *g,
+                           const double *height, const uint8_t *cell_types)
+{
+	const enum ss_cpu_path p = ss_cpu_path();
+	return SS_PATH_CALL(p, ss_sweep_fast_begin, f, g, height, cell_types);
+}
+
+double ss_sweep_fast_step(struct ss_sweep_fast *f, const struct ss_grid *g,
+                          const struct ss_face_rule *rule, double dt,
+                          const double *restrict source_rate,
+                          const double *restrict bedrock,
+                          const uint8_t *restrict cell_types,
+                          double *restrict height, double *restrict open_flux)
+{
+	const enum ss_cpu_path p = ss_cpu_path();
+	return SS_PATH_CALL(p, ss_sweep_fast_step, f, g, rule, dt, source_rate, bedrock,
+	                    cell_types, height, open_flux);
+}
+
+double ss_sweep_fast_stage(struct ss_sweep_fast *f, const struct ss_grid *g,
+                           const struct ss_face_rule *rule,
+                           const struct ss_sweep_stage *stage, int last,
+                           const double *restrict source_rate,
+                           const uint8_t *restrict cell_types,
+                           double *restrict height, double *restrict open_flux)
+{
+	const enum ss_cpu_path p = ss_cpu_path();
+	return SS_PATH_CALL(p, ss_sweep_fast_stage, f, g, rule, stage, last, source_rate,
+	                    cell_types, height, open_flux);
+}
+#endif
