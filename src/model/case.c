@@ -572,6 +572,19 @@ static int unknown_key(struct parse *p, const char *section, const char *key)
 	return fail_at(p, "unknown key '%s' in [%s]: expected one of %s", key, section, known);
 }
 
+/* The option of [section] key of a fixed section, or NULL after the
+ * message naming the keys the section has. */
+static const struct ss_option *fixed_key(struct parse *p, const char *section,
+                                         const char *key, int *index, size_t *offset)
+{
+	char full[256];
+	snprintf(full, sizeof full, "%s.%s", section, key);
+	const struct ss_option *o = find_key(full, index, offset);
+	if (!o)
+		unknown_key(p, section, key);
+	return o;
+}
+
 static int apply(struct parse *p, const char *section, const char *key,
                  const char *value)
 {
@@ -584,13 +597,11 @@ static int apply(struct parse *p, const char *section, const char *key,
 		return fail_at(p, "[%s] %s continues on an indented line: only polygon "
 		               "values may", section, key);
 
-	char full[256];
 	int index;
 	size_t offset;
-	snprintf(full, sizeof full, "%s.%s", section, key);
-	const struct ss_option *o = find_key(full, &index, &offset);
+	const struct ss_option *o = fixed_key(p, section, key, &index, &offset);
 	if (!o)
-		return unknown_key(p, section, key);
+		return SS_ERR_INPUT;
 	struct key_state *k = &p->key[index];
 	if (k->set && !p->overriding)
 		return fail_at(p, "[%s] %s is set twice (first at %s)", section, key, k->where);
@@ -646,13 +657,11 @@ static int unset(struct parse *p, char *lhs)
 		}
 		return SS_OK;
 	}
-	char full[256];
 	int index;
 	size_t offset;
-	snprintf(full, sizeof full, "%s.%s", section, key);
-	const struct ss_option *o = find_key(full, &index, &offset);
+	const struct ss_option *o = fixed_key(p, section, key, &index, &offset);
 	if (!o)
-		return unknown_key(p, section, key);
+		return SS_ERR_INPUT;
 	reset_value(p, o, offset);
 	memset(&p->key[index], 0, sizeof p->key[index]);
 	return SS_OK;
