@@ -115,6 +115,11 @@ int ss_dem_read(const char *spec, const char *context,
  * infinite value in a cell with data. */
 int ss_dem_write(const char *path, enum ss_dem_format format, const struct ss_raster *r);
 
+/* SS_ERR_INPUT when path is the file r was read from (the input is never
+ * modified): what ss_dem_write refuses, for a caller to ask before it does
+ * the work whose result it would write. */
+int ss_dem_check_not_source(const char *path, const struct ss_raster *r);
+
 /* The format of path from its extension, SS_DEM_AUTO when it is none of
  * those below; prints nothing. */
 enum ss_dem_format ss_dem_format_of(const char *path);

@@ -182,6 +182,9 @@ static int read_inputs(struct relax *x, struct ss_relax_report *rep)
 		                     "write .asc, .png or .h5", rep->output);
 	if (!err && !o->output_raster)
 		err = ss_output_check_folder(rep->output, o->output == NULL);
+	/* refused now, not after the relaxation whose result it would be */
+	if (!err && !o->output_raster)
+		err = ss_dem_check_not_source(rep->output, &x->dem);
 	if (err || !o->bedrock)
 		return err;
 	struct ss_dem_read_options bo = o->read;

@@ -399,8 +399,7 @@ int ss_dem_pick_nodata(const struct ss_raster *r, const char *path, int allow_na
 	                     "-1e30) is a height of a cell with data", path);
 }
 
-/* Refuse to replace the file r was read from: the input is never modified. */
-static int check_not_source(const char *path, const struct ss_raster *r)
+int ss_dem_check_not_source(const char *path, const struct ss_raster *r)
 {
 	struct stat a, b;
 	if (r->source && stat(path, &a) == 0 && stat(r->source, &b) == 0 &&
@@ -450,7 +449,7 @@ int ss_dem_write(const char *path, enum ss_dem_format format, const struct ss_ra
 		return gdal_unavailable(path, NULL);
 	if (!r->values || r->nx < 1 || r->ny < 1)
 		SS_BUG("ss_dem_write: empty raster");
-	int err = check_not_source(path, r);
+	int err = ss_dem_check_not_source(path, r);
 	if (!err)
 		err = ss_dem_check_finite(r, path);
 	if (err)

@@ -470,3 +470,23 @@ def test_numbers_print_exactly_and_shortest(tmp_path):
     grid = [line for line in r.stdout.splitlines() if line.startswith("grid")][0]
     assert grid.endswith("dx = 0.3 m, dy = 0.3 m, lower-left corner (263811.5, 5479330.25) m"), \
         grid
+
+
+def test_output_over_the_input_is_refused_before_the_work(tmp_path):
+    """-o naming the DEM itself, even with --force: refused (exit 2) before
+    the relaxation, not after it.  The hooked binary would stop after its
+    first substep and leave a marker file had the relaxation begun."""
+    import subprocess
+    from conftest import SANDSLIDE_PAUSE, hook_binary, pause_env
+    h0 = cliff(24, 16)
+    write_asc(tmp_path / "dem.asc", h0)
+    before = (tmp_path / "dem.asc").read_bytes()
+    marker = tmp_path / "paused"
+    env = dict(pause_env(1, marker), SANDSLIDE_TEST_PAUSE_SECONDS="1")
+    r = subprocess.run([hook_binary(SANDSLIDE_PAUSE), "relax", "dem.asc", "-o", "dem.asc",
+                        "--force"], cwd=tmp_path, env=env, capture_output=True, text=True,
+                       timeout=120)
+    assert r.returncode == 2 and "the file the raster was read from" in r.stderr, \
+        (r.returncode, r.stderr)
+    assert not marker.exists(), "the relaxation ran before the output was refused"
+    assert (tmp_path / "dem.asc").read_bytes() == before, "the input changed"
