@@ -66,6 +66,11 @@ struct ss_option {
 	size_t value_offset;       /* OPTIONAL_INT: where its value goes */
 };
 
+/* The range of a REAL option that takes any finite number > 0, for a
+ * table's designated initialiser: {..., SS_OPTION_POSITIVE, ...} (with no
+ * other .flags). */
+#define SS_OPTION_POSITIVE .lo = 0.0, .hi = INFINITY, .flags = SS_OPTION_LO_OPEN
+
 /* A table, and another whose options continue it (relax's options go on
  * with the model's, at the offset of its ss_model_options), or NULL. */
 struct ss_option_table {

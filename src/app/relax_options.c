@@ -55,8 +55,6 @@ static int parse_sand_shape(const char *value, void *field)
 }
 
 #define AT(m) offsetof(struct ss_relax_options, m)
-/* > 0, finite */
-#define POSITIVE .lo = 0.0, .hi = INFINITY, .flags = SS_OPTION_LO_OPEN
 
 static const struct ss_option options[] = {
 	{.name = "dem", .kind = SS_OPTION_TEXT, .offset = AT(dem), .flags = SS_OPTION_NAMED_ONLY,
@@ -91,20 +89,20 @@ static const struct ss_option options[] = {
 	 .expected = "rect=X0,Y0,X1,Y1 (X0 < X1, Y0 < Y1) or disk=X,Y,R (R > 0), in m",
 	 .help = "pour sand on rect=X0,Y0,X1,Y1 or disk=X,Y,R (m)"},
 	{.name = "sand-rate", .value_name = "R", .kind = SS_OPTION_REAL, .offset = AT(sand_rate),
-	 POSITIVE, .expected = "m/s > 0", .help = "at R m/s (needed with --add-sand)"},
+	 SS_OPTION_POSITIVE, .expected = "m/s > 0", .help = "at R m/s (needed with --add-sand)"},
 	{.name = "sand-duration", .value_name = "S", .kind = SS_OPTION_REAL,
-	 .offset = AT(sand_duration), POSITIVE, .expected = "s > 0",
+	 .offset = AT(sand_duration), SS_OPTION_POSITIVE, .expected = "s > 0",
 	 .help = "for S seconds from t = 0 (needed with --add-sand)"},
 	{.name = "dx", .value_name = "M", .kind = SS_OPTION_REAL, .offset = AT(read.cellsize),
-	 POSITIVE, .expected = "m > 0", .help = "cell size, for files that do not give one"},
+	 SS_OPTION_POSITIVE, .expected = "m > 0", .help = "cell size, for files that do not give one"},
 	{.name = "zscale", .value_name = "Z", .kind = SS_OPTION_REAL, .offset = AT(read.zscale),
-	 POSITIVE, .expected = "m per grey level > 0",
+	 SS_OPTION_POSITIVE, .expected = "m per grey level > 0",
 	 .help = "PNG: m per grey level (default: the file's range)"},
 	{.name = "zoffset", .value_name = "Z0", .kind = SS_OPTION_REAL,
 	 .offset = AT(read.zoffset), .lo = -INFINITY, .hi = INFINITY, .expected = "m",
 	 .help = "PNG: height of grey 0, m (default 0; needs --zscale)"},
 	{.name = "output-every", .value_name = "T", .kind = SS_OPTION_REAL,
-	 .offset = AT(output_every), POSITIVE, .expected = "s > 0",
+	 .offset = AT(output_every), SS_OPTION_POSITIVE, .expected = "s > 0",
 	 .help = ".h5 output: a snapshot every T s (default: 20 over\n"
 	         "--max-time, else the first and the last)"},
 	{.name = "report", .value_name = "FILE.json", .kind = SS_OPTION_TEXT, .offset = AT(report),

@@ -102,8 +102,6 @@ void ss_option_defaults(const struct ss_option_table *t, void *base)
 				break;
 			case SS_OPTION_INT:
 			case SS_OPTION_FLAG:
-				*(int *)field = 0;
-				break;
 			case SS_OPTION_OPTIONAL_INT:
 				*(int *)field = 0;
 				break;

@@ -3,6 +3,7 @@
  */
 #include "base/strings.h"
 
+#include <ctype.h>
 #include <errno.h>
 #include <math.h>
 #include <stdarg.h>
@@ -56,6 +57,27 @@ int ss_parse_real(const char *s, double lo, double hi, double *out)
 		return -1;
 	*out = v;
 	return 0;
+}
+
+int ss_parse_numbers(const char *s, int commas, double *out, int max)
+{
+	int n = 0;
+	for (;;) {
+		while (isspace((unsigned char)*s) || (commas && n > 0 && *s == ','))
+			s++;
+		if (!*s)
+			return n;
+		char *end;
+		errno = 0;
+		const double v = strtod(s, &end);
+		if (end == s || errno == ERANGE || !isfinite(v) ||
+		    (*end && !(commas && *end == ',') && !isspace((unsigned char)*end)))
+			return -1;
+		if (n < max)
+			out[n] = v;
+		n++;
+		s = end;
+	}
 }
 
 int ss_parse_tile(const char *s, int tile[2])

@@ -16,6 +16,12 @@ char *ss_strings_join(const char *const *v, int n, const char *separator, int te
  * options and the options set by name (app/named.c) parse with these. */
 int ss_parse_int(const char *s, long lo, long hi, int *out);
 int ss_parse_real(const char *s, double lo, double hi, double *out);
+/* Finite numbers separated by white space (and by commas when commas is
+ * set: "0,0,1,1"), the first max of them into out (out may be NULL when
+ * max is 0): the count of numbers in s, or -1 when something in it is not
+ * one.  Case files' pairs and polygons, and the shapes of case and
+ * command line (shape.h), are read with it. */
+int ss_parse_numbers(const char *s, int commas, double *out, int max);
 /* "NXxNY", each 1 to 2^20, into tile[0], tile[1] (--tile); 0 or -1. */
 int ss_parse_tile(const char *s, int tile[2]);
 

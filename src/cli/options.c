@@ -132,8 +132,6 @@ static const struct ss_option *find(const struct cli_command *c, const char *wor
                                     int *k, const char **inline_value)
 {
 	*inline_value = NULL;
-	if (strncmp(word, "--", 2) && word[0] != '-')
-		return NULL;
 	for (*g = 0; *g < c->group_count; ++*g) {
 		const struct ss_option_table *t = c->groups[*g].table;
 		for (*k = 0; *k < t->count; ++*k) {

@@ -25,6 +25,7 @@
 
 #include <ini.h>
 
+#include "base/strings.h"
 #include "sandslide/error.h"
 
 /* ---- the keys of the fixed sections ----------------------------------- */
@@ -32,26 +33,10 @@
 /* "X Y" into two doubles */
 static int parse_pair(const char *value, void *field)
 {
-	double v[3];
-	char *end;
-	const char *s = value;
-	int n = 0;
-	for (;;) {
-		while (isspace((unsigned char)*s))
-			s++;
-		if (!*s)
-			break;
-		errno = 0;
-		const double x = strtod(s, &end);
-		if (end == s || errno == ERANGE || !isfinite(x) ||
-		    (*end && !isspace((unsigned char)*end)) || n == 3)
-			return -1;
-		v[n++] = x;
-		s = end;
-	}
-	if (n != 2)
+	double v[2];
+	if (ss_parse_numbers(value, 0, v, 2) != 2)
 		return -1;
-	memcpy(field, v, 2 * sizeof *v);
+	memcpy(field, v, sizeof v);
 	return 0;
 }
 
@@ -89,8 +74,6 @@ static int parse_initial(const char *value, void *field)
 }
 
 #define AT(m) offsetof(struct ss_case, m)
-/* > 0, finite */
-#define POSITIVE .lo = 0.0, .hi = INFINITY, .flags = SS_OPTION_LO_OPEN
 #define KEY(k, kind_, field, ...) \
 	{.case_key = k, .kind = kind_, .offset = AT(field), __VA_ARGS__}
 #define NUMBER(k, field, ...) KEY(k, SS_OPTION_REAL, field, __VA_ARGS__)
@@ -106,22 +89,22 @@ static const struct ss_option keys[] = {
 	NUMBER("grid.dx", dx, .lo = 0.0, .hi = INFINITY,
 	       .flags = SS_OPTION_CASE_REQUIRED | SS_OPTION_LO_OPEN,
 	       .expected = "a finite number > 0", .help = "cell size in m"),
-	NUMBER("grid.dy", dy, POSITIVE, .expected = "a finite number > 0",
+	NUMBER("grid.dy", dy, SS_OPTION_POSITIVE, .expected = "a finite number > 0",
 	       .help = "cell size south to north, m (default dx)"),
 	WORD("grid.origin", origin_x, parse_pair, .default_value = "0 0",
 	     .expected = "two finite numbers 'X Y'", .help = "lower-left corner, m"),
-	NUMBER("model.delta", delta, POSITIVE, .expected = "a finite number > 0",
+	NUMBER("model.delta", delta, SS_OPTION_POSITIVE, .expected = "a finite number > 0",
 	       .help = "sliding layer thickness, m"),
-	NUMBER("model.density", density, POSITIVE, .expected = "a finite number > 0",
+	NUMBER("model.density", density, SS_OPTION_POSITIVE, .expected = "a finite number > 0",
 	       .help = "kg/m^3"),
-	NUMBER("model.gravity", gravity, .default_value = "9.81", POSITIVE,
+	NUMBER("model.gravity", gravity, .default_value = "9.81", SS_OPTION_POSITIVE,
 	       .expected = "a finite number > 0", .help = "m/s^2"),
-	NUMBER("model.viscosity", viscosity, POSITIVE, .expected = "a finite number > 0",
+	NUMBER("model.viscosity", viscosity, SS_OPTION_POSITIVE, .expected = "a finite number > 0",
 	       .help = "mu, Pa s (bingham, casson)"),
-	NUMBER("model.consistency", consistency, POSITIVE,
+	NUMBER("model.consistency", consistency, SS_OPTION_POSITIVE,
 	       .expected = "a finite number > 0", .help = "k, Pa s^gamma (herschel-bulkley)"),
 	WORD("time.end", end, parse_end, .flags = SS_OPTION_CASE_REQUIRED,
-	     .expected = "a time in s > 0, or steady", .help = "a time in s, or steady"),
+	     .expected = "a time in s > 0, or steady", .help = "when the run stops"),
 	NUMBER("time.output_every", output_every, .lo = 0.0, .hi = INFINITY,
 	       .flags = SS_OPTION_CASE_REQUIRED | SS_OPTION_LO_OPEN,
 	       .expected = "a finite number > 0", .help = "seconds between snapshots"),
@@ -141,7 +124,7 @@ static const struct ss_option keys[] = {
 	       .hi = INFINITY, .expected = "a finite number", .help = "m"),
 	WORD("initial.center", cone_x, parse_pair, .expected = "two finite numbers 'X Y'",
 	     .help = "'X Y' in m"),
-	NUMBER("initial.radius", cone_radius, POSITIVE, .expected = "a finite number > 0",
+	NUMBER("initial.radius", cone_radius, SS_OPTION_POSITIVE, .expected = "a finite number > 0",
 	       .help = "m, > 0"),
 	NUMBER("initial.angle", cone_angle_deg, .lo = 0.0, .hi = 90.0,
 	       .flags = SS_OPTION_LO_OPEN | SS_OPTION_HI_OPEN, .expected = "degrees in (0, 90)",
@@ -404,23 +387,7 @@ static int region_shape(struct parse *p, struct ss_region *r, const char *key,
 		return SS_OK;
 	}
 	/* polygon, possibly continued on indented lines */
-	double scratch;
-	int count = 0;
-	for (const char *s = value;; count++) {
-		while (isspace((unsigned char)*s))
-			s++;
-		if (!*s)
-			break;
-		char *end;
-		errno = 0;
-		scratch = strtod(s, &end);
-		if (end == s || errno == ERANGE || !isfinite(scratch) ||
-		    (*end && !isspace((unsigned char)*end))) {
-			count = -1;
-			break;
-		}
-		s = end;
-	}
+	const int count = ss_parse_numbers(value, 0, NULL, 0);
 	if (count < 0 || count % 2)
 		return fail_at(p, "[%s] polygon = '%s': expected %s", section, value,
 		               ss_shape_expected(SS_SHAPE_POLYGON));
@@ -428,12 +395,7 @@ static int region_shape(struct parse *p, struct ss_region *r, const char *key,
 	if (!pts)
 		return ss_error_fail("out of memory");
 	sh->polygon = pts;
-	const char *s = value;
-	for (int k = 0; k < count; k++) {
-		char *end;
-		pts[2 * sh->polygon_points + k] = strtod(s, &end);
-		s = end;
-	}
+	ss_parse_numbers(value, 0, pts + 2 * sh->polygon_points, count);
 	sh->polygon_points += count / 2;
 	sh->kind = SS_SHAPE_POLYGON;
 	return SS_OK;
@@ -524,15 +486,9 @@ static int apply_region_key(struct parse *p, const char *section, const char *ke
 		const int is_rate = key[0] == 'r', is_start = key[2] == 'a';
 		char *where = is_rate ? r->rate_where : is_start ? r->start_where : r->stop_where;
 		double v;
-		char *end;
-		errno = 0;
-		v = strtod(value, &end);
-		while (isspace((unsigned char)*end))
-			end++;
 		if (where[0] && !p->overriding)
 			return fail_at(p, "[%s] %s is set twice (first at %s)", section, key, where);
-		if (end == value || *end || errno == ERANGE || !isfinite(v) ||
-		    (is_rate ? !(v > 0.0) : !(v >= 0.0)))
+		if (ss_parse_real(value, 0.0, INFINITY, &v) || (is_rate && v == 0.0))
 			return fail_at(p, "[%s] %s = '%s': expected %s", section, key, value,
 			               is_rate ? "a finite number > 0 (m/s)" : "a time in s >= 0");
 		*(is_rate ? &r->rate : is_start ? &r->start : &r->stop) = v;
@@ -793,6 +749,24 @@ static int prescan(struct parse *p)
 
 /* ---- checks across keys ---------------------------------------------- */
 
+/* Every key flagged SS_OPTION_CASE_REQUIRED, in the tables' order: its
+ * help and what it accepts say what is missing. */
+static int require_flagged(struct parse *p)
+{
+	for (const struct ss_option_table *t = &ss_case_option_table; t; t = t->more) {
+		for (int k = 0; k < t->count; k++) {
+			const struct ss_option *o = &t->options[k];
+			if (!(o->flags & SS_OPTION_CASE_REQUIRED) || is_set(p, o->case_key))
+				continue;
+			const char *dot = strchr(o->case_key, '.');
+			return ss_error_input("%s: [%.*s] is missing '%s' (%s, %s)", p->path,
+			                      (int)(dot - o->case_key), o->case_key, dot + 1, o->help,
+			                      o->expected);
+		}
+	}
+	return SS_OK;
+}
+
 static int require(struct parse *p, const char *key, const char *meaning)
 {
 	if (is_set(p, key))
@@ -852,9 +826,7 @@ static int finish_model(struct parse *p)
 {
 	struct ss_case *c = p->c;
 	struct ss_model_options *m = &c->model;
-	int err = require(p, "model.repose_angle", "degrees in (0, 90)");
-	if (err)
-		return err;
+	int err;
 	if (m->closure != SS_CLOSURE_HERSCHEL_BULKLEY)
 		m->gamma = 1.0;   /* the others have no exponent (the output says 1) */
 
@@ -1042,11 +1014,7 @@ static int finish(struct parse *p)
 {
 	struct ss_case *c = p->c;
 	int err;
-	if ((err = require(p, "grid.nx", "number of cells west to east, an integer >= 1")) ||
-	    (err = require(p, "grid.ny", "number of cells south to north, an integer >= 1")) ||
-	    (err = require(p, "grid.dx", "cell size in m, > 0")) ||
-	    (err = require(p, "time.end", "a time in s, or steady")) ||
-	    (err = require(p, "time.output_every", "seconds between snapshots, > 0")))
+	if ((err = require_flagged(p)))
 		return err;
 	if (!is_set(p, "grid.dy"))
 		c->dy = c->dx;

@@ -22,8 +22,6 @@ static int parse_integrator(const char *value, void *field)
 #define TEXT(x) TEXT_OF(x)
 
 #define AT(m) offsetof(struct ss_model_options, m)
-/* > 0, finite */
-#define POSITIVE .lo = 0.0, .hi = INFINITY, .flags = SS_OPTION_LO_OPEN
 
 static const struct ss_option options[] = {
 	{.help = "The model and its time stepping (also the case file's [model] and\n"
@@ -38,18 +36,18 @@ static const struct ss_option options[] = {
 	 .hi = 90.0, .flags = SS_OPTION_LO_OPEN | SS_OPTION_HI_OPEN | SS_OPTION_CASE_REQUIRED,
 	 .expected = "degrees in (0, 90)", .help = "repose angle a_cr"},
 	{.name = "gamma", .case_key = "model.gamma", .value_name = "G", .kind = SS_OPTION_REAL,
-	 .offset = AT(gamma), .default_value = "1", POSITIVE, .expected = "a number > 0",
+	 .offset = AT(gamma), .default_value = "1", SS_OPTION_POSITIVE, .expected = "a number > 0",
 	 .help = "herschel-bulkley exponent (1: bingham's law)"},
 	{.name = "nu", .case_key = "model.nu", .value_name = "V", .kind = SS_OPTION_REAL,
-	 .offset = AT(nu), .default_value = "1", POSITIVE, .expected = "m^2/s > 0",
+	 .offset = AT(nu), .default_value = "1", SS_OPTION_POSITIVE, .expected = "m^2/s > 0",
 	 .help = "m^2/s: sets the time scale only (a case gives it,\n"
 	         "or the sliding layer it derives from)"},
 	{.name = "tol", .case_key = "time.steady_tol", .value_name = "X", .kind = SS_OPTION_REAL,
-	 .offset = AT(steady_tol), .default_value = "1e-9", POSITIVE, .expected = "m/s > 0",
+	 .offset = AT(steady_tol), .default_value = "1e-9", SS_OPTION_POSITIVE, .expected = "m/s > 0",
 	 .help = "steady when max |dh/dt| < X m/s"},
 	{.name = "slope-tol", .case_key = "time.steady_slope_tol", .value_name = "E",
 	 .kind = SS_OPTION_REAL, .offset = AT(steady_slope_tol), .default_value = "1e-6",
-	 POSITIVE, .expected = "a number > 0",
+	 SS_OPTION_POSITIVE, .expected = "a number > 0",
 	 .help = "and no sand face steeper than tan(angle) + E\n"
 	         "(other closures: the same flux)"},
 	{.name = "integrator", .case_key = "time.integrator", .value_name = "NAME",
@@ -64,12 +62,12 @@ static const struct ss_option options[] = {
 	 .default_value = TEXT(SS_RKL2_MAX_STAGES_DEFAULT), .lo = 2, .hi = 100000,
 	 .expected = "an integer from 2 to 100000", .help = "rkl2: at most S stages a super-step"},
 	{.name = "rkl2-tol", .case_key = "time.rkl2_tol", .value_name = "E", .kind = SS_OPTION_REAL,
-	 .offset = AT(rkl2_tol), .default_value = TEXT(SS_RKL2_TOL_DEFAULT), POSITIVE,
+	 .offset = AT(rkl2_tol), .default_value = TEXT(SS_RKL2_TOL_DEFAULT), SS_OPTION_POSITIVE,
 	 .expected = "a number > 0",
 	 .help = "rkl2: error estimate of a super-step at most\n"
 	         "E tan(angle) min(dx, dy)"},
 	{.name = "max-time", .case_key = "time.max_time", .value_name = "T", .kind = SS_OPTION_REAL,
-	 .offset = AT(max_time), POSITIVE, .expected = "s > 0",
+	 .offset = AT(max_time), SS_OPTION_POSITIVE, .expected = "s > 0",
 	 .help = "stop at T s even if not steady (default: no limit;\n"
 	         "a case: with end = steady)"},
 	{.name = "cfl", .case_key = "time.cfl", .value_name = "C", .kind = SS_OPTION_REAL,

@@ -29,7 +29,7 @@ struct start {
 	enum ss_kernel kernel;
 	const char *integrator_what;          /* "--integrator rkl2" */
 	const char *bedrock_what;             /* "--bedrock" */
-	const char *grid_what;                /* "dem.asc: 60 x 40 cells" */
+	const char *grid_what;                /* "dem.asc: 60 x 40 cells need" */
 	const char *memory_advice;            /* " (reduce nx and ny)", or "" */
 };
 
@@ -57,10 +57,9 @@ static int start(const struct start *s, struct ss_stepper *st)
 	const double have = ss_memory_available_bytes();
 	if (have > 0.0 && need > have) {
 		char nb[32], hb[32];
-		return ss_error_input("%s need%s %s of memory; this machine has %s available%s",
-		                      s->grid_what, strstr(s->grid_what, "cells") ? "" : "s",
-		                      ss_format_bytes(need, nb), ss_format_bytes(have, hb),
-		                      s->memory_advice);
+		return ss_error_input("%s %s of memory; this machine has %s available%s",
+		                      s->grid_what, ss_format_bytes(need, nb),
+		                      ss_format_bytes(have, hb), s->memory_advice);
 	}
 	err = ss_closure_init(&closure, m->closure, m->angle_deg, m->gamma, m->nu);
 	if (!err)
@@ -178,7 +177,7 @@ int ss_setup_stepper(const struct ss_case *c, int tile_nx, int tile_ny,
 	char integrator_what[SS_CASE_WHERE_SIZE + 64], grid_what[SS_CASE_WHERE_SIZE + 64];
 	snprintf(integrator_what, sizeof integrator_what,
 	         "%s: [time] integrator = rkl2", c->bedrock_where);
-	snprintf(grid_what, sizeof grid_what, "%s: [grid] nx = %d, ny = %d", c->grid_where,
+	snprintf(grid_what, sizeof grid_what, "%s: [grid] nx = %d, ny = %d needs", c->grid_where,
 	         c->nx, c->ny);
 	const struct start s = {
 		.m = &c->model, .nx = c->nx, .ny = c->ny, .dx = c->dx, .dy = c->dy,
@@ -298,7 +297,7 @@ int ss_setup_stepper_from_raster(const struct ss_raster_setup *s, struct ss_step
 	if (err)
 		return err;
 	char grid_what[4200];
-	snprintf(grid_what, sizeof grid_what, "%s: %d x %d cells", s->name, r->nx, r->ny);
+	snprintf(grid_what, sizeof grid_what, "%s: %d x %d cells need", s->name, r->nx, r->ny);
 	const struct ss_boundary sides = {{s->sides, s->sides, s->sides, s->sides}, level};
 	const struct start start_with = {
 		.m = s->model, .nx = r->nx, .ny = r->ny, .dx = dx, .dy = dy,

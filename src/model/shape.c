@@ -6,12 +6,10 @@
  */
 #include "sandslide/shape.h"
 
-#include <ctype.h>
-#include <errno.h>
-#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/strings.h"
 #include "io/png_mask.h"
 #include "sandslide/error.h"
 
@@ -51,34 +49,11 @@ static int read_mask(const struct ss_shape *s, const struct ss_grid *g, uint8_t 
 	return SS_OK;
 }
 
-/* Up to max finite numbers separated by white space or commas; the count,
- * or -1 when something is not a number. */
-static int numbers(const char *s, double *out, int max)
-{
-	int n = 0;
-	for (;;) {
-		while (isspace((unsigned char)*s) || (n > 0 && *s == ','))
-			s++;
-		if (!*s)
-			return n;
-		char *end;
-		errno = 0;
-		const double v = strtod(s, &end);
-		if (end == s || errno == ERANGE || !isfinite(v) ||
-		    (*end && *end != ',' && !isspace((unsigned char)*end)))
-			return -1;
-		if (n < max)
-			out[n] = v;
-		n++;
-		s = end;
-	}
-}
-
 int ss_shape_parse_numbers(enum ss_shape_kind kind, const char *value, struct ss_shape *s)
 {
 	double v[4];
 	const int want = kind == SS_SHAPE_RECT ? 4 : kind == SS_SHAPE_DISK ? 3 : 0;
-	if (!want || numbers(value, v, 4) != want)
+	if (!want || ss_parse_numbers(value, 1, v, 4) != want)
 		return -1;
 	if (kind == SS_SHAPE_RECT && !(v[0] < v[2] && v[1] < v[3]))
 		return -1;
