@@ -154,6 +154,16 @@ static void advance_to(struct ss_stepper *st, double t)
 	      ss_integrator_name(st->integrator), t, (int)end, st->time);
 }
 
+/* At most one super-step towards t (max_steps = 1). */
+static void advance_steps(struct ss_stepper *st, double t, long long steps)
+{
+	const struct ss_advance_options o = {.steady_tol = 0.0, .max_steps = steps};
+	enum ss_advance_end end = ss_stepper_advance(st, t, &o);
+	CHECK(end == SS_ADVANCE_REACHED || end == SS_ADVANCE_STEPS,
+	      "%s: a step towards t = %g s ended with %d at t = %.17g s",
+	      ss_integrator_name(st->integrator), t, (int)end, st->time);
+}
+
 static enum ss_advance_end advance_steady(struct ss_stepper *st, double tol, double t_cap)
 {
 	const struct ss_advance_options o = {.steady_tol = tol};
@@ -804,16 +814,23 @@ static void test_subcritical_unchanged(void)
 
 /* test_physics.c's conservation case: a ramp with noise, a wall block, an
  * open pit, an open west side and two sources, one stopping early, one
- * starting late. */
-static void conservation_case(enum ss_closure_kind kind, enum ss_kernel kernel)
+ * starting late.  max_stages > 0: nu so large and the tolerance so loose
+ * that every super-step between the checks takes max_stages stages, where
+ * the recursion's round-off is largest (sweep.h: the increments D_j). */
+static void conservation_case(enum ss_closure_kind kind, enum ss_kernel kernel,
+                              int max_stages)
 {
 	const int nx = 40, ny = 30;
-	const double dx = 0.1, nu = 0.01, T = 300.0;
+	const double dx = 0.1, nu = max_stages > 0 ? 100.0 : 0.01, T = 300.0;
 	struct ss_stepper st;
 	if (setup(&st, nx, ny, dx, kind, 1.0, nu,
 	          sides(SS_SIDE_OPEN, SS_SIDE_WALL, SS_SIDE_WALL, SS_SIDE_WALL, 0.0), 16, 8,
 	          SS_INTEGRATOR_RKL2, kernel))
 		return;
+	if (max_stages > 0) {
+		st.rkl2_max_stages = max_stages;
+		st.rkl2_tol = 1e9;
+	}
 	struct rng r = {seed ^ (uint64_t)kind};
 	for (int j = 0; j < ny; j++) {
 		for (int i = 0; i < nx; i++) {
@@ -839,8 +856,12 @@ static void conservation_case(enum ss_closure_kind kind, enum ss_kernel kernel)
 	const double v0 = diag(&st).volume;
 	const double times[] = {T / 12.0, T / 3.0, 0.4 * T, T / 2.0, 0.7 * T, 0.9 * T, T};
 	double worst = 0.0;
+	int stages_max = 0;
 	for (size_t k = 0; k < sizeof times / sizeof *times; k++) {
-		advance_to(&st, times[k]);
+		while (st.time < times[k]) {
+			advance_steps(&st, times[k], 1);
+			stages_max = st.last_stages > stages_max ? st.last_stages : stages_max;
+		}
 		struct ss_diagnostics d = diag(&st);
 		const double err = fabs((d.volume - v0) - (d.inflow - d.outflow));
 		const double scale = fmax(d.volume, d.inflow);
@@ -857,19 +878,26 @@ static void conservation_case(enum ss_closure_kind kind, enum ss_kernel kernel)
 	          "its 38 flow cells for T/3 plus source 2 on 48 cells from T/2 to 0.9 T",
 	          ss_closure_name(kind), kernel_name(kernel));
 	CHECK(d.outflow > 0.01 * v0, "rkl2: hardly any outflow (%g of %g m^3)", d.outflow, v0);
+	if (max_stages > 0)
+		CHECK(stages_max == max_stages, "rkl2, %s: the largest super-step took %d stages, "
+		      "not the cap %d the test is about", kernel_name(kernel), stages_max, max_stages);
 	printf("  conservation rkl2 %-8s %-9s: V0 %.6f, V %.6f, in %.6f, out %.6f m^3, %.0f "
-	       "super-steps, %.0f evaluations, worst |dV - (in - out)| / max = %.2e\n",
-	       ss_closure_name(kind), kernel_name(kernel), v0, d.volume, d.inflow, d.outflow,
-	       d.steps, d.evaluations, worst);
+	       "super-steps, %.0f evaluations, up to %d stages, worst |dV - (in - out)| / max = "
+	       "%.2e\n", ss_closure_name(kind), kernel_name(kernel), v0, d.volume, d.inflow,
+	       d.outflow, d.steps, d.evaluations, stages_max, worst);
 out:
 	ss_stepper_release(&st);
 }
 
 static void test_conservation(void)
 {
-	conservation_case(SS_CLOSURE_COULOMB, SS_KERNEL_FAST);
-	conservation_case(SS_CLOSURE_COULOMB, SS_KERNEL_REFERENCE);
-	conservation_case(SS_CLOSURE_CASSON, SS_KERNEL_FAST);
+	conservation_case(SS_CLOSURE_COULOMB, SS_KERNEL_FAST, 0);
+	conservation_case(SS_CLOSURE_COULOMB, SS_KERNEL_REFERENCE, 0);
+	conservation_case(SS_CLOSURE_CASSON, SS_KERNEL_FAST, 0);
+	/* the ledger at stage counts past the old cap of 256 */
+	conservation_case(SS_CLOSURE_COULOMB, SS_KERNEL_FAST, 1024);
+	conservation_case(SS_CLOSURE_COULOMB, SS_KERNEL_REFERENCE, 1024);
+	conservation_case(SS_CLOSURE_COULOMB, SS_KERNEL_FAST, 2048);
 }
 
 /* ---- 7. periodic sides ---------------------------------------------------- */

@@ -18,7 +18,9 @@
  *
  * The delta form equals the usual mu Y_{j-1} + nu Y_{j-2} + (1 - mu - nu) Y_0
  * (the weights sum to 1) but a cell whose every M is exactly 0 keeps its
- * bits, and it rounds increments of size tau M rather than heights.
+ * bits.  The kernels carry the increments D_j = Y_j - Y_0 themselves
+ * (sweep.h), so the recursion rounds at the scale of tau M, not of the
+ * heights, and its round-off is not fed back through Y_{j-1} and Y_{j-2}.
  *
  * Stability: the amplification of a mode with forward-Euler number z =
  * tau lambda is R_s(z) = a_s + b_s P_s(1 + w_1 z) (P_s Legendre), which

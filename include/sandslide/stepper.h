@@ -136,7 +136,8 @@ struct ss_stepper {
 	                               * (-infinity where no sand lies: walls,
 	                               * open cells, open and wall ghosts) */
 	double *row_scratch;          /* ny per-row partial sums */
-	double *rkl2_y0, *rkl2_prev;  /* RKL2 only: Y_0, Y_{j-2} (m), with halo */
+	double *rkl2_y0;              /* RKL2 only: Y_0, m, with halo */
+	double *rkl2_d1, *rkl2_d2;    /*   D_{j-1}, D_{j-2} = Y - Y_0, m (sweep.h) */
 	double *rkl2_m0;              /*   M(Y_0), m/s */
 
 	struct ss_source *sources;

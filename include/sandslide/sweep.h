@@ -108,55 +108,63 @@ double ss_sweep_update(const struct ss_grid *g, const struct ss_tiling *t,
 /*
  * One stage of an RKL2 super-step (rkl2.h) as both kernels apply it to the
  * flow cells, in place of pass 2's forward Euler.  With M the rate of pass 2
- * (flux divergence plus source) at the heights Y_{j-1} of this stage:
+ * (flux divergence plus source) at the heights Y_{j-1} of this stage, the
+ * stage is carried as its increment D_j = Y_j - Y_0 (doc/model.md#rkl2-super-steps):
  *
- *   Y_j = Y_0 + mu (Y_{j-1} - Y_0) + nu (Y_{j-2} - Y_0)
- *             + tau mu~ M(Y_{j-1}) + tau gamma~ M(Y_0)
+ *   D_j = mu D_{j-1} + nu D_{j-2} + tau mu~ M(Y_{j-1}) + tau gamma~ M(Y_0)
+ *   Y_j = Y_0 + D_j
  *
- * The first stage stores Y_0 and M(Y_0) (mu = nu = gamma~ = 0); every stage
- * moves Y_{j-1} into prev, which held Y_{j-2}.  Cells that are not flow
- * cells keep their height.  After the last stage, one more evaluation
- * (estimate_only: nothing is written) estimates the super-step's error from
- * its start Y^n and M(Y^n) (y0, m0) and its end Y^{n+1}, as RKC and
- * SUNDIALS' LSRKStep do for RKL2:
+ * Why the increments: the heights are O(m) and the increments of a
+ * super-step O(mm), and the recursion amplifies what each stage rounds
+ * (its homogeneous part grows like the stage count).  Rounded at the
+ * heights' scale, as Y_j = Y_0 + mu (Y_{j-1} - Y_0) + ... was, the volume
+ * drifted by 3e-11 of itself over a door run at 256 stages; rounded at the
+ * increments' scale, Y_j is rounded once per stage and not fed back.
  *
- *   est = max |0.8 (Y^n - Y^{n+1}) + 0.4 tau (M(Y^n) + M(Y^{n+1}))|
+ * The first stage stores Y_0 and M(Y_0) (mu = nu = gamma~ = 0, D_0 = 0);
+ * every stage moves D_{j-1} into d2, which held D_{j-2}.  Cells that are
+ * not flow cells keep their height.  After the last stage, one more
+ * evaluation (estimate_only: no height is written) estimates the
+ * super-step's error from its start Y^n and M(Y^n) (y0, m0) and its change
+ * D_s = Y^{n+1} - Y^n, as RKC and SUNDIALS' LSRKStep do for RKL2:
+ *
+ *   est = max |0.4 tau (M(Y^n) + M(Y^{n+1})) - 0.8 D_s|
  *
  * (0 for a state the trapezoidal rule would also reach; a stiff mode that
  * RKL2 damps only by its a_s ~ 1/2 where it should vanish gives ~ tau M).
  */
 /* The error estimate of one cell (the same expression in both kernels). */
-static inline double ss_sweep_stage_estimate(double tau, double y_old, double m_old,
-                                             double y, double m)
+static inline double ss_sweep_stage_estimate(double tau, double change, double m_old,
+                                             double m)
 {
-	return fabs(0.8 * (y_old - y) + 0.4 * tau * (m_old + m));
+	return fabs(0.4 * tau * (m_old + m) - 0.8 * change);
 }
 
 struct ss_sweep_stage {
-	int first;                /* stage 1: y0, prev <- Y_0; m0 <- M(Y_0) */
+	int first;                /* stage 1: y0 <- Y_0; d1, d2 <- 0; m0 <- M(Y_0) */
 	int estimate_only;        /* after the last stage: est only, no write */
 	double estimate_tau;      /* estimate_only: the super-step's length, s */
 	double *estimate;         /* estimate_only: out, the largest est, m */
-	double mu, nu;            /* weights of Y_{j-1} - Y_0, Y_{j-2} - Y_0 */
+	double mu, nu;            /* weights of D_{j-1}, D_{j-2} */
 	double tau_mu, tau_gamma; /* tau mu~_j, tau gamma~_j, s */
 	double *y0;               /* Y_0, m, by storage index */
-	double *prev;             /* Y_{j-2} in, Y_{j-1} out, m */
+	double *d1;               /* D_{j-1} in, D_j out, m */
+	double *d2;               /* D_{j-2} in, D_{j-1} out, m */
 	double *m0;               /* M(Y_0), m/s */
 };
 
-/* Y_j of one cell: the one expression both kernels evaluate, so that they
- * give the same bits.  A cell with Y_{j-1} = Y_{j-2} = Y_0 and M = M_0 = 0
- * keeps its height exactly. */
-static inline double ss_sweep_stage_value(const struct ss_sweep_stage *s, double y0,
-                                          double y1, double y2, double m, double m0)
+/* D_j of one cell: the one expression both kernels evaluate, so that they
+ * give the same bits.  A cell with D_{j-1} = D_{j-2} = 0 and M = M_0 = 0
+ * keeps its height exactly (Y_0 + 0). */
+static inline double ss_sweep_stage_delta(const struct ss_sweep_stage *s, double d1,
+                                          double d2, double m, double m0)
 {
-	return y0 + ((s->mu * (y1 - y0) + s->nu * (y2 - y0)) +
-	             (s->tau_mu * m + s->tau_gamma * m0));
+	return (s->mu * d1 + s->nu * d2) + (s->tau_mu * m + s->tau_gamma * m0);
 }
 
 /*
  * Pass 2 of an RKL2 stage with the fluxes of pass 1 and the source rate
- * (NULL: none).  Returns max |Y_j - Y_0| over flow cells, m (INFINITY on
+ * (NULL: none).  Returns max |D_j| over flow cells, m (INFINITY on
  * NaN).
  */
 double ss_sweep_stage_update(const struct ss_grid *g, const struct ss_tiling *t,
@@ -305,7 +313,7 @@ double ss_sweep_fast_step(struct ss_sweep_fast *f, const struct ss_grid *g,
  * change in it, in place, with the fluxes of the step above (no bedrock:
  * RKL2 is not used with one).  A tile swept in one stage is swept in every
  * later stage of the super-step; `last` (j = s) plans the next super-step's
- * first stage.  Returns max |Y_j - Y_0| over the flow cells swept, m
+ * first stage.  Returns max |D_j| over the flow cells swept, m
  * (INFINITY on NaN); open_flux gets the fluxes of M(Y_{j-1}). */
 double ss_sweep_fast_stage(struct ss_sweep_fast *f, const struct ss_grid *g,
                            const struct ss_face_rule *rule,

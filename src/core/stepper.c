@@ -45,9 +45,9 @@ enum ss_integrator ss_integrator_resolve(enum ss_integrator asked, int has_bedro
 double ss_stepper_memory_bytes(const struct ss_grid *g, enum ss_integrator integrator)
 {
 	/* height and source_rate (doubles) and the packed types, and RKL2's
-	 * Y_0, Y_{j-2} and M(Y_0); the fast sweep's ring rows and buffers
-	 * are below 2 % of that */
-	const double doubles = integrator == SS_INTEGRATOR_RKL2 ? 5.0 : 2.0;
+	 * Y_0, D_{j-1}, D_{j-2} and M(Y_0); the fast sweep's ring rows and
+	 * buffers are below 2 % of that */
+	const double doubles = integrator == SS_INTEGRATOR_RKL2 ? 6.0 : 2.0;
 	return (double)ss_grid_storage_cells(g) * (doubles * sizeof(double) + 0.25);
 }
 
@@ -117,7 +117,8 @@ void ss_stepper_release(struct ss_stepper *st)
 	ss_free(st->open_flux);
 	ss_sweep_fast_release(&st->fast);
 	ss_free(st->rkl2_m0);
-	ss_free(st->rkl2_prev);
+	ss_free(st->rkl2_d2);
+	ss_free(st->rkl2_d1);
 	ss_free(st->rkl2_y0);
 	ss_free(st->bedrock);
 	ss_free(st->source_rate);
@@ -251,7 +252,7 @@ static double rkl2_dt_all(const struct ss_stepper *st)
  * starts with no measure of how fast its state changes. */
 #define RKL2_START_STAGES 4
 
-/* RKL2's arrays: Y_0 = Y_{j-2} = the heights and M(Y_0) = 0 everywhere, as
+/* RKL2's arrays: Y_0 = the heights, D = 0 and M(Y_0) = 0 everywhere, as
  * after a super-step in which nothing moved (the fast sweep relies on it
  * for the tiles it skips). */
 static int rkl2_prepare(struct ss_stepper *st)
@@ -265,12 +266,14 @@ static int rkl2_prepare(struct ss_stepper *st)
 		return ss_error_input("rkl2_tol %g must be above 0", st->rkl2_tol);
 	const size_t n = ss_grid_storage_cells(&st->grid);
 	st->rkl2_y0 = ss_alloc(n, sizeof(double), "RKL2 Y_0");
-	st->rkl2_prev = ss_alloc(n, sizeof(double), "RKL2 Y_{j-2}");
+	st->rkl2_d1 = ss_alloc(n, sizeof(double), "RKL2 D_{j-1}");
+	st->rkl2_d2 = ss_alloc(n, sizeof(double), "RKL2 D_{j-2}");
 	st->rkl2_m0 = ss_alloc(n, sizeof(double), "RKL2 M(Y_0)");
-	if (!st->rkl2_y0 || !st->rkl2_prev || !st->rkl2_m0)
+	if (!st->rkl2_y0 || !st->rkl2_d1 || !st->rkl2_d2 || !st->rkl2_m0)
 		return SS_ERR_FAIL;
 	memcpy(st->rkl2_y0, st->height, n * sizeof(double));
-	memcpy(st->rkl2_prev, st->height, n * sizeof(double));
+	memset(st->rkl2_d1, 0, n * sizeof(double));
+	memset(st->rkl2_d2, 0, n * sizeof(double));
 	memset(st->rkl2_m0, 0, n * sizeof(double));
 	st->rkl2_tau = rkl2_dt_all(st) * ss_rkl2_stable_ratio(RKL2_START_STAGES);
 	return SS_OK;
@@ -639,7 +642,7 @@ static double rkl2_pass(struct ss_stepper *st, const struct ss_sweep_stage *stag
  * tau (mu~ out(M(Y_{j-1})) + gamma~ out(M(Y_0))), as the heights are, so
  * that it is the outflow of the super-step's change; the source is
  * constant over it, so the inflow is tau times its rate.  Returns
- * max |Y_s - Y_0|, m (INFINITY on NaN), and the error estimate (sweep.h)
+ * max |Y_s - Y_0| (as max |D_s|), m (INFINITY on NaN), and the error estimate (sweep.h)
  * in *estimate.
  */
 static double rkl2_superstep(struct ss_stepper *st, double tau, int s, double *estimate)
@@ -650,13 +653,13 @@ static double rkl2_superstep(struct ss_stepper *st, double tau, int s, double *e
 		const struct ss_sweep_stage stage = {
 			.first = j == 1, .mu = k.mu, .nu = k.nu,
 			.tau_mu = tau * k.mu_tilde, .tau_gamma = tau * k.gamma_tilde,
-			.y0 = st->rkl2_y0, .prev = st->rkl2_prev, .m0 = st->rkl2_m0,
+			.y0 = st->rkl2_y0, .d1 = st->rkl2_d1, .d2 = st->rkl2_d2, .m0 = st->rkl2_m0,
 		};
 		change = rkl2_pass(st, &stage, j == s, j == 1, 1.0 / (s + 1));
 		const double out = outflow_rate(st);
 		if (j == 1)
 			out_m0 = out;
-		const double out_j = ss_sweep_stage_value(&stage, 0.0, out_1, out_2, out, out_m0);
+		const double out_j = ss_sweep_stage_delta(&stage, out_1, out_2, out, out_m0);
 		out_2 = j == 1 ? 0.0 : out_1;
 		out_1 = out_j;
 		if (!isfinite(change))
@@ -670,7 +673,7 @@ static double rkl2_superstep(struct ss_stepper *st, double tau, int s, double *e
 	 * restart from Y_s needs nothing a snapshot does not hold */
 	const struct ss_sweep_stage est = {
 		.estimate_only = 1, .estimate_tau = tau, .estimate = estimate,
-		.y0 = st->rkl2_y0, .prev = st->rkl2_prev, .m0 = st->rkl2_m0,
+		.y0 = st->rkl2_y0, .d1 = st->rkl2_d1, .d2 = st->rkl2_d2, .m0 = st->rkl2_m0,
 	};
 	rkl2_pass(st, &est, 0, 0, 1.0 / (s + 1));
 	return change;

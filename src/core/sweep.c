@@ -218,7 +218,7 @@ double ss_sweep_stage_update(const struct ss_grid *g, const struct ss_tiling *t,
 	const int tiles = t->tiles_x * t->tiles_y;
 	const ptrdiff_t stride = g->stride;
 	const double inv_dx = 1.0 / g->dx, inv_dy = 1.0 / g->dy;
-	double *restrict y0 = stage->y0, *restrict prev = stage->prev;
+	double *restrict y0 = stage->y0, *restrict d1 = stage->d1, *restrict d2 = stage->d2;
 	double *restrict m0 = stage->m0;
 	double change_max = 0.0, estimate = 0.0;
 
@@ -234,8 +234,8 @@ double ss_sweep_stage_update(const struct ss_grid *g, const struct ss_tiling *t,
 				const double y1 = height[k];
 				if (stage->estimate_only) {
 					const double e = flows
-						? ss_sweep_stage_estimate(stage->estimate_tau, y0[k],
-						                          m0[k], y1, rate)
+						? ss_sweep_stage_estimate(stage->estimate_tau, d1[k],
+						                          m0[k], rate)
 						: 0.0;
 					if (e > estimate || e != e)
 						estimate = e != e ? INFINITY : e;
@@ -243,14 +243,16 @@ double ss_sweep_stage_update(const struct ss_grid *g, const struct ss_tiling *t,
 				}
 				if (stage->first) {
 					y0[k] = y1;
-					prev[k] = y1;
+					d1[k] = 0.0;
+					d2[k] = 0.0;
 					m0[k] = flows ? rate : 0.0;
 				}
-				const double y = ss_sweep_stage_value(stage, y0[k], y1, prev[k],
-				                                      rate, m0[k]);
-				height[k] = flows ? y : y1;
-				prev[k] = y1;
-				const double a = flows ? fabs(y - y0[k]) : 0.0;
+				const double d = flows ? ss_sweep_stage_delta(stage, d1[k], d2[k], rate, m0[k])
+				                       : 0.0;
+				height[k] = flows ? y0[k] + d : y1;
+				d2[k] = d1[k];
+				d1[k] = d;
+				const double a = fabs(d);
 				if (a > change_max || a != a)
 					change_max = a != a ? INFINITY : a;
 			}

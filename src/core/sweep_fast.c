@@ -1016,18 +1016,19 @@ static inline double *row_rates(const struct tile_ctx *c, const struct tile *t,
 	return rate;
 }
 
-/* An RKL2 stage (ss_sweep_stage_value) on the flow cells of row j, in
- * place; max |Y_j - Y_0| into t->rate_max (INFINITY on NaN), and whether a
- * cell changed into t->moving: a tile that changed in any stage is swept
- * at the start of the next super-step. */
+/* An RKL2 stage (ss_sweep_stage_delta) on the flow cells of row j, in
+ * place; max |D_j| into t->rate_max (INFINITY on NaN), and whether a cell
+ * changed into t->moving: a tile that changed in any stage is swept at the
+ * start of the next super-step. */
 static inline void row_stage(const struct tile_ctx *c, struct tile *t,
                              const double *restrict rate, const struct ring *r, int j)
 {
 	const struct ss_sweep_stage *sg = c->stage;
 	const int W = t->W, first = sg->first, plain = t->plain;
 	const ptrdiff_t k0 = ss_grid_index(c->g, t->i0, j);
-	double *restrict y0 = sg->y0 + k0, *restrict prev = sg->prev + k0;
-	double *restrict m0 = sg->m0 + k0, *restrict hn = c->h + k0;
+	double *restrict y0 = sg->y0 + k0, *restrict d1 = sg->d1 + k0;
+	double *restrict d2 = sg->d2 + k0, *restrict m0 = sg->m0 + k0;
+	double *restrict hn = c->h + k0;
 	const double *cur = r->cur + 1;
 	const int64_t *tc = r->type_cur + 1;
 	uint64_t row_max = 0;
@@ -1035,14 +1036,14 @@ static inline void row_stage(const struct tile_ctx *c, struct tile *t,
 
 	if (sg->estimate_only) {
 		/* a tile not swept in the super-step did not change in it, and its
-		 * M was 0 at its start: its y0 and m0 may be older */
+		 * M was 0 at its start: its d1 and m0 may be older */
 		const int swept = c->f->swept_last[t->index];
 		double est_max = 0.0;
 		for (int x = 0; x < W; x++) {
 			const int flows = plain || tc[x] == SS_CELL_FLOW;
-			const double y_old = swept ? y0[x] : cur[x], m_old = swept ? m0[x] : 0.0;
-			const double e = flows ? ss_sweep_stage_estimate(sg->estimate_tau, y_old, m_old,
-			                                                 cur[x], rate[x]) : 0.0;
+			const double change = swept ? d1[x] : 0.0, m_old = swept ? m0[x] : 0.0;
+			const double e = flows ? ss_sweep_stage_estimate(sg->estimate_tau, change, m_old,
+			                                                 rate[x]) : 0.0;
 			est_max = e > est_max || e != e ? e : est_max;
 		}
 		t->estimate = est_max != est_max ? INFINITY : max2(t->estimate, est_max);
@@ -1053,15 +1054,17 @@ static inline void row_stage(const struct tile_ctx *c, struct tile *t,
 		const double y1 = cur[x];
 		if (first) {
 			y0[x] = y1;
-			prev[x] = y1;
+			d1[x] = 0.0;
+			d2[x] = 0.0;
 			m0[x] = flows ? rate[x] : 0.0;
 		}
-		const double y = ss_sweep_stage_value(sg, y0[x], y1, prev[x], rate[x], m0[x]);
-		const double h = flows ? y : y1;
-		prev[x] = y1;
+		const double d = flows ? ss_sweep_stage_delta(sg, d1[x], d2[x], rate[x], m0[x]) : 0.0;
+		const double h = flows ? y0[x] + d : y1;
+		d2[x] = d1[x];
+		d1[x] = d;
 		hn[x] = h;
 		changed |= h != y1;
-		const uint64_t a = flows ? bits_of(fabs(h - y0[x])) : 0;
+		const uint64_t a = bits_of(fabs(d));
 		row_max = a > row_max ? a : row_max;
 	}
 	const double row_change_max = double_of(row_max);
@@ -1185,7 +1188,7 @@ static inline void row_measure_behind(const struct tile_ctx *c, struct tile *t,
 
 /*
  * A tile first swept in a later stage of a super-step was not swept before
- * in it: its heights are Y_0 = Y_1 = ... and M(Y_0) = 0 on it (a tile is
+ * in it: its heights are Y_0 = Y_1 = ..., D = 0 and M(Y_0) = 0 on it (a tile is
  * left out of a stage only when it cannot change).  Its stage arrays say so
  * before the stage reads them.
  */
@@ -1195,7 +1198,8 @@ static void stage_tile_start(const struct tile_ctx *c, const struct tile *t)
 	for (int j = t->j0; j < t->j1; j++) {
 		const ptrdiff_t k0 = ss_grid_index(c->g, t->i0, j);
 		memcpy(sg->y0 + k0, c->h + k0, (size_t)t->W * sizeof(double));
-		memcpy(sg->prev + k0, c->h + k0, (size_t)t->W * sizeof(double));
+		memset(sg->d1 + k0, 0, (size_t)t->W * sizeof(double));
+		memset(sg->d2 + k0, 0, (size_t)t->W * sizeof(double));
 		memset(sg->m0 + k0, 0, (size_t)t->W * sizeof(double));
 	}
 }
