@@ -155,6 +155,7 @@ struct ss_stepper {
 	int rank_south, rank_north;   /* ranks beside, -1: none */
 	double tiles_all;             /* tiles of the whole grid */
 	double tiles_awake;           /* tiles the coming pass sweeps, all ranks */
+	double tiles_awake_here;      /*   of them on this rank */
 	uint8_t *edges_in;            /* 2 tiles_x: the changed edges of the
 	                               * tile rows beside (sweep.h) */
 

@@ -298,6 +298,12 @@ void ss_sweep_fast_mark_sources(struct ss_sweep_fast *f, const struct ss_grid *g
 double ss_sweep_fast_begin(struct ss_sweep_fast *f, const struct ss_grid *g,
                            const double *height, const uint8_t *cell_types);
 
+/* Start of an RKL2 stage after the first: only the ring rows of the tiles
+ * to sweep.  A stage's length is fixed by its super-step, so it needs no
+ * slope; a NaN shows in the stage's own change (ss_sweep_fast_stage). */
+void ss_sweep_fast_save_rings(struct ss_sweep_fast *f, const struct ss_grid *g,
+                              const double *height);
+
 /* The step: advance the tiles to sweep by dt, in place, with the fluxes
  * limited by the bedrock as ss_sweep_limit does (bedrock NULL: none).
  * Returns max |dh/dt| over the flow cells (INFINITY on NaN); open_flux gets

@@ -491,8 +491,29 @@ static double measure(struct ss_stepper *st)
 	st->seconds_measure += ss_parallel_wall_seconds() - t0;
 	st->tiles_awake = st->kernel == SS_KERNEL_FAST
 		? ss_sweep_fast_awake(&st->fast) : (double)st->tiling.tiles_x * st->tiling.tiles_y;
+	st->tiles_awake_here = st->tiles_awake;
 	ss_comm_reduce(&s_max, 1, &st->tiles_awake, 1);
 	return isinf(s_max) ? NAN : s_max;
+}
+
+/* The start of an RKL2 stage after the first: the halo and what the sweep
+ * reads besides the heights (the fast sweep's ring rows, the reference
+ * sweep's fluxes), but no slope and nothing summed over the ranks: the
+ * super-step's length is fixed, and a NaN shows in the stage's change.
+ * Returns the tiles this rank sweeps. */
+static double measure_stage(struct ss_stepper *st)
+{
+	const struct ss_grid *g = &st->grid;
+	ss_boundary_fill_heights(g, &st->boundary, st->height);
+	const double t0 = ss_parallel_wall_seconds();
+	if (st->kernel == SS_KERNEL_FAST)
+		ss_sweep_fast_save_rings(&st->fast, g, st->height);
+	else
+		ss_sweep_fluxes(g, &st->tiling, &st->face_rule, st->height, st->cell_type_bytes,
+		                st->flux_x, st->flux_y);
+	st->seconds_measure += ss_parallel_wall_seconds() - t0;
+	return st->kernel == SS_KERNEL_FAST
+		? ss_sweep_fast_awake(&st->fast) : (double)st->tiling.tiles_x * st->tiling.tiles_y;
 }
 
 /* After a pass of the fast sweep that planned the next: the tiles here
@@ -604,19 +625,17 @@ static void euler_step(struct ss_stepper *st, double dt)
 }
 
 /* One pass of the stencil for an RKL2 stage (or the estimate after the
- * last), from the halo and the measure (unless `measured`: step_begin did
- * them for stage 1).  Returns what the sweep returns, the largest of every
- * rank (and so does the estimate). */
+ * last), from the halo (unless `measured`: step_begin measured the state
+ * for stage 1).  Returns what the sweep returns on this rank; the tiles it
+ * swept here are added to *awake. */
 static double rkl2_pass(struct ss_stepper *st, const struct ss_sweep_stage *stage, int last,
-                        int measured, double weight)
+                        int measured, double *awake)
 {
 	const struct ss_grid *g = &st->grid;
 	const double *src = st->sources_on ? st->source_rate : NULL;
-	if (!measured)
-		measure(st);
+	*awake += measured ? st->tiles_awake_here : measure_stage(st);
 	const double t1 = ss_parallel_wall_seconds();
 	double change;
-	st->tile_sweeps += st->tiles_awake * weight;
 	if (st->kernel == SS_KERNEL_FAST) {
 		change = ss_sweep_fast_stage(&st->fast, g, &st->face_rule, stage, last, src,
 		                             st->cell_types, st->height, st->open_flux);
@@ -628,11 +647,7 @@ static double rkl2_pass(struct ss_stepper *st, const struct ss_sweep_stage *stag
 	if (!stage->estimate_only)
 		wake_across(st);
 	st->evaluations++;
-	double max[2] = {change, stage->estimate_only ? *stage->estimate : 0.0};
-	ss_comm_reduce(max, 2, NULL, 0);
-	if (stage->estimate_only)
-		*stage->estimate = max[1];
-	return max[0];
+	return change;
 }
 
 /*
@@ -641,13 +656,14 @@ static double rkl2_pass(struct ss_stepper *st, const struct ss_sweep_stage *stag
  * combined with the stage weights, O_j = mu O_{j-1} + nu O_{j-2} +
  * tau (mu~ out(M(Y_{j-1})) + gamma~ out(M(Y_0))), as the heights are, so
  * that it is the outflow of the super-step's change; the source is
- * constant over it, so the inflow is tau times its rate.  Returns
- * max |Y_s - Y_0| (as max |D_s|), m (INFINITY on NaN), and the error estimate (sweep.h)
- * in *estimate.
+ * constant over it, so the inflow is tau times its rate.  The ranks agree
+ * once a super-step, after the estimate (the stages need nothing summed
+ * over them but the outflow).  Returns max |Y_s - Y_0| (as max |D_s|), m
+ * (INFINITY on NaN), and the error estimate (sweep.h) in *estimate.
  */
 static double rkl2_superstep(struct ss_stepper *st, double tau, int s, double *estimate)
 {
-	double out_1 = 0.0, out_2 = 0.0, out_m0 = 0.0, change = 0.0;
+	double out_1 = 0.0, out_2 = 0.0, out_m0 = 0.0, change = 0.0, awake = 0.0;
 	for (int j = 1; j <= s; j++) {
 		const struct ss_rkl2_stage k = ss_rkl2_stage(s, j);
 		const struct ss_sweep_stage stage = {
@@ -655,15 +671,13 @@ static double rkl2_superstep(struct ss_stepper *st, double tau, int s, double *e
 			.tau_mu = tau * k.mu_tilde, .tau_gamma = tau * k.gamma_tilde,
 			.y0 = st->rkl2_y0, .d1 = st->rkl2_d1, .d2 = st->rkl2_d2, .m0 = st->rkl2_m0,
 		};
-		change = rkl2_pass(st, &stage, j == s, j == 1, 1.0 / (s + 1));
+		change = rkl2_pass(st, &stage, j == s, j == 1, &awake);
 		const double out = outflow_rate(st);
 		if (j == 1)
 			out_m0 = out;
 		const double out_j = ss_sweep_stage_delta(&stage, out_1, out_2, out, out_m0);
 		out_2 = j == 1 ? 0.0 : out_1;
 		out_1 = out_j;
-		if (!isfinite(change))
-			return INFINITY;
 	}
 	add_compensated(&st->outflow_sum, &st->outflow_carry, out_1);
 	add_compensated(&st->inflow_sum, &st->inflow_carry, tau * st->source_volume_rate);
@@ -675,8 +689,14 @@ static double rkl2_superstep(struct ss_stepper *st, double tau, int s, double *e
 		.estimate_only = 1, .estimate_tau = tau, .estimate = estimate,
 		.y0 = st->rkl2_y0, .d1 = st->rkl2_d1, .d2 = st->rkl2_d2, .m0 = st->rkl2_m0,
 	};
-	rkl2_pass(st, &est, 0, 0, 1.0 / (s + 1));
-	return change;
+	rkl2_pass(st, &est, 0, 0, &awake);
+	/* the tile counts are whole numbers: their sum has the same bits for
+	 * any rank count */
+	double max[2] = {change, *estimate};
+	ss_comm_reduce(max, 2, &awake, 1);
+	*estimate = max[1];
+	st->tile_sweeps += awake / (s + 1);
+	return isfinite(max[0]) ? max[0] : INFINITY;
 }
 
 /*

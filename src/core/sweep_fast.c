@@ -576,7 +576,32 @@ void SS_PATH_FN(ss_sweep_fast_wake_all)(struct ss_sweep_fast *f, const struct ss
 	f->nonfinite = bad;
 }
 
+static int list_rows(struct ss_sweep_fast *f);
+
 #if SS_PATH == SS_PATH_GENERIC
+void ss_sweep_fast_save_rings(struct ss_sweep_fast *f, const struct ss_grid *g,
+                              const double *height)
+{
+	const struct ss_tiling *t = &f->tiling;
+	const int rows = list_rows(f);
+	const ptrdiff_t stride = g->stride;
+
+	#pragma omp parallel for schedule(dynamic, 1) num_threads(f->threads) if(rows > 1)
+	for (int r = 0; r < rows; r++) {
+		const int ty = f->row_list[r];
+		for (int tx = 0; tx < t->tiles_x; tx++) {
+			if (!f->sweep[ty * t->tiles_x + tx])
+				continue;
+			const struct ss_tile_span s = ss_tiling_span(&f->tiling, g, tx, ty);
+			const size_t n = (size_t)(s.i1 - s.i0 + 2);
+			memcpy(f->ring_south + ty * stride + s.i0,
+			       height + ss_grid_index(g, s.i0 - 1, s.j0 - 1), n * sizeof(double));
+			memcpy(f->ring_north + ty * stride + s.i0,
+			       height + ss_grid_index(g, s.i0 - 1, s.j1), n * sizeof(double));
+		}
+	}
+}
+
 void ss_sweep_fast_mark_sources(struct ss_sweep_fast *f, const struct ss_grid *g,
                                 const double *source_rate)
 {
