@@ -5,6 +5,8 @@
 #   make deps-test  add those the test suite needs (pytest, GDAL's tools,
 #                   xarray, CDO, ParaView, Chromium and selenium for the
 #                   HTML viewer, clang for the race check)
+#   make deps-bench add the real DEMs tools/real_dems.py writes for the
+#                   benchmarks (BENCH_ALL=1: those of --all too); not tests
 #   make test       build and run every test (C programs, then CLI tests)
 #   make install    bin, lib (.so and .a), headers, sandslide.pc, the man
 #                   page, the example cases and the Python module under
@@ -83,9 +85,20 @@ DEB_TEST   := python3-h5py python3-pytest netcdf-bin gdal-bin python3-gdal \
 # render --html's page is tested in headless Chromium through selenium
 # (tests/cli/test_html.py), its screenshot read with PIL
 DEB_TEST   += chromium chromium-driver python3-selenium python3-pil
+# The benchmarks' real DEMs (tools/real_dems.py, read by
+# tools/time_to_solution.py --workloads relax): the Debian packages that
+# ship them, the reader of R's data files, h5py for the outputs.  About
+# 100 MB installed (R's core, OpenFOAM's tutorials); BENCH_ALL=1 adds the
+# GeoTIFFs of --all (R's sf stack: about 100 MB more).  Never on the
+# test path.
+DEB_BENCH  := python3-h5py python3-rdata r-base-core r-cran-spatstat.data \
+              openfoam-examples python-matplotlib-data
+ifeq ($(BENCH_ALL),1)
+  DEB_BENCH += python3-gdal r-cran-satellite r-cran-stars r-cran-terra
+endif
 
 # Goals that need no library: do not probe pkg-config for them.
-NO_PROBE_GOALS := deps deps-test clean help uninstall
+NO_PROBE_GOALS := deps deps-test deps-bench clean help uninstall
 ifeq ($(filter-out $(NO_PROBE_GOALS),$(or $(MAKECMDGOALS),all)),)
 else
   ifeq ($(shell command -v $(PKG_CONFIG) 2>/dev/null),)
@@ -201,7 +214,7 @@ TEST_SRC := $(wildcard tests/test_*.c)
 TEST_BIN := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
 HEADERS  := $(wildcard include/sandslide/*.h)
 
-.PHONY: all deps deps-test test check demo clean headers-check check-layering help \
+.PHONY: all deps deps-test deps-bench test check demo clean headers-check check-layering help \
         install uninstall
 SONAME   := libsandslide.so.$(SOVERSION)
 SHLIB    := libsandslide.so.$(VERSION)
@@ -487,7 +500,7 @@ demo: all
 # `make deps`: what building and running need (DEB_BUILD, DEB_RUN, and
 # with MPI=1 Open MPI); `make deps-test`: what the test suite adds
 # (DEB_TEST: pytest, the readers the output is checked with, ParaView,
-# clang).  apt-get only for what is missing.
+# clang); `make deps-bench`: the benchmarks' real DEMs (DEB_BENCH).  apt-get only for what is missing.
 DEPS_INSTALL = missing=""; for p in $(1); do \
 	  dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q 'ok installed' || missing="$$missing $$p"; \
 	done; \
@@ -502,6 +515,8 @@ deps:
 	@$(call DEPS_INSTALL,$(DEB_BUILD) $(DEB_RUN))
 deps-test: deps
 	@$(call DEPS_INSTALL,$(DEB_TEST))
+deps-bench: deps
+	@$(call DEPS_INSTALL,$(DEB_BENCH))
 
 clean:
 	rm -rf $(BUILD)

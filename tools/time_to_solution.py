@@ -29,6 +29,33 @@ removed at the end unless --keep DIR.  Examples:
 
 --compare-cfl C (a debug aid) compares euler with euler at cfl = C in place
 of rkl2, to exercise the comparison without a second integrator.
+
+  relax  `sandslide relax DEM -o OUT.h5 --report R.json` on DEMs (only with
+        --workloads relax; not in the default door,cone).  --dems DIR_OR_FILE,...
+        (a folder gives its *.asc, *.tif and *.png) or by default the real DEMs
+        of tools/real_dems.py (Debian packages: `make deps-bench`), written into
+        the output folder, and cases/dem/terrain.asc; --fractal 2048,4096 adds
+        terrains of cases/fractal_dem.py of those sizes.  The variants are
+        --integrators (each as `--integrator NAME`; `default` passes none, so
+        the binary's own default) and --variant 'NAME:OPTIONS' (any relax
+        options); --relax-opt OPTIONS goes to every run.  --bin-b B runs every
+        variant with a second binary too (interleaved A B B A), e.g. an older
+        commit's build against the new one.  Per DEM and variant: the median
+        wall (measured here; the report's own wall beside it in the JSON),
+        steps, stencil evaluations, whether it ended steady, the steepest face
+        left (the report's max_slope_after_deg, and tan of it less tan(angle)),
+        the volume change relative to the volume, the largest difference of
+        the end state to the first variant's over cells with data, in metres
+        and in tan(angle) min(dx, dy), and the first variant's wall / this
+        one's.  --timeout S stops a run after S s of wall (SIGTERM: relax
+        writes what it has) and drops that variant's later rounds.
+
+  tools/time_to_solution.py --workloads relax --threads 1 --timeout 120
+  tools/time_to_solution.py --workloads relax --dems out/dems --integrators default \
+      --bin OLD/build/sandslide --bin-b build/sandslide --rounds 2
+  tools/time_to_solution.py --workloads relax --dems cases/dem/terrain.asc \
+      --integrators euler --variant 'rkl2-tol3:--integrator rkl2 --rkl2-tol 3'
+  tools/time_to_solution.py --workloads relax --dems none --fractal 2048,4096
 """
 import argparse
 import configparser
@@ -54,8 +81,11 @@ def parse_args(argv):
     ints = lambda s: [int(v) for v in s.split(",") if v]
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--bin", default=os.path.join(ROOT, "build", "sandslide"))
-    p.add_argument("--workloads", default="door,cone", help="door,cone (default both)")
-    p.add_argument("--integrators", default="euler,rkl2", help="default euler,rkl2")
+    p.add_argument("--bin-b", help="relax: a second binary, every variant run with both")
+    p.add_argument("--workloads", default="door,cone",
+                   help="door,cone,relax (default door,cone)")
+    p.add_argument("--integrators", help="default euler,rkl2 (relax: none if --variant "
+                   "is given; `default`: no --integrator)")
     p.add_argument("--door", type=ints, default=[60, 120, 240, 480], help="door nx list")
     p.add_argument("--door-end", type=float, default=1000.0, help="s (default 1000)")
     p.add_argument("--door-output-every", type=float, default=10.0, help="s (default 10)")
@@ -70,13 +100,32 @@ def parse_args(argv):
                    help="passed to every run")
     p.add_argument("--rkl2-set", action="append", default=[], metavar="K=V",
                    help="passed to rkl2 runs only")
+    p.add_argument("--dems", help="relax: DEM files or folders, comma-separated (default: "
+                   "tools/real_dems.py's set and cases/dem/terrain.asc; `none`: no DEM)")
+    p.add_argument("--fractal", type=ints, default=[],
+                   help="relax: add cases/fractal_dem.py terrains of these sizes")
+    p.add_argument("--variant", action="append", default=[], metavar="NAME:OPTIONS",
+                   help="relax: a variant with these relax options")
+    p.add_argument("--relax-opt", action="append", default=[], metavar="OPTIONS",
+                   help="relax: options passed to every run")
+    p.add_argument("--timeout", type=float, help="relax: stop a run after this many s")
     p.add_argument("--compare-cfl", type=float, help=argparse.SUPPRESS)
     p.add_argument("--json", metavar="FILE", help="write every number to FILE")
     p.add_argument("--keep", metavar="DIR", help="keep the outputs in DIR")
     p.add_argument("--dry", action="store_true", help="print the commands, run nothing")
     args = p.parse_args(argv)
-    if not set(args.workloads.split(",")) <= {"door", "cone"}:
-        p.error(f"--workloads {args.workloads}: expected door, cone or door,cone")
+    wl = args.workloads.split(",")
+    if not set(wl) <= {"door", "cone", "relax"}:
+        p.error(f"--workloads {args.workloads}: expected a list of door, cone, relax")
+    if "relax" not in wl and (args.bin_b or args.dems or args.fractal or args.variant
+                              or args.relax_opt or args.timeout):
+        p.error("--bin-b, --dems, --fractal, --variant, --relax-opt and --timeout are for "
+                "--workloads relax")
+    if args.integrators is None:
+        args.integrators = "" if args.variant and wl == ["relax"] else "euler,rkl2"
+    for v in args.variant:
+        if ":" not in v or not v.split(":", 1)[0]:
+            p.error(f"--variant {v!r}: expected NAME:OPTIONS")
     return args
 
 
@@ -87,7 +136,7 @@ def variants(args):
                 (f"euler-cfl{args.compare_cfl:g}", "euler",
                  ["time.integrator=euler", f"time.cfl={args.compare_cfl!r}"])]
     out = []
-    for name in args.integrators.split(","):
+    for name in [n for n in args.integrators.split(",") if n]:
         # always named: the case's default (auto) is rkl2
         sets = [f"time.integrator={name}"]
         out.append((name, name, sets + (args.rkl2_set if name == "rkl2" else [])))
@@ -261,8 +310,9 @@ def print_table(results, ref_name):
 def main(argv):
     """Plan, print the commands, run them, compare, print the table and the JSON."""
     args = parse_args(argv)
-    if not os.access(args.bin, os.X_OK):
-        sys.exit(f"time_to_solution: no sandslide binary at {args.bin} (make, or give --bin)")
+    for b in [args.bin] + ([args.bin_b] if args.bin_b else []):
+        if not os.access(b, os.X_OK):
+            sys.exit(f"time_to_solution: no sandslide binary at {b} (make, or give --bin)")
     outdir = args.keep or tempfile.mkdtemp(prefix="time_to_solution.")
     os.makedirs(outdir, exist_ok=True)
     try:
@@ -272,8 +322,33 @@ def main(argv):
             shutil.rmtree(outdir)
 
 
+def warn_load(args):
+    """The load average before the first run, with a warning when it is high."""
+    load = os.getloadavg()[0]
+    if load > 0.5:
+        print(f"# warning: load average {load:.2f} before the first run: the wall times will "
+              f"be noisy" + (", with --threads > 1 maybe far too long" if args.threads > 1 else ""))
+    return load
+
+
 def benchmark(args, argv, outdir):
     """Everything but the output folder's life: see main."""
+    wl = args.workloads.split(",")
+    load = warn_load(args)
+    results = benchmark_run(args, outdir) if {"door", "cone"} & set(wl) else []
+    relax = benchmark_relax(args, outdir) if "relax" in wl else []
+    if args.json and not args.dry:
+        with open(args.json, "w") as f:
+            json.dump(dict(argv=argv, bin=args.bin, bin_b=args.bin_b, threads=args.threads,
+                           rounds=args.rounds, load_average_before=load,
+                           load_average_after=os.getloadavg()[0],
+                           outputs=outdir if args.keep else None, results=results,
+                           relax=relax), f, indent=1)
+    return 0
+
+
+def benchmark_run(args, outdir):
+    """door and cone: `sandslide run` per job and integrator; the results (none if --dry)."""
     vs, jobs = variants(args), plan(args)
     skip = lambda job, v: (v[0] == "euler" and job["workload"] == "door"
                            and 0 < args.skip_euler_above < job["nx"])
@@ -284,16 +359,12 @@ def benchmark(args, argv, outdir):
             for v in (todo if r % 2 == 0 else todo[::-1]):
                 out = os.path.join(outdir, f"{job['workload']}-{job['nx']}x{job['ny']}-{v[0]}-r{r}.h5")
                 runs.append((k, v, r, out, command(args, job, v, out)))
-    load = os.getloadavg()[0]
-    if load > 0.5:
-        print(f"# warning: load average {load:.2f} before the first run: the wall times will "
-              f"be noisy" + (", with --threads > 1 maybe far too long" if args.threads > 1 else ""))
     print("# commands, in the order they run:")
     for run_ in runs:
         print(shlex.join(run_[4]))
     sys.stdout.flush()
     if args.dry:
-        return 0
+        return []
     # a one-step run of each integrator first, so a rejected --set fails at once
     for job in jobs[:1]:
         tiny = (["time.max_time=0.001"] if job["workload"] == "cone" else
@@ -315,12 +386,7 @@ def benchmark(args, argv, outdir):
             os.remove(out)
     results = collect(vs, jobs, runs, walls, outputs)
     print_table(results, vs[0][0])
-    if args.json:
-        with open(args.json, "w") as f:
-            json.dump(dict(argv=argv, bin=args.bin, threads=args.threads, rounds=args.rounds,
-                           load_average_before=load, load_average_after=os.getloadavg()[0],
-                           outputs=outdir if args.keep else None, results=results), f, indent=1)
-    return 0
+    return results
 
 
 def collect(vs, jobs, runs, walls, outputs):
@@ -363,6 +429,221 @@ def collect(vs, jobs, runs, walls, outputs):
             res["comparison"][v[0]] = c
         results.append(res)
     return results
+
+
+# ---- relax: `sandslide relax` on DEMs ---------------------------------------
+
+def relax_variants(args):
+    """[(name, relax options)]: --integrators, then --variant NAME:OPTIONS; the first is
+    the reference."""
+    out = [(n, [] if n == "default" else ["--integrator", n])
+           for n in args.integrators.split(",") if n]
+    out += [(v.split(":", 1)[0], shlex.split(v.split(":", 1)[1])) for v in args.variant]
+    names = [n for n, _ in out]
+    if not out or len(set(names)) != len(names):
+        sys.exit(f"time_to_solution: relax variants {names}: need at least one, each "
+                 f"name once (--integrators, --variant)")
+    return out
+
+
+def relax_dems(args, outdir):
+    """The DEMs [(name, path)] and the commands that make them [(what, command)]: --dems,
+    or tools/real_dems.py's default set written into outdir/dems and cases/dem/terrain.asc;
+    then --fractal's terrains."""
+    dems, makers = [], []
+    if args.dems is None:
+        folder = os.path.join(outdir, "dems")
+        makers.append(("real DEMs (Debian packages, make deps-bench)",
+                       [sys.executable, os.path.join(ROOT, "tools", "real_dems.py"), folder]))
+        sys.path.insert(0, os.path.join(ROOT, "tools"))
+        import real_dems
+        dems += [os.path.join(folder, d["name"] + ".asc") for d in real_dems.CATALOGUE
+                 if not d.get("gentle")]
+        dems.append(os.path.join(ROOT, "cases", "dem", "terrain.asc"))
+    else:
+        for item in [x for x in args.dems.split(",") if x and x != "none"]:
+            if os.path.isdir(item):
+                found = sorted(os.path.join(item, f) for f in os.listdir(item)
+                               if f.lower().endswith((".asc", ".tif", ".tiff", ".png")))
+                if not found:
+                    sys.exit(f"time_to_solution: --dems {item}: no .asc, .tif or .png in it")
+                dems += found
+            elif os.path.isfile(item):
+                dems.append(item)
+            else:
+                sys.exit(f"time_to_solution: --dems {item}: no such file or folder")
+    for n in args.fractal:
+        path = os.path.join(outdir, f"fractal-{n}.asc")
+        makers.append((f"fractal terrain {n}^2",
+                       [sys.executable, os.path.join(ROOT, "cases", "fractal_dem.py"), str(n), path]))
+        dems.append(path)
+    named, seen = [], {}
+    for path in dems:
+        name = os.path.splitext(os.path.basename(path))[0]
+        seen[name] = seen.get(name, 0) + 1
+        named.append((name if seen[name] == 1 else f"{name}-{seen[name]}", path))
+    if not named:
+        sys.exit("time_to_solution: no DEM to relax (--dems, --fractal)")
+    return named, makers
+
+
+def relax_command(args, binary, dem, opts, out, report):
+    """The sandslide relax command line of one run."""
+    cmd = [binary, "relax", dem, "-o", out, "--report", report, "--force", "--quiet",
+           "--threads", str(args.threads)]
+    for o in args.relax_opt:
+        cmd += shlex.split(o)
+    return cmd + opts
+
+
+def run_stoppable(cmd, timeout):
+    """Run cmd; (wall seconds, stopped).  Past timeout s it gets SIGTERM (relax then
+    writes the surface it has) and counts as stopped.  On failure print its stderr,
+    exit 1."""
+    t0 = time.monotonic()
+    p = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    try:
+        err = p.communicate(timeout=timeout)[1]
+        stopped = False
+    except subprocess.TimeoutExpired:
+        p.terminate()
+        err = p.communicate()[1]
+        stopped = True
+    wall = time.monotonic() - t0
+    if p.returncode != 0 and not stopped:
+        sys.stderr.write(f"time_to_solution: failed (exit {p.returncode}): {shlex.join(cmd)}\n"
+                         f"{err}")
+        sys.exit(1)
+    return wall, stopped
+
+
+def read_relax(out, report):
+    """The report's numbers, and the output's path for the end state."""
+    with open(report) as f:
+        r = json.load(f)
+    r["path"] = out
+    return r
+
+
+def compare_relax(a, b):
+    """The largest |h_b - h_a| of the end states over cells with data of both: in metres and
+    in tan(angle) min(dx, dy)."""
+    with h5py.File(a["path"], "r", locking=False) as fa, \
+            h5py.File(b["path"], "r", locking=False) as fb:
+        ha, hb = fa["height"][-1], fb["height"][-1]
+        cells = (fa["cell_type"][...] == 0) & (fb["cell_type"][...] == 0)
+    if ha.shape != hb.shape:
+        return dict(diff_m=None, diff_unit=None)
+    d = np.abs(hb - ha)[cells & np.isfinite(ha) & np.isfinite(hb)]
+    m = float(d.max()) if d.size else 0.0
+    unit = math.tan(math.radians(a["repose_angle_deg"])) * min(a["dx"], a["dy"])
+    return dict(diff_m=m, diff_unit=m / unit)
+
+
+def benchmark_relax(args, outdir):
+    """relax: make the DEMs, run every (DEM, variant, binary) --rounds times interleaved,
+    compare, print the table; the results (none if --dry)."""
+    vs = relax_variants(args)
+    bins = [("A", args.bin)] + ([("B", args.bin_b)] if args.bin_b else [])
+    label = lambda v, b: v[0] + (f" {b[0]}" if args.bin_b else "")
+    dems, makers = relax_dems(args, outdir)
+    runs = []  # (dem index, label, round, output, report, command), in the order they run
+    for k, (name, path) in enumerate(dems):
+        todo = [(v, b) for v in vs for b in bins]
+        for r in range(args.rounds):
+            for v, b in (todo if r % 2 == 0 else todo[::-1]):
+                stem = os.path.join(outdir, f"relax-{name}-{label(v, b).replace(' ', '-')}-r{r}")
+                runs.append((k, label(v, b), r, stem + ".h5", stem + ".json",
+                             relax_command(args, b[1], path, v[1], stem + ".h5", stem + ".json")))
+    if args.bin_b:
+        print(f"# A = {args.bin}\n# B = {args.bin_b}")
+    if makers:
+        print("# the DEMs:")
+    for what, cmd in makers:
+        print(f"{shlex.join(cmd)}   # {what}")
+    print("# commands, in the order they run:")
+    for run_ in runs:
+        print(shlex.join(run_[5]))
+    sys.stdout.flush()
+    if args.dry:
+        return []
+    for what, cmd in makers:
+        sys.stdout.flush()
+        if subprocess.run(cmd).returncode != 0:
+            sys.exit(f"time_to_solution: making the {what} failed: {shlex.join(cmd)}")
+    # a short run of each variant and binary first, so a rejected option fails at once
+    smallest = min((p for _, p in dems), key=os.path.getsize)
+    for v in vs:
+        for b in bins:
+            run(relax_command(args, b[1], smallest, v[1], os.path.join(outdir, "preflight.asc"),
+                              os.path.join(outdir, "preflight.json")) + ["--max-time", "0.001"],
+                "short check of the options: ")
+    walls, outputs, stopped = {}, {}, set()
+    for k, lab, r, out, report, cmd in runs:
+        if (k, lab) in stopped:
+            continue
+        wall, stop = run_stoppable(cmd, args.timeout)
+        walls.setdefault((k, lab), []).append(wall)
+        print(f"# relax {dems[k][0]} {lab} round {r}: {wall:.2f} s"
+              + (f" (stopped at --timeout {args.timeout:g} s)" if stop else ""), file=sys.stderr)
+        if stop:
+            stopped.add((k, lab))
+        if r == 0:
+            outputs[(k, lab)] = read_relax(out, report)
+            outputs[(k, lab)]["stopped"] = stop
+        elif not args.keep:
+            os.remove(out)
+    labels = [label(v, b) for v in vs for b in bins]
+    results = []
+    for k, (name, path) in enumerate(dems):
+        ref = outputs[(k, labels[0])]
+        res = dict(dem=name, path=path, nx=ref["nx"], ny=ref["ny"], dx=ref["dx"], dy=ref["dy"],
+                   repose_angle_deg=ref["repose_angle_deg"],
+                   max_slope_before_deg=ref["max_slope_before_deg"], variants={},
+                   commands=[shlex.join(x[5]) for x in runs if x[0] == k])
+        for lab in labels:
+            o = outputs[(k, lab)]
+            vol = o["volume_before"]
+            res["variants"][lab] = dict(
+                walls=walls[(k, lab)], wall_median=statistics.median(walls[(k, lab)]),
+                stopped=o["stopped"], report_wall=o["wall_seconds"], steps=o["steps"],
+                evaluations=o.get("stencil_evaluations", o["steps"]), time=o["time"],
+                end=o.get("end", "steady" if o.get("steady") else "not steady"),  # fc0c21b: no "end"
+                steady=o.get("steady"),
+                cells_moved=o["cells_moved"], volume_moved=o["volume_moved"],
+                max_slope_after_deg=o["max_slope_after_deg"],
+                face_excess=(math.tan(math.radians(o["max_slope_after_deg"])) -
+                             math.tan(math.radians(o["repose_angle_deg"]))),
+                volume_change=((o["volume_after"] - vol - (o["inflow"] - o["outflow"])) / vol
+                               if vol else None),
+                **compare_relax(ref, o),
+                ratio=statistics.median(walls[(k, labels[0])]) / statistics.median(walls[(k, lab)]))
+        results.append(res)
+    print_relax_table(results, labels[0])
+    return results
+
+
+def print_relax_table(results, ref_name):
+    """One line per DEM x variant."""
+    cols = (f"{'DEM':20} {'cells':>9} {'cell m':>11} {'variant':14} {'wall s':>8} {'steps':>7} "
+            f"{'evals':>7} {'end':>8} {'worst face':>12} {'tan - tan a':>11} {'vol change':>10} "
+            f"{'diff m':>8} {'diff t*dx':>9} {'ratio':>6}")
+    print(f"\nwall: median over rounds; worst face: the steepest sand face left (deg); "
+          f"diff: max |h - h_{ref_name}| of the end states over cells with data, in m and in "
+          f"t*dx = tan(a) min(dx,dy); ratio: {ref_name}/variant of median walls")
+    print(cols + "\n" + "-" * len(cols))
+    for res in results:
+        cells = f"{res['nx']}x{res['ny']}"
+        cell = (f"{res['dx']:.4g}" if res["dx"] == res["dy"]
+                else f"{res['dx']:.4g}x{res['dy']:.4g}")
+        for name, v in res["variants"].items():
+            end = "stopped" if v["stopped"] else v["end"]
+            print(f"{res['dem']:20} {cells:>9} {cell:>11} {name:14} {v['wall_median']:8.2f} "
+                  f"{v['steps']:7.0f} {v['evaluations']:7.0f} {end:>8} "
+                  f"{v['max_slope_after_deg']:12.7f} {v['face_excess']:11.1e} "
+                  f"{fmt(v['volume_change'], '.1e'):>10} {fmt(v['diff_m'], '.2e'):>8} "
+                  f"{fmt(v['diff_unit'], '.2e'):>9} {fmt(v['ratio'], '.3g'):>6}")
+
 
 
 if __name__ == "__main__":
