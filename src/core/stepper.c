@@ -730,7 +730,7 @@ enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,
 	const double tol = st->rkl2_tol * c->tan_cr * fmin(g->dx, g->dy);
 
 	long long steps_left = o->max_steps > 0 ? o->max_steps : -1;
-	int steady_candidate = 0;
+	int steady_candidate = 0, polish = 0;
 	while (st->time < t_target) {
 		if (steps_left == 0)
 			return SS_ADVANCE_STEPS;
@@ -739,14 +739,18 @@ enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,
 			st->rate_max = NAN;
 			return SS_ADVANCE_NONFINITE;
 		}
-		if (steady_candidate && slopes_settled(st, b.s_max, slope_tol))
-			return SS_ADVANCE_STEADY;
+		if (steady_candidate) {
+			if (slopes_settled(st, b.s_max, slope_tol))
+				return SS_ADVANCE_STEADY;
+			/* RKL2 near rest: polish with forward Euler (stepper.h) */
+			polish = rkl2;
+		}
 
 		const double lambda = c->nu * ss_cfl_bound_lookup(&st->cfl_bound, b.s_max);
 		double dt = lambda > 0.0 ? st->cfl / (2.0 * lambda * inv_d2) : INFINITY;
 		/* RKL2: stable for every state its stages can reach, also when
 		 * a source is about to raise a flat state past the onset */
-		if (rkl2 && (lambda > 0.0 || st->sources_on))
+		if (rkl2 && !polish && (lambda > 0.0 || st->sources_on))
 			dt = fmin(tau_stages, st->rkl2_tau);
 		if (st->sources_on && source_rise / st->source_rate_max < dt)
 			dt = source_rise / st->source_rate_max;
@@ -767,7 +771,7 @@ enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,
 		else if (st->time + dt == st->time)
 			return SS_ADVANCE_STALLED;
 
-		if (rkl2) {
+		if (rkl2 && !polish) {
 			int s = ss_rkl2_stages_for(dt / dt_all);
 			s = s < st->rkl2_max_stages ? s : st->rkl2_max_stages;
 			double estimate = 0.0;
