@@ -105,11 +105,10 @@ int ss_integrator_parse(const char *name, enum ss_integrator *out);
 /* The integrator a stepper uses: the one asked for, and for auto (the one
  * place this rule is written): euler with a bedrock (RKL2's stages have
  * negative weights, so the per-face limit cannot keep sand above the
- * rock), else rkl2, for pouring and flowing (9 to 16 times fewer
- * evaluations) and, since RKL2 polishes the approach to rest with Euler,
- * for relaxing too (relaxing is kept for the callers: measured on nine
- * terrains in doc/performance.md, RKL2 1.1 to 7 times faster on six,
- * slower by under a second on three). */
+ * rock), euler to relax a surface to rest (relaxing: a DEM spends its time
+ * coming to rest, where RKL2 damps the stiff remainder only by about 1/2
+ * a super-step; measured in doc/performance.md), else rkl2 (pouring and
+ * flowing: 9 to 14 times fewer evaluations). */
 enum ss_integrator ss_integrator_resolve(enum ss_integrator asked, int has_bedrock,
                                          int relaxing);
 
