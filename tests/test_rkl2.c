@@ -155,9 +155,9 @@ static void advance_to(struct ss_stepper *st, double t)
 }
 
 /* At most one super-step towards t (max_steps = 1). */
-static void advance_steps(struct ss_stepper *st, double t, long long steps)
+static void advance_one(struct ss_stepper *st, double t)
 {
-	const struct ss_advance_options o = {.steady_tol = 0.0, .max_steps = steps};
+	const struct ss_advance_options o = {.steady_tol = 0.0, .max_steps = 1};
 	enum ss_advance_end end = ss_stepper_advance(st, t, &o);
 	CHECK(end == SS_ADVANCE_REACHED || end == SS_ADVANCE_STEPS,
 	      "%s: a step towards t = %g s ended with %d at t = %.17g s",
@@ -859,7 +859,7 @@ static void conservation_case(enum ss_closure_kind kind, enum ss_kernel kernel,
 	int stages_max = 0;
 	for (size_t k = 0; k < sizeof times / sizeof *times; k++) {
 		while (st.time < times[k]) {
-			advance_steps(&st, times[k], 1);
+			advance_one(&st, times[k]);
 			stages_max = st.last_stages > stages_max ? st.last_stages : stages_max;
 		}
 		struct ss_diagnostics d = diag(&st);

@@ -347,6 +347,14 @@ def benchmark(args, argv, outdir):
     return 0
 
 
+def print_commands(commands):
+    """The command lines, in the order they run, before any runs."""
+    print("# commands, in the order they run:")
+    for cmd in commands:
+        print(shlex.join(cmd))
+    sys.stdout.flush()
+
+
 def benchmark_run(args, outdir):
     """door and cone: `sandslide run` per job and integrator; the results (none if --dry)."""
     vs, jobs = variants(args), plan(args)
@@ -359,10 +367,7 @@ def benchmark_run(args, outdir):
             for v in (todo if r % 2 == 0 else todo[::-1]):
                 out = os.path.join(outdir, f"{job['workload']}-{job['nx']}x{job['ny']}-{v[0]}-r{r}.h5")
                 runs.append((k, v, r, out, command(args, job, v, out)))
-    print("# commands, in the order they run:")
-    for run_ in runs:
-        print(shlex.join(run_[4]))
-    sys.stdout.flush()
+    print_commands(run_[4] for run_ in runs)
     if args.dry:
         return []
     # a one-step run of each integrator first, so a rejected --set fails at once
@@ -561,10 +566,7 @@ def benchmark_relax(args, outdir):
         print("# the DEMs:")
     for what, cmd in makers:
         print(f"{shlex.join(cmd)}   # {what}")
-    print("# commands, in the order they run:")
-    for run_ in runs:
-        print(shlex.join(run_[5]))
-    sys.stdout.flush()
+    print_commands(run_[5] for run_ in runs)
     if args.dry:
         return []
     for what, cmd in makers:

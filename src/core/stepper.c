@@ -476,6 +476,14 @@ static double outflow_rate(const struct ss_stepper *st)
 	return sum[0] * st->grid.dy + sum[1] * st->grid.dx;
 }
 
+/* The tiles the coming pass sweeps on this rank (the reference sweep:
+ * all). */
+static double tiles_to_sweep(const struct ss_stepper *st)
+{
+	return st->kernel == SS_KERNEL_FAST
+		? ss_sweep_fast_awake(&st->fast) : (double)st->tiling.tiles_x * st->tiling.tiles_y;
+}
+
 /* The halo, then the largest face slope S of the state over every rank
  * (the fast sweep also saves its ring rows; the reference sweep computes
  * the fluxes), and the tiles the coming pass sweeps into st->tiles_awake. */
@@ -489,9 +497,7 @@ static double measure(struct ss_stepper *st)
 		: ss_sweep_fluxes(g, &st->tiling, &st->face_rule, st->height,
 		                  st->cell_type_bytes, st->flux_x, st->flux_y);
 	st->seconds_measure += ss_parallel_wall_seconds() - t0;
-	st->tiles_awake = st->kernel == SS_KERNEL_FAST
-		? ss_sweep_fast_awake(&st->fast) : (double)st->tiling.tiles_x * st->tiling.tiles_y;
-	st->tiles_awake_here = st->tiles_awake;
+	st->tiles_awake = st->tiles_awake_here = tiles_to_sweep(st);
 	ss_comm_reduce(&s_max, 1, &st->tiles_awake, 1);
 	return isinf(s_max) ? NAN : s_max;
 }
@@ -512,8 +518,7 @@ static double measure_stage(struct ss_stepper *st)
 		ss_sweep_fluxes(g, &st->tiling, &st->face_rule, st->height, st->cell_type_bytes,
 		                st->flux_x, st->flux_y);
 	st->seconds_measure += ss_parallel_wall_seconds() - t0;
-	return st->kernel == SS_KERNEL_FAST
-		? ss_sweep_fast_awake(&st->fast) : (double)st->tiling.tiles_x * st->tiling.tiles_y;
+	return tiles_to_sweep(st);
 }
 
 /* After a pass of the fast sweep that planned the next: the tiles here
