@@ -21,8 +21,8 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pytest
 
-from conftest import (BASE, CASES, SANDSLIDE, edit, h5open, run, run_ok, text_attr,
-                      wait_for)
+from conftest import (BASE, CASES, SANDSLIDE, SANDSLIDE_PAUSE, edit, h5open, hook_binary,
+                      run, run_ok, text_attr, wait_for)
 
 SOURCE = "\n[source pour]\nrect = 0.5 0.5 0.9 0.9\nrate = 0.001\n"   # 16 cells of 0.1 m
 DIAGNOSTICS = ["volume", "inflow", "outflow", "max_height", "max_slope_deg", "steps",
@@ -164,15 +164,25 @@ def test_info(tmp_path):
 
 # ---- quiet, progress, default output ----------------------------------------
 
-# Long enough (about 1.8 s of wall time with the fast sweep) that a progress
-# line, first printed 0.5 s after the start, would surely appear; end = 1 took
-# 0.6 s, too close to tell a suppressed line from one not yet due.
-PROGRESS_CASE = slow_case(3.0, 1.5, scale=1)   # its length is the point
+# A run of BASE that lasts 1.5 s of wall time on any machine, sanitized or
+# not: sandslide-pause (tests/hooks/pause_step.c) waits that long after its
+# first substep, then goes on without a word.  A progress line, first
+# printed 0.5 s after the start, would surely appear.
+def lasting_run(args, cwd, on_terminal):
+    env = dict(os.environ, SANDSLIDE_TEST_PAUSE_STEP="1", SANDSLIDE_TEST_PAUSE_SECONDS="1.5",
+               SANDSLIDE_TEST_PAUSE_SILENT="1")
+    binary = hook_binary(SANDSLIDE_PAUSE)
+    if on_terminal:
+        return run_on_terminal(args, cwd, env=env, binary=binary)
+    r = subprocess.run([binary] + args, cwd=cwd, env=env, capture_output=True, text=True,
+                       timeout=120)
+    assert r.returncode == 0, (r.returncode, r.stderr)
+    return r
 
 
 def test_not_a_terminal_no_progress(tmp_path):
-    write(tmp_path, PROGRESS_CASE)
-    r = run_ok(["run", "case.ini", "-o", "o.h5"], cwd=tmp_path)
+    write(tmp_path, BASE)
+    r = lasting_run(["run", "case.ini", "-o", "o.h5"], tmp_path, on_terminal=False)
     assert "\r" not in r.stderr, "progress line written although stderr is not a terminal"
     assert r.stderr == "", f"unexpected stderr: {r.stderr!r}"
     assert "o.h5" in r.stdout, "without --quiet a summary names the output"
@@ -187,11 +197,11 @@ def test_quiet(tmp_path):
     assert (tmp_path / "o.h5").exists()
 
 
-def run_on_terminal(args, cwd, timeout=60):
+def run_on_terminal(args, cwd, timeout=60, env=None, binary=SANDSLIDE):
     """Run with stderr on a pseudo-terminal; returns (exit code, stderr bytes)."""
     master, slave = pty.openpty()
-    p = subprocess.Popen([SANDSLIDE] + args, cwd=cwd, stdout=subprocess.DEVNULL,
-                         stderr=slave, stdin=subprocess.DEVNULL)
+    p = subprocess.Popen([binary] + args, cwd=cwd, stdout=subprocess.DEVNULL,
+                         stderr=slave, stdin=subprocess.DEVNULL, env=env)
     os.close(slave)
     chunks = []
     deadline = time.monotonic() + timeout
@@ -213,12 +223,13 @@ def run_on_terminal(args, cwd, timeout=60):
 
 
 def test_progress_on_terminal_and_quiet(tmp_path):
-    write(tmp_path, PROGRESS_CASE)
-    rc, err = run_on_terminal(["run", "case.ini", "-o", "o.h5"], tmp_path)
+    write(tmp_path, BASE)
+    rc, err = lasting_run(["run", "case.ini", "-o", "o.h5"], tmp_path, on_terminal=True)
     assert rc == 0, err
     assert b"\r" in err and b"t = " in err, \
         f"a run of over a second on a terminal shows a progress line: {err!r}"
-    rc, err = run_on_terminal(["run", "case.ini", "-o", "q.h5", "--quiet"], tmp_path)
+    rc, err = lasting_run(["run", "case.ini", "-o", "q.h5", "--quiet"], tmp_path,
+                          on_terminal=True)
     assert rc == 0, err
     assert err == b"", f"--quiet must print nothing on a terminal either: {err!r}"
 

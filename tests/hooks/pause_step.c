@@ -16,7 +16,9 @@
  *   - waits, polling every millisecond, until a stop signal was caught
  *     (*o->stop, the flag the CLI's handler sets), or for
  *     SANDSLIDE_TEST_PAUSE_SECONDS (default 60; then it says so on stderr
- *     and goes on, so a test that never signals cannot hang).
+ *     and goes on, so a test that never signals cannot hang; with
+ *     SANDSLIDE_TEST_PAUSE_SILENT=1 it goes on without a word: a test that
+ *     only needs a run to last that long, whatever the machine's speed).
  *
  * The stepper reads the flag at the end of each substep, before the
  * progress callback, so a signal sent during the pause stops the run after
@@ -31,6 +33,7 @@
  */
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -44,6 +47,7 @@ enum ss_advance_end __wrap_ss_stepper_advance(struct ss_stepper *st, double t_ta
 struct hook {
 	long long pause_step;
 	double seconds;                       /* the longest wait */
+	int silent;                           /* no word when it ends */
 	const char *marker;                   /* NULL: none */
 	const struct ss_advance_options *caller;
 };
@@ -91,6 +95,8 @@ static void pause_here(void *context, const struct ss_stepper *seen)
 	const double until = now() + h->seconds;
 	while (!*stop) {
 		if (now() > until) {
+			if (h->silent)
+				return;
 			fprintf(stderr, "pause hook: no stop signal within %g s of step %lld: "
 			        "going on\n", h->seconds, seen->steps);
 			return;
@@ -107,8 +113,9 @@ enum ss_advance_end __wrap_ss_stepper_advance(struct ss_stepper *st, double t_ta
 		return __real_ss_stepper_advance(st, t_target, o);
 	const char *file = getenv("SANDSLIDE_TEST_PAUSE_FILE");
 	const char *secs = getenv("SANDSLIDE_TEST_PAUSE_SECONDS");
+	const char *silent = getenv("SANDSLIDE_TEST_PAUSE_SILENT");
 	struct hook h = {atoll(env), secs && *secs ? atof(secs) : 60.0,
-	                 file && *file ? file : NULL, o};
+	                 silent && !strcmp(silent, "1"), file && *file ? file : NULL, o};
 	struct ss_advance_options hooked = *o;
 	hooked.progress = pause_here;
 	hooked.context = &h;
