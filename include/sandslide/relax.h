@@ -48,6 +48,8 @@ struct ss_relax_options {
 	                                     SS_CELL_OPEN */
 	double open_level;                /* m; NAN: the lowest height of the DEM */
 	const char *bedrock;              /* raster of the fixed base, or NULL */
+	int tile[2];                      /* cells per tile, nx and ny; <= 0:
+	                                   * relax's defaults (setup.h) */
 	struct ss_shape sand_shape;       /* pour sand on it (rect or disk, m;
 	                                   * SS_SHAPE_NONE: none): */
 	double sand_rate;                 /*   m/s */

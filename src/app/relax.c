@@ -114,6 +114,7 @@ static int rebuild(void *context, struct ss_stepper *st)
 		.model = &o->model, .name = o->dem, .heights = &x->dem, .dx = o->read.cellsize,
 		.sides = o->sides, .nodata_type = o->nodata_type, .open_level = o->open_level,
 		.bedrock = o->bedrock ? &x->bedrock : NULL,
+		.tile_nx = o->tile[0], .tile_ny = o->tile[1],
 		.pour = o->sand_shape.kind != SS_SHAPE_NONE ? &o->sand_shape : NULL,
 		.pour_rate = o->sand_rate, .pour_duration = o->sand_duration,
 	};

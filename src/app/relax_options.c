@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "base/strings.h"
 #include "sandslide/error.h"
 
 int ss_relax_sides_parse(const char *word, enum ss_side_kind *sides)
@@ -32,6 +33,11 @@ int ss_relax_nodata_parse(const char *word, enum ss_cell_type *type)
 static int parse_sides(const char *value, void *field)
 {
 	return ss_relax_sides_parse(value, field);
+}
+
+static int parse_tile(const char *value, void *field)
+{
+	return ss_parse_tile(value, field);
 }
 
 static int parse_nodata(const char *value, void *field)
@@ -84,6 +90,11 @@ static const struct ss_option options[] = {
 	 .expected = "a path",
 	 .help = "non-erodible base, a raster of the DEM's size: only\n"
 	         "the sand above it moves"},
+	{.name = "tile", .value_name = "NXxNY", .kind = SS_OPTION_WORD, .offset = AT(tile),
+	 .parse = parse_tile, .expected = "NXxNY, e.g. 64x32",
+	 .help = "cells per tile of the sweep (default 256x128, smaller\n"
+	         "on small grids); results are the same bits for any\n"
+	         "tile size and thread count"},
 	{.name = "add-sand", .value_name = "SHAPE", .kind = SS_OPTION_WORD,
 	 .offset = AT(sand_shape), .parse = parse_sand_shape,
 	 .expected = "rect=X0,Y0,X1,Y1 (X0 < X1, Y0 < Y1) or disk=X,Y,R (R > 0), in m",

@@ -303,6 +303,7 @@ int ss_setup_stepper_from_raster(const struct ss_raster_setup *s, struct ss_step
 		.m = s->model, .nx = r->nx, .ny = r->ny, .dx = dx, .dy = dy,
 		.x0 = isnan(r->x0) ? 0.0 : r->x0, .y0 = isnan(r->y0) ? 0.0 : r->y0,
 		.boundary = &sides, .has_bedrock = s->bedrock != NULL, .relaxing = 1,
+		.tile_nx = s->tile_nx, .tile_ny = s->tile_ny,
 		.kernel = SS_KERNEL_FAST, .integrator_what = "--integrator rkl2",
 		.bedrock_what = "--bedrock", .grid_what = grid_what, .memory_advice = "",
 	};

@@ -36,6 +36,8 @@ struct ss_raster_setup {
 	                                   * raster (where an open side or cell
 	                                   * lets sand leave) */
 	const struct ss_raster *bedrock;  /* the same size, or NULL */
+	int tile_nx, tile_ny;             /* cells per tile; <= 0: relax's
+	                                   * defaults */
 	const struct ss_shape *pour;      /* sand poured from t = 0, or NULL: */
 	double pour_rate;                 /*   m/s */
 	double pour_duration;             /*   s */

@@ -99,6 +99,20 @@ def test_cliff_relaxes_to_repose_with_volume_conserved(tmp_path):
     assert rep["steps"] > 0 and rep["wall_seconds"] > 0, rep
 
 
+@pytest.mark.parametrize("integrator", ["euler", "rkl2"])
+def test_same_bits_for_any_tile_size_and_thread_count(tmp_path, integrator):
+    write_asc(tmp_path / "cliff.asc", cliff(30, 20))
+    outputs = []
+    for k, extra in enumerate([["--threads", "1"], ["--threads", "2", "--tile", "8x4"],
+                               ["--threads", "2", "--tile", "7x3"]]):
+        # 20 s of a collapse that takes about 450 s: a few thousand steps
+        relax(["cliff.asc", "-o", f"{k}.asc", "--integrator", integrator, "--max-time", "20"]
+              + extra, tmp_path)
+        outputs.append((tmp_path / f"{k}.asc").read_bytes())
+    assert outputs[0] == outputs[1] == outputs[2], \
+        f"{integrator}: the relaxed surface depends on --tile or --threads"
+
+
 def test_subcritical_dem_is_returned_bit_for_bit_without_steps(tmp_path):
     ny, nx = 30, 25
     y, x = np.mgrid[0:ny, 0:nx] * 0.1
@@ -300,6 +314,7 @@ def test_hdf5_input_relaxes_the_last_snapshot(tmp_path):
     ("plain", ["dem.asc", "-o", "missing/out.asc"], "does not exist"),
     ("plain", ["dem.asc", "--add-sand", "disk=1,1,0.1"], "--sand-rate"),
     ("plain", ["dem.asc", "--angle", "95"], "--angle"),
+    ("plain", ["dem.asc", "--tile", "0x8"], "--tile"),
 ])
 def test_bad_input_exits_2_and_leaves_the_input_alone(tmp_path, setup, args, message):
     h = cliff(12, 10)
