@@ -735,7 +735,12 @@ enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,
 	const double tol = st->rkl2_tol * c->tan_cr * fmin(g->dx, g->dy);
 
 	long long steps_left = o->max_steps > 0 ? o->max_steps : -1;
-	int steady_candidate = 0, polish = 0;
+	int steady_candidate = 0;
+	/* polishing near rest (stepper.h): the forward-Euler steps left in the
+	 * burst, the stages of this call's last super-step (a burst's length),
+	 * and whether a burst just ended (the next step is a super-step) */
+	long long polish_left = 0;
+	int stages = 0, burst_ended = 0;
 	while (st->time < t_target) {
 		if (steps_left == 0)
 			return SS_ADVANCE_STEPS;
@@ -747,9 +752,12 @@ enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,
 		if (steady_candidate) {
 			if (slopes_settled(st, b.s_max, slope_tol))
 				return SS_ADVANCE_STEADY;
-			/* RKL2 near rest: polish with forward Euler (stepper.h) */
-			polish = rkl2;
+			/* RKL2 near rest: a burst of forward-Euler steps, as
+			 * many as the last super-step had stages (stepper.h) */
+			if (rkl2 && polish_left == 0 && !burst_ended)
+				polish_left = stages > 0 ? stages : 1;
 		}
+		const int polish = polish_left > 0;
 
 		const double lambda = c->nu * ss_cfl_bound_lookup(&st->cfl_bound, b.s_max);
 		double dt = lambda > 0.0 ? st->cfl / (2.0 * lambda * inv_d2) : INFINITY;
@@ -782,10 +790,13 @@ enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,
 			double estimate = 0.0;
 			const double change = rkl2_superstep(st, dt, s, &estimate);
 			rkl2_control(st, dt, estimate, tol, tau_stages);
-			st->last_stages = s;
+			st->last_stages = stages = s;
 			st->rate_max = change / dt;
+			burst_ended = 0;
 		} else {
 			euler_step(st, dt);
+			if (polish && --polish_left == 0)
+				burst_ended = 1;
 		}
 		st->time = lands ? b.next_event : st->time + dt;
 		st->steps++;
