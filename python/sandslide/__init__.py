@@ -117,7 +117,8 @@ def _grid(name, values):
 def relax(heights, dx, dy=None, angle=None, closure=None, nu=None, sides=None,
           bedrock=None, tol=None, threads=None, *, gamma=None, slope_tol=None,
           integrator=None, rkl2_max_stages=None, rkl2_tol=None, max_time=None, cfl=None,
-          nodata=None, open_level=None, add_sand=None, sand_rate=None, sand_duration=None):
+          nodata=None, open_level=None, add_sand=None, sand_rate=None, sand_duration=None,
+          tile=None):
     """Relax a DEM to the repose angle, as `sandslide relax` does.
 
     heights: 2-D array [row, column], row 0 the NORTH edge (GDAL's and
@@ -130,7 +131,8 @@ def relax(heights, dx, dy=None, angle=None, closure=None, nu=None, sides=None,
     Every other keyword is relax's option of that name ('_' for '-'),
     checked by the library as the command line checks it; None (the
     default) takes the library's default.  add_sand is "rect=X0,Y0,X1,Y1"
-    or "disk=X,Y,R" (m) with sand_rate (m/s) and sand_duration (s).  The
+    or "disk=X,Y,R" (m) with sand_rate (m/s) and sand_duration (s); tile
+    is "NXxNY" or a pair (nx, ny).  The
     options and their defaults, from the library (sandslide.options("relax")):
 
 {options}
@@ -160,7 +162,9 @@ def relax(heights, dx, dy=None, angle=None, closure=None, nu=None, sides=None,
              "integrator": integrator, "rkl2_max_stages": rkl2_max_stages,
              "rkl2_tol": rkl2_tol, "max_time": max_time, "cfl": cfl, "nodata": nodata,
              "open_level": open_level, "add_sand": add_sand, "sand_rate": sand_rate,
-             "sand_duration": sand_duration}
+             "sand_duration": sand_duration,
+             "tile": "x".join(str(int(n)) for n in tile) if isinstance(tile, (tuple, list))
+             else tile}
     report = ctypes.create_string_buffer(_JSON_BYTES)
     ny, nx = h.shape
     with _native.lock, _native.Options("relax") as o:

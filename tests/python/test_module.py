@@ -134,6 +134,10 @@ def test_threads_give_the_same_bits():
     one, _ = sandslide.relax(h0, 1.0, threads=1)
     two, _ = sandslide.relax(h0, 1.0, threads=2)
     assert same_bits(one, two), "2 threads differ from 1 (doc/model.md#same-bits)"
+    tiled, _ = sandslide.relax(h0, 1.0, threads=2, tile=(8, 4))
+    named, _ = sandslide.relax(h0, 1.0, threads=2, tile="5x3")
+    assert same_bits(one, tiled) and same_bits(one, named), \
+        "tiles of 8x4 or 5x3 cells differ from the default tiles"
 
 
 # ---- physics ---------------------------------------------------------------
