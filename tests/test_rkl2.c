@@ -1289,10 +1289,11 @@ static void test_refusals(void)
 	ss_stepper_release(&st);
 	CHECK(ss_integrator_resolve(SS_INTEGRATOR_AUTO, 1, 0) == SS_INTEGRATOR_EULER &&
 	      ss_integrator_resolve(SS_INTEGRATOR_AUTO, 0, 0) == SS_INTEGRATOR_RKL2 &&
-	      ss_integrator_resolve(SS_INTEGRATOR_AUTO, 0, 1) == SS_INTEGRATOR_EULER &&
+	      ss_integrator_resolve(SS_INTEGRATOR_AUTO, 0, 1) == SS_INTEGRATOR_RKL2 &&
+	      ss_integrator_resolve(SS_INTEGRATOR_AUTO, 1, 1) == SS_INTEGRATOR_EULER &&
 	      ss_integrator_resolve(SS_INTEGRATOR_RKL2, 1, 0) == SS_INTEGRATOR_RKL2 &&
 	      ss_integrator_resolve(SS_INTEGRATOR_RKL2, 0, 1) == SS_INTEGRATOR_RKL2,
-	      "auto does not resolve to euler with a bedrock or to relax, and rkl2 else");
+	      "auto does not resolve to euler with a bedrock, and rkl2 else (relax too)");
 
 	/* too few stages, no change allowed */
 	const struct {

@@ -112,10 +112,12 @@ int ss_integrator_parse(const char *name, enum ss_integrator *out);
 /* The integrator a stepper uses: the one asked for, and for auto (the one
  * place this rule is written): euler with a bedrock (RKL2's stages have
  * negative weights, so the per-face limit cannot keep sand above the
- * rock), euler to relax a surface to rest (relaxing: a DEM spends its time
- * coming to rest, where RKL2 damps the stiff remainder only by about 1/2
- * a super-step; measured in doc/performance.md), else rkl2 (pouring and
- * flowing: 9 to 14 times fewer evaluations). */
+ * rock), else rkl2: pouring and flowing take 9 to 16 times fewer
+ * evaluations, and relaxing a DEM, now that RKL2 polishes its approach
+ * to rest in bursts of Euler steps, is faster on the real DEMs measured
+ * (doc/model.md#which-integrator-is-the-default; slower on large
+ * terrains of many small cliffs, where --integrator euler is the choice).
+ * relaxing no longer changes the rule; it is kept for the callers. */
 enum ss_integrator ss_integrator_resolve(enum ss_integrator asked, int has_bedrock,
                                          int relaxing);
 

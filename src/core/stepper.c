@@ -39,7 +39,8 @@ enum ss_integrator ss_integrator_resolve(enum ss_integrator asked, int has_bedro
 {
 	if (asked != SS_INTEGRATOR_AUTO)
 		return asked;
-	return has_bedrock || relaxing ? SS_INTEGRATOR_EULER : SS_INTEGRATOR_RKL2;
+	(void)relaxing;
+	return has_bedrock ? SS_INTEGRATOR_EULER : SS_INTEGRATOR_RKL2;
 }
 
 double ss_stepper_memory_bytes(const struct ss_grid *g, enum ss_integrator integrator)

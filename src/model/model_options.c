@@ -53,10 +53,9 @@ static const struct ss_option options[] = {
 	{.name = "integrator", .case_key = "time.integrator", .value_name = "NAME",
 	 .kind = SS_OPTION_WORD, .offset = AT(integrator), .default_value = "auto",
 	 .parse = parse_integrator, .expected = SS_INTEGRATOR_NAMES,
-	 .help = "euler, rkl2 (super-steps) or auto: rkl2 for run,\n"
-	         "euler for relax (DEMs come to rest faster, as\n"
-	         "measured) and with a bedrock (rkl2 cannot keep\n"
-	         "sand above it)"},
+	 .help = "euler, rkl2 (super-steps) or auto: rkl2, or\n"
+	         "euler with a bedrock (rkl2 cannot keep sand\n"
+	         "above it)"},
 	{.name = "rkl2-max-stages", .case_key = "time.rkl2_max_stages", .value_name = "S",
 	 .kind = SS_OPTION_INT, .offset = AT(rkl2_max_stages),
 	 .default_value = TEXT(SS_RKL2_MAX_STAGES_DEFAULT), .lo = 2, .hi = 100000,
