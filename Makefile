@@ -116,10 +116,10 @@ endif
 # when pkg-config finds it (GDAL=0 builds without); otherwise .tif input
 # and output fail with "unavailable in this build".  `make deps` installs
 # it: DEMs come as GeoTIFFs (about 100 packages, 54 MB: 34 s on the dev VM).
-# An MPI build leaves GDAL out: GDAL links the serial HDF5.
-ifeq ($(MPI),1)
-  GDAL ?= 0
-endif
+# The MPI build has it too: GDAL links the serial HDF5 and sandslide the
+# parallel one, and both load in one process because Debian versions their
+# symbols per flavour (GDAL's H5Fopen is H5Fopen@HDF5_SERIAL_1.8.7, ours
+# H5Fopen@HDF5_MPI_1.8.7; doc/cluster.md#build-and-run).
 GDAL ?= 1
 DEB_BUILD += libgdal-dev
 ifeq ($(GDAL),1)
