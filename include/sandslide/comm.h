@@ -91,6 +91,14 @@ void ss_comm_gather_rows(const void *mine, size_t bytes, void *all);
  * ranks included): the communication share of a run. */
 double ss_comm_seconds(void);
 
+/* bytes of buf from rank `from` to rank `to` (the two call it; a rank
+ * that is neither returns at once, and from == to does nothing): rows
+ * streamed to the rank that writes a file. */
+void ss_comm_relay(void *buf, size_t bytes, int from, int to);
+
+/* The part of `items` that ss_comm_split gives rank `rank`. */
+void ss_comm_split_of(long long items, int rank, long long *first, long long *count);
+
 /* bytes of buf from rank `root` to every rank. */
 void ss_comm_broadcast(void *buf, size_t bytes, int root);
 void ss_comm_barrier(void);

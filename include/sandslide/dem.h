@@ -51,11 +51,15 @@ enum ss_dem_format {
 };
 
 struct ss_raster {
-	int nx, ny;             /* columns (west to east), rows (south to north) */
-	double *values;         /* nx * ny heights, m; row j = j-th from the south;
-	                           0 where nodata is set */
-	uint8_t *nodata;        /* nx * ny flags (1: no data), NULL when no cell
-	                           lacks data */
+	int nx, ny;             /* columns (west to east), rows (south to north)
+	                           of the whole raster */
+	int row_first, rows;    /* the rows held: row_first .. row_first + rows - 1
+	                           (from the south); 0 and ny for a whole raster,
+	                           a rank's rows for a window (read options) */
+	double *values;         /* nx * rows heights, m; values[j * nx + i] is
+	                           row row_first + j; 0 where nodata is set */
+	uint8_t *nodata;        /* nx * rows flags (1: no data), NULL when no
+	                           cell held lacks data */
 	double cellsize;        /* x spacing, m, NAN when the file does not say */
 	double cellsize_y;      /* y spacing, m: cellsize unless the file has
 	                           rectangular cells; NAN when unknown */
@@ -91,6 +95,17 @@ struct ss_dem_read_options {
 	                       without a geotransform); overrides sandslide:dx;
 	                       must agree with a cell size the file states.
 	                       NAN (default): the file's */
+	/* A window: only rows row_first .. row_first + rows - 1 (from the
+	 * south) are kept, so that a rank of a distributed run holds its rows
+	 * and never the whole raster: GDAL reads the window (RasterIO, in
+	 * blocks of the file's strips or tiles), HDF5 a hyperslab, ESRI ASCII
+	 * streams the text (no more than a buffer of it in memory) and stops
+	 * after the window, PNG decodes row by row (an interlaced PNG whole,
+	 * as Adam7 needs).  rows = 0 reads the header alone (size, geometry,
+	 * CRS, nodata value); rows < 0 (default) the whole raster.  A window
+	 * past the raster's rows is SS_ERR_INPUT.  Values of rows outside the
+	 * window are not checked. */
+	int row_first, rows;
 };
 
 void ss_dem_read_options_init(struct ss_dem_read_options *o);
@@ -114,6 +129,46 @@ int ss_dem_read(const char *spec, const char *context,
  * format needs and r lacks (a cell size for .asc); SS_ERR_FAIL for a NaN or
  * infinite value in a cell with data. */
 int ss_dem_write(const char *path, enum ss_dem_format format, const struct ss_raster *r);
+
+/*
+ * Streamed writing, for a raster no process holds whole (a distributed
+ * run's rows, dem.h's windows): the same file as ss_dem_write, written
+ * row block by row block, so that the writer holds one block.
+ *
+ * What a writer must know of all the data before its first row (the PNG's
+ * range, a nodata value no cell holds) is a summary: each rank summarises
+ * the rows it holds, and the ranks combine the summaries by taking the
+ * maxima of max[] and the sums of count[] (integers: exact in any order;
+ * comm.h's ss_comm_reduce does both).
+ */
+#define SS_DEM_NODATA_CANDIDATES 4
+struct ss_dem_summary {
+	/* highest height, minus the lowest, 1 if a cell lacks data (0 else) */
+	double max[3];
+	/* cells with data holding each candidate nodata value: the raster's
+	 * own nodata_value, -9999, -99999, -1e30 */
+	double count[SS_DEM_NODATA_CANDIDATES];
+};
+void ss_dem_summarize(const struct ss_raster *r, struct ss_dem_summary *s);
+
+struct ss_dem_writer;
+
+/* Start writing path in format (SS_DEM_AUTO: from the path) with head's
+ * size, geometry, CRS and metadata (its values are not read; head must
+ * outlive the writer) and the summary of all the data.  Checks as
+ * ss_dem_write; on SS_OK *w is open and ss_dem_writer_close must follow. */
+int ss_dem_writer_open(struct ss_dem_writer **w, const char *path, enum ss_dem_format format,
+                       const struct ss_raster *head, const struct ss_dem_summary *s);
+/* The next `rows` rows of the file, north row first: values[k * nx + i]
+ * (and nodata[k * nx + i], which may be NULL for none) is the file's next
+ * row k.  After a failure (SS_ERR_FAIL, once) later calls do nothing and
+ * return it again. */
+int ss_dem_writer_put(struct ss_dem_writer *w, const double *values, const uint8_t *nodata,
+                      int rows);
+/* Finish: with keep and every row put and written, the file takes its
+ * name (SS_OK, or the failure of the last write); else it is removed.  *w
+ * is freed and set to NULL either way. */
+int ss_dem_writer_close(struct ss_dem_writer **w, int keep);
 
 /* SS_ERR_INPUT when path is the file r was read from (the input is never
  * modified): what ss_dem_write refuses, for a caller to ask before it does

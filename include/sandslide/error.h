@@ -62,4 +62,8 @@ const char *ss_format_bytes(double bytes, char buf[32]);
  * bytes; 0 when unknown. */
 double ss_memory_available_bytes(void);
 
+/* The largest resident memory this process has had (getrusage's
+ * ru_maxrss), in bytes; 0 when unknown. */
+double ss_memory_peak_bytes(void);
+
 #endif

@@ -124,6 +124,11 @@ struct ss_relax_report {
 	const char *integrator;           /* "euler" or "rkl2" */
 	double time;                      /* simulated, s */
 	double wall_seconds;
+	int ranks;                        /* MPI ranks (comm.h) */
+	double bytes_per_cell;            /* the stepper's arrays over the cells
+	                                     of a rank's slab */
+	double memory_peak_bytes;         /* the largest peak resident memory
+	                                     of any rank, the output written */
 	int steady;                       /* reached the steady rule */
 	int interrupted;                  /* by *stop_signal: the output holds
 	                                     the surface as it was then */

@@ -87,7 +87,10 @@ struct ss_run_summary {
 	long long evaluations_here;  /* those this process made */
 	const char *integrator;      /* "euler" or "rkl2" */
 	int stages_max;              /* RKL2: the stage cap (rkl2_max_stages) */
-	double bytes_per_cell;       /* the stepper's arrays over the cells */
+	double bytes_per_cell;       /* the stepper's arrays over the cells
+	                                (of a rank's slab) */
+	double memory_peak_bytes;    /* the largest peak resident memory of
+	                                any rank (ss_memory_peak_bytes) */
 	double cells;                /* of the grid */
 	double wall_seconds;         /* the whole run */
 	double measure_seconds;      /* measuring the largest slope */

@@ -60,10 +60,11 @@ struct ss_snapshot_meta {
 	                          * CF grid mapping variable /crs */
 	const struct ss_boundary *boundary; /* the grid's sides (root attribute
 	                          * boundary), or NULL: not written */
-	const uint8_t *nodata;   /* the whole grid's cells without data (nx x
-	                          * global_ny bytes, south row first, nonzero: no
-	                          * data, as struct ss_raster holds them), or
-	                          * NULL: none.  Written as /cell_type
+	const uint8_t *nodata;   /* this rank's rows of the cells without data
+	                          * (nx x ny of its slab, south row first,
+	                          * nonzero: no data, as a window of struct
+	                          * ss_raster holds them), or NULL: none (on
+	                          * every rank, or on none).  Written as /cell_type
 	                          * SS_SNAPSHOT_CELL_NODATA and NaN in /height,
 	                          * whatever the stepper's type of the cell */
 };

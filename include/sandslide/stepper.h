@@ -210,6 +210,14 @@ struct ss_stepper {
  * tile rows is SS_ERR_INPUT.  Every function below then works on the slab
  * (masks, bedrock and heights are the slab's rows) and is collective:
  * every rank calls it, in the same order. */
+/* The rows first_row .. first_row + rows - 1 (from the south) of the whole
+ * grid g that rank `rank`'s slab holds, as ss_stepper_init splits it (the
+ * tile sizes as there); rows 0 for a rank that would get no tile row.
+ * What a rank reads of a raster before its stepper exists (dem.h's
+ * windows), and what the rank that writes a raster receives from each. */
+void ss_stepper_slab_rows(const struct ss_grid *g, int tile_nx, int tile_ny, int rank,
+                          int *first_row, int *rows);
+
 int ss_stepper_init(struct ss_stepper *st, const struct ss_grid *g,
                     const struct ss_closure *c, const struct ss_boundary *b,
                     double cfl, int tile_nx, int tile_ny);

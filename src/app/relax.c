@@ -80,19 +80,82 @@ static int write_report(const char *path, const struct ss_relax_options *o,
 	return err;
 }
 
-/* The relaxed heights into r's values (nodata cells keep theirs): each
- * rank's rows, gathered on rank 0. */
+/* The relaxed heights into r's values (this rank's rows: r holds them,
+ * dem.h's window); nodata cells keep theirs. */
 static void heights_to_raster(const struct ss_stepper *st, struct ss_raster *r)
 {
 	const struct ss_grid *g = &st->grid;
-	double *rows = r->values + (size_t)g->offset_j * g->nx;
-	const uint8_t *nodata = r->nodata ? r->nodata + (size_t)g->offset_j * g->nx : NULL;
+	double *rows = r->values + (size_t)(g->offset_j - r->row_first) * g->nx;
+	const uint8_t *nodata = r->nodata ? r->nodata + (size_t)(g->offset_j - r->row_first) * g->nx
+	                                  : NULL;
 	for (int j = 0; j < g->ny; j++)
 		for (int i = 0; i < g->nx; i++)
 			if (!nodata || !nodata[(size_t)j * g->nx + i])
 				rows[(size_t)j * g->nx + i] = st->height[ss_grid_index(g, i, j)];
-	if (!ss_grid_is_whole(g))
-		ss_comm_gather_rows(rows, (size_t)g->ny * g->nx * sizeof *rows, r->values);
+}
+
+/* Rows per block of a streamed write: about 4 MiB of heights and flags,
+ * what rank 0 holds of the other ranks' rows at a time. */
+static int block_rows(int nx)
+{
+	const long long rows = (4LL << 20) / (9LL * nx);
+	return rows < 1 ? 1 : rows > 1 << 20 ? 1 << 20 : (int)rows;
+}
+
+/*
+ * The raster r (each rank's rows, its window) written to path by rank 0,
+ * north row first: rank 0 writes its own rows and receives the others' in
+ * blocks (ss_comm_relay), so that no rank holds the whole raster.  The
+ * writer needs the summary of all the data first (the PNG's range, a
+ * nodata value no height takes): a reduction.  After a failed write rank
+ * 0 goes on receiving (the senders cannot know), then all agree.
+ */
+static int write_streamed(const char *path, enum ss_dem_format format, const struct ss_raster *r,
+                          const struct ss_relax_options *o)
+{
+	struct ss_dem_summary s;
+	ss_dem_summarize(r, &s);
+	ss_comm_reduce(s.max, 3, s.count, SS_DEM_NODATA_CANDIDATES);
+	const int me = ss_comm_rank(), nx = r->nx, block = block_rows(nx);
+	struct ss_dem_writer *w = NULL;
+	int err = me == 0 ? ss_dem_writer_open(&w, path, format, r, &s) : SS_OK;
+	if ((err = ss_comm_agree(err)))
+		return err;
+	double *values = ss_alloc((size_t)block * nx, sizeof *values, "a block of rows");
+	uint8_t *flags = ss_alloc((size_t)block * nx, 1, "a block of nodata flags");
+	err = ss_comm_agree(values && flags ? SS_OK : SS_ERR_FAIL);
+	struct ss_grid whole;
+	if (!err)
+		err = ss_grid_init(&whole, nx, r->ny, 1.0, 1.0, 0.0, 0.0);
+	for (int q = ss_comm_size() - 1; q >= 0 && !err; q--) {   /* north first */
+		int first, rows;
+		ss_stepper_slab_rows(&whole, o->tile[0], o->tile[1], q, &first, &rows);
+		if (me != 0 && me != q)
+			continue;
+		for (int top = first + rows; top > first;) {   /* rows top - n .. top - 1 */
+			const int n = top - first < block ? top - first : block;
+			if (me == q) {   /* north row first */
+				for (int k = 0; k < n; k++) {
+					const size_t from = (size_t)(top - 1 - k - r->row_first) * nx;
+					memcpy(values + (size_t)k * nx, r->values + from, nx * sizeof *values);
+					if (r->nodata)
+						memcpy(flags + (size_t)k * nx, r->nodata + from, (size_t)nx);
+					else
+						memset(flags + (size_t)k * nx, 0, (size_t)nx);
+				}
+			}
+			ss_comm_relay(values, (size_t)n * nx * sizeof *values, q, 0);
+			ss_comm_relay(flags, (size_t)n * nx, q, 0);
+			if (me == 0)
+				ss_dem_writer_put(w, values, flags, n);   /* its failure: at close */
+			top -= n;
+		}
+	}
+	if (me == 0)
+		err = ss_dem_writer_close(&w, !err);
+	ss_free(values);
+	ss_free(flags);
+	return ss_comm_agree(err);
 }
 
 /* Everything one relaxation holds, released by ss_relax_run. */
@@ -122,10 +185,13 @@ static int rebuild(void *context, struct ss_stepper *st)
 }
 
 /* A copy of a caller's raster (values, nodata and geometry: the writers'
- * metadata is not needed in memory) into r. */
+ * metadata is not needed in memory) into r, whole (one rank). */
 static int raster_copy(const struct ss_raster *from, struct ss_raster *r)
 {
 	const size_t cells = (size_t)from->nx * (size_t)from->ny;
+	if (ss_comm_size() > 1 || from->rows != from->ny)
+		return ss_error_input("relax of a raster in memory runs on one rank, of a whole "
+		                      "raster: give the file to each rank");
 	int err = ss_raster_init(r, from->nx, from->ny);
 	if (!err && from->nodata && !(r->nodata = ss_alloc(cells, 1, "nodata flags")))
 		err = SS_ERR_FAIL;
@@ -154,8 +220,56 @@ static int check_options(const struct ss_relax_options *o)
 	return SS_OK;
 }
 
-/* The inputs and the output's name and format, all checked. */
+/* This rank's rows of the raster spec: its window (dem.h), found from the
+ * header as ss_stepper_init will split the grid, so that no rank holds
+ * the whole raster; one rank reads it whole. */
+static int read_window(const char *spec, const char *context, struct ss_dem_read_options opt,
+                       const struct ss_relax_options *o, struct ss_raster *r)
+{
+	if (ss_comm_size() > 1) {
+		opt.rows = 0;
+		int err = ss_dem_read(spec, context, &opt, r);
+		struct ss_grid whole;
+		if (!err)
+			err = ss_grid_init(&whole, r->nx, r->ny, 1.0, 1.0, 0.0, 0.0);
+		if (!err)
+			ss_stepper_slab_rows(&whole, o->tile[0], o->tile[1], ss_comm_rank(),
+			                     &opt.row_first, &opt.rows);
+		ss_raster_release(r);
+		if (err)
+			return err;
+	}
+	return ss_dem_read(spec, context, &opt, r);
+}
+
+/* Flags for r's rows when another rank's rows have some: the snapshot's
+ * nodata (snapshot.h) is given by every rank or by none. */
+static int agree_nodata(struct ss_raster *r)
+{
+	double any = r->nodata ? 1.0 : 0.0;
+	ss_comm_reduce(&any, 1, NULL, 0);
+	if (any == 0.0 || r->nodata)
+		return SS_OK;
+	const size_t cells = (size_t)r->nx * (size_t)r->rows;
+	if (!(r->nodata = ss_alloc(cells ? cells : 1, 1, "nodata flags")))
+		return SS_ERR_FAIL;
+	memset(r->nodata, 0, cells ? cells : 1);
+	return SS_OK;
+}
+
+/* The inputs and the output's name and format, all checked: every rank
+ * reads its own rows, so a failure of one is agreed by all. */
+static int read_inputs_here(struct relax *x, struct ss_relax_report *rep);
+
 static int read_inputs(struct relax *x, struct ss_relax_report *rep)
+{
+	int err = ss_comm_agree(read_inputs_here(x, rep));
+	if (!err)
+		err = ss_comm_agree(agree_nodata(&x->dem));
+	return err;
+}
+
+static int read_inputs_here(struct relax *x, struct ss_relax_report *rep)
 {
 	const struct ss_relax_options *o = x->o;
 	if ((o->input_raster && !o->dem) || (o->bedrock_raster && !o->bedrock))
@@ -170,7 +284,7 @@ static int read_inputs(struct relax *x, struct ss_relax_report *rep)
 	else
 		default_output(o->dem, rep->output, sizeof rep->output);
 	err = o->input_raster ? raster_copy(o->input_raster, &x->dem)
-	                      : ss_dem_read(o->dem, NULL, &o->read, &x->dem);
+	                      : read_window(o->dem, NULL, o->read, o, &x->dem);
 	if (!err && o->output_raster && (o->output_raster->nx != x->dem.nx ||
 	                                 o->output_raster->ny != x->dem.ny))
 		err = ss_error_input("the output raster is %d x %d cells: expected the DEM's "
@@ -188,9 +302,8 @@ static int read_inputs(struct relax *x, struct ss_relax_report *rep)
 		err = ss_dem_check_not_source(rep->output, &x->dem);
 	if (err || !o->bedrock)
 		return err;
-	struct ss_dem_read_options bo = o->read;
 	if ((err = o->bedrock_raster ? raster_copy(o->bedrock_raster, &x->bedrock)
-	                             : ss_dem_read(o->bedrock, "--bedrock", &bo, &x->bedrock)))
+	                             : read_window(o->bedrock, "--bedrock", o->read, o, &x->bedrock)))
 		return err;
 	if (x->bedrock.nx != x->dem.nx || x->bedrock.ny != x->dem.ny)
 		return ss_error_input("--bedrock %s is %d x %d cells: expected the DEM's %d x %d",
@@ -289,13 +402,12 @@ static int write_raster(struct relax *x, const char *path)
 	if (x->format == SS_DEM_H5)
 		return SS_OK;
 	heights_to_raster(&x->st, &x->dem);
-	if (x->o->output_raster) {
+	if (x->o->output_raster) {   /* one rank, whole (raster_copy) */
 		memcpy(x->o->output_raster->values, x->dem.values,
 		       (size_t)x->dem.nx * x->dem.ny * sizeof *x->dem.values);
 		return SS_OK;
 	}
-	return ss_comm_agree(ss_comm_rank() == 0 ? ss_dem_write(path, x->format, &x->dem)
-	                                         : SS_OK);
+	return write_streamed(path, x->format, &x->dem, x->o);
 }
 
 /* The guard fired: the last good state goes to a raster output too. */
@@ -335,6 +447,14 @@ int ss_relax_run(const struct ss_relax_options *o, struct ss_relax_report *rep)
 		err = write_raster(&x, rep->output);
 	}
 	rep->wall_seconds = ss_parallel_wall_seconds() - started;
+	if (!err) {   /* the output is written: the peak is the run's */
+		const struct ss_grid *g = &x.st.grid;
+		rep->ranks = ss_comm_size();
+		rep->bytes_per_cell = ss_stepper_memory_bytes(g, x.st.integrator) /
+		                      fmax((double)g->nx * g->ny, 1.0);
+		rep->memory_peak_bytes = ss_memory_peak_bytes();
+		ss_comm_reduce(&rep->memory_peak_bytes, 1, NULL, 0);
+	}
 	if (!err && o->report)
 		err = ss_comm_agree(ss_comm_rank() == 0 ? write_report(o->report, o, rep) : SS_OK);
 	err = ss_drive_finish(&x.drive, err);

@@ -38,6 +38,10 @@ int ss_relax_report_json(const struct ss_relax_options *o, const struct ss_relax
 	ss_strbuf_json_number(&b, r->time, 17);
 	ss_strbuf_printf(&b, ", \"wall_seconds\": ");
 	ss_strbuf_json_number(&b, r->wall_seconds, 6);
+	ss_strbuf_printf(&b, ",\n  \"ranks\": %d, \"bytes_per_cell\": ", r->ranks);
+	ss_strbuf_json_number(&b, r->bytes_per_cell, 17);
+	ss_strbuf_printf(&b, ", \"memory_peak_bytes\": ");
+	ss_strbuf_json_number(&b, r->memory_peak_bytes, 17);
 	ss_strbuf_printf(&b, ",\n  \"integrator\": \"%s\", \"stencil_evaluations\": %lld, "
 	                 "\"slope_tol\": ", r->integrator ? r->integrator : "", r->evaluations);
 	ss_strbuf_json_number(&b, o->model.steady_slope_tol, 17);

@@ -263,6 +263,8 @@ static void summarise(const struct run *r, enum ss_drive_end end, struct ss_run_
 	s->sweep_seconds = st->seconds_sweep;
 	s->output_seconds = r->drive.seconds_output;
 	s->comm_seconds = ss_comm_seconds();
+	s->memory_peak_bytes = ss_memory_peak_bytes();
+	ss_comm_reduce(&s->memory_peak_bytes, 1, NULL, 0);
 	s->threads = ss_parallel_max_threads();
 	const int notes = (int)(sizeof s->notes / sizeof *s->notes);
 	for (int k = 0; k < r->c.note_count && k < notes; k++)

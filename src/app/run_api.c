@@ -43,6 +43,8 @@ int ss_run_summary_json(const struct ss_run_summary *s, char *buf, size_t size)
 	ss_strbuf_json_number(&b, s->cells, 17);
 	ss_strbuf_printf(&b, ", \"bytes_per_cell\": ");
 	ss_strbuf_json_number(&b, s->bytes_per_cell, 17);
+	ss_strbuf_printf(&b, ", \"memory_peak_bytes\": ");
+	ss_strbuf_json_number(&b, s->memory_peak_bytes, 17);
 	ss_strbuf_printf(&b, ", \"threads\": %d, \"ranks\": %d,\n  \"wall_seconds\": ", s->threads,
 	                 s->ranks);
 	ss_strbuf_json_number(&b, s->wall_seconds, 6);

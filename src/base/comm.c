@@ -243,6 +243,21 @@ void ss_comm_barrier(void)
 		MPI_Barrier(MPI_COMM_WORLD);
 }
 
+static void relay(void *buf, size_t bytes, int from, int to)
+{
+	if (from == to || (comm_rank != from && comm_rank != to))
+		return;
+	const size_t piece = (size_t)1 << 30;   /* an MPI count is an int */
+	for (size_t at = 0; at < bytes; at += piece) {
+		const int n = (int)(bytes - at < piece ? bytes - at : piece);
+		if (comm_rank == from)
+			MPI_Send((char *)buf + at, n, MPI_BYTE, to, 7, MPI_COMM_WORLD);
+		else
+			MPI_Recv((char *)buf + at, n, MPI_BYTE, from, 7, MPI_COMM_WORLD,
+			         MPI_STATUS_IGNORE);
+	}
+}
+
 static int agree(int status)
 {
 	if (comm_size == 1)
@@ -306,6 +321,11 @@ void ss_comm_gather_rows(const void *mine, size_t bytes, void *all)
 void ss_comm_broadcast(void *buf, size_t bytes, int root)
 {
 	TIMED(broadcast(buf, bytes, root));
+}
+
+void ss_comm_relay(void *buf, size_t bytes, int from, int to)
+{
+	TIMED(relay(buf, bytes, from, to));
 }
 
 int ss_comm_agree(int status)
@@ -388,6 +408,11 @@ void ss_comm_broadcast(void *buf, size_t bytes, int root)
 	(void)buf, (void)bytes, (void)root;
 }
 
+void ss_comm_relay(void *buf, size_t bytes, int from, int to)
+{
+	(void)buf, (void)bytes, (void)from, (void)to;   /* one rank: from == to */
+}
+
 void ss_comm_barrier(void)
 {
 }
@@ -399,12 +424,17 @@ int ss_comm_agree(int status)
 
 #endif
 
-void ss_comm_split(long long items, long long *first, long long *count)
+void ss_comm_split_of(long long items, int rank, long long *first, long long *count)
 {
-	const long long p = ss_comm_size(), r = ss_comm_rank();
+	const long long p = ss_comm_size(), r = rank;
 	const long long base = items / p, extra = items % p;
 	*count = base + (r < extra ? 1 : 0);
 	*first = r * base + (r < extra ? r : extra);
+}
+
+void ss_comm_split(long long items, long long *first, long long *count)
+{
+	ss_comm_split_of(items, ss_comm_rank(), first, count);
 }
 
 void ss_comm_neighbours(int periodic, int *south, int *north)

@@ -11,6 +11,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 
 /* The last message of this process: in a distributed run only rank 0
  * prints, and ss_comm_agree has it printed there when another rank failed
@@ -128,6 +129,12 @@ const char *ss_format_bytes(double bytes, char buf[32])
 	}
 	snprintf(buf, 32, u ? "%.1f %s" : "%.0f %s", bytes, unit[u]);
 	return buf;
+}
+
+double ss_memory_peak_bytes(void)
+{
+	struct rusage u;
+	return getrusage(RUSAGE_SELF, &u) == 0 ? (double)u.ru_maxrss * 1024.0 : 0.0;
 }
 
 double ss_memory_available_bytes(void)

@@ -9,6 +9,7 @@
 
 #include "base/strings.h"
 #include "sandslide/comm.h"
+#include "sandslide/error.h"
 #include "sandslide/parallel.h"
 
 static void format_duration(double s, char *buf, size_t size)
@@ -81,17 +82,18 @@ void cli_print_run_end(const struct ss_run_summary *s, int quiet)
 	       s->end == SS_RUN_STEADY ? " (steady)"
 	       : s->end == SS_RUN_NOT_STEADY ? " (not steady by max_time)" : "");
 	/* with ranks: rank 0's phases, and its time in MPI calls */
-	char ranks[48] = "", mpi[48] = "";
+	char ranks[48] = "", mpi[48] = "", peak[32];
 	if (s->ranks > 1) {
 		snprintf(ranks, sizeof ranks, "%d ranks x ", s->ranks);
 		snprintf(mpi, sizeof mpi, ", mpi %.3f s", s->comm_seconds);
 	}
 	printf("wall %.3f s: slope %.3f s, sweep %.3f s, output %.3f s%s; %lld stencil "
-	       "evaluations, %.3g cell-updates/s on %s%d thread%s; %.0f B per cell\n",
+	       "evaluations, %.3g cell-updates/s on %s%d thread%s; %.0f B per cell, peak %s%s\n",
 	       s->wall_seconds, s->measure_seconds, s->sweep_seconds, s->output_seconds, mpi,
 	       s->evaluations, (double)s->evaluations_here * s->cells /
 	       fmax(s->measure_seconds + s->sweep_seconds, 1e-9), ranks, s->threads,
-	       s->threads == 1 ? "" : "s", s->bytes_per_cell);
+	       s->threads == 1 ? "" : "s", s->bytes_per_cell,
+	       ss_format_bytes(s->memory_peak_bytes, peak), s->ranks > 1 ? " a rank" : "");
 }
 
 void cli_print_relax_end(const struct ss_relax_report *r, double angle_deg, int quiet)
@@ -110,10 +112,16 @@ void cli_print_relax_end(const struct ss_relax_report *r, double angle_deg, int 
 	       : r->interrupted ? "NOT steady (interrupted)" : "NOT steady by --max-time",
 	       r->steps, strcmp(r->integrator, "rkl2") ? "steps (euler)" : "super-steps (rkl2)",
 	       r->time, r->evaluations);
+	char ranks[48] = "", peak[32];
+	if (r->ranks > 1)
+		snprintf(ranks, sizeof ranks, "%d ranks x ", r->ranks);
 	printf("cells moved %lld, volume moved %.6g m^3, steepest sand face %.4f -> "
-	       "%.4f deg (repose %g), wall %.3f s on %d thread%s\n", r->cells_moved,
+	       "%.4f deg (repose %g), wall %.3f s on %s%d thread%s\n", r->cells_moved,
 	       r->volume_moved, r->max_slope_before_deg, r->max_slope_after_deg, angle_deg,
-	       r->wall_seconds, ss_parallel_max_threads(), ss_parallel_max_threads() == 1 ? "" : "s");
+	       r->wall_seconds, ranks, ss_parallel_max_threads(),
+	       ss_parallel_max_threads() == 1 ? "" : "s");
+	printf("memory: %.0f B per cell, peak %s%s\n", r->bytes_per_cell,
+	       ss_format_bytes(r->memory_peak_bytes, peak), r->ranks > 1 ? " (the largest rank)" : "");
 	/* sand poured, and sand that left through open sides or open nodata
 	 * cells: what the volume change is made of */
 	printf("volume %.9g -> %.9g m^3: poured %.6g m^3, left through open cells and "

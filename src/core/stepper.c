@@ -52,6 +52,19 @@ double ss_stepper_memory_bytes(const struct ss_grid *g, enum ss_integrator integ
 	return (double)ss_grid_storage_cells(g) * (doubles * sizeof(double) + 0.25);
 }
 
+void ss_stepper_slab_rows(const struct ss_grid *g, int tile_nx, int tile_ny, int rank,
+                          int *first_row, int *rows)
+{
+	struct ss_tiling t;
+	ss_tiling_init(&t, g, tile_nx, tile_ny);
+	long long first = 0, count = t.tiles_y;
+	if (ss_comm_size() > 1)
+		ss_comm_split_of(t.tiles_y, rank, &first, &count);
+	const long long j0 = first * t.tile_ny, j1 = (first + count) * t.tile_ny;
+	*first_row = (int)(j0 < g->ny ? j0 : g->ny);
+	*rows = (int)((j1 < g->ny ? j1 : g->ny) - *first_row);
+}
+
 int ss_stepper_init(struct ss_stepper *st, const struct ss_grid *g,
                     const struct ss_closure *c, const struct ss_boundary *b,
                     double cfl, int tile_nx, int tile_ny)
@@ -79,12 +92,10 @@ int ss_stepper_init(struct ss_stepper *st, const struct ss_grid *g,
 	st->tiles_all = (double)st->tiling.tiles_x * (double)tile_rows;
 	st->grid = *g;
 	if (ss_comm_size() > 1) {
-		long long first, count;
-		ss_comm_split(tile_rows, &first, &count);
-		const long long j0 = first * st->tiling.tile_ny;
-		const long long j1 = (first + count) * st->tiling.tile_ny;
-		ss_grid_take_rows(&st->grid, j0, (int)((j1 < g->ny ? j1 : g->ny) - j0));
-		st->tiling.tiles_y = (int)count;
+		int first_row, rows;
+		ss_stepper_slab_rows(g, tile_nx, tile_ny, ss_comm_rank(), &first_row, &rows);
+		ss_grid_take_rows(&st->grid, first_row, rows);
+		st->tiling.tiles_y = (rows + st->tiling.tile_ny - 1) / st->tiling.tile_ny;
 	}
 	g = &st->grid;
 	ss_boundary_neighbours(g, b, &st->rank_south, &st->rank_north);

@@ -40,6 +40,7 @@ int ss_raster_init(struct ss_raster *r, int nx, int ny)
 		SS_BUG("ss_raster_init: %d x %d cells", nx, ny);
 	r->nx = nx;
 	r->ny = ny;
+	r->rows = ny;
 	r->values = ss_alloc((size_t)nx * (size_t)ny, sizeof(double), "raster heights");
 	return r->values ? SS_OK : SS_ERR_FAIL;
 }
@@ -57,6 +58,30 @@ void ss_dem_read_options_init(struct ss_dem_read_options *o)
 {
 	o->format = SS_DEM_AUTO;
 	o->zscale = o->zoffset = o->cellsize = NAN;
+	o->row_first = 0;
+	o->rows = -1;
+}
+
+int ss_dem_window(const struct ss_dem_read_options *opt, const char *spec,
+                  const char *context, struct ss_raster *r)
+{
+	if (opt->rows < 0) {
+		r->row_first = 0;
+		r->rows = r->ny;
+		return SS_OK;
+	}
+	if (opt->row_first < 0 || opt->row_first > r->ny || opt->rows > r->ny - opt->row_first)
+		return ss_error_input_at(context, "'%s' has %d rows: rows %d to %d (from the south) "
+		                         "are not in it", spec, r->ny, opt->row_first,
+		                         opt->row_first + opt->rows - 1);
+	r->row_first = opt->row_first;
+	r->rows = opt->rows;
+	return SS_OK;
+}
+
+size_t ss_raster_cells(const struct ss_raster *r)
+{
+	return (size_t)r->nx * (size_t)r->rows;
 }
 
 char *ss_dem_strdup(const char *s)
@@ -154,11 +179,11 @@ static int gdal_unavailable(const char *path, const char *context)
  * their values are 0 already (read as walls). */
 static int read_h5_nodata(struct ss_snapshot_file *f, struct ss_raster *r)
 {
-	const size_t n = (size_t)f->nx * (size_t)f->ny;
-	uint8_t *flags = ss_alloc(n, 1, "cell types");
+	const size_t n = ss_raster_cells(r);
+	uint8_t *flags = ss_alloc(n ? n : 1, 1, "cell types");
 	if (!flags)
 		return SS_ERR_FAIL;
-	int err = ss_snapshot_file_read_cell_flags(f, 0, f->ny, flags);
+	int err = n ? ss_snapshot_file_read_cell_flags(f, r->row_first, r->rows, flags) : SS_OK;
 	size_t none = 0;
 	for (size_t k = 0; k < n && !err; k++)
 		none += (flags[k] = flags[k] == SS_SNAPSHOT_CELL_NODATA);
@@ -169,24 +194,28 @@ static int read_h5_nodata(struct ss_snapshot_file *f, struct ss_raster *r)
 	return err;
 }
 
-/* The last snapshot of a sandslide file, with its cell size and corner,
- * and its cells without data. */
-static int read_h5_output(const char *path, struct ss_raster *r)
+/* The last snapshot of a sandslide file (the window's rows: a hyperslab),
+ * with its cell size and corner, and its cells without data. */
+static int read_h5_output(const char *path, const char *context,
+                          const struct ss_dem_read_options *opt, struct ss_raster *r)
 {
 	struct ss_snapshot_file f;
 	int err = ss_snapshot_file_open(&f, path);
 	if (!err && f.count < 1)
 		err = ss_error_input("'%s' holds no snapshot", path);
-	if (!err && !(r->values = ss_alloc((size_t)f.nx * (size_t)f.ny, sizeof *r->values,
-	                                   "input heights")))
-		err = SS_ERR_FAIL;
-	if (!err)
-		err = ss_snapshot_file_read_rows(&f, f.count - 1, 0, f.ny, r->values);
-	if (!err)
-		err = read_h5_nodata(&f, r);
 	if (!err) {
 		r->nx = f.nx;
 		r->ny = f.ny;
+		err = ss_dem_window(opt, path, context, r);
+	}
+	const size_t n = ss_raster_cells(r);
+	if (!err && !(r->values = ss_alloc(n ? n : 1, sizeof *r->values, "input heights")))
+		err = SS_ERR_FAIL;
+	if (!err && n)
+		err = ss_snapshot_file_read_rows(&f, f.count - 1, r->row_first, r->rows, r->values);
+	if (!err)
+		err = read_h5_nodata(&f, r);
+	if (!err) {
 		r->cellsize = f.dx;
 		r->cellsize_y = f.dy;
 		r->x0 = f.origin_x;
@@ -202,11 +231,27 @@ static int read_h5_output(const char *path, struct ss_raster *r)
 	return err;
 }
 
+/* Any (y, x) or (time, y, x) dataset: read whole (ss_snapshot_read_field),
+ * then cut to the window. */
+static int read_h5_dataset(const char *path, const char *dataset, const char *spec,
+                           const char *context, const struct ss_dem_read_options *opt,
+                           struct ss_raster *r)
+{
+	int err = ss_snapshot_read_field(path, dataset, -1, &r->nx, &r->ny, &r->values);
+	if (!err)
+		err = ss_dem_window(opt, spec, context, r);
+	if (!err && r->row_first > 0)
+		memmove(r->values, r->values + (size_t)r->row_first * r->nx,
+		        ss_raster_cells(r) * sizeof *r->values);
+	return err;
+}
+
 /* sandslide HDF5: "file.h5" (the last snapshot of a sandslide file, with
  * the run's cell size and corner) or "file.h5:/dataset" (any (y, x) or
  * (time, y, x) variable of any HDF5 file: its last snapshot, no
  * geometry). */
-static int read_h5(const char *spec, const char *context, struct ss_raster *r)
+static int read_h5(const char *spec, const char *context, const struct ss_dem_read_options *opt,
+                   struct ss_raster *r)
 {
 	const char *dataset = h5_dataset(spec);
 	char *path = ss_dem_strdup(spec);
@@ -220,17 +265,17 @@ static int read_h5(const char *spec, const char *context, struct ss_raster *r)
 	if (!f)
 		return ss_error_input_at(context, "cannot open '%s': %s", path, strerror(errno));
 	fclose(f);
-	int err = dataset ? ss_snapshot_read_field(path, dataset, -1, &r->nx, &r->ny, &r->values)
-	                  : read_h5_output(path, r);
+	int err = dataset ? read_h5_dataset(path, dataset, spec, context, opt, r)
+	                  : read_h5_output(path, context, opt, r);
 	if (err)
 		return err;
-	const size_t n = (size_t)r->nx * (size_t)r->ny;
+	const size_t n = ss_raster_cells(r);
 	for (size_t k = 0; k < n; k++) {
 		if (!isfinite(r->values[k]))
 			return ss_error_input_at(context, "%s: height %g at column %zu, row %zu (from the south) "
 			                         "is not finite: heights must be finite numbers", spec,
 			                         r->values[k], k % (size_t)r->nx + 1,
-			                         k / (size_t)r->nx + 1);
+			                         k / (size_t)r->nx + 1 + (size_t)r->row_first);
 	}
 	return SS_OK;
 }
@@ -331,7 +376,7 @@ int ss_dem_read(const char *spec, const char *context, const struct ss_dem_read_
 		err = ss_dem_read_asc(spec, context, opt, r);
 		break;
 	case SS_DEM_H5:
-		err = read_h5(spec, context, r);
+		err = read_h5(spec, context, opt, r);
 		break;
 	case SS_DEM_PNG:
 		err = ss_dem_read_png(spec, context, opt, r);
@@ -353,50 +398,70 @@ int ss_dem_read(const char *spec, const char *context, const struct ss_dem_read_
 /* ------------------------------------------------------------------ */
 /* writing                                                              */
 
-int ss_dem_check_finite(const struct ss_raster *r, const char *path)
+void ss_dem_summarize(const struct ss_raster *r, struct ss_dem_summary *s)
 {
-	const size_t n = (size_t)r->nx * (size_t)r->ny;
+	const double candidate[SS_DEM_NODATA_CANDIDATES] = {r->nodata_value, -9999.0, -99999.0,
+	                                                    -1e30};
+	double lo = INFINITY, hi = -INFINITY;
+	memset(s->count, 0, sizeof s->count);
+	const size_t n = ss_raster_cells(r);
 	for (size_t k = 0; k < n; k++) {
-		if (!isfinite(r->values[k]) && !(r->nodata && r->nodata[k]))
-			return ss_error_fail("cannot write '%s': height %g at column %zu, row %zu (from "
-			                     "the south) is not finite", path, r->values[k],
-			                     k % (size_t)r->nx + 1, k / (size_t)r->nx + 1);
+		if (r->nodata && r->nodata[k])
+			continue;
+		const double v = r->values[k];
+		lo = fmin(lo, v);
+		hi = fmax(hi, v);
+		for (int a = 0; a < SS_DEM_NODATA_CANDIDATES; a++)
+			s->count[a] += v == candidate[a];
 	}
-	return SS_OK;
+	s->max[0] = hi;
+	s->max[1] = -lo;
+	s->max[2] = r->nodata ? 1.0 : 0.0;
 }
 
-static int value_is_used(const struct ss_raster *r, double v)
-{
-	const size_t n = (size_t)r->nx * (size_t)r->ny;
-	for (size_t k = 0; k < n; k++) {
-		if ((!r->nodata || !r->nodata[k]) &&
-		    (r->values[k] == v || (isnan(v) && isnan(r->values[k]))))
-			return 1;
-	}
-	return 0;
-}
-
-int ss_dem_pick_nodata(const struct ss_raster *r, const char *path, int allow_nan, int *has,
-                       double *value)
+/* The value to write for nodata cells: head's nodata value when no cell
+ * with data holds it (and it is not NaN, unless allow_nan), else the
+ * first of -9999, -99999, -1e30 that none holds.  *has is 0 when there
+ * are neither cells without data nor a nodata value (write none). */
+static int pick_nodata(const struct ss_raster *head, const struct ss_dem_summary *s,
+                       const char *path, int allow_nan, int *has, double *value)
 {
 	static const double fallback[] = {-9999.0, -99999.0, -1e30};
-	*has = r->has_nodata_value || r->nodata;
+	*has = head->has_nodata_value || s->max[2] > 0.0;
 	*value = NAN;
 	if (!*has)
 		return SS_OK;
-	if (r->has_nodata_value && (allow_nan || !isnan(r->nodata_value)) &&
-	    !value_is_used(r, r->nodata_value)) {
-		*value = r->nodata_value;
+	if (head->has_nodata_value && (allow_nan || !isnan(head->nodata_value)) &&
+	    s->count[0] == 0.0) {
+		*value = head->nodata_value;
 		return SS_OK;
 	}
-	for (size_t a = 0; a < sizeof fallback / sizeof *fallback; a++) {
-		if (!value_is_used(r, fallback[a])) {
+	for (int a = 0; a < 3; a++) {
+		if (s->count[a + 1] == 0.0) {
 			*value = fallback[a];
 			return SS_OK;
 		}
 	}
 	return ss_error_fail("cannot write '%s': every candidate nodata value (-9999, -99999, "
 	                     "-1e30) is a height of a cell with data", path);
+}
+
+/* A PNG's zmin, zmax: head's range if every value with data lies within
+ * it (to half a grey level), else the data's own, so that the lowest and
+ * the highest come back exactly. */
+static void png_range(const struct ss_raster *head, const struct ss_dem_summary *s,
+                      double *zmin, double *zmax)
+{
+	const double lo = -s->max[1], hi = s->max[0];
+	*zmin = 0.0;
+	*zmax = 1.0;
+	if (!(lo <= hi))   /* no cell has data */
+		return;
+	const double a = head->png_zmin, b = head->png_zmax;
+	const double half = 0.5 * (b - a) / 65534.0;
+	const int within = isfinite(a) && isfinite(b) && a < b && lo >= a - half && hi <= b + half;
+	*zmin = within ? a : lo;
+	*zmax = within ? b : hi;
 }
 
 int ss_dem_check_not_source(const char *path, const struct ss_raster *r)
@@ -434,8 +499,50 @@ static int create_temp(const char *path, char *tmp, size_t size, int *fd)
 	return ss_error_input("cannot write '%s': cannot find a free temporary name beside it", path);
 }
 
-int ss_dem_write(const char *path, enum ss_dem_format format, const struct ss_raster *r)
+static int writer_end(struct ss_dem_writer *w)
 {
+	switch (w->format) {
+	case SS_DEM_PNG:
+		return ss_dem_png_end(w);
+	case SS_DEM_GDAL:
+		return ss_dem_gdal_end(w);
+	default:
+		return SS_OK;
+	}
+}
+
+int ss_dem_writer_close(struct ss_dem_writer **wp, int keep)
+{
+	struct ss_dem_writer *w = *wp;
+	*wp = NULL;
+	if (!w)
+		return SS_OK;
+	if (keep && !w->err && w->line != w->head->ny)
+		SS_BUG("ss_dem_writer_close: %d of %d rows put", w->line, w->head->ny);
+	keep = keep && !w->err;
+	const int ended = writer_end(w);
+	int err = w->err ? w->err : keep ? ended : SS_OK;
+	if (w->f) {
+		/* complete on disk before it takes the name */
+		if (keep && !err && (fflush(w->f) || fsync(fileno(w->f))))
+			err = ss_error_fail("cannot write '%s': %s", w->path, strerror(errno));
+		if (fclose(w->f) && keep && !err)
+			err = ss_error_fail("cannot write '%s': %s", w->path, strerror(errno));
+	}
+	if (keep && !err && rename(w->tmp, w->path))
+		err = ss_error_input("cannot write '%s': cannot rename the finished temporary file "
+		                     "'%s' to it: %s", w->path, w->tmp, strerror(errno));
+	if (!keep || err)
+		unlink(w->tmp);
+	ss_free(w->row);
+	ss_free(w);
+	return err;
+}
+
+int ss_dem_writer_open(struct ss_dem_writer **wp, const char *path, enum ss_dem_format format,
+                       const struct ss_raster *head, const struct ss_dem_summary *s)
+{
+	*wp = NULL;
 	if (format == SS_DEM_AUTO) {
 		int err = ss_dem_format_from_path(path, NULL, &format);
 		if (err)
@@ -447,41 +554,88 @@ int ss_dem_write(const char *path, enum ss_dem_format format, const struct ss_ra
 		                      ".tif", path);
 	if (format == SS_DEM_GDAL && !ss_dem_gdal_available())
 		return gdal_unavailable(path, NULL);
-	if (!r->values || r->nx < 1 || r->ny < 1)
-		SS_BUG("ss_dem_write: empty raster");
-	int err = ss_dem_check_not_source(path, r);
-	if (!err)
-		err = ss_dem_check_finite(r, path);
+	if (head->nx < 1 || head->ny < 1)
+		SS_BUG("ss_dem_writer_open: an empty raster");
+	if (strlen(path) >= sizeof (*wp)->path)
+		return ss_error_input("cannot write '%s': the path is too long", path);
+	int err = ss_dem_check_not_source(path, head);
 	if (err)
 		return err;
-
-	char tmp[4096];
+	struct ss_dem_writer *w = ss_alloc(1, sizeof *w, "a raster writer");
+	if (!w)
+		return SS_ERR_FAIL;
+	memset(w, 0, sizeof *w);
+	w->format = format;
+	w->head = head;
+	snprintf(w->path, sizeof w->path, "%s", path);
+	png_range(head, s, &w->zmin, &w->zmax);
 	int fd = -1;
-	err = create_temp(path, tmp, sizeof tmp, &fd);
-	if (err)
+	if (!(w->row = ss_alloc((size_t)head->nx, sizeof *w->row, "a raster row")))
+		err = SS_ERR_FAIL;
+	if (!err)
+		err = pick_nodata(head, s, path, format == SS_DEM_GDAL, &w->has_nodata, &w->nodata);
+	if (!err)
+		err = create_temp(path, w->tmp, sizeof w->tmp, &fd);
+	if (err) {
+		ss_free(w->row);
+		ss_free(w);
 		return err;
+	}
 	if (format == SS_DEM_GDAL) {
 		close(fd);   /* the name is ours; GDAL rewrites the file */
-		err = ss_dem_write_gdal(tmp, path, r);
-	} else {
-		FILE *f = fdopen(fd, "wb");
-		if (!f) {
-			close(fd);
-			err = ss_error_fail("cannot write '%s': %s", path, strerror(errno));
-		} else {
-			err = format == SS_DEM_ASC ? ss_dem_write_asc(f, path, r)
-			                           : ss_dem_write_png(f, path, r);
-			/* complete on disk before it takes the name */
-			if (!err && (fflush(f) || fsync(fileno(f))))
-				err = ss_error_fail("cannot write '%s': %s", path, strerror(errno));
-			if (fclose(f) && !err)
-				err = ss_error_fail("cannot write '%s': %s", path, strerror(errno));
-		}
+	} else if (!(w->f = fdopen(fd, "wb"))) {
+		close(fd);
+		err = ss_error_fail("cannot write '%s': %s", path, strerror(errno));
 	}
-	if (!err && rename(tmp, path))
-		err = ss_error_input("cannot write '%s': cannot rename the finished temporary file "
-		                     "'%s' to it: %s", path, tmp, strerror(errno));
-	if (err)
-		unlink(tmp);
-	return err;
+	if (!err)
+		err = format == SS_DEM_ASC ? ss_dem_asc_begin(w)
+		    : format == SS_DEM_PNG ? ss_dem_png_begin(w) : ss_dem_gdal_begin(w);
+	if (err) {
+		w->err = err;
+		ss_dem_writer_close(&w, 0);
+		return err;
+	}
+	*wp = w;
+	return SS_OK;
+}
+
+int ss_dem_writer_put(struct ss_dem_writer *w, const double *values, const uint8_t *nodata,
+                      int rows)
+{
+	const int nx = w->head->nx;
+	if (w->line + rows > w->head->ny)
+		SS_BUG("ss_dem_writer_put: %d rows past the raster's %d", w->line + rows, w->head->ny);
+	for (int k = 0; k < rows && !w->err; k++, w->line++) {
+		const double *v = values + (size_t)k * nx;
+		const uint8_t *none = nodata ? nodata + (size_t)k * nx : NULL;
+		for (int i = 0; i < nx; i++)
+			w->row[i] = none && none[i] ? w->nodata : v[i];
+		for (int i = 0; i < nx && !w->err; i++)
+			if (!(none && none[i]) && !isfinite(v[i]))
+				w->err = ss_error_fail("cannot write '%s': height %g at column %d, row %d "
+				                       "(from the south) is not finite", w->path, v[i],
+				                       i + 1, w->head->ny - w->line);
+		if (w->err)
+			break;
+		w->err = w->format == SS_DEM_ASC ? ss_dem_asc_rows(w, w->row, 1)
+		       : w->format == SS_DEM_PNG ? ss_dem_png_rows(w, v, none, 1)
+		                                 : ss_dem_gdal_rows(w, w->row, 1);
+	}
+	return w->err;
+}
+
+int ss_dem_write(const char *path, enum ss_dem_format format, const struct ss_raster *r)
+{
+	if (!r->values || r->nx < 1 || r->ny < 1 || r->row_first != 0 || r->rows != r->ny)
+		SS_BUG("ss_dem_write: not a whole raster (rows %d + %d of %d)", r->row_first, r->rows,
+		       r->ny);
+	struct ss_dem_summary s;
+	ss_dem_summarize(r, &s);
+	struct ss_dem_writer *w;
+	int err = ss_dem_writer_open(&w, path, format, r, &s);
+	for (int j = r->ny - 1; j >= 0 && !err; j--)   /* north row first */
+		err = ss_dem_writer_put(w, r->values + (size_t)j * r->nx,
+		                        r->nodata ? r->nodata + (size_t)j * r->nx : NULL, 1);
+	const int closed = ss_dem_writer_close(&w, !err);
+	return err ? err : closed;
 }

@@ -18,49 +18,69 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/stat.h>
 
 #include "sandslide/error.h"
 
-/* A cursor over text that knows its line. */
+/* A cursor over a file that knows its line: the text is streamed through
+ * stdio's buffer, never held whole, so that a rank reads its window of a
+ * grid of any size in bounded memory.  A token read ahead (the header's
+ * end is the first number) is kept in `ahead`. */
 struct scan {
-	const char *s;
+	FILE *f;
 	int line;
+	char ahead[128];
+	int has_ahead;
 };
 
-/* Next white-space separated token into buf; 0 at the end of the text. */
+/* Next white-space separated token into buf (cut at size - 1 characters);
+ * 0 at the end of the file. */
 static int next_token(struct scan *sc, char *buf, size_t size)
 {
-	while (*sc->s && isspace((unsigned char)*sc->s)) {
-		if (*sc->s == '\n')
-			sc->line++;
-		sc->s++;
+	if (sc->has_ahead) {
+		snprintf(buf, size, "%s", sc->ahead);
+		sc->has_ahead = 0;
+		return 1;
 	}
-	if (!*sc->s)
+	int c;
+	while ((c = getc_unlocked(sc->f)) != EOF && isspace(c)) {
+		if (c == '\n')
+			sc->line++;
+	}
+	if (c == EOF)
 		return 0;
 	size_t n = 0;
-	while (*sc->s && !isspace((unsigned char)*sc->s)) {
+	do {
 		if (n + 1 < size)
-			buf[n++] = *sc->s;
-		sc->s++;
-	}
+			buf[n++] = (char)c;
+	} while ((c = getc_unlocked(sc->f)) != EOF && !isspace(c));
+	if (c == '\n')
+		ungetc(c, sc->f);   /* counted by the next call */
 	buf[n] = '\0';
 	return 1;
 }
 
-/* White-space separated tokens from s on, counting up to limit. */
-static size_t count_tokens(const char *s, size_t limit)
+/* Skip n tokens (rows outside the window: not converted, not checked);
+ * the number skipped, fewer at the end of the file. */
+static size_t skip_tokens(struct scan *sc, size_t n)
 {
-	size_t n = 0;
-	while (n < limit) {
-		while (*s && isspace((unsigned char)*s))
-			s++;
-		if (!*s)
-			break;
-		n++;
-		while (*s && !isspace((unsigned char)*s))
-			s++;
+	size_t done = 0;
+	if (n > 0 && sc->has_ahead) {
+		sc->has_ahead = 0;
+		done++;
 	}
-	return n;
+	int c = ' ';
+	while (done < n) {
+		while ((c = getc_unlocked(sc->f)) != EOF && isspace(c))
+			sc->line += c == '\n';
+		if (c == EOF)
+			break;
+		while ((c = getc_unlocked(sc->f)) != EOF && !isspace(c)) {
+		}
+		sc->line += c == '\n';
+		done++;
+	}
+	return done;
 }
 
 static int to_double(const char *t, double *v)
@@ -71,43 +91,6 @@ static int to_double(const char *t, double *v)
 	/* ERANGE on underflow still gives the nearest double: only overflow
 	 * (an infinite result from finite digits) is refused */
 	return end != t && *end == '\0' && !(errno == ERANGE && isinf(*v)) ? 0 : -1;
-}
-
-static char *read_text(const char *path, const char *context, int *err)
-{
-	FILE *f = fopen(path, "rb");
-	if (!f) {
-		*err = ss_error_input_at(context, "cannot open '%s': %s", path, strerror(errno));
-		return NULL;
-	}
-	char *text = NULL;
-	size_t size = 0, cap = 0;
-	for (;;) {
-		if (cap - size < 65536) {
-			cap = cap ? 2 * cap : 1 << 20;
-			char *grown = realloc(text, cap);
-			if (!grown) {
-				free(text);
-				fclose(f);
-				*err = ss_error_fail("out of memory reading '%s'", path);
-				return NULL;
-			}
-			text = grown;
-		}
-		size_t got = fread(text + size, 1, cap - size - 1, f);
-		size += got;
-		if (got == 0)
-			break;
-	}
-	int bad = ferror(f);
-	fclose(f);
-	if (bad) {
-		free(text);
-		*err = ss_error_input_at(context, "cannot read '%s'", path);
-		return NULL;
-	}
-	text[size] = '\0';
-	return text;
 }
 
 /* Header keys; the two spellings of a corner share a slot. */
@@ -143,13 +126,12 @@ static int read_header(struct scan *sc, const char *path, const char *context,
 	memset(h, 0, sizeof *h);
 	for (int k = 0; k < K_COUNT; k++)
 		h->val[k] = NAN;
-	const char *mark = sc->s;
-	int mark_line = sc->line;
 	while (next_token(sc, tok, sizeof tok)) {
 		if (!isalpha((unsigned char)tok[0]) || !strcasecmp(tok, "nan") ||
 		    !strcasecmp(tok, "inf") || !strcasecmp(tok, "infinity")) {
-			sc->s = mark;   /* the first value: rewind */
-			sc->line = mark_line;
+			/* the first value: kept for read_values */
+			snprintf(sc->ahead, sizeof sc->ahead, "%s", tok);
+			sc->has_ahead = 1;
 			break;
 		}
 		snprintf(key, sizeof key, "%s", tok);
@@ -172,8 +154,6 @@ static int read_header(struct scan *sc, const char *path, const char *context,
 		h->line[k] = key_line;
 		h->center[k] = is_center;
 		h->val[k] = v;
-		mark = sc->s;
-		mark_line = sc->line;
 	}
 	return SS_OK;
 }
@@ -217,20 +197,19 @@ static int apply_header(const struct asc_header *h, const char *path, const char
 	return SS_OK;
 }
 
-/* One value of the grid, file row `row` (north first), column i, into r;
- * a NODATA_value marks the cell. */
+/* One value of the grid, file row `row` (north first), column i, into r
+ * (whose window holds that row); a NODATA_value marks the cell. */
 static int store_value(struct ss_raster *r, const char *tok, int line, int row, int i,
                        const char *path, const char *context)
 {
-	const size_t n = (size_t)r->nx * (size_t)r->ny;
-	const size_t m = (size_t)(r->ny - 1 - row) * r->nx + i;
+	const size_t m = (size_t)(r->ny - 1 - row - r->row_first) * r->nx + i;
 	const double nodata = r->nodata_value;
 	double v;
 	if (to_double(tok, &v))
 		return ss_error_input_at(context, "%s:%d: '%s' (row %d, column %d) is not a number",
 		                         path, line, tok, row + 1, i + 1);
 	if (r->has_nodata_value && (v == nodata || (isnan(v) && isnan(nodata)))) {
-		if (!r->nodata && !(r->nodata = ss_alloc(n, 1, "nodata flags")))
+		if (!r->nodata && !(r->nodata = ss_alloc(ss_raster_cells(r), 1, "nodata flags")))
 			return SS_ERR_FAIL;
 		r->nodata[m] = 1;
 		v = 0.0;
@@ -243,28 +222,45 @@ static int store_value(struct ss_raster *r, const char *tok, int line, int row, 
 	return SS_OK;
 }
 
-/* The nrows x ncols values after the header, north row first; exactly
- * that many. */
-static int read_values(struct scan *sc, const char *path, const char *context,
-                       struct ss_raster *r)
+/* The values after the header, north row first: the window's rows kept,
+ * the rows north of it skipped, the file read no further than the window
+ * unless it ends at the south row, when exactly nrows x ncols values must
+ * follow. */
+static int read_values(struct scan *sc, off_t file_bytes, const char *path,
+                       const char *context, struct ss_raster *r)
 {
 	char tok[128];
-	/* a short file is refused before the heights are allocated: a header
-	 * of a few bytes must not claim gigabytes */
 	const size_t n = (size_t)r->nx * (size_t)r->ny;
-	const size_t given = count_tokens(sc->s, n);
-	if (given < n)
+	/* a header of a few bytes must not claim gigabytes: n values need at
+	 * least 2 n - 1 bytes, and a shorter file is counted (it is small)
+	 * and refused before the heights are allocated */
+	if ((double)file_bytes < 2.0 * (double)n - 1.0) {
+		const size_t given = skip_tokens(sc, n);
 		return ss_error_input_at(context, "%s: ends after %zu of %d x %d values", path, given,
 		                         r->nx, r->ny);
-	if (!(r->values = ss_alloc(n, sizeof(double), "raster heights")))
+	}
+	if (!(r->values = ss_alloc(ss_raster_cells(r) ? ss_raster_cells(r) : 1, sizeof(double),
+	                           "raster heights")))
 		return SS_ERR_FAIL;
-	for (int row = 0; row < r->ny; row++) {
-		for (int i = 0; i < r->nx; i++) {
-			next_token(sc, tok, sizeof tok);   /* counted above */
-			const int err = store_value(r, tok, sc->line, row, i, path, context);
-			if (err)
-				return err;
-		}
+	const int north = r->ny - r->row_first - r->rows;   /* file rows before the window */
+	size_t given = skip_tokens(sc, (size_t)north * r->nx);
+	const size_t window_end = (size_t)(north + r->rows) * r->nx;
+	for (size_t k = (size_t)north * r->nx; given == k && k < window_end; k++) {
+		if (!next_token(sc, tok, sizeof tok))
+			break;
+		given++;
+		const int err = store_value(r, tok, sc->line, (int)(k / r->nx), (int)(k % r->nx),
+		                            path, context);
+		if (err)
+			return err;
+	}
+	if (r->row_first > 0 && given == window_end)
+		return SS_OK;   /* the window ends north of the last row: the rank
+		                   holding the south rows checks the file's end */
+	if (given < n) {
+		given += skip_tokens(sc, n - given);
+		return ss_error_input_at(context, "%s: ends after %zu of %d x %d values", path, given,
+		                         r->nx, r->ny);
 	}
 	if (next_token(sc, tok, sizeof tok))
 		return ss_error_input_at(context, "%s:%d: more values than ncols x nrows = %d x %d",
@@ -275,17 +271,23 @@ static int read_values(struct scan *sc, const char *path, const char *context,
 int ss_dem_read_asc(const char *path, const char *context, const struct ss_dem_read_options *opt,
                     struct ss_raster *r)
 {
-	(void)opt;   /* the cell size option is checked by dem.c */
-	int err = SS_OK;
-	char *text = read_text(path, context, &err);
-	if (!text)
-		return err;
-	struct scan sc = {text, 1};
+	FILE *f = fopen(path, "rb");
+	if (!f)
+		return ss_error_input_at(context, "cannot open '%s': %s", path, strerror(errno));
+	struct stat sb;
+	const off_t bytes = fstat(fileno(f), &sb) == 0 ? sb.st_size : 0;
+	struct scan sc = {.f = f, .line = 1};
 	struct asc_header h;
-	if (!(err = read_header(&sc, path, context, &h)) &&
-	    !(err = apply_header(&h, path, context, r)))
-		err = read_values(&sc, path, context, r);
-	free(text);
+	int err = read_header(&sc, path, context, &h);
+	if (!err)
+		err = apply_header(&h, path, context, r);
+	if (!err)
+		err = ss_dem_window(opt, path, context, r);
+	if (!err && r->rows > 0)
+		err = read_values(&sc, bytes, path, context, r);
+	if (!err && ferror(f))
+		err = ss_error_input_at(context, "cannot read '%s': %s", path, strerror(errno));
+	fclose(f);
 	return err;
 }
 
@@ -302,17 +304,14 @@ static const char *exact(double x, char buf[32])
 	return buf;
 }
 
-int ss_dem_write_asc(FILE *f, const char *path, const struct ss_raster *r)
+int ss_dem_asc_begin(struct ss_dem_writer *w)
 {
+	const struct ss_raster *r = w->head;
+	FILE *f = w->f;
 	const double dx = r->cellsize, dy = ss_dem_dy(r);
 	if (!(dx > 0.0 && dy > 0.0))
 		return ss_error_input("cannot write '%s' as an ESRI ASCII grid: the cell size is "
-		                      "unknown (the input did not give one)", path);
-	int has_nodata;
-	double nodata;
-	int err = ss_dem_pick_nodata(r, path, 0, &has_nodata, &nodata);
-	if (err)
-		return err;
+		                      "unknown (the input did not give one)", w->path);
 	/* an unknown corner is written as the origin */
 	const double x0 = isnan(r->x0) ? 0.0 : r->x0, y0 = isnan(r->y0) ? 0.0 : r->y0;
 	char u[32], v[32];
@@ -326,17 +325,24 @@ int ss_dem_write_asc(FILE *f, const char *path, const struct ss_raster *r)
 		fprintf(f, "cellsize %s\n", exact(dx, u));
 	else
 		fprintf(f, "dx %s\ndy %s\n", exact(dx, u), exact(dy, v));
-	if (has_nodata)
-		fprintf(f, "NODATA_value %s\n", exact(nodata, u));
-	for (int j = r->ny - 1; j >= 0; j--) {
-		const double *row = r->values + (size_t)j * r->nx;
-		const uint8_t *flag = r->nodata ? r->nodata + (size_t)j * r->nx : NULL;
-		for (int i = 0; i < r->nx; i++)
-			fprintf(f, i ? " %.17g" : "%.17g", flag && flag[i] ? nodata : row[i]);
-		if (putc('\n', f) == EOF)
+	if (w->has_nodata)
+		fprintf(f, "NODATA_value %s\n", exact(w->nodata, u));
+	if (ferror(f))
+		return ss_error_fail("cannot write '%s': %s", w->path, strerror(errno));
+	return SS_OK;
+}
+
+int ss_dem_asc_rows(struct ss_dem_writer *w, const double *values, int rows)
+{
+	const int nx = w->head->nx;
+	for (int k = 0; k < rows; k++) {
+		const double *row = values + (size_t)k * nx;
+		for (int i = 0; i < nx; i++)
+			fprintf(w->f, i ? " %.17g" : "%.17g", row[i]);
+		if (putc('\n', w->f) == EOF)
 			break;
 	}
-	if (ferror(f))
-		return ss_error_fail("cannot write '%s': %s", path, strerror(errno));
+	if (ferror(w->f))
+		return ss_error_fail("cannot write '%s': %s", w->path, strerror(errno));
 	return SS_OK;
 }

@@ -141,7 +141,7 @@ static int refuse_degrees(const char *path, const char *context, const char *crs
 }
 
 static int read_dataset(GDALDatasetH ds, const char *path, const char *context,
-                        struct ss_raster *r)
+                        const struct ss_dem_read_options *opt, struct ss_raster *r)
 {
 	const int bands = GDALGetRasterCount(ds);
 	if (bands != 1)
@@ -187,14 +187,28 @@ static int read_dataset(GDALDatasetH ds, const char *path, const char *context,
 
 	r->nx = nx;
 	r->ny = ny;
-	const size_t n = (size_t)nx * (size_t)ny;
+	int err = ss_dem_window(opt, path, context, r);
+	if (err || r->rows == 0)
+		return err;
+	const size_t n = ss_raster_cells(r);
+	const int rows = r->rows, file_first = ny - r->row_first - rows;   /* north first */
 	r->values = ss_alloc(n, sizeof(double), "raster heights");
 	if (!r->values)
 		return SS_ERR_FAIL;
-	if (GDALRasterIO(band, GF_Read, 0, 0, nx, ny, r->values, nx, ny, GDT_Float64, 0, 0) !=
-	    CE_None)
-		return ss_error_input_at(context, "cannot read the heights of '%s': %s", path,
-		                         gdal_message());
+	/* the window in runs of whole blocks (strips or tiles) of the file, so
+	 * that GDAL decodes each block once and holds a few in its cache */
+	int block_nx = 0, block_ny = 0;
+	GDALGetBlockSize(band, &block_nx, &block_ny);
+	const int run = block_ny > 0 ? block_ny * ((256 + block_ny - 1) / block_ny) : 256;
+	for (int a = file_first; a < file_first + rows;) {
+		const int b = (a / run + 1) * run < file_first + rows ? (a / run + 1) * run
+		                                                      : file_first + rows;
+		if (GDALRasterIO(band, GF_Read, 0, a, nx, b - a, r->values + (size_t)(a - file_first) * nx,
+		                 nx, b - a, GDT_Float64, 0, 0) != CE_None)
+			return ss_error_input_at(context, "cannot read the heights of '%s': %s", path,
+			                         gdal_message());
+		a = b;
+	}
 	for (size_t k = 0; k < n; k++) {   /* still north row first */
 		const double v = r->values[k];
 		if (has_nodata && (v == nodata || (isnan(v) && isnan(nodata)))) {
@@ -209,12 +223,13 @@ static int read_dataset(GDALDatasetH ds, const char *path, const char *context,
 			return ss_error_input_at(context, "%s: height %g at row %zu, column %zu (from the "
 			                         "north-west) is not finite: heights must be finite numbers "
 			                         "(mark missing cells with the band's nodata value)", path,
-			                         h, k / (size_t)nx + 1, k % (size_t)nx + 1);
+			                         h, k / (size_t)nx + 1 + (size_t)file_first,
+			                         k % (size_t)nx + 1);
 		r->values[k] = h;
 	}
-	flip_rows(r->values, nx, ny);
+	flip_rows(r->values, nx, rows);
 	if (r->nodata) {
-		for (int a = 0, b = ny - 1; a < b; a++, b--) {
+		for (int a = 0, b = rows - 1; a < b; a++, b--) {
 			uint8_t *p = r->nodata + (size_t)a * nx, *q = r->nodata + (size_t)b * nx;
 			for (int i = 0; i < nx; i++) {
 				const uint8_t t = p[i];
@@ -229,7 +244,6 @@ static int read_dataset(GDALDatasetH ds, const char *path, const char *context,
 int ss_dem_read_gdal(const char *path, const char *context, const struct ss_dem_read_options *opt,
                      struct ss_raster *r)
 {
-	(void)opt;   /* the cell size option is checked by dem.c */
 	gdal_start();
 	int err;
 	GDALDatasetH ds = GDALOpenEx(path, GDAL_OF_RASTER | GDAL_OF_READONLY, NULL, NULL, NULL);
@@ -237,16 +251,22 @@ int ss_dem_read_gdal(const char *path, const char *context, const struct ss_dem_
 		err = ss_error_input_at(context, "cannot read '%s' as a GDAL raster: %s; expected "
 		                        SS_DEM_ACCEPTED_READ, path, gdal_message());
 	} else {
-		err = read_dataset(ds, path, context, r);
+		err = read_dataset(ds, path, context, opt, r);
 		GDALClose(ds);
 	}
 	CPLPopErrorHandler();
 	return err;
 }
 
-static int write_dataset(GDALDatasetH ds, const char *path, const struct ss_raster *r)
+/* The side of a GeoTIFF's tiles, cells. */
+#define GDAL_TILE 256
+
+/* The geotransform, CRS and nodata value of the new dataset. */
+static int write_metadata(GDALDatasetH ds, const struct ss_dem_writer *w)
 {
-	const int nx = r->nx, ny = r->ny;
+	const struct ss_raster *r = w->head;
+	const char *path = w->path;
+	const int ny = r->ny;
 	double gt[6] = {0};
 	if (r->has_geotransform) {
 		memcpy(gt, r->geotransform, sizeof gt);
@@ -261,55 +281,78 @@ static int write_dataset(GDALDatasetH ds, const char *path, const struct ss_rast
 	if (r->crs_wkt && GDALSetProjection(ds, r->crs_wkt) != CE_None)
 		return ss_error_input("cannot write '%s': the CRS is not one GDAL accepts: %s", path,
 		                      gdal_message());
-
 	GDALRasterBandH band = GDALGetRasterBand(ds, 1);
-	int has_nodata;
-	double nodata;
-	int err = ss_dem_pick_nodata(r, path, 1, &has_nodata, &nodata);
-	if (err)
-		return err;
-	if (has_nodata && GDALSetRasterNoDataValue(band, nodata) != CE_None)
+	if (w->has_nodata && GDALSetRasterNoDataValue(band, w->nodata) != CE_None)
 		return ss_error_fail("cannot write '%s': nodata value: %s", path, gdal_message());
-	double *row = ss_alloc((size_t)nx, sizeof(double), "a raster row");
-	if (!row)
-		return SS_ERR_FAIL;
-	for (int line = 0; line < ny && !err; line++) {   /* north row first */
-		const size_t j = (size_t)(ny - 1 - line);
-		for (int i = 0; i < nx; i++)
-			row[i] = r->nodata && r->nodata[j * nx + i] ? nodata : r->values[j * nx + i];
-		if (GDALRasterIO(band, GF_Write, 0, line, nx, 1, row, nx, 1, GDT_Float64, 0, 0) != CE_None)
-			err = ss_error_fail("cannot write '%s': %s", path, gdal_message());
-	}
-	ss_free(row);
-	return err;
+	return SS_OK;
 }
 
-int ss_dem_write_gdal(const char *tmp, const char *path, const struct ss_raster *r)
+int ss_dem_gdal_begin(struct ss_dem_writer *w)
 {
+	const struct ss_raster *r = w->head;
 	gdal_start();
 	int err = SS_OK;
 	GDALDriverH drv = GDALGetDriverByName("GTiff");
 	if (!drv) {
-		err = ss_error_input("cannot write '%s': this GDAL has no GTiff driver", path);
+		err = ss_error_input("cannot write '%s': this GDAL has no GTiff driver", w->path);
 		goto out;
 	}
-	/* lossless: deflate with the floating-point predictor */
+	/* lossless: deflate with the floating-point predictor; in tiles, so
+	 * that a reader's window (dem.h) decodes only its rows, and so that
+	 * the writer holds one row of tiles (flushed when complete) */
 	char **options = NULL;
+	char block[16];
+	snprintf(block, sizeof block, "%d", GDAL_TILE);
 	options = CSLSetNameValue(options, "COMPRESS", "DEFLATE");
 	options = CSLSetNameValue(options, "PREDICTOR", "3");
 	options = CSLSetNameValue(options, "BIGTIFF", "IF_SAFER");
-	GDALDatasetH ds = GDALCreate(drv, tmp, r->nx, r->ny, 1, GDT_Float64, options);
+	options = CSLSetNameValue(options, "TILED", "YES");
+	options = CSLSetNameValue(options, "BLOCKXSIZE", block);
+	options = CSLSetNameValue(options, "BLOCKYSIZE", block);
+	GDALDatasetH ds = GDALCreate(drv, w->tmp, r->nx, r->ny, 1, GDT_Float64, options);
 	CSLDestroy(options);
 	if (!ds) {
-		err = ss_error_input("cannot write '%s': %s", path, gdal_message());
+		err = ss_error_input("cannot write '%s': %s", w->path, gdal_message());
 		goto out;
 	}
-	err = write_dataset(ds, path, r);
-	CPLErrorReset();
-	GDALClose(ds);   /* flushes: a failure here is a failed write */
-	if (!err && CPLGetLastErrorType() >= CE_Failure)
-		err = ss_error_fail("cannot write '%s': %s", path, gdal_message());
+	w->state = ds;
+	err = write_metadata(ds, w);
 out:
+	CPLPopErrorHandler();
+	return err;
+}
+
+int ss_dem_gdal_rows(struct ss_dem_writer *w, const double *values, int rows)
+{
+	GDALRasterBandH band = GDALGetRasterBand(w->state, 1);
+	gdal_start();
+	int err = SS_OK;
+	if (GDALRasterIO(band, GF_Write, 0, w->line, w->head->nx, rows, (void *)values,
+	                 w->head->nx, rows, GDT_Float64, 0, 0) != CE_None)
+		err = ss_error_fail("cannot write '%s': %s", w->path, gdal_message());
+	/* a row of tiles complete: to the file, out of GDAL's cache (which
+	 * would otherwise keep up to 5 % of the machine's memory of them) */
+	const int done = w->line + rows;
+	if (!err && done / GDAL_TILE != w->line / GDAL_TILE && done < w->head->ny) {
+		GDALFlushCache(w->state);
+		if (CPLGetLastErrorType() >= CE_Failure)
+			err = ss_error_fail("cannot write '%s': %s", w->path, gdal_message());
+	}
+	CPLPopErrorHandler();
+	return err;
+}
+
+int ss_dem_gdal_end(struct ss_dem_writer *w)
+{
+	if (!w->state)
+		return SS_OK;
+	gdal_start();
+	CPLErrorReset();
+	GDALClose(w->state);   /* flushes: a failure here is a failed write */
+	w->state = NULL;
+	int err = SS_OK;
+	if (CPLGetLastErrorType() >= CE_Failure)
+		err = ss_error_fail("cannot write '%s': %s", w->path, gdal_message());
 	CPLPopErrorHandler();
 	return err;
 }
@@ -329,10 +372,22 @@ int ss_dem_read_gdal(const char *path, const char *context, const struct ss_dem_
 	SS_BUG("GDAL reader called in a build without GDAL");
 }
 
-int ss_dem_write_gdal(const char *tmp, const char *path, const struct ss_raster *r)
+int ss_dem_gdal_begin(struct ss_dem_writer *w)
 {
-	(void)tmp, (void)path, (void)r;
+	(void)w;
 	SS_BUG("GDAL writer called in a build without GDAL");
+}
+
+int ss_dem_gdal_rows(struct ss_dem_writer *w, const double *values, int rows)
+{
+	(void)w, (void)values, (void)rows;
+	SS_BUG("GDAL writer called in a build without GDAL");
+}
+
+int ss_dem_gdal_end(struct ss_dem_writer *w)
+{
+	(void)w;
+	return SS_OK;
 }
 
 #endif

@@ -25,21 +25,43 @@ int ss_dem_read_gdal(const char *path, const char *context,
 /* 1 if GDAL has a driver that recognises path (quietly), else 0. */
 int ss_dem_gdal_identify(const char *path);
 
-/* Writers: write to tmp (already created, empty), which dem.c renames to
- * path when they return SS_OK.  Messages name path, not tmp. */
-int ss_dem_write_asc(FILE *f, const char *path, const struct ss_raster *r);
-int ss_dem_write_png(FILE *f, const char *path, const struct ss_raster *r);
-int ss_dem_write_gdal(const char *tmp, const char *path, const struct ss_raster *r);
+/* The window of opt (dem.h) into r->row_first and r->rows, once the
+ * reader knows r->ny: the whole raster when opt->rows < 0, else checked
+ * against r->ny (SS_ERR_INPUT naming spec). */
+int ss_dem_window(const struct ss_dem_read_options *opt, const char *spec,
+                  const char *context, struct ss_raster *r);
 
-/* The value to write for nodata cells: r's nodata value when no valid cell
- * holds it (and it is not NaN, unless allow_nan), else the first of -9999,
- * -99999, -1e30 that none holds.  *has is 0 when r has neither flags nor a
- * nodata value (write none). */
-int ss_dem_pick_nodata(const struct ss_raster *r, const char *path, int allow_nan, int *has,
-                       double *value);
+/* Cells held: nx * rows. */
+size_t ss_raster_cells(const struct ss_raster *r);
 
-/* SS_ERR_FAIL naming the first cell with data whose value is not finite. */
-int ss_dem_check_finite(const struct ss_raster *r, const char *path);
+/* A write in progress (dem.h's streamed writing): the file is written to
+ * tmp (created empty), which takes path's name when complete. */
+struct ss_dem_writer {
+	enum ss_dem_format format;
+	char path[4096], tmp[4096];
+	const struct ss_raster *head;   /* size, geometry, metadata */
+	int has_nodata;                 /* write a nodata value: */
+	double nodata;                  /*   this one, for cells without data */
+	double zmin, zmax;              /* PNG: heights of grey 1 and 65535 */
+	int line;                       /* file rows written, north first */
+	int err;                        /* the first failure */
+	FILE *f;                        /* ESRI ASCII, PNG */
+	void *state;                    /* the format's own (libpng, GDAL) */
+	double *row;                    /* one row as written */
+};
+
+/* The formats' writers: begin (the header), rows (the next rows, north
+ * first, values with nodata cells already set to w->nodata), end (finish
+ * and free the state, also after a failure).  Messages name w->path. */
+int ss_dem_asc_begin(struct ss_dem_writer *w);
+int ss_dem_asc_rows(struct ss_dem_writer *w, const double *values, int rows);
+int ss_dem_png_begin(struct ss_dem_writer *w);
+int ss_dem_png_rows(struct ss_dem_writer *w, const double *values, const uint8_t *nodata,
+                    int rows);
+int ss_dem_png_end(struct ss_dem_writer *w);
+int ss_dem_gdal_begin(struct ss_dem_writer *w);
+int ss_dem_gdal_rows(struct ss_dem_writer *w, const double *values, int rows);
+int ss_dem_gdal_end(struct ss_dem_writer *w);
 
 /* Cell sizes to write: cellsize and cellsize_y (cellsize_y NAN: cellsize). */
 double ss_dem_dy(const struct ss_raster *r);

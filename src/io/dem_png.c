@@ -52,6 +52,12 @@ struct png_job {
 	char message[ERROR_SIZE]; /* libpng's error */
 	uint8_t *pixels;         /* big-endian 16-bit samples, north row first */
 	png_bytep *rows;         /* row pointers into pixels */
+	uint8_t *skip;           /* a row outside the window */
+	png_uint_32 first, held; /* pixels holds file rows first .. first + held - 1
+	                            (north first): the window asked for, or the
+	                            whole image of an interlaced PNG */
+	long long want_first, want_rows; /* the window asked for (dem.h: rows
+	                            from the south; want_rows < 0 the whole) */
 	double file_bytes;       /* size of the file */
 	png_uint_32 width, height;
 	int bit_depth, color_type;
@@ -95,16 +101,38 @@ static int decode(png_structp png, png_infop info, png_infop end, FILE *f, struc
 	 * rows, each with its filter byte, must fit in what the file can hold */
 	if ((double)job->height * (1.0 + 2.0 * job->width) > DEFLATE_MAX_RATIO * job->file_bytes)
 		return DECODE_TOO_SHORT;
-	png_set_interlace_handling(png);
+	/* the window's rows only, decoded row by row; Adam7 spreads every
+	 * row over seven passes, so an interlaced image is held whole */
+	const int passes = png_set_interlace_handling(png);
 	png_read_update_info(png, info);
+	job->first = 0;
+	job->held = job->height;
+	if (passes == 1 && job->want_rows >= 0 && job->want_first >= 0 &&
+	    job->want_first + job->want_rows <= (long long)job->height) {
+		job->first = (png_uint_32)(job->height - job->want_first - job->want_rows);
+		job->held = (png_uint_32)job->want_rows;
+	}
 	const size_t row_bytes = 2 * (size_t)job->width;
-	job->pixels = ss_alloc((size_t)job->height, row_bytes, "PNG pixels");
-	job->rows = ss_alloc((size_t)job->height, sizeof *job->rows, "PNG rows");
-	if (!job->pixels || !job->rows)
+	job->pixels = ss_alloc(job->held ? job->held : 1, row_bytes, "PNG pixels");
+	job->rows = ss_alloc(job->held ? job->held : 1, sizeof *job->rows, "PNG rows");
+	uint8_t *skip = passes == 1 ? ss_alloc(1, row_bytes, "a PNG row") : NULL;
+	if (!job->pixels || !job->rows || (passes == 1 && !skip)) {
+		ss_free(skip);
 		return DECODE_NO_MEMORY;
-	for (png_uint_32 y = 0; y < job->height; y++)
+	}
+	for (png_uint_32 y = 0; y < job->held; y++)
 		job->rows[y] = job->pixels + y * row_bytes;
-	png_read_image(png, job->rows);
+	if (passes > 1) {
+		png_read_image(png, job->rows);
+	} else {
+		/* every row is decoded (the text chunks may follow the image), the
+		 * window's kept; on a libpng error skip is lost to the longjmp,
+		 * so it lives in the job */
+		job->skip = skip;
+		for (png_uint_32 y = 0; y < job->height; y++)
+			png_read_row(png, y >= job->first && y - job->first < job->held
+			                  ? job->rows[y - job->first] : skip, NULL);
+	}
 	png_read_end(png, end);   /* text chunks may also follow the image */
 	return DECODE_OK;
 }
@@ -171,6 +199,7 @@ static void reader_close(struct png_reader *rd)
 	                        rd->end ? &rd->end : NULL);
 	ss_free(rd->job.rows);
 	ss_free(rd->job.pixels);
+	ss_free(rd->job.skip);
 	if (rd->f)
 		fclose(rd->f);
 }
@@ -269,12 +298,13 @@ static int grey_map(const struct png_reader *rd, const struct ss_dem_read_option
 static int greys_to_heights(const struct png_reader *rd, const struct grey_map *g,
                             const char *path, const char *context, struct ss_raster *r)
 {
-	const size_t n = (size_t)r->nx * (size_t)r->ny;
-	if (!(r->values = ss_alloc(n, sizeof(double), "raster heights")))
+	const size_t n = ss_raster_cells(r);
+	if (!(r->values = ss_alloc(n ? n : 1, sizeof(double), "raster heights")))
 		return SS_ERR_FAIL;
-	for (int row = 0; row < r->ny; row++) {   /* north row first in the file */
-		const size_t j = (size_t)(r->ny - 1 - row);
-		const uint8_t *p = rd->job.rows[row];
+	const int north = r->ny - r->row_first - r->rows;   /* file rows before the window */
+	for (int row = north; row < north + r->rows; row++) {   /* north row first in the file */
+		const size_t j = (size_t)(r->ny - 1 - row - r->row_first);
+		const uint8_t *p = rd->job.rows[row - (int)rd->job.first];
 		for (int i = 0; i < r->nx; i++) {
 			const int grey = p[2 * i] << 8 | p[2 * i + 1];
 			if (grey == g->trns_grey || (grey == 0 && !g->given)) {
@@ -302,6 +332,8 @@ int ss_dem_read_png(const char *path, const char *context, const struct ss_dem_r
 	struct png_reader rd;
 	struct grey_map g;
 	int err = reader_open(&rd, path, context);
+	rd.job.want_first = opt->row_first;
+	rd.job.want_rows = opt->rows;
 	if (!err)
 		err = reader_decode(&rd, path, context);
 	if (!err)
@@ -317,7 +349,9 @@ int ss_dem_read_png(const char *path, const char *context, const struct ss_dem_r
 		r->cellsize_y = isnan(g.m.dy) ? g.m.dx : g.m.dy;
 		r->x0 = g.m.x0;
 		r->y0 = g.m.y0;
-		err = greys_to_heights(&rd, &g, path, context, r);
+		err = ss_dem_window(opt, path, context, r);
+		if (!err)
+			err = greys_to_heights(&rd, &g, path, context, r);
 	}
 	reader_close(&rd);
 	return err;
@@ -326,83 +360,54 @@ int ss_dem_read_png(const char *path, const char *context, const struct ss_dem_r
 /* ------------------------------------------------------------------ */
 /* writing                                                              */
 
-/* zmin, zmax: r's range if every value with data lies within it (to half
- * a grey level), else the data's own, so min and max come back exactly. */
-static void choose_range(const struct ss_raster *r, double *zmin, double *zmax)
-{
-	const size_t n = (size_t)r->nx * (size_t)r->ny;
-	double lo = INFINITY, hi = -INFINITY;
-	for (size_t k = 0; k < n; k++) {
-		if (!r->nodata || !r->nodata[k]) {
-			lo = fmin(lo, r->values[k]);
-			hi = fmax(hi, r->values[k]);
-		}
-	}
-	if (isinf(lo)) {   /* no cell has data */
-		*zmin = 0.0;
-		*zmax = 1.0;
-		return;
-	}
-	const double a = r->png_zmin, b = r->png_zmax;
-	if (isfinite(a) && isfinite(b) && a < b) {
-		const double half = 0.5 * (b - a) / 65534.0;
-		if (lo >= a - half && hi <= b + half) {
-			*zmin = a;
-			*zmax = b;
-			return;
-		}
-	}
-	*zmin = lo;
-	*zmax = hi;
-}
-
+/* A PNG being written: libpng's structures and one row of samples. */
 struct png_out {
 	char message[ERROR_SIZE];
-	const struct ss_raster *r;
-	double zmin, zmax;
-	png_textp text;
-	int text_count;
+	png_structp png;
+	png_infop info;
 	uint8_t *row;   /* one row of big-endian samples */
 };
 
-static int encode(png_structp png, png_infop info, FILE *f, struct png_out *o)
+static int encode_header(struct png_out *o, FILE *f, const struct ss_raster *r,
+                         png_textp text, int text_count)
 {
-	if (setjmp(png_jmpbuf(png)))
+	if (setjmp(png_jmpbuf(o->png)))
 		return -1;
-	const struct ss_raster *r = o->r;
-	png_init_io(png, f);
-	png_set_IHDR(png, info, (png_uint_32)r->nx, (png_uint_32)r->ny, 16, PNG_COLOR_TYPE_GRAY,
-	             PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-	png_set_text(png, info, o->text, o->text_count);
+	png_init_io(o->png, f);
+	png_set_IHDR(o->png, o->info, (png_uint_32)r->nx, (png_uint_32)r->ny, 16,
+	             PNG_COLOR_TYPE_GRAY, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
+	             PNG_FILTER_TYPE_DEFAULT);
+	png_set_text(o->png, o->info, text, text_count);
 	png_color_16 transparent = {0};   /* grey 0: no data */
-	png_set_tRNS(png, info, NULL, 0, &transparent);
-	png_write_info(png, info);
-	/* the renderer's rounding: v = 1 + round((h - zmin) / (zmax - zmin) * 65534) */
-	const double to_steps = o->zmax > o->zmin ? 65534.0 / (o->zmax - o->zmin) : 0.0;
-	for (int j = r->ny - 1; j >= 0; j--) {   /* north row first */
-		const double *h = r->values + (size_t)j * r->nx;
-		const uint8_t *flag = r->nodata ? r->nodata + (size_t)j * r->nx : NULL;
-		for (int i = 0; i < r->nx; i++) {
-			long grey = 0;
-			if (!flag || !flag[i]) {
-				const double s = (h[i] - o->zmin) * to_steps;
-				grey = 1 + (s <= 0.0 ? 0 : s >= 65534.0 ? 65534 : (long)(s + 0.5));
-			}
-			o->row[2 * i] = (uint8_t)(grey >> 8);
-			o->row[2 * i + 1] = (uint8_t)(grey & 0xff);
-		}
-		png_write_row(png, o->row);
-	}
-	png_write_end(png, info);
+	png_set_tRNS(o->png, o->info, NULL, 0, &transparent);
+	png_write_info(o->png, o->info);
 	return 0;
 }
 
-int ss_dem_write_png(FILE *f, const char *path, const struct ss_raster *r)
+static int encode_row(struct png_out *o)
 {
-	struct png_out o;
-	memset(&o, 0, sizeof o);
-	o.r = r;
-	choose_range(r, &o.zmin, &o.zmax);
+	if (setjmp(png_jmpbuf(o->png)))
+		return -1;
+	png_write_row(o->png, o->row);
+	return 0;
+}
+
+static int encode_end(struct png_out *o)
+{
+	if (setjmp(png_jmpbuf(o->png)))
+		return -1;
+	png_write_end(o->png, o->info);
+	return 0;
+}
+
+int ss_dem_png_begin(struct ss_dem_writer *w)
+{
+	const struct ss_raster *r = w->head;
+	struct png_out *o = ss_alloc(1, sizeof *o, "a PNG writer");
+	if (!o)
+		return SS_ERR_FAIL;
+	memset(o, 0, sizeof *o);
+	w->state = o;
 
 	/* the renderer's gray16 chunks, then the geometry; numbers as "%.17g"
 	 * so they read back exactly */
@@ -415,8 +420,8 @@ int ss_dem_write_png(FILE *f, const char *path, const struct ss_raster *r)
 #define NUMBER(k, x) (snprintf(num[n], sizeof num[n], "%.17g", (x)), TEXT(k, num[n]))
 	TEXT("Software", "sandslide " SS_VERSION);
 	TEXT("style", "gray16");
-	NUMBER(KEY_ZMIN, o.zmin);
-	NUMBER(KEY_ZMAX, o.zmax);
+	NUMBER(KEY_ZMIN, w->zmin);
+	NUMBER(KEY_ZMAX, w->zmax);
 	TEXT("height_m", "zmin_m + (value - 1) * (zmax_m - zmin_m) / 65534 for value >= 1; "
 	                 "value 0: wall or no data (transparent)");
 	if (r->cellsize > 0.0)
@@ -437,21 +442,54 @@ int ss_dem_write_png(FILE *f, const char *path, const struct ss_raster *r)
 		text[a].text = (png_charp)values[a];
 		text[a].text_length = strlen(values[a]);
 	}
-	o.text = text;
-	o.text_count = n;
-
-	o.row = ss_alloc((size_t)r->nx, 2, "a PNG row");
-	if (!o.row)
+	o->row = ss_alloc((size_t)r->nx, 2, "a PNG row");
+	o->png = png_create_write_struct(PNG_LIBPNG_VER_STRING, o->message, on_error, on_warning);
+	o->info = o->png ? png_create_info_struct(o->png) : NULL;
+	if (!o->row)
 		return SS_ERR_FAIL;
+	if (!o->png || !o->info)
+		return ss_error_fail("cannot write '%s': out of memory in libpng", w->path);
+	if (encode_header(o, w->f, r, text, n))
+		return ss_error_fail("cannot write '%s': %s", w->path, o->message);
+	return SS_OK;
+}
+
+int ss_dem_png_rows(struct ss_dem_writer *w, const double *values, const uint8_t *nodata,
+                    int rows)
+{
+	struct png_out *o = w->state;
+	const int nx = w->head->nx;
+	/* the renderer's rounding: v = 1 + round((h - zmin) / (zmax - zmin) * 65534) */
+	const double to_steps = w->zmax > w->zmin ? 65534.0 / (w->zmax - w->zmin) : 0.0;
+	for (int k = 0; k < rows; k++) {
+		const double *h = values + (size_t)k * nx;
+		const uint8_t *flag = nodata ? nodata + (size_t)k * nx : NULL;
+		for (int i = 0; i < nx; i++) {
+			long grey = 0;
+			if (!flag || !flag[i]) {
+				const double s = (h[i] - w->zmin) * to_steps;
+				grey = 1 + (s <= 0.0 ? 0 : s >= 65534.0 ? 65534 : (long)(s + 0.5));
+			}
+			o->row[2 * i] = (uint8_t)(grey >> 8);
+			o->row[2 * i + 1] = (uint8_t)(grey & 0xff);
+		}
+		if (encode_row(o))
+			return ss_error_fail("cannot write '%s': %s", w->path, o->message);
+	}
+	return SS_OK;
+}
+
+int ss_dem_png_end(struct ss_dem_writer *w)
+{
+	struct png_out *o = w->state;
 	int err = SS_OK;
-	png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, o.message, on_error,
-	                                          on_warning);
-	png_infop info = png ? png_create_info_struct(png) : NULL;
-	if (!png || !info)
-		err = ss_error_fail("cannot write '%s': out of memory in libpng", path);
-	else if (encode(png, info, f, &o))
-		err = ss_error_fail("cannot write '%s': %s", path, o.message);
-	png_destroy_write_struct(png ? &png : NULL, info ? &info : NULL);
-	ss_free(o.row);
+	if (!o)
+		return SS_OK;
+	if (o->png && o->info && !w->err && w->line == w->head->ny && encode_end(o))
+		err = ss_error_fail("cannot write '%s': %s", w->path, o->message);
+	png_destroy_write_struct(o->png ? &o->png : NULL, o->info ? &o->info : NULL);
+	ss_free(o->row);
+	ss_free(o);
+	w->state = NULL;
 	return err;
 }

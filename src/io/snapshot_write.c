@@ -553,7 +553,7 @@ int ss_snapshot_create(struct ss_snapshot **out, const char *path,
 			ss_snapshot_destroy(s);
 			return SS_ERR_FAIL;
 		}
-		memcpy(s->nodata, meta->nodata + (size_t)g->offset_j * g->nx, cells);
+		memcpy(s->nodata, meta->nodata, cells);
 	}
 	if (write_static(s, cell_types, meta) || H5Fflush(s->file, H5F_SCOPE_GLOBAL) < 0) {
 		ss_snapshot_destroy(s);

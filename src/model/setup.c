@@ -96,16 +96,42 @@ static int rasterize(const struct ss_shape *shape, const struct ss_grid *g, uint
 
 /* ---- from a case ------------------------------------------------------ */
 
+/* This rank's rows of the raster `path`, which must be the grid's size
+ * (a window, dem.h: no rank holds the whole file).  The header is read
+ * first when there are other ranks, so that a file of another size is
+ * named as that; `what` ("initial file", "bedrock") names it. */
+static int read_slab(const char *path, const char *where, const char *what,
+                     const struct ss_grid *g, struct ss_raster *r)
+{
+	struct ss_dem_read_options o;
+	ss_dem_read_options_init(&o);
+	if (!ss_grid_is_whole(g)) {
+		o.rows = 0;
+		int err = ss_dem_read(path, where, &o, r);
+		if (!err && (r->nx != g->global_nx || r->ny != g->global_ny))
+			err = ss_error_input("%s: %s '%s' is %d x %d cells: expected the grid's "
+			                     "%lld x %lld (nx x ny)", where, what, path, r->nx, r->ny,
+			                     g->global_nx, g->global_ny);
+		ss_raster_release(r);
+		if (err)
+			return err;
+		o.row_first = (int)g->offset_j;
+		o.rows = g->ny;
+	}
+	int err = ss_dem_read(path, where, &o, r);
+	if (!err && (r->nx != g->global_nx || r->ny != g->global_ny))
+		err = ss_error_input("%s: %s '%s' is %d x %d cells: expected the grid's "
+		                     "%lld x %lld (nx x ny)", where, what, path, r->nx, r->ny,
+		                     g->global_nx, g->global_ny);
+	return err;
+}
+
 static int initial_heights(const struct ss_case *c, struct ss_stepper *st)
 {
 	const struct ss_grid *g = &st->grid;
 	if (c->initial == SS_INITIAL_FILE) {
 		struct ss_raster r;
-		int err = ss_dem_read(c->initial_file, c->initial_where, NULL, &r);
-		if (!err && (r.nx != g->global_nx || r.ny != g->global_ny))
-			err = ss_error_input("%s: initial file '%s' is %d x %d cells: expected the "
-			                     "grid's %lld x %lld (nx x ny)", c->initial_where,
-			                     c->initial_file, r.nx, r.ny, g->global_nx, g->global_ny);
+		int err = read_slab(c->initial_file, c->initial_where, "initial file", g, &r);
 		if (!err && !isnan(r.cellsize) &&
 		    (fabs(r.cellsize - g->dx) > 1e-9 * g->dx || fabs(r.cellsize - g->dy) > 1e-9 * g->dy))
 			err = ss_error_input("%s: initial file '%s' has cellsize %g m: expected the "
@@ -115,10 +141,10 @@ static int initial_heights(const struct ss_case *c, struct ss_stepper *st)
 			ss_raster_release(&r);
 			return err;
 		}
-		/* every rank reads the file and keeps its rows */
+		/* the window: this rank's rows */
 		for (int j = 0; j < g->ny; j++) {
 			for (int i = 0; i < g->nx; i++) {
-				const size_t m = (size_t)(g->offset_j + j) * g->nx + i;
+				const size_t m = (size_t)j * g->nx + i;
 				const ptrdiff_t k = ss_grid_index(g, i, j);
 				st->height[k] = r.values[m];
 				if (r.nodata && r.nodata[m] &&
@@ -154,19 +180,15 @@ static int load_bedrock(const struct ss_case *c, struct ss_stepper *st)
 {
 	const struct ss_grid *g = &st->grid;
 	struct ss_raster r;
-	int err = ss_dem_read(c->bedrock_file, c->bedrock_where, NULL, &r);
-	if (!err && (r.nx != g->global_nx || r.ny != g->global_ny))
-		err = ss_error_input("%s: bedrock '%s' is %d x %d cells: expected the grid's "
-		                     "%lld x %lld (nx x ny)", c->bedrock_where, c->bedrock_file,
-		                     r.nx, r.ny, g->global_nx, g->global_ny);
-	for (size_t m = 0; !err && r.nodata && m < (size_t)r.nx * r.ny; m++)
+	int err = read_slab(c->bedrock_file, c->bedrock_where, "bedrock", g, &r);
+	for (size_t m = 0; !err && r.nodata && m < (size_t)r.nx * r.rows; m++)
 		if (r.nodata[m])
 			err = ss_error_input("%s: bedrock '%s' has no data at cell (%d, %d): the "
 			                     "bedrock needs a value in every cell", c->bedrock_where,
 			                     c->bedrock_file, (int)(m % (size_t)r.nx),
-			                     (int)(m / (size_t)r.nx));
-	if (!err)   /* this rank's rows */
-		err = ss_stepper_set_bedrock(st, r.values + (size_t)g->offset_j * g->nx);
+			                     (int)(m / (size_t)r.nx) + r.row_first);
+	if (!err)   /* the window: this rank's rows */
+		err = ss_stepper_set_bedrock(st, r.values);
 	ss_raster_release(&r);
 	return err;
 }
@@ -240,14 +262,17 @@ int ss_setup_stepper(const struct ss_case *c, int tile_nx, int tile_ny,
 
 /* ---- from a raster ---------------------------------------------------- */
 
-/* The lowest height of the raster's cells with data: where sand leaves. */
+/* The lowest height of the raster's cells with data: where sand leaves.
+ * The minimum of the ranks' rows (exact in any order). */
 static int lowest_height(const struct ss_raster_setup *s, double *level)
 {
 	const struct ss_raster *r = s->heights;
-	*level = INFINITY;
-	for (size_t m = 0; m < (size_t)r->nx * r->ny; m++)
+	double minus_lowest = -INFINITY;
+	for (size_t m = 0; m < (size_t)r->nx * r->rows; m++)
 		if (!r->nodata || !r->nodata[m])
-			*level = fmin(*level, r->values[m]);
+			minus_lowest = fmax(minus_lowest, -r->values[m]);
+	ss_comm_reduce(&minus_lowest, 1, NULL, 0);
+	*level = -minus_lowest;
 	if (isinf(*level))
 		return ss_error_input("%s: every cell is nodata: nothing to relax", s->name);
 	return SS_OK;
@@ -259,7 +284,11 @@ static int fill_from_raster(const struct ss_raster_setup *s, struct ss_stepper *
 {
 	const struct ss_raster *r = s->heights;
 	const struct ss_grid g = st->grid;
-	const size_t first = (size_t)g.offset_j * g.nx;   /* every rank read the raster */
+	if (g.offset_j < r->row_first || g.offset_j + g.ny > r->row_first + r->rows)
+		SS_BUG("the raster holds rows %d + %d: not the slab's %lld + %d", r->row_first,
+		       r->rows, (long long)g.offset_j, g.ny);
+	/* the raster holds the slab's rows (a window) or more */
+	const size_t first = (size_t)(g.offset_j - r->row_first) * g.nx;
 	for (int j = 0; j < g.ny; j++) {
 		for (int i = 0; i < g.nx; i++) {
 			const size_t m = first + (size_t)j * g.nx + i;
@@ -270,8 +299,12 @@ static int fill_from_raster(const struct ss_raster_setup *s, struct ss_stepper *
 		}
 	}
 	/* agreed: the collective calls of prepare follow */
-	int err = ss_comm_agree(s->bedrock ? ss_stepper_set_bedrock(st, s->bedrock->values + first)
-	                                   : SS_OK);
+	const struct ss_raster *rock = s->bedrock;
+	if (rock && (g.offset_j < rock->row_first || g.offset_j + g.ny > rock->row_first + rock->rows))
+		SS_BUG("the bedrock holds rows %d + %d: not the slab's", rock->row_first, rock->rows);
+	int err = ss_comm_agree(rock ? ss_stepper_set_bedrock(st, rock->values + (size_t)(g.offset_j -
+	                                                      rock->row_first) * g.nx)
+	                             : SS_OK);
 	if (err || !s->pour)
 		return err;
 	uint8_t *mask = ss_alloc((size_t)g.nx * g.ny, 1, "sand source mask");

@@ -27,15 +27,15 @@ int ss_setup_stepper(const struct ss_case *c, int tile_nx, int tile_ny,
 struct ss_raster_setup {
 	const struct ss_model_options *model;
 	const char *name;                 /* the raster, for messages */
-	const struct ss_raster *heights;  /* the whole raster (each rank keeps
-	                                   * its rows) */
+	const struct ss_raster *heights;  /* this rank's rows at least (a
+	                                   * window, dem.h, or the whole) */
 	double dx;                        /* m; NaN: the raster's cell size */
 	enum ss_side_kind sides;          /* all four sides */
 	enum ss_cell_type nodata_type;    /* cells without data: wall or open */
 	double open_level;                /* m; NaN: the lowest height of the
 	                                   * raster (where an open side or cell
 	                                   * lets sand leave) */
-	const struct ss_raster *bedrock;  /* the same size, or NULL */
+	const struct ss_raster *bedrock;  /* the same size and rows, or NULL */
 	int tile_nx, tile_ny;             /* cells per tile; <= 0: relax's
 	                                   * defaults */
 	const struct ss_shape *pour;      /* sand poured from t = 0, or NULL: */
