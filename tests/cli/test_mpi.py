@@ -24,6 +24,18 @@ SANDSLIDE_MPI; `make MPI=1 test-mpi` builds it).
                    the XDMF sidecar
   relax            np = 3 equal to serial: .asc in and .asc out (the bytes,
                    and the --report but wall_seconds), .asc in and .h5 out
+  rasters          (builds with GDAL) a tiled GeoTIFF with nodata and a UTM
+                   CRS relaxed to GeoTIFF under np = 1..4 and without
+                   mpirun: the serial file's bytes, values, geotransform,
+                   CRS, nodata value and report; a VRT of 4 GeoTIFF tiles
+                   under np = 3: the serial relax of the one GeoTIFF; a
+                   GeoTIFF cut at 2000, 9000, 15000 bytes under np = 3: one
+                   message, exit 2, no hang; a 4096^2 GeoTIFF for one
+                   super-step: the largest rank's peak memory under np = 4
+                   at most 40 % of one rank's, the same output bytes;
+                   SIGTERM to relax under np = 4 paused after step 40: one
+                   message, stopped after step 41, the input unchanged, a
+                   readable .h5 ending with that step
   restart          np = 2 cut by a file-size limit (exit 1, one message, the
                    snapshots before it complete), continued by run --restart
                    under np = 3 to the end: every snapshot and the final
@@ -550,13 +562,7 @@ def test_relax_asc_under_3_ranks_is_the_serial_raster(tmp_path, serial_relax):
             where = f": max |dh| {np.abs(a - b).max()!r} at cell (i, j) = ({i}, {j})"
         raise AssertionError(f"relax under np = 3: the .asc output differs from the serial "
                              f"one ({b.shape} cells, serial {a.shape}){where}")
-    ra = json.loads((serial_relax / "report.json").read_text())
-    rb = json.loads((tmp_path / "report.json").read_text())
-    assert ra["steady"] is True, f"test set-up: the serial relax did not settle: {ra}"
-    for k in sorted(set(ra) | set(rb)):
-        if k != "wall_seconds":
-            assert ra.get(k) == rb.get(k), \
-                f"relax under np = 3: report {k} is {rb.get(k)!r}, serial {ra.get(k)!r}"
+    same_report(serial_relax / "report.json", tmp_path / "report.json", "relax under np = 3")
 
 
 def test_relax_h5_under_3_ranks_is_the_serial_series(tmp_path, serial_relax):
@@ -597,6 +603,207 @@ def test_relax_h5_with_nodata_under_3_ranks_is_the_serial_series(tmp_path, nodat
             "test set-up: the serial file's cells without data are not the DEM's"
     assert_same_output(tmp_path / "serial" / "relaxed.h5", tmp_path / "mpi" / "relaxed.h5",
                        f"relax (.h5, nodata {nodata}) under np = 3")
+
+
+# ---- b2. rasters by windows: GeoTIFF, a VRT mosaic, memory, failures, SIGTERM -------------
+
+def gdal_in(binary):
+    """Whether binary was built with GDAL (its --version says)."""
+    out = subprocess.run([binary, "--version"], capture_output=True, text=True).stdout
+    return "GDAL: on" in out
+
+
+needs_gdal = pytest.mark.skipif(
+    not (os.path.isfile(SANDSLIDE_MPI) and gdal_in(SANDSLIDE_MPI) and gdal_in(SANDSLIDE)),
+    reason="a build without GDAL (made with GDAL=0, or without libgdal-dev)")
+
+
+def write_geotiff(path, h, nodata=None, block=16, dx=0.1, epsg=32633):
+    """h (row 0 south) as a tiled float64 GeoTIFF with a UTM CRS, its nodata
+    value if given; tiles of block x block cells, so that the ranks' rows cut
+    through tiles."""
+    from osgeo import gdal, osr
+    gdal.UseExceptions()
+    ny, nx = h.shape
+    ds = gdal.GetDriverByName("GTiff").Create(
+        str(path), nx, ny, 1, gdal.GDT_Float64,
+        ["TILED=YES", f"BLOCKXSIZE={block}", f"BLOCKYSIZE={block}"])
+    ds.SetGeoTransform([500000.0, dx, 0.0, 5400000.0 + ny * dx, 0.0, -dx])
+    crs = osr.SpatialReference()
+    crs.ImportFromEPSG(epsg)
+    ds.SetProjection(crs.ExportToWkt())
+    band = ds.GetRasterBand(1)
+    if nodata is not None:
+        band.SetNoDataValue(nodata)
+    band.WriteArray(h[::-1])
+    ds = None
+
+
+def clipped_terrain(ny=48, nx=40):
+    """A plateau on a rough floor, no data outside a disk (and in one hole):
+    every rank's rows hold cells with and without data."""
+    rng = np.random.default_rng(5)
+    h = 0.02 * rng.random((ny, nx))
+    h[:, : nx // 3] += 0.3
+    y, x = np.mgrid[0:ny, 0:nx] + 0.5
+    nodata = np.hypot(x - nx / 2, y - ny / 2) > 22
+    nodata[30, 25] = True
+    return np.where(nodata, -9999.0, h)
+
+
+def read_geotiff(path):
+    """(values row 0 north, geotransform, CRS WKT, nodata value) of band 1."""
+    from osgeo import gdal
+    gdal.UseExceptions()
+    ds = gdal.Open(str(path))
+    band = ds.GetRasterBand(1)
+    return (band.ReadAsArray(), ds.GetGeoTransform(), ds.GetProjection(),
+            band.GetNoDataValue())
+
+
+def assert_same_geotiff(want, got, what):
+    a, b = read_geotiff(want), read_geotiff(got)
+    assert a[0].shape == b[0].shape, f"{what}: {b[0].shape} cells, serial {a[0].shape}"
+    bad = a[0].view(np.int64) != b[0].view(np.int64)
+    if bad.any():
+        row, col = np.argwhere(bad)[0]
+        raise AssertionError(f"{what}: {bad.sum()} cells differ from the serial output, the "
+                             f"first at row {row}, column {col} (from the north-west): "
+                             f"{b[0][row, col]!r}, serial {a[0][row, col]!r}")
+    for k, name in ((1, "geotransform"), (2, "CRS"), (3, "nodata value")):
+        assert a[k] == b[k], f"{what}: {name} {b[k]!r}, serial {a[k]!r}"
+    assert "UTM zone 33N" in b[2], f"{what}: the input's CRS is lost: {b[2]!r}"
+    assert b[3] == -9999.0, f"{what}: the nodata value is {b[3]!r}, not the input's -9999"
+
+
+RELAX_TIF = ["--tile", "16x8", "-q", *RELAX_FAST]   # 48 rows: six tile rows
+
+
+@pytest.fixture(scope="module")
+def serial_geotiff(tmp_path_factory):
+    d = tmp_path_factory.mktemp("serial-geotiff")
+    write_geotiff(d / "dem.tif", clipped_terrain(), nodata=-9999.0)
+    serial_run_ok(["relax", "dem.tif", "-o", "relaxed.tif", "--report", "report.json",
+                   *RELAX_TIF], d)
+    return d
+
+
+def same_report(want, got, what):
+    """The --report of two relaxations: the same but for time and memory."""
+    ra, rb = json.loads(want.read_text()), json.loads(got.read_text())
+    assert ra["steady"] is True, f"test set-up: the serial relax did not settle: {ra}"
+    for k in sorted(set(ra) | set(rb)):
+        if k not in ("wall_seconds", "ranks", "bytes_per_cell", "memory_peak_bytes"):
+            assert ra.get(k) == rb.get(k), f"{what}: report {k} is {rb.get(k)!r}, " \
+                                           f"serial {ra.get(k)!r}"
+
+
+@needs_gdal
+@pytest.mark.parametrize("np_", [1, 2, 3, 4, None],
+                         ids=["np1", "np2", "np3", "np4", "no-mpirun"])
+def test_relax_geotiff_by_windows_is_the_serial_raster(tmp_path, serial_geotiff, np_):
+    """A tiled GeoTIFF with nodata and a CRS, each rank reading its rows
+    (tiles of 16 rows, slabs of 8, 16 or 24): the relaxed GeoTIFF, streamed
+    to rank 0 in blocks, has the serial values, georeferencing, CRS and
+    nodata value, and the report is the serial one."""
+    shutil.copy(serial_geotiff / "dem.tif", tmp_path / "dem.tif")
+    mpi_run_ok(np_, ["relax", "dem.tif", "-o", "relaxed.tif", "--report", "report.json",
+                     *RELAX_TIF], tmp_path)
+    what = f"relax of a GeoTIFF under {np_label(np_)}"
+    assert_same_geotiff(serial_geotiff / "relaxed.tif", tmp_path / "relaxed.tif", what)
+    assert (tmp_path / "relaxed.tif").read_bytes() == \
+        (serial_geotiff / "relaxed.tif").read_bytes(), f"{what}: not the serial file's bytes"
+    same_report(serial_geotiff / "report.json", tmp_path / "report.json", what)
+
+
+@needs_gdal
+def test_relax_vrt_of_four_tiles_under_3_ranks_is_the_serial_raster(tmp_path, serial_geotiff):
+    """The same terrain as a VRT mosaic of four GeoTIFF tiles (2 x 2: the
+    ranks' rows cross the tiles' edge), relaxed to .asc under np = 3: the
+    serial build's relax of the one GeoTIFF, bit for bit."""
+    from osgeo import gdal
+    gdal.UseExceptions()
+    src = gdal.Open(str(serial_geotiff / "dem.tif"))
+    names = []
+    for k, (x0, y0) in enumerate([(0, 0), (20, 0), (0, 24), (20, 24)]):
+        name = str(tmp_path / f"tile{k}.tif")
+        gdal.Translate(name, src, srcWin=[x0, y0, 20, 24])
+        names.append(name)
+    gdal.BuildVRT(str(tmp_path / "mosaic.vrt"), names)
+    src = None
+    shutil.copy(serial_geotiff / "dem.tif", tmp_path / "dem.tif")
+    serial_run_ok(["relax", "dem.tif", "-o", "serial.asc", *RELAX_TIF], tmp_path)
+    mpi_run_ok(3, ["relax", "mosaic.vrt", "-o", "mosaic.asc", *RELAX_TIF], tmp_path)
+    assert (tmp_path / "mosaic.asc").read_bytes() == (tmp_path / "serial.asc").read_bytes(), \
+        "relax of a VRT of 4 tiles under np = 3: not the serial relax of the GeoTIFF"
+
+
+@needs_gdal
+@pytest.mark.parametrize("kept", [2000, 9000, 15000])
+def test_truncated_geotiff_one_message_exit_2_on_every_rank(tmp_path, serial_geotiff, kept):
+    """The GeoTIFF cut after `kept` bytes: some ranks' tiles are missing,
+    others' are there.  One message (from the first failing rank), exit 2,
+    no hang, no output."""
+    (tmp_path / "cut.tif").write_bytes((serial_geotiff / "dem.tif").read_bytes()[:kept])
+    r = mpi_run(3, ["relax", "cut.tif", "-o", "relaxed.tif", *RELAX_TIF], tmp_path)
+    ours = [line for line in r.stderr.splitlines() if line.startswith("sandslide:")]
+    assert r.returncode == 2 and len(ours) == 1 and "cut.tif" in ours[0], \
+        f"a GeoTIFF cut at {kept} bytes under np = 3: expected one message naming it and " \
+        f"exit 2, got exit {r.returncode}:\n{r.stderr}"
+    assert not (tmp_path / "relaxed.tif").exists(), "an output was written"
+
+
+@needs_gdal
+def test_windows_bound_each_ranks_memory(tmp_path):
+    """A 4096^2 GeoTIFF relaxed for one super-step to a GeoTIFF: under np = 4
+    every rank's peak resident memory (the report's largest rank) is at most
+    40 % of the one-rank run's, since no rank holds the whole raster, in or
+    out; the outputs are the same bytes."""
+    subprocess.run(["/usr/bin/python3", os.path.join(ROOT, "cases", "fractal_dem.py"), "4096",
+                    str(tmp_path / "big.tif"), "--epsg", "32633"], check=True)
+    args = ["relax", "big.tif", "--max-time", "0.01", "-q", "--report"]
+    mpi_run_ok(None, args + ["one.json", "-o", "one.tif"], tmp_path, timeout=120)
+    mpi_run_ok(4, args + ["four.json", "-o", "four.tif"], tmp_path, timeout=120)
+    one = json.loads((tmp_path / "one.json").read_text())["memory_peak_bytes"]
+    four = json.loads((tmp_path / "four.json").read_text())["memory_peak_bytes"]
+    assert four <= 0.4 * one, \
+        f"4096^2 under np = 4: the largest rank's peak is {four / 2**20:.0f} MiB, " \
+        f"{100 * four / one:.0f} % of one rank's {one / 2**20:.0f} MiB (at most 40 %)"
+    assert (tmp_path / "one.tif").read_bytes() == (tmp_path / "four.tif").read_bytes(), \
+        "4096^2 under np = 4: not the one-rank output's bytes"
+
+
+@needs_gdal
+def test_sigterm_mid_relax_leaves_the_input_and_a_readable_series(tmp_path, serial_geotiff):
+    """SIGTERM to mpirun -np 4 relaxing a GeoTIFF to .h5, its ranks paused
+    after substep 40: one message, every rank stops after the next substep,
+    the input is the same bytes, the file is readable and ends with that
+    substep's snapshot."""
+    shutil.copy(serial_geotiff / "dem.tif", tmp_path / "dem.tif")
+    before = (tmp_path / "dem.tif").read_bytes()
+    out = tmp_path / "relaxed.h5"
+    step = 40
+    p = start_paused(4, ["relax", "dem.tif", "-o", out.name, "--integrator", "euler",
+                         "--output-every", "0.5", *RELAX_TIF], tmp_path, step)
+    try:
+        wait_paused(p, tmp_path / "paused", step, 60)
+        files = shared_memory_of(p.pid)
+        p.send_signal(signal.SIGTERM)
+        r = finish(p, "relax under mpirun -np 4, interrupted", 60)
+        remove_leftovers(p.pid, files)
+    finally:
+        kill_session(p.pid)
+    ours = [line for line in r.stderr.splitlines() if line.startswith("sandslide:")]
+    assert r.returncode != 0 and len(ours) == 1 and "interrupted" in ours[0] and \
+        f"(step {step + 1})" in ours[0], \
+        f"relax under np = 4, SIGTERM: one message, stopped in step {step + 1}:\n{r.stderr}"
+    assert (tmp_path / "dem.tif").read_bytes() == before, "the input GeoTIFF was changed"
+    with h5open(out) as f:
+        assert f["steps"][-1] == step + 1, \
+            f"signalled after step {step}: the last snapshot is after step {f['steps'][-1]}"
+        h = f["height"][-1]
+        assert h.shape == (48, 40) and np.isfinite(h[f["cell_type"][()] != 3]).all(), \
+            "the last snapshot is not a whole surface"
 
 
 # ---- c. cut, restarted under another rank count, interrupted, killed ------------------------
