@@ -7,6 +7,7 @@
 #                   HTML viewer, clang for the race check)
 #   make deps-bench add the real DEMs tools/real_dems.py writes for the
 #                   benchmarks (BENCH_ALL=1: those of --all too); not tests
+#   make deps-slurm add Slurm and munge for `make MPI=1 test-slurm`
 #   make test       build and run every test (C programs, then CLI tests)
 #   make install    bin, lib (.so and .a), headers, sandslide.pc, the man
 #                   page, the example cases and the Python module under
@@ -96,9 +97,14 @@ DEB_BENCH  := python3-h5py python3-rdata r-base-core r-cran-spatstat.data \
 ifeq ($(BENCH_ALL),1)
   DEB_BENCH += python3-gdal r-cran-satellite r-cran-stars r-cran-terra
 endif
+# A real Slurm on this one machine (tests/slurm/run.sh, make MPI=1
+# test-slurm): the controller, the node daemon, sbatch/srun/sinfo, and
+# munge, which signs their messages.  Not slurm-wlm, which adds slurmdbd
+# and the plugins for what a single test node never uses.
+DEB_SLURM  := slurmctld slurmd slurm-client munge
 
 # Goals that need no library: do not probe pkg-config for them.
-NO_PROBE_GOALS := deps deps-test deps-bench clean help uninstall
+NO_PROBE_GOALS := deps deps-test deps-bench deps-slurm clean help uninstall
 ifeq ($(filter-out $(NO_PROBE_GOALS),$(or $(MAKECMDGOALS),all)),)
 else
   ifeq ($(shell command -v $(PKG_CONFIG) 2>/dev/null),)
@@ -214,7 +220,7 @@ TEST_SRC := $(wildcard tests/test_*.c)
 TEST_BIN := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
 HEADERS  := $(wildcard include/sandslide/*.h)
 
-.PHONY: all deps deps-test deps-bench test check demo clean headers-check check-layering help \
+.PHONY: all deps deps-test deps-bench deps-slurm test check demo clean headers-check check-layering help \
         install uninstall
 SONAME   := libsandslide.so.$(SOVERSION)
 SHLIB    := libsandslide.so.$(VERSION)
@@ -500,7 +506,9 @@ demo: all
 # `make deps`: what building and running need (DEB_BUILD, DEB_RUN, and
 # with MPI=1 Open MPI); `make deps-test`: what the test suite adds
 # (DEB_TEST: pytest, the readers the output is checked with, ParaView,
-# clang); `make deps-bench`: the benchmarks' real DEMs (DEB_BENCH).  apt-get only for what is missing.
+# clang); `make deps-bench`: the benchmarks' real DEMs (DEB_BENCH);
+# `make deps-slurm`: Slurm and munge (DEB_SLURM).  apt-get only for what
+# is missing.
 DEPS_INSTALL = missing=""; for p in $(1); do \
 	  dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q 'ok installed' || missing="$$missing $$p"; \
 	done; \
@@ -517,6 +525,8 @@ deps-test: deps
 	@$(call DEPS_INSTALL,$(DEB_TEST))
 deps-bench: deps
 	@$(call DEPS_INSTALL,$(DEB_BENCH))
+deps-slurm: deps
+	@$(call DEPS_INSTALL,$(DEB_SLURM))
 
 clean:
 	rm -rf $(BUILD)
