@@ -29,12 +29,19 @@ for c in munged mungekey slurmctld slurmd sbatch sinfo srun scontrol; do
 	}
 done
 [ "$(id -u)" = 0 ] || { echo "test-slurm: run as root (slurmd starts the job's tasks as their user)" >&2; exit 1; }
+/usr/bin/python3 -c 'import h5py' 2>/dev/null ||
+	{ echo "test-slurm: h5py not found: tools/compare_outputs.py needs it (make deps-test)" >&2; exit 1; }
 
 tmp=$(mktemp -d /tmp/sandslide-slurm.XXXXXX)
+# munged wants its socket's folders open to all (it warns otherwise);
+# nothing in them is secret but the key, which is 0600
+chmod 755 "$tmp"
 pids=""
 ok=0
 stop() {
 	# the daemons, by the pids we started; then their logs if it failed
+	# (to the end even if whoever reads them has gone: a closed pipe)
+	trap '' PIPE
 	for p in $pids; do kill "$p" 2>/dev/null || true; done
 	for p in $pids; do
 		n=0
@@ -42,7 +49,7 @@ stop() {
 		kill -9 "$p" 2>/dev/null || true
 	done
 	if [ $ok = 0 ]; then
-		for f in "$tmp"/munged.log "$tmp"/slurmctld.log "$tmp"/slurmd.log "$tmp"/*.err; do
+		for f in "$tmp"/slurmctld.log "$tmp"/slurmd.log "$tmp"/*.err; do
 			[ -s "$f" ] || continue
 			echo "---- $f (last 40 lines)"
 			tail -n 40 "$f"
@@ -57,11 +64,10 @@ fail() { echo "test-slurm: FAILED: $*" >&2; exit 1; }
 
 # ---- munge: a key of our own, and munged on a socket of our own ----------
 mkdir -p "$tmp/munge"
-chmod 700 "$tmp/munge"
-[ -f "$tmp/munge/munge.key" ] || mungekey --create --keyfile="$tmp/munge/munge.key"
+# (in the foreground munged logs to stderr; --force: it runs as root)
+mungekey --create --keyfile="$tmp/munge/munge.key"
 munged --foreground --force --socket="$tmp/munge/socket" --key-file="$tmp/munge/munge.key" \
-	--pid-file="$tmp/munge/munged.pid" --log-file="$tmp/munged.log" \
-	--seed-file="$tmp/munge/seed" >"$tmp/munged.err" 2>&1 &
+	--pid-file="$tmp/munge/munged.pid" --seed-file="$tmp/munge/seed" >"$tmp/munged.err" 2>&1 &
 pids="$pids $!"
 
 # ---- slurm.conf for this node --------------------------------------------
@@ -107,11 +113,13 @@ MpiDefault=none
 # show the host's sockets, or a cgroup's fewer CPUs)
 SlurmdParameters=config_overrides
 ReturnToService=2
-# sbatch --wait polls the job every 2 s, then every 8 and 32 s unless
-# MinJobAge is below twice that (sbatch.c, _job_wait): a job of 3 s would
-# take 10 s.  0 keeps finished jobs' records, which this cluster of two
-# jobs never needs purged, and the poll at 2 s.
-MinJobAge=0
+# sbatch --wait polls the job after 2 s, then backs off to 8 and 32 s
+# unless MinJobAge / 2 is at most 2 (sbatch.c, _job_wait): a job of 3 s
+# would take 10 s.  4 keeps the poll at 2 s, and a finished job's record
+# for 4 s, two polls (0 is refused: "MinJobAge must be at least 2").
+MinJobAge=4
+# no mail is sent (the default program is not installed)
+MailProg=/bin/true
 NodeName=$host NodeAddr=127.0.0.1 CPUs=$cpus RealMemory=$mem State=UNKNOWN
 PartitionName=test Nodes=$host Default=YES MaxTime=10 State=UP
 EOF
