@@ -156,6 +156,10 @@ cp "$root/cases/dem/terrain.asc" "$tmp/dem.asc"
 # by sbatch; srun starts the ranks, so nothing asks for mpirun's root check
 export OMPI_MCA_mpi_yield_when_idle=1 OMPI_MCA_btl_vader_single_copy_mechanism=none \
 	OMPI_MCA_pml=ob1 OMPI_MCA_btl=self,vader OMPI_MCA_btl_base_warn_component_unused=0
+# OpenMP threads that sleep when they wait: a 2-thread rank whose threads
+# spin while another program holds one of the 2 cores took 5 to 28 s
+# instead of 0.5 (load average 6 to 8, the same bits either way)
+export OMP_WAIT_POLICY=PASSIVE
 export SANDSLIDE_MPI="$mpi_bin"
 job=0
 for layout in "2 1" "1 2"; do
