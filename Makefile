@@ -21,7 +21,9 @@
 #   make race       data-race check of the OpenMP code: ThreadSanitizer + Archer
 #   make MPI=1      build-mpi/sandslide with Open MPI and parallel HDF5
 #                   (`make deps MPI=1` installs them; `make MPI=1 test-mpi`
-#                   runs the distributed tests, tests/cli/test_mpi.py)
+#                   runs the distributed tests, tests/cli/test_mpi.py;
+#                   `make MPI=1 test-slurm` runs doc/cluster.md's Slurm job
+#                   on a one-node Slurm started here, as root)
 #   make check-layering  the tiers of src/README.md, by their #includes
 #   make V=1        show the full commands
 #
@@ -408,6 +410,19 @@ test-mpi: all $(BUILD)/tests/test_comm $(HOOK_PAUSE)
 	@echo "== tests/cli/test_mpi.py (pytest)"; \
 	  $(MPI_ENV) SANDSLIDE_MPI=$(abspath $(BUILD)/sandslide) SANDSLIDE=$(abspath build/sandslide) \
 	  SANDSLIDE_MPI_PAUSE=$(abspath $(HOOK_PAUSE)) $(PYTHON) -m pytest -q -rs tests/cli/test_mpi.py
+
+# A real Slurm on this machine (make MPI=1 test-slurm; make deps-slurm
+# installs it): tests/slurm/run.sh starts munged, slurmctld and slurmd as
+# root, submits the job of doc/cluster.md#slurm (tests/slurm/job.sh) with
+# sbatch --wait, as 2 tasks x 1 CPU and 1 task x 2 CPUs, and compares each
+# output with the serial build/sandslide's (built first) bit for bit.
+# About 10 s.  Not in `make test`: it needs root and starts daemons.
+.PHONY: test-slurm
+test-slurm: all
+	@[ "$(MPI)" = 1 ] || { echo "test-slurm: run it as make MPI=1 test-slurm"; exit 2; }
+	$(MAKE) MPI=0 all
+	@echo "== tests/slurm/run.sh (sbatch --wait, srun --mpi=pmix)"; \
+	  timeout 300 sh tests/slurm/run.sh $(BUILD)/sandslide build/sandslide
 
 # The tiers of src/README.md, checked by the #includes of each file: the
 # kernel knows nothing of files, printing or the command line, I/O nothing
