@@ -102,8 +102,10 @@ endif
 # A real Slurm on this one machine (tests/slurm/run.sh, make MPI=1
 # test-slurm): the controller, the node daemon, sbatch/srun/sinfo, and
 # munge, which signs their messages.  Not slurm-wlm, which adds slurmdbd
-# and the plugins for what a single test node never uses.
-DEB_SLURM  := slurmctld slurmd slurm-client munge
+# and the plugins for what a single test node never uses.  srun
+# --mpi=pmix's plugin dlopens pmix2/lib/libpmix.so, the unversioned name
+# that only libpmix-dev ships (libopenmpi-dev pulls it in too).
+DEB_SLURM  := slurmctld slurmd slurm-client munge libpmix-dev
 
 # Goals that need no library: do not probe pkg-config for them.
 NO_PROBE_GOALS := deps deps-test deps-bench deps-slurm clean help uninstall
