@@ -8,7 +8,7 @@
 # whatever happened; on a failure their logs are printed.
 #
 # Debian's packages (make deps-slurm): slurmctld, slurmd, slurm-client,
-# munge.  Everything runs as root in a temporary folder with its own munge
+# munge, libpmix-dev.  Everything runs as root in a temporary folder with its own munge
 # key and socket and its own ports (SANDSLIDE_SLURM_PORT, default 16817,
 # and the next one), so a Slurm or munged already on the machine is left
 # alone.  The settings suit a container: no systemd, no cgroups.
@@ -28,7 +28,7 @@ for c in munged mungekey slurmctld slurmd sbatch sinfo srun scontrol; do
 		exit 1
 	}
 done
-[ "$(id -u)" = 0 ] || { echo "test-slurm: run as root (slurmd starts the job's tasks as their user)" >&2; exit 1; }
+[ "$(id -u)" = 0 ] || { echo "test-slurm: run as root (slurmd must be root to start a job's tasks as their user)" >&2; exit 1; }
 /usr/bin/python3 -c 'import h5py' 2>/dev/null ||
 	{ echo "test-slurm: h5py not found: tools/compare_outputs.py needs it (make deps-test)" >&2; exit 1; }
 
@@ -39,9 +39,16 @@ chmod 755 "$tmp"
 pids=""
 ok=0
 stop() {
-	# the daemons, by the pids we started; then their logs if it failed
-	# (to the end even if whoever reads them has gone: a closed pipe)
+	# a job still running (a timeout, a signal) cancelled first: its tasks
+	# are slurmstepd's, which outlive slurmd; then the daemons, by the pids
+	# we started; then their logs if it failed (to the end even if whoever
+	# reads them has gone: a closed pipe)
 	trap '' PIPE
+	if [ $ok = 0 ] && [ -n "${SLURM_CONF:-}" ] && [ -n "$(squeue -h -o %i 2>/dev/null)" ]; then
+		scancel --full -u root 2>/dev/null || true
+		n=0
+		while [ -n "$(squeue -h -o %i 2>/dev/null)" ] && [ $n -lt 100 ]; do sleep 0.1; n=$((n + 1)); done
+	fi
 	for p in $pids; do kill "$p" 2>/dev/null || true; done
 	for p in $pids; do
 		n=0
