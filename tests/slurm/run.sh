@@ -80,6 +80,8 @@ pids="$pids $!"
 # ---- slurm.conf for this node --------------------------------------------
 host=$(hostname -s)
 cpus=$(nproc)
+# both jobs take 2 CPUs; on 1 they would wait for ever
+[ "$cpus" -ge 2 ] || fail "the jobs need 2 CPUs, nproc says $cpus"
 # MB, as slurmd counts it; a little under MemTotal, so that the node is not
 # drained for having less memory than configured
 mem=$(awk '/^MemTotal:/ { printf "%d", $2 / 1024 * 0.95 }' /proc/meminfo)
@@ -169,25 +171,26 @@ export OMPI_MCA_mpi_yield_when_idle=1 OMPI_MCA_btl_vader_single_copy_mechanism=n
 export OMP_WAIT_POLICY=PASSIVE
 export SANDSLIDE_MPI="$mpi_bin"
 job=0
-for layout in "2 1" "1 2"; do
-	set -- $layout
+for layout in 2x1 1x2; do
+	tasks=${layout%x*}
+	threads=${layout#*x}
 	job=$((job + 1))
 	d="$tmp/job$job"
 	cp "$tmp/dem.asc" "$d/dem.asc"
 	t0=$(date +%s%N)
 	timeout 120 sbatch --wait --parsable --chdir="$d" --output="$d/slurm.out" \
-		--ntasks="$1" --cpus-per-task="$2" "$here/job.sh" >"$d/sbatch.out" 2>"$tmp/sbatch$job.err" ||
-		{ cat "$d/slurm.out" 2>/dev/null; fail "sbatch --wait ($1 tasks x $2 CPUs) failed: $(cat "$tmp/sbatch$job.err")"; }
+		--ntasks="$tasks" --cpus-per-task="$threads" "$here/job.sh" >"$d/sbatch.out" 2>"$tmp/sbatch$job.err" ||
+		{ cat "$d/slurm.out" 2>/dev/null; fail "sbatch --wait ($tasks tasks x $threads CPUs) failed: $(cat "$tmp/sbatch$job.err")"; }
 	id=$(cat "$d/sbatch.out")
-	echo "test-slurm: job $id ($1 tasks x $2 CPUs) done in $((($(date +%s%N) - t0) / 1000000)) ms; its output:"
+	echo "test-slurm: job $id ($tasks tasks x $threads CPUs) done in $((($(date +%s%N) - t0) / 1000000)) ms; its output:"
 	sed 's/^/    /' "$d/slurm.out"
 	# one summary: rank 0 alone prints.  Two would be two one-rank runs
 	# that never formed one MPI job (srun without its MPI plugin).
 	n=$(grep -c '^wrote relaxed.h5:' "$d/slurm.out" || true)
-	[ "$n" = 1 ] || fail "job $id: $n summaries from $1 tasks, 1 expected (one MPI job)"
-	grep -q "on $2 thread" "$d/slurm.out" || fail "job $id: not on $2 threads"
+	[ "$n" = 1 ] || fail "job $id: $n summaries from $tasks tasks, 1 expected (one MPI job)"
+	grep -q "on $threads thread" "$d/slurm.out" || fail "job $id: not on $threads threads"
 	/usr/bin/python3 "$root/tools/compare_outputs.py" "$tmp/serial.h5" "$d/relaxed.h5" ||
-		fail "job $id ($1 tasks x $2 CPUs): relaxed.h5 is not the serial build's"
+		fail "job $id ($tasks tasks x $threads CPUs): relaxed.h5 is not the serial build's"
 done
 ok=1
 echo "test-slurm: ok"
