@@ -7,6 +7,7 @@
 #                   HTML viewer, clang for the race check)
 #   make deps-bench add the real DEMs tools/real_dems.py writes for the
 #                   benchmarks (BENCH_ALL=1: those of --all too); not tests
+#   make deps-slurm add Slurm and munge for `make MPI=1 test-slurm`
 #   make test       build and run every test (C programs, then CLI tests)
 #   make install    bin, lib (.so and .a), headers, sandslide.pc, the man
 #                   page, the example cases and the Python module under
@@ -20,7 +21,9 @@
 #   make race       data-race check of the OpenMP code: ThreadSanitizer + Archer
 #   make MPI=1      build-mpi/sandslide with Open MPI and parallel HDF5
 #                   (`make deps MPI=1` installs them; `make MPI=1 test-mpi`
-#                   runs the distributed tests, tests/cli/test_mpi.py)
+#                   runs the distributed tests, tests/cli/test_mpi.py;
+#                   `make MPI=1 test-slurm` runs doc/cluster.md's Slurm job
+#                   on a one-node Slurm started here, as root)
 #   make check-layering  the tiers of src/README.md, by their #includes
 #   make V=1        show the full commands
 #
@@ -96,9 +99,16 @@ DEB_BENCH  := python3-h5py python3-rdata r-base-core r-cran-spatstat.data \
 ifeq ($(BENCH_ALL),1)
   DEB_BENCH += python3-gdal r-cran-satellite r-cran-stars r-cran-terra
 endif
+# A real Slurm on this one machine (tests/slurm/run.sh, make MPI=1
+# test-slurm): the controller, the node daemon, sbatch/srun/sinfo, and
+# munge, which signs their messages.  Not slurm-wlm, which adds slurmdbd
+# and the plugins for what a single test node never uses.  srun
+# --mpi=pmix's plugin dlopens pmix2/lib/libpmix.so, the unversioned name
+# that only libpmix-dev ships (libopenmpi-dev pulls it in too).
+DEB_SLURM  := slurmctld slurmd slurm-client munge libpmix-dev
 
 # Goals that need no library: do not probe pkg-config for them.
-NO_PROBE_GOALS := deps deps-test deps-bench clean help uninstall
+NO_PROBE_GOALS := deps deps-test deps-bench deps-slurm clean help uninstall
 ifeq ($(filter-out $(NO_PROBE_GOALS),$(or $(MAKECMDGOALS),all)),)
 else
   ifeq ($(shell command -v $(PKG_CONFIG) 2>/dev/null),)
@@ -214,7 +224,7 @@ TEST_SRC := $(wildcard tests/test_*.c)
 TEST_BIN := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
 HEADERS  := $(wildcard include/sandslide/*.h)
 
-.PHONY: all deps deps-test deps-bench test check demo clean headers-check check-layering help \
+.PHONY: all deps deps-test deps-bench deps-slurm test check demo clean headers-check check-layering help \
         install uninstall
 SONAME   := libsandslide.so.$(SOVERSION)
 SHLIB    := libsandslide.so.$(VERSION)
@@ -403,6 +413,19 @@ test-mpi: all $(BUILD)/tests/test_comm $(HOOK_PAUSE)
 	  $(MPI_ENV) SANDSLIDE_MPI=$(abspath $(BUILD)/sandslide) SANDSLIDE=$(abspath build/sandslide) \
 	  SANDSLIDE_MPI_PAUSE=$(abspath $(HOOK_PAUSE)) $(PYTHON) -m pytest -q -rs tests/cli/test_mpi.py
 
+# A real Slurm on this machine (make MPI=1 test-slurm; make deps-slurm
+# installs it): tests/slurm/run.sh starts munged, slurmctld and slurmd as
+# root, submits the job of doc/cluster.md#slurm (tests/slurm/job.sh) with
+# sbatch --wait, as 2 tasks x 1 CPU and 1 task x 2 CPUs, and compares each
+# output with the serial build/sandslide's (built first) bit for bit.
+# About 10 s.  Not in `make test`: it needs root and starts daemons.
+.PHONY: test-slurm
+test-slurm: all
+	@[ "$(MPI)" = 1 ] || { echo "test-slurm: run it as make MPI=1 test-slurm"; exit 2; }
+	$(MAKE) MPI=0 all
+	@echo "== tests/slurm/run.sh (sbatch --wait, srun --mpi=pmix)"; \
+	  timeout 300 sh tests/slurm/run.sh $(BUILD)/sandslide build/sandslide
+
 # The tiers of src/README.md, checked by the #includes of each file: the
 # kernel knows nothing of files, printing or the command line, I/O nothing
 # of the stencil, and <hdf5.h> is in two files (tests/check_layering.sh).
@@ -500,7 +523,9 @@ demo: all
 # `make deps`: what building and running need (DEB_BUILD, DEB_RUN, and
 # with MPI=1 Open MPI); `make deps-test`: what the test suite adds
 # (DEB_TEST: pytest, the readers the output is checked with, ParaView,
-# clang); `make deps-bench`: the benchmarks' real DEMs (DEB_BENCH).  apt-get only for what is missing.
+# clang); `make deps-bench`: the benchmarks' real DEMs (DEB_BENCH);
+# `make deps-slurm`: Slurm and munge (DEB_SLURM).  apt-get only for what
+# is missing.
 DEPS_INSTALL = missing=""; for p in $(1); do \
 	  dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q 'ok installed' || missing="$$missing $$p"; \
 	done; \
@@ -517,6 +542,8 @@ deps-test: deps
 	@$(call DEPS_INSTALL,$(DEB_TEST))
 deps-bench: deps
 	@$(call DEPS_INSTALL,$(DEB_BENCH))
+deps-slurm: deps
+	@$(call DEPS_INSTALL,$(DEB_SLURM))
 
 clean:
 	rm -rf $(BUILD)
