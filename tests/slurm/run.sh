@@ -188,7 +188,11 @@ for layout in 2x1 1x2; do
 	# that never formed one MPI job (srun without its MPI plugin).
 	n=$(grep -c '^wrote relaxed.h5:' "$d/slurm.out" || true)
 	[ "$n" = 1 ] || fail "job $id: $n summaries from $tasks tasks, 1 expected (one MPI job)"
-	grep -q "on $threads thread" "$d/slurm.out" || fail "job $id: not on $threads threads"
+	# relax says "on 2 ranks x 1 thread", or "on 2 threads" for one rank
+	ranks=""
+	[ "$tasks" = 1 ] || ranks="$tasks ranks x "
+	grep -q "on $ranks$threads thread" "$d/slurm.out" ||
+		fail "job $id: not on $ranks$threads thread(s)"
 	/usr/bin/python3 "$root/tools/compare_outputs.py" "$tmp/serial.h5" "$d/relaxed.h5" ||
 		fail "job $id ($tasks tasks x $threads CPUs): relaxed.h5 is not the serial build's"
 done
