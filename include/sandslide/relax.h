@@ -124,6 +124,9 @@ struct ss_relax_report {
 	const char *integrator;           /* "euler" or "rkl2" */
 	double time;                      /* simulated, s */
 	double wall_seconds;
+	double read_seconds;              /* of wall_seconds: reading the inputs */
+	double write_seconds;             /*   and writing a raster output (a
+	                                     series is written as it goes) */
 	int ranks;                        /* MPI ranks (comm.h) */
 	double bytes_per_cell;            /* the stepper's arrays over the cells
 	                                     of a rank's slab */

@@ -432,6 +432,7 @@ int ss_relax_run(const struct ss_relax_options *o, struct ss_relax_report *rep)
 
 	enum ss_drive_end end = SS_DRIVE_END;
 	int err = read_inputs(&x, rep);
+	rep->read_seconds = ss_parallel_wall_seconds() - started;
 	if (!err)
 		err = rebuild(&x, &x.st);
 	if (!err)
@@ -444,7 +445,9 @@ int ss_relax_run(const struct ss_relax_options *o, struct ss_relax_report *rep)
 		err = nonfinite(&x, rep->output);
 	if (!err) {
 		measure_after(&x, end, rep);
+		const double t0 = ss_parallel_wall_seconds();
 		err = write_raster(&x, rep->output);
+		rep->write_seconds = ss_parallel_wall_seconds() - t0;
 	}
 	rep->wall_seconds = ss_parallel_wall_seconds() - started;
 	if (!err) {   /* the output is written: the peak is the run's */
@@ -452,8 +455,12 @@ int ss_relax_run(const struct ss_relax_options *o, struct ss_relax_report *rep)
 		rep->ranks = ss_comm_size();
 		rep->bytes_per_cell = ss_stepper_memory_bytes(g, x.st.integrator) /
 		                      fmax((double)g->nx * g->ny, 1.0);
-		rep->memory_peak_bytes = ss_memory_peak_bytes();
-		ss_comm_reduce(&rep->memory_peak_bytes, 1, NULL, 0);
+		/* the largest rank's: the job waits for it */
+		double most[3] = {ss_memory_peak_bytes(), rep->read_seconds, rep->write_seconds};
+		ss_comm_reduce(most, 3, NULL, 0);
+		rep->memory_peak_bytes = most[0];
+		rep->read_seconds = most[1];
+		rep->write_seconds = most[2];
 	}
 	if (!err && o->report)
 		err = ss_comm_agree(ss_comm_rank() == 0 ? write_report(o->report, o, rep) : SS_OK);

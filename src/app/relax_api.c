@@ -38,6 +38,10 @@ int ss_relax_report_json(const struct ss_relax_options *o, const struct ss_relax
 	ss_strbuf_json_number(&b, r->time, 17);
 	ss_strbuf_printf(&b, ", \"wall_seconds\": ");
 	ss_strbuf_json_number(&b, r->wall_seconds, 6);
+	ss_strbuf_printf(&b, ", \"read_seconds\": ");
+	ss_strbuf_json_number(&b, r->read_seconds, 6);
+	ss_strbuf_printf(&b, ", \"write_seconds\": ");
+	ss_strbuf_json_number(&b, r->write_seconds, 6);
 	ss_strbuf_printf(&b, ",\n  \"ranks\": %d, \"bytes_per_cell\": ", r->ranks);
 	ss_strbuf_json_number(&b, r->bytes_per_cell, 17);
 	ss_strbuf_printf(&b, ", \"memory_peak_bytes\": ");

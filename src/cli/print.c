@@ -120,7 +120,8 @@ void cli_print_relax_end(const struct ss_relax_report *r, double angle_deg, int 
 	       r->volume_moved, r->max_slope_before_deg, r->max_slope_after_deg, angle_deg,
 	       r->wall_seconds, ranks, ss_parallel_max_threads(),
 	       ss_parallel_max_threads() == 1 ? "" : "s");
-	printf("memory: %.0f B per cell, peak %s%s\n", r->bytes_per_cell,
+	printf("read %.3f s, write %.3f s; memory: %.0f B per cell, peak %s%s\n",
+	       r->read_seconds, r->write_seconds, r->bytes_per_cell,
 	       ss_format_bytes(r->memory_peak_bytes, peak), r->ranks > 1 ? " (the largest rank)" : "");
 	/* sand poured, and sand that left through open sides or open nodata
 	 * cells: what the volume change is made of */
