@@ -259,11 +259,12 @@ int ss_dem_read_prj(const char *path, const char *context, struct ss_raster *r)
 /* ------------------------------------------------------------------ */
 /* writing                                                              */
 
-int ss_dem_prj_check_not_source(const char *path, const struct ss_raster *r)
+/* SS_ERR_INPUT when the .prj of an .asc written to path would be the one
+ * r was read with. */
+static int check_not_source_prj(const char *path, const struct ss_raster *r)
 {
 	char src[4096], out[4096];
-	if (ss_dem_format_of(path) != SS_DEM_ASC || !r->source || r->format != SS_DEM_ASC ||
-	    find_prj(r->source, src, sizeof src) != 1)
+	if (!r->source || r->format != SS_DEM_ASC || find_prj(r->source, src, sizeof src) != 1)
 		return SS_OK;
 	static const char *const ext[] = {"prj", "PRJ"};
 	for (int k = 0; k < 2; k++) {
@@ -273,6 +274,11 @@ int ss_dem_prj_check_not_source(const char *path, const struct ss_raster *r)
 			                      "another output name", path, out);
 	}
 	return SS_OK;
+}
+
+int ss_dem_prj_check_not_source(const char *path, const struct ss_raster *r)
+{
+	return ss_dem_format_of(path) == SS_DEM_ASC ? check_not_source_prj(path, r) : SS_OK;
 }
 
 /* The ESRI WKT of r's CRS (ss_free it); NULL after a message. */
@@ -351,7 +357,7 @@ static int write_temp(const char *path, const char *dest, const char *text, char
 int ss_dem_prj_prepare(const char *path, const struct ss_raster *r, struct ss_dem_prj *p)
 {
 	memset(p, 0, sizeof *p);
-	int err = ss_dem_prj_check_not_source(path, r);
+	int err = check_not_source_prj(path, r);   /* an .asc by any name */
 	if (err)
 		return err;
 	if (sibling(path, "prj", p->dest, sizeof p->dest))
