@@ -53,6 +53,11 @@ static int hidden_files(void)
 	return n;
 }
 
+static int exists(const char *path)
+{
+	return access(path, F_OK) == 0;
+}
+
 static void remove_dir(void)
 {
 	DIR *d = opendir(check_scratch());
@@ -751,6 +756,8 @@ static void geotiff_round_trip(void)
 	CHECK(err == SS_OK && ss_dem_read(check_file("g.asc"), NULL, NULL, &c) == SS_OK &&
 	      same_values(&b, &c) && same_flags(&b, &c) && c.nodata_value == -32768.0 &&
 	      c.x0 == 500000.0, "GeoTIFF to .asc");
+	CHECK(c.crs_wkt && strstr(c.crs_wkt, "UTM zone 33N") && exists(check_file("g.prj")),
+	      "and its CRS in g.prj: %s", c.crs_wkt ? c.crs_wkt : "(none)");
 	ss_raster_release(&c);
 
 	/* a rotated geotransform is refused */
@@ -778,6 +785,152 @@ static void geotiff_round_trip(void)
 	ss_raster_release(&b);
 }
 
+/* ------------------------------------------------------------------ */
+/* the CRS of an .asc: the .prj beside it                               */
+
+/* What GDAL 3.6 writes as dem.prj for EPSG:32633 (gdal_translate -of AAIGrid). */
+static const char utm33n_esri[] =
+	"PROJCS[\"WGS_1984_UTM_Zone_33N\",GEOGCS[\"GCS_WGS_1984\",DATUM[\"D_WGS_1984\","
+	"SPHEROID[\"WGS_1984\",6378137.0,298.257223563]],PRIMEM[\"Greenwich\",0.0],"
+	"UNIT[\"Degree\",0.0174532925199433]],PROJECTION[\"Transverse_Mercator\"],"
+	"PARAMETER[\"False_Easting\",500000.0],PARAMETER[\"False_Northing\",0.0],"
+	"PARAMETER[\"Central_Meridian\",15.0],PARAMETER[\"Scale_Factor\",0.9996],"
+	"PARAMETER[\"Latitude_Of_Origin\",0.0],UNIT[\"Meter\",1.0]]";
+
+static const char small_asc[] =
+	"ncols 3\nnrows 2\nxllcorner 500000\nyllcorner 5200000\ncellsize 2\n1 2 3\n4 5 6\n";
+
+static void asc_prj_round_trip(void)
+{
+	check_write_file(check_file("p.asc"), small_asc);
+	check_write_file(check_file("p.prj"), utm33n_esri);
+	struct ss_raster a, b;
+	int err = ss_dem_read(check_file("p.asc"), NULL, NULL, &a);
+	CHECK(err == SS_OK, "read p.asc with p.prj: %d", err);
+	/* with GDAL the OGC WKT gdalinfo shows (importFromESRI); without, as read */
+	if (ss_dem_gdal_available())
+		CHECK(a.crs_wkt && strstr(a.crs_wkt, "PROJCS[\"WGS 84 / UTM zone 33N\"") &&
+		      strstr(a.crs_wkt, "\"central_meridian\",15"), "CRS as OGC WKT: %s",
+		      a.crs_wkt ? a.crs_wkt : "(none)");
+	else
+		CHECK(a.crs_wkt && !strcmp(a.crs_wkt, utm33n_esri), "CRS as read: %s",
+		      a.crs_wkt ? a.crs_wkt : "(none)");
+
+	err = ss_dem_write(check_file("q.asc"), SS_DEM_AUTO, &a);
+	CHECK(err == SS_OK, "write q.asc: %d", err);
+	size_t n;
+	char *text = slurp(check_file("q.prj"), &n);
+	CHECK(text && !strcmp(text, utm33n_esri), "q.prj in ESRI WKT, the text GDAL writes: %s",
+	      text ? text : "(none)");
+	free(text);
+	CHECK(ss_dem_read(check_file("q.asc"), NULL, NULL, &b) == SS_OK && b.crs_wkt &&
+	      a.crs_wkt && !strcmp(a.crs_wkt, b.crs_wkt), "the same CRS read back");
+	CHECK(same_values(&a, &b), "and the same heights");
+	ss_raster_release(&b);
+
+	/* GDAL's other spelling, X.PRJ, when there is no X.prj */
+	check_write_file(check_file("u.asc"), small_asc);
+	check_write_file(check_file("u.PRJ"), utm33n_esri);
+	CHECK(ss_dem_read(check_file("u.asc"), NULL, NULL, &b) == SS_OK && b.crs_wkt &&
+	      !strcmp(a.crs_wkt, b.crs_wkt), "u.PRJ read as u.asc's CRS");
+	ss_raster_release(&b);
+
+	/* the input's .prj is never replaced, even through another name */
+	capture_begin();
+	err = ss_dem_write(check_file("p.ASC"), SS_DEM_ASC, &a);
+	const char *msg = capture_end();
+	CHECK(err == SS_ERR_INPUT && strstr(msg, "p.prj") && strstr(msg, "never modified"),
+	      "writing p.ASC over p.asc's p.prj refused: %s", msg);
+	capture_begin();
+	err = ss_dem_check_not_source(check_file("p.ASC"), &a);
+	capture_end();
+	CHECK(err == SS_ERR_INPUT, "and so ss_dem_check_not_source says, before any work");
+	CHECK(!exists(check_file("p.ASC")), "nothing written");
+	text = slurp(check_file("p.prj"), &n);
+	CHECK(text && !strcmp(text, utm33n_esri), "p.prj untouched");
+	free(text);
+	CHECK(hidden_files() == 0, "no temporary file left");
+	ss_raster_release(&a);
+}
+
+static void asc_without_crs_has_no_prj(void)
+{
+	check_write_file(check_file("n.asc"), small_asc);
+	struct ss_raster a, b;
+	CHECK(ss_dem_read(check_file("n.asc"), NULL, NULL, &a) == SS_OK && !a.crs_wkt,
+	      "no .prj: no CRS");
+	CHECK(ss_dem_write(check_file("m.asc"), SS_DEM_AUTO, &a) == SS_OK, "write m.asc");
+	CHECK(!exists(check_file("m.prj")) && !exists(check_file("m.PRJ")), "and no m.prj");
+
+	/* a .prj left by an earlier m.asc would claim a CRS for this one */
+	check_write_file(check_file("m.prj"), utm33n_esri);
+	check_write_file(check_file("m.PRJ"), utm33n_esri);
+	CHECK(ss_dem_write(check_file("m.asc"), SS_DEM_AUTO, &a) == SS_OK, "write m.asc again");
+	CHECK(!exists(check_file("m.prj")) && !exists(check_file("m.PRJ")),
+	      "the stale m.prj and m.PRJ removed");
+	CHECK(ss_dem_read(check_file("m.asc"), NULL, NULL, &b) == SS_OK && !b.crs_wkt,
+	      "m.asc reads without a CRS");
+	ss_raster_release(&b);
+
+	/* a failed write leaves an earlier grid's .prj with it */
+	check_write_file(check_file("m.prj"), utm33n_esri);
+	a.values[1] = NAN;
+	capture_begin();
+	const int err = ss_dem_write(check_file("m.asc"), SS_DEM_AUTO, &a);
+	capture_end();
+	CHECK(err == SS_ERR_FAIL && exists(check_file("m.prj")), "a failed write keeps m.prj");
+	unlink(check_file("m.prj"));
+	CHECK(hidden_files() == 0, "no temporary file left");
+	ss_raster_release(&a);
+}
+
+/* A .prj that is there but is no CRS is refused naming it, rather than
+ * read as none. */
+static void asc_bad_prj_is_refused(void)
+{
+	static const struct {
+		const char *text;
+		const char *words[3];
+	} bad[] = {
+		{"", {"b.prj", "b.asc", "empty"}},
+		{"  \n\n", {"b.prj", "empty"}},
+		{"this is not a CRS\n", {"b.prj", "b.asc", "fix or remove it"}},
+		{"PROJCS[\"cut short\",GEOGCS[", {"b.prj", "fix or remove it"}},
+		/* a geographic CRS: degrees, refused as a GeoTIFF in degrees is */
+		{"GEOGCS[\"GCS_WGS_1984\",DATUM[\"D_WGS_1984\",SPHEROID[\"WGS_1984\",6378137.0,"
+		 "298.257223563]],PRIMEM[\"Greenwich\",0.0],UNIT[\"Degree\",0.0174532925199433]]",
+		 {"b.asc", "degrees, not metres", "gdalwarp -t_srs EPSG:32632"}},
+	};
+	/* around 8.5 E, 47.4 N: UTM zone 32 north */
+	check_write_file(check_file("b.asc"), "ncols 2\nnrows 2\nxllcorner 8.5\nyllcorner 47.4\n"
+	                                      "cellsize 0.001\n1 2\n3 4\n");
+	for (size_t a = 0; a < sizeof bad / sizeof *bad; a++) {
+		check_write_file(check_file("b.prj"), bad[a].text);
+		struct ss_raster r;
+		capture_begin();
+		int err = ss_dem_read(check_file("b.asc"), "case.ini:3", NULL, &r);
+		const char *msg = capture_end();
+		ss_raster_release(&r);
+		CHECK(err == SS_ERR_INPUT, "case %zu: status %d", a, err);
+		CHECK(strstr(msg, "case.ini:3") != NULL, "case %zu names where: %s", a, msg);
+		for (int w = 0; w < 3 && bad[a].words[w]; w++)
+			CHECK(strstr(msg, bad[a].words[w]) != NULL, "case %zu: '%s' in: %s", a,
+			      bad[a].words[w], msg);
+		CHECK(strchr(msg, '\n') == msg + strlen(msg) - 1, "case %zu: one message: %s", a, msg);
+	}
+	/* one that cannot be read: a folder of that name */
+	unlink(check_file("b.prj"));
+	CHECK(mkdir(check_file("b.prj"), 0700) == 0, "mkdir b.prj");
+	struct ss_raster r;
+	capture_begin();
+	int err = ss_dem_read(check_file("b.asc"), NULL, NULL, &r);
+	const char *msg = capture_end();
+	ss_raster_release(&r);
+	CHECK(err == SS_ERR_INPUT && strstr(msg, "b.prj") && strstr(msg, "b.asc"),
+	      "an unreadable .prj: %s", msg);
+	rmdir(check_file("b.prj"));
+}
+
 int main(void)
 {
 	if (check_scratch_make("test_dem"))
@@ -796,6 +949,9 @@ int main(void)
 	RUN(writes_are_atomic_and_spare_the_input);
 	RUN(nodata_value_avoids_real_heights);
 	RUN(geotiff_round_trip);
+	RUN(asc_prj_round_trip);
+	RUN(asc_without_crs_has_no_prj);
+	RUN(asc_bad_prj_is_refused);
 	remove_dir();
 	return check_report();
 }

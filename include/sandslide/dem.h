@@ -7,12 +7,18 @@
  *                  yllcorner|yllcenter, cellsize (or dx and dy, as GDAL
  *                  writes for rectangular cells), optional NODATA_value.
  *                  Written with "%.17g", so values come back bit for bit.
+ *                  The CRS is in the ".prj" beside it, as GDAL keeps it:
+ *                  read from X.prj (else X.PRJ), ESRI WKT converted to OGC
+ *                  WKT with GDAL (kept as read without); written to X.prj
+ *                  in ESRI WKT when the raster has one, else a stale X.prj
+ *                  is removed.  A .prj that is no CRS, or a geographic
+ *                  one, is refused.
  *   .h5[:/dataset] sandslide HDF5 (read only here; the snapshot module writes
  *                  it): "FILE.h5" is the last snapshot of /height of a
  *                  sandslide output, with its cell size and corner;
  *                  "FILE.h5:/dataset" any (y, x) or (time, y, x) variable
  *                  (the last time), with no geometry.
- *   .png           16-bit greyscale heightmap in the renderer's gray16 form:
+ *   .png           16-bit greyscale heightmap (no CRS) in the renderer's gray16 form:
  *                  grey 0 is no data (tRNS-transparent), grey v >= 1 is
  *                  zmin + (v - 1) (zmax - zmin) / 65534, zmin and zmax in
  *                  the tEXt chunks "zmin_m" and "zmax_m"; optional chunks
@@ -79,8 +85,9 @@ struct ss_raster {
 	double geotransform[6]; /* GDAL: x = g0 + col g1, y = g3 + row g5, row 0
 	                           the north row; g2 = g4 = 0.  When set, the
 	                           GeoTIFF writer uses it rather than x0, y0 */
-	char *crs_wkt;          /* GDAL: coordinate reference system (owned),
-	                           NULL when none */
+	char *crs_wkt;          /* coordinate reference system as WKT (owned),
+	                           NULL when none: a GDAL raster's, an .asc's
+	                           .prj, an .h5's /crs */
 };
 
 /* Options of ss_dem_read; NULL means ss_dem_read_options_init's defaults. */
@@ -124,7 +131,8 @@ int ss_dem_read(const char *spec, const char *context,
  * png_zmin/png_zmax if every value lies within them, else the data's
  * minimum and maximum, which then come back exactly; other values to half
  * a grey level), the cell size and corner, nodata cells as grey 0; GeoTIFF the
- * geotransform, CRS and nodata value.  SS_ERR_INPUT for an unwritable path,
+ * geotransform, CRS and nodata value; an .asc's CRS goes to the .prj beside
+ * it (see above).  SS_ERR_INPUT for an unwritable path,
  * a format that cannot be written (HDF5, GDAL missing) or metadata the
  * format needs and r lacks (a cell size for .asc); SS_ERR_FAIL for a NaN or
  * infinite value in a cell with data. */
@@ -170,9 +178,10 @@ int ss_dem_writer_put(struct ss_dem_writer *w, const double *values, const uint8
  * is freed and set to NULL either way. */
 int ss_dem_writer_close(struct ss_dem_writer **w, int keep);
 
-/* SS_ERR_INPUT when path is the file r was read from (the input is never
- * modified): what ss_dem_write refuses, for a caller to ask before it does
- * the work whose result it would write. */
+/* SS_ERR_INPUT when path is the file r was read from, or an .asc whose
+ * .prj is the one r was read with (the input is never modified): what
+ * ss_dem_write refuses, for a caller to ask before it does the work whose
+ * result it would write. */
 int ss_dem_check_not_source(const char *path, const struct ss_raster *r);
 
 /* The format of path from its extension, SS_DEM_AUTO when it is none of

@@ -374,6 +374,8 @@ int ss_dem_read(const char *spec, const char *context, const struct ss_dem_read_
 	switch (format) {
 	case SS_DEM_ASC:
 		err = ss_dem_read_asc(spec, context, opt, r);
+		if (!err)   /* its CRS, in the .prj beside it (dem_prj.c) */
+			err = ss_dem_read_prj(spec, context, r);
 		break;
 	case SS_DEM_H5:
 		err = read_h5(spec, context, opt, r);
@@ -471,7 +473,7 @@ int ss_dem_check_not_source(const char *path, const struct ss_raster *r)
 	    a.st_dev == b.st_dev && a.st_ino == b.st_ino)
 		return ss_error_input("cannot write '%s': it is the file the raster was read from, "
 		                      "which is never overwritten: choose another output name", path);
-	return SS_OK;
+	return ss_dem_prj_check_not_source(path, r);   /* nor its .prj */
 }
 
 /* Create an empty, new file beside path ("DIR/.BASE.tmp-PID-N") with the
@@ -529,11 +531,18 @@ int ss_dem_writer_close(struct ss_dem_writer **wp, int keep)
 		if (fclose(w->f) && keep && !err)
 			err = ss_error_fail("cannot write '%s': %s", w->path, strerror(errno));
 	}
+	/* an .asc's CRS goes beside it, X.prj, ready before either is renamed */
+	struct ss_dem_prj prj = {.tmp = ""};
+	if (keep && !err && w->format == SS_DEM_ASC)
+		err = ss_dem_prj_prepare(w->path, w->head, &prj);
 	if (keep && !err && rename(w->tmp, w->path))
 		err = ss_error_input("cannot write '%s': cannot rename the finished temporary file "
 		                     "'%s' to it: %s", w->path, w->tmp, strerror(errno));
+	if (keep && !err && w->format == SS_DEM_ASC)
+		err = ss_dem_prj_commit(w->path, &prj);
 	if (!keep || err)
 		unlink(w->tmp);
+	ss_dem_prj_discard(&prj);
 	ss_free(w->row);
 	ss_free(w);
 	return err;

@@ -107,7 +107,7 @@ static double two_digits(double x)
  * -dstnodata marks what lies outside the source after the rotation of the
  * projection, which would otherwise be 0 m: a cliff all round.
  */
-static int refuse_degrees(const char *path, const char *context, const char *crs,
+int ss_dem_refuse_degrees(const char *path, const char *context, const char *crs,
                           const struct ss_raster *r, int nx, int ny)
 {
 	char target[64] = "EPSG:<a projected CRS in metres, e.g. your UTM zone>";
@@ -171,7 +171,7 @@ static int read_dataset(GDALDatasetH ds, const char *path, const char *context,
 	const char *wkt = GDALGetProjectionRef(ds);
 	char crs[160];
 	if (wkt && *wkt && geographic(wkt, crs, sizeof crs))
-		return refuse_degrees(path, context, crs, r, nx, ny);
+		return ss_dem_refuse_degrees(path, context, crs, r, nx, ny);
 	if (wkt && *wkt && !(r->crs_wkt = ss_dem_strdup(wkt)))
 		return SS_ERR_FAIL;
 

@@ -63,6 +63,31 @@ int ss_dem_gdal_begin(struct ss_dem_writer *w);
 int ss_dem_gdal_rows(struct ss_dem_writer *w, const double *values, int rows);
 int ss_dem_gdal_end(struct ss_dem_writer *w);
 
+/* The CRS of an ESRI ASCII grid, in the .prj beside it (dem_prj.c): read
+ * into r->crs_wkt after the grid (SS_OK and no CRS when there is none). */
+int ss_dem_read_prj(const char *path, const char *context, struct ss_raster *r);
+
+/* Its .prj written with an .asc: prepared (the text in a temporary file
+ * beside it) before the grid is renamed into place, committed (renamed to
+ * X.prj; with no CRS, a stale X.prj or X.PRJ removed) after, discarded
+ * (the temporary file removed, if still there) always. */
+struct ss_dem_prj {
+	char dest[4096];    /* X.prj */
+	char tmp[4096];     /* the temporary file, "" when none */
+	int remove;         /* r has no CRS: remove a stale one */
+};
+int ss_dem_prj_prepare(const char *path, const struct ss_raster *r, struct ss_dem_prj *p);
+int ss_dem_prj_commit(const char *path, struct ss_dem_prj *p);
+void ss_dem_prj_discard(struct ss_dem_prj *p);
+/* SS_ERR_INPUT when writing path as .asc would replace the .prj r's grid
+ * was read with (dem.asc read, dem.ASC written). */
+int ss_dem_prj_check_not_source(const char *path, const struct ss_raster *r);
+
+/* dem_gdal.c's refusal of a raster in degrees (crs: its name), from r's
+ * geotransform; GDAL builds only. */
+int ss_dem_refuse_degrees(const char *path, const char *context, const char *crs,
+                          const struct ss_raster *r, int nx, int ny);
+
 /* Cell sizes to write: cellsize and cellsize_y (cellsize_y NAN: cellsize). */
 double ss_dem_dy(const struct ss_raster *r);
 
