@@ -165,7 +165,6 @@ struct relax {
 	enum ss_dem_format format;        /* of the output */
 	struct ss_stepper st;
 	struct ss_drive drive;
-	double *h0;                       /* the initial heights, halo layout */
 };
 
 /* The driver's rebuild: the DEM's stepper at t = 0 (model/setup.h). */
@@ -311,14 +310,12 @@ static int read_inputs_here(struct relax *x, struct ss_relax_report *rep)
 	return SS_OK;
 }
 
-/* The initial state's measures, and a copy of it to count what moved. */
+/* The initial state's measures.  What moved is counted against the DEM's
+ * rows (x->dem, until write_raster overwrites them), which hold the
+ * initial height of every flow cell: no copy of the heights. */
 static int measure_before(struct relax *x, struct ss_relax_report *rep)
 {
 	const struct ss_grid *g = &x->st.grid;
-	const size_t cells = ss_grid_storage_cells(g);
-	if (!(x->h0 = ss_alloc(cells, sizeof *x->h0, "initial heights")))
-		return SS_ERR_FAIL;
-	memcpy(x->h0, x->st.height, cells * sizeof *x->h0);
 	rep->nx = (int)g->global_nx;
 	rep->ny = (int)g->global_ny;
 	rep->dx = g->dx;
@@ -378,15 +375,16 @@ static void measure_after(struct relax *x, enum ss_drive_end end, struct ss_rela
 	rep->max_slope_after_deg = steepest_sand_face_deg(st);
 	/* in row order, carried from rank to rank (comm.h) */
 	double moved = 0.0, cells_moved = 0.0, none = 0.0;
+	const double *h0 = x->dem.values + (size_t)(g->offset_j - x->dem.row_first) * g->nx;
 	ss_comm_fold_start(&moved, 1);
 	for (int j = 0; j < g->ny; j++) {
 		for (int i = 0; i < g->nx; i++) {
 			const ptrdiff_t k = ss_grid_index(g, i, j);
-			if (ss_cell_type_get(st->cell_types, k) != SS_CELL_FLOW ||
-			    st->height[k] == x->h0[k])
+			const double before = h0[(size_t)j * g->nx + i];
+			if (ss_cell_type_get(st->cell_types, k) != SS_CELL_FLOW || st->height[k] == before)
 				continue;
 			cells_moved++;
-			moved += fabs(st->height[k] - x->h0[k]);
+			moved += fabs(st->height[k] - before);
 		}
 	}
 	ss_comm_fold_finish(&moved, 1);
@@ -465,7 +463,6 @@ int ss_relax_run(const struct ss_relax_options *o, struct ss_relax_report *rep)
 	if (!err && o->report)
 		err = ss_comm_agree(ss_comm_rank() == 0 ? write_report(o->report, o, rep) : SS_OK);
 	err = ss_drive_finish(&x.drive, err);
-	ss_free(x.h0);
 	ss_stepper_release(&x.st);
 	ss_raster_release(&x.bedrock);
 	ss_raster_release(&x.dem);

@@ -207,6 +207,9 @@ static int read_dataset(GDALDatasetH ds, const char *path, const char *context,
 		                 nx, b - a, GDT_Float64, 0, 0) != CE_None)
 			return ss_error_input_at(context, "cannot read the heights of '%s': %s", path,
 			                         gdal_message());
+		/* read once: out of GDAL's cache, which would otherwise keep up
+		 * to 5 % of the machine's memory of a window read already */
+		GDALFlushCache(ds);
 		a = b;
 	}
 	for (size_t k = 0; k < n; k++) {   /* still north row first */
