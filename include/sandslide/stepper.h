@@ -207,9 +207,9 @@ struct ss_stepper {
  * ranks' lists in rank order, so each rank's part continues the sum the
  * rank before it ended with: summed each evaluation that is a chain of
  * P - 1 messages.  Instead, with more than one rank and open faces, each
- * rank keeps its faces' non-zero fluxes of each evaluation in a batch of at
- * most outflow_batch_bytes (a rank with more open faces than fit keeps one
- * evaluation's, 8 B a face), and the ranks fold the batch in one pass
+ * rank keeps its faces' non-zero fluxes of each evaluation in a batch of
+ * outflow_batch_bytes and room for one more evaluation's (8 B an open face
+ * of the rank), and the ranks fold the batch in one pass
  * (P - 1 messages for the whole batch) when ss_stepper_advance returns,
  * when ss_stepper_diagnostics is called and when the batch is full, then
  * add each evaluation to the ledger as one rank would have: the same bits.

@@ -267,11 +267,13 @@ static double outflow_rate(const struct ss_stepper *st)
  *
  * The batch holds entries_max evaluations (same on every rank) and this
  * rank terms_max terms; the flush comes before an evaluation that might
- * not fit.  Whether it fits must be the same answer on every rank without
- * a message: `fits` is how many more evaluations surely fit on every rank,
- * each taking at most its open_face_count terms there; it counts down each
+ * not fit.  Whether it fits must be the same answer on every rank:
+ * `fits` is how many more evaluations surely fit on every rank, each
+ * taking at most its open_face_count terms there; it counts down each
  * evaluation, and the reduction that ends each step (step_end) sets it to
- * min over ranks of (terms_max - terms_used) / open_face_count.
+ * min over ranks of (terms_max - terms_used) / open_face_count.  When it
+ * runs out between those (an RKL2 super-step's stages), one reduction asks
+ * the same, and only if that says no the batch is folded.
  */
 enum {
 	OUTFLOW_EULER = 0,      /* a forward-Euler step */
@@ -292,6 +294,8 @@ struct ss_outflow_batch {
 	int entries_max, count;       /* evaluations: room, kept (every rank) */
 	double fits, fits_empty;      /* evaluations that surely fit now, and
 	                               * after a flush (every rank) */
+	int fits_measured;            /* fits is the room measured, not a
+	                               * count down since */
 	size_t terms_max, terms_used; /* this rank's */
 	struct outflow_entry *entries;
 	size_t *ends;                 /* 2 a evaluation: the end of its x-face
@@ -327,8 +331,9 @@ static double outflow_fits_here(const struct ss_stepper *st)
 }
 
 /* The ledger and, on several ranks with open faces, the batch: a quarter
- * of outflow_batch_bytes for the evaluations, the rest for the terms (at
- * least one evaluation's).  Allocates (the caller agrees on failure). */
+ * of outflow_batch_bytes for the evaluations, the rest for the terms, and
+ * one more evaluation's terms (8 B a face of this rank).  Allocates (the
+ * caller agrees on failure). */
 static int outflow_batch_init(struct ss_stepper *st)
 {
 	struct ss_outflow_batch *b = ss_alloc(1, sizeof *b, "outflow ledger");
@@ -345,10 +350,12 @@ static int outflow_batch_init(struct ss_stepper *st)
 	entries = entries < 1 ? 1 : entries > (size_t)INT_MAX / 2 ? (size_t)INT_MAX / 2 : entries;
 	const size_t left = bytes > entries * OUTFLOW_ENTRY_BYTES
 	                  ? bytes - entries * OUTFLOW_ENTRY_BYTES : 0;
-	/* at least one evaluation's terms, at most every face of every one */
+	/* and room for one more evaluation's, every face, so that the batch
+	 * is folded only when the terms kept (not the faces) pass the bytes;
+	 * no more than every face of every evaluation */
 	const size_t faces = st->open_face_count;
-	size_t terms = left / sizeof(double);
-	terms = terms < faces ? faces : terms > entries * faces ? entries * faces : terms;
+	size_t terms = left / sizeof(double) + faces;
+	terms = terms > entries * faces ? entries * faces : terms;
 	b->entries_max = (int)entries;
 	b->terms_max = terms;
 	b->entries = ss_alloc(entries, sizeof *b->entries, "outflow batch");
@@ -371,6 +378,7 @@ static void outflow_batch_agree(struct ss_stepper *st)
 	double least[2] = {-outflow_fits_here(st), -(double)b->entries_max};
 	ss_comm_reduce(least, 2, NULL, 0);
 	b->fits = b->fits_empty = -least[0];
+	b->fits_measured = 1;
 	b->entries_max = (int)-least[1];
 }
 
@@ -425,6 +433,7 @@ static void outflow_flush(struct ss_stepper *st)
 	b->count = 0;
 	b->terms_used = 0;
 	b->fits = b->fits_empty;
+	b->fits_measured = 1;
 	st->outflow = st->outflow_sum + st->outflow_carry;
 }
 
@@ -456,6 +465,13 @@ static void outflow_account(struct ss_stepper *st, const struct outflow_entry *e
 		ledger_apply(st, e, outflow_rate(st));
 		return;
 	}
+	if (b->fits < 1.0 && !b->fits_measured && b->count < b->entries_max) {
+		/* the guess ran out (RKL2 stages: no reduction between them):
+		 * ask every rank, one reduction, before folding */
+		double least = -outflow_fits_here(st);
+		ss_comm_reduce(&least, 1, NULL, 0);
+		b->fits = -least;
+	}
 	if (b->count == b->entries_max || b->fits < 1.0)
 		outflow_flush(st);
 	const int k = b->count;
@@ -466,6 +482,7 @@ static void outflow_account(struct ss_stepper *st, const struct outflow_entry *e
 	b->entries[k] = *e;
 	b->count++;
 	b->fits -= 1.0;
+	b->fits_measured = 0;
 }
 
 static int open_faces_build(struct ss_stepper *st)
@@ -829,8 +846,10 @@ static int step_end(struct ss_stepper *st, const struct ss_advance_options *o,
 	                   ob->on ? -outflow_fits_here(st) : 0.0};
 	ss_comm_reduce(agree, ob->on ? 3 : 2, NULL, 0);
 	st->rate_max = agree[0];
-	if (ob->on)
+	if (ob->on) {
 		ob->fits = -agree[2];
+		ob->fits_measured = 1;
+	}
 	if (o->progress)
 		o->progress(o->context, st);
 	if (!isfinite(st->rate_max))
