@@ -64,8 +64,8 @@ Every run gets --threads 1 and --bind-to none, and the Open MPI settings of
 doc/cluster.md#open-mpi-as-root-on-a-small-machine (root, oversubscription of 2 cores,
 yielding when idle, shared memory only).  A run that hangs (a deadlock) is
 killed, all its processes (and what they leave in /dev/shm and mpirun's
-session folder), after 60 s and fails the test.  About 60 mpirun starts:
-31 s on 2 busy cores.
+session folder), after 60 s and fails the test.  About 75 mpirun starts:
+45 s on 2 busy cores.
 """
 import glob
 import json
