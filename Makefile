@@ -348,16 +348,20 @@ $(FUZZ_BUILD)/replay/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/replay.c $(FUZZ_BUIL
 # with the stepper's advance wrapped, as $(BUILD)/tests/sandslide-NAME, so
 # that a test can put a NaN into a height (nan: the non-finite guard), or
 # stop a run at a known substep until it is signalled (pause: the
-# interrupt, without racing the run); the real sandslide has no hook.
+# interrupt, without racing the run); or with its prepare wrapped, to
+# shrink the outflow batch of a distributed run (batch: test-mpi only);
+# the real sandslide has no hook.
 HOOK_NAN   := $(BUILD)/tests/sandslide-nan
 HOOK_PAUSE := $(BUILD)/tests/sandslide-pause
+HOOK_BATCH := $(BUILD)/tests/sandslide-batch
 HOOK_BIN   := $(HOOK_NAN) $(HOOK_PAUSE)
-$(HOOK_BIN): $(BUILD)/tests/sandslide-%: tests/hooks/%_step.c $(MAIN_OBJ) $(BUILD)/libsandslide.a \
-             $(BUILD)/.flags
+$(HOOK_BIN) $(HOOK_BATCH): $(BUILD)/tests/sandslide-%: tests/hooks/%_step.c $(MAIN_OBJ) \
+             $(BUILD)/libsandslide.a $(BUILD)/.flags
 	@mkdir -p $(@D)
 	@$(if $(Q),echo '  LINK    $@')
 	$(Q)$(CC) $(filter-out -MMD -MP,$(ALL_CFLAGS)) $< $(MAIN_OBJ) \
-	  $(BUILD)/libsandslide.a $(ALL_LDFLAGS) -Wl,--wrap=ss_stepper_advance $(LIBS) -o $@
+	  $(BUILD)/libsandslide.a $(ALL_LDFLAGS) \
+	  -Wl,--wrap=$(if $(filter batch,$*),ss_stepper_prepare,ss_stepper_advance) $(LIBS) -o $@
 
 # The Python module's tests load the library into python3: a sanitized one
 # needs its run-time libraries loaded first, and Python's own allocations
@@ -394,14 +398,14 @@ test check: all $(TEST_BIN) $(HOOK_BIN) headers-check check-layering $(FUZZ_REPL
 # the ordered sums alone and under mpirun -np 1 .. 4, then
 # tests/cli/test_mpi.py (which `make test` leaves out), which
 # compares every snapshot of build-mpi/sandslide under np = 1..4 with the
-# serial build/sandslide (built first).  Open MPI's settings for a root
+# serial build/sandslide (built first), also with the pause and batch hooks.  Open MPI's settings for a root
 # user, more ranks than cores, no RDMA (doc/cluster.md#open-mpi-as-root-on-a-small-machine).
 MPI_ENV := OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 \
            OMPI_MCA_rmaps_base_oversubscribe=1 OMPI_MCA_mpi_yield_when_idle=1 \
            OMPI_MCA_btl_vader_single_copy_mechanism=none OMPI_MCA_pml=ob1 \
            OMPI_MCA_btl=self,vader OMPI_MCA_btl_base_warn_component_unused=0 OMP_NUM_THREADS=1
 .PHONY: test-mpi
-test-mpi: all $(BUILD)/tests/test_comm $(HOOK_PAUSE)
+test-mpi: all $(BUILD)/tests/test_comm $(HOOK_PAUSE) $(HOOK_BATCH)
 	@[ "$(MPI)" = 1 ] || { echo "test-mpi: run it as make MPI=1 test-mpi"; exit 2; }
 	$(MAKE) MPI=0 all
 	@echo "== $(BUILD)/tests/test_comm (alone, then mpirun -np 1 .. 4)"; \
@@ -411,7 +415,8 @@ test-mpi: all $(BUILD)/tests/test_comm $(HOOK_PAUSE)
 	  done
 	@echo "== tests/cli/test_mpi.py (pytest)"; \
 	  $(MPI_ENV) SANDSLIDE_MPI=$(abspath $(BUILD)/sandslide) SANDSLIDE=$(abspath build/sandslide) \
-	  SANDSLIDE_MPI_PAUSE=$(abspath $(HOOK_PAUSE)) $(PYTHON) -m pytest -q -rs tests/cli/test_mpi.py
+	  SANDSLIDE_MPI_PAUSE=$(abspath $(HOOK_PAUSE)) SANDSLIDE_MPI_BATCH=$(abspath $(HOOK_BATCH)) \
+	  $(PYTHON) -m pytest -q -rs tests/cli/test_mpi.py
 
 # A real Slurm on this machine (make MPI=1 test-slurm; make deps-slurm
 # installs it): tests/slurm/run.sh starts munged, slurmctld and slurmd as

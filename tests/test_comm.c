@@ -26,6 +26,12 @@
  *                split over the ranks (some ranks may hold none) has the
  *                bits of the serial left fold; the values are chosen so that
  *                adding per-rank partial sums would not
+ *   fold many    the outflow batch's fold (stepper.c): 3000 folds of two
+ *                sums in one call (6000 running values, 48 kB a message),
+ *                each of 0 to 22 values split over the ranks, a third of
+ *                them +0 or -0 and left out by the ranks: every total has
+ *                the bits (the sign of a zero included) of its own serial
+ *                left fold over every value, zeros included
  *   gather       rows of different lengths (one rank sends none) arrive on
  *                rank 0 in rank order; broadcast from the first and the last
  *                rank
@@ -490,6 +496,55 @@ static void test_fold(void)
 	      1000 - ranks);
 }
 
+/* Value k of fold e of test_fold_many, of sum `which` (0, 1): value()'s
+ * cancelling terms, a third of them replaced by +0 or -0. */
+static double many_value(int e, int k, int which)
+{
+	const int m = e * 7 + k * 3 + which;
+	if (m % 3 == 0)
+		return m % 2 ? -0.0 : 0.0;
+	return value(e + k + 5 * which);
+}
+
+#define N_FOLDS 3000
+
+static void test_fold_many(void)
+{
+	double *run = zalloc(2 * N_FOLDS * sizeof *run);
+	for (int k = 0; k < 2 * N_FOLDS; k++)
+		run[k] = rank == 0 ? 0.0 : NAN;
+	ss_comm_fold_start(run, 2 * N_FOLDS);
+	for (int e = 0; e < N_FOLDS; e++) {
+		long long first, count;
+		ss_comm_split(e % 23, &first, &count);
+		for (int which = 0; which < 2; which++) {
+			double sum = run[2 * e + which];
+			for (long long k = first; k < first + count; k++) {
+				const double t = many_value(e, (int)k, which);
+				if (t != 0.0)   /* as the batch keeps them */
+					sum += t;
+			}
+			run[2 * e + which] = sum;
+		}
+	}
+	ss_comm_fold_finish(run, 2 * N_FOLDS);
+	int bad = 0, zeros = 0;
+	for (int e = 0; e < N_FOLDS; e++) {
+		for (int which = 0; which < 2; which++) {
+			double want = 0.0;
+			for (int k = 0; k < e % 23; k++)
+				want += many_value(e, k, which);
+			zeros += want == 0.0;
+			if (!same_bits(run[2 * e + which], want) && bad++ < 3)
+				CHECK(0, "fold %d, sum %d: %.17g, the serial left fold %.17g", e, which,
+				      run[2 * e + which], want);
+		}
+	}
+	CHECK(bad == 0, "%d of %d batched folds differ from the serial ones", bad, 2 * N_FOLDS);
+	CHECK(zeros > 0, "test set-up: no fold ends at zero (the sign of a zero is not tested)");
+	free(run);
+}
+
 /* ---- gather, broadcast --------------------------------------------------------- */
 
 static void test_gather_and_broadcast(void)
@@ -581,6 +636,7 @@ int main(int argc, char **argv)
 	RUN_ALL(test_halo);
 	RUN_ALL(test_reduce);
 	RUN_ALL(test_fold);
+	RUN_ALL(test_fold_many);
 	RUN_ALL(test_gather_and_broadcast);
 	RUN_ALL(test_agree);
 

@@ -189,7 +189,10 @@ struct ss_stepper {
 	int last_stages;              /* s of the last super-step */
 	double inflow, outflow;       /* cumulative, m^3 */
 	double inflow_sum, inflow_carry;   /* compensated partial sums of them */
-	double outflow_sum, outflow_carry;
+	double outflow_sum, outflow_carry; /* (on several ranks: see below) */
+	size_t outflow_batch_bytes;   /* set before ss_stepper_prepare; 0:
+	                               * SS_OUTFLOW_BATCH_BYTES (below) */
+	struct ss_outflow_batch *outflow_batch; /* stepper.c */
 	double rate_max;              /* max |dh/dt| of the last substep, m/s */
 	double tile_sweeps, tile_slots; /* for active_fraction, since last reset */
 	double seconds_measure;       /* kernel wall time, s: measuring S */
@@ -197,6 +200,25 @@ struct ss_stepper {
 };
 
 #define SS_MAX_SOURCES 64
+
+/*
+ * The outflow on several ranks.  The outflow of an evaluation is a sum
+ * over the open faces in list order, and the list of the whole grid is the
+ * ranks' lists in rank order, so each rank's part continues the sum the
+ * rank before it ended with: summed each evaluation that is a chain of
+ * P - 1 messages.  Instead, with more than one rank and open faces, each
+ * rank keeps its faces' non-zero fluxes of each evaluation in a batch of
+ * outflow_batch_bytes and room for one more evaluation's (8 B an open face
+ * of the rank), and the ranks fold the batch in one pass
+ * (P - 1 messages for the whole batch) when ss_stepper_advance returns,
+ * when ss_stepper_diagnostics is called and when the batch is full, then
+ * add each evaluation to the ledger as one rank would have: the same bits.
+ * So outflow, outflow_sum and outflow_carry are those of the current state
+ * between calls to ss_stepper_advance; inside its progress callback they
+ * may lag (several ranks only).  One rank adds each evaluation at once, as
+ * before.
+ */
+#define SS_OUTFLOW_BATCH_BYTES ((size_t)4 << 20)
 
 /* Allocate the arrays for grid g (zero heights, all flow cells).  Returns
  * SS_ERR_INPUT for a bad cfl or boundary, SS_ERR_FAIL when an allocation

@@ -170,8 +170,11 @@ static void reduce(double *max, int n_max, double *sum, int n_sum)
 		b.sum[k] = k < n_sum ? sum[k] : 0.0;
 	}
 	MPI_Allreduce(MPI_IN_PLACE, &b, 1, reduce_type, reduce_op, MPI_COMM_WORLD);
-	memcpy(max, b.max, (size_t)n_max * sizeof *max);
-	memcpy(sum, b.sum, (size_t)n_sum * sizeof *sum);
+	/* max or sum may be NULL with a count of 0, which memcpy may not get */
+	if (n_max > 0)
+		memcpy(max, b.max, (size_t)n_max * sizeof *max);
+	if (n_sum > 0)
+		memcpy(sum, b.sum, (size_t)n_sum * sizeof *sum);
 }
 
 static void fold_start(double *running, int n)

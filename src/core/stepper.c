@@ -4,6 +4,7 @@
  */
 #include "sandslide/stepper.h"
 
+#include <limits.h>
 #include <math.h>
 #include <string.h>
 
@@ -12,6 +13,8 @@
 #include "sandslide/error.h"
 #include "sandslide/parallel.h"
 #include "sandslide/rkl2.h"
+
+static void outflow_batch_release(struct ss_stepper *st);
 
 static const char *const integrator_names[] = {
 	[SS_INTEGRATOR_EULER] = "euler", [SS_INTEGRATOR_RKL2] = "rkl2",
@@ -127,6 +130,7 @@ void ss_stepper_release(struct ss_stepper *st)
 	ss_free(st->sources);
 	ss_free(st->open_faces);
 	ss_free(st->open_flux);
+	outflow_batch_release(st);
 	ss_sweep_fast_release(&st->fast);
 	ss_free(st->rkl2_m0);
 	ss_free(st->rkl2_d2);
@@ -208,6 +212,288 @@ int ss_stepper_set_bedrock(struct ss_stepper *st, const double *bedrock)
 		}
 	}
 	return SS_OK;
+}
+
+/* Neumaier's compensated sum: *sum + *carry holds the total of every term
+ * to about one rounding, however many substeps are added up. */
+static void add_compensated(double *sum, double *carry, double term)
+{
+	const double t = *sum + term;
+	if (fabs(*sum) >= fabs(term))
+		*carry += (*sum - t) + term;
+	else
+		*carry += (term - t) + *sum;
+	*sum = t;
+}
+
+/* Volume leaving through open faces per second with the current fluxes,
+ * on one rank (or none open anywhere); summed in list order, so the same
+ * bits for any thread count and kernel. */
+static double outflow_rate(const struct ss_stepper *st)
+{
+	if (st->open_face_count_all == 0.0)
+		return 0.0;
+	/* two sums in registers: sum[f->axis] would go through memory */
+	double sum_x = 0.0, sum_y = 0.0;   /* x-faces, y-faces */
+	for (size_t m = 0; m < st->open_face_count; m++) {
+		const struct ss_open_face *f = &st->open_faces[m];
+		const double flux = st->kernel == SS_KERNEL_FAST ? st->open_flux[m]
+		                  : f->axis == 0 ? st->flux_x[f->index] : st->flux_y[f->index];
+		if (f->axis == 0)
+			sum_x += f->sign * flux;
+		else
+			sum_y += f->sign * flux;
+	}
+	return sum_x * st->grid.dy + sum_y * st->grid.dx;
+}
+
+/*
+ * The outflow ledger and, on several ranks, its batch (stepper.h).
+ *
+ * What an evaluation's outflow rate r (m^3/s) does to outflow_sum and
+ * outflow_carry, an entry of the ledger: forward Euler adds dt r; RKL2's
+ * stage j combines it as the heights are combined (rkl2_superstep),
+ *
+ *   O_j = (mu O_{j-1} + nu O_{j-2}) + (tau mu~ r_j + tau gamma~ r_1),
+ *
+ * from O_0 = O_{-1} = 0, and the last stage adds O_s.
+ *
+ * One rank applies each entry at once.  On several ranks with open faces
+ * r = sum_x dy + sum_y dx, with sum_x the left fold ((+0 + t_1) + t_2) + ...
+ * of the x-faces' signed fluxes t in the order of the whole grid's list
+ * (sum_y likewise), which is the ranks' lists in rank order: rank q's part
+ * continues the sum rank q - 1 ended with.  Each rank keeps, per
+ * evaluation, its own non-zero terms in list order (x-faces, then
+ * y-faces), and every rank the entry (the same on all).  A flush starts
+ * 2 K running sums at +0 for the K evaluations kept, carries them from
+ * rank to rank once (ss_comm_fold_start/finish: P - 1 messages of 16 K
+ * bytes, then a broadcast), each rank continuing each with its terms, and
+ * applies the K entries in order with the totals: the operations of one
+ * rank on the same values, so the same bits.
+ *
+ * Zero terms are left out: a running sum that starts at +0 is never -0
+ * (an IEEE sum is -0 only when both operands are, an exact cancellation
+ * gives +0), and s + (+0) = s + (-0) = s for every s but -0.  NaN terms are
+ * kept (NaN != 0).
+ *
+ * The batch holds entries_max evaluations (same on every rank) and this
+ * rank terms_max terms; the flush comes before an evaluation that might
+ * not fit.  Whether it fits must be the same answer on every rank:
+ * `fits` is how many more evaluations surely fit on every rank, each
+ * taking at most its open_face_count terms there; it counts down each
+ * evaluation, and the reduction that ends each step (step_end) sets it to
+ * min over ranks of (terms_max - terms_used) / open_face_count.  When it
+ * runs out between those (an RKL2 super-step's stages), one reduction asks
+ * the same, and only if that says no the batch is folded.
+ */
+enum {
+	OUTFLOW_EULER = 0,      /* a forward-Euler step */
+	OUTFLOW_STAGE = 1,      /* an RKL2 stage, */
+	OUTFLOW_FIRST = 2,      /*   the first of its super-step */
+	OUTFLOW_LAST = 4,       /*   the last: O_s is added */
+};
+
+struct outflow_entry {
+	double mu, nu, tau_mu, tau_gamma;   /* the stage's (ss_sweep_stage);
+	                                     * Euler: dt in tau_mu */
+	int kind;
+};
+
+struct ss_outflow_batch {
+	double out_1, out_2, out_m0;  /* RKL2: O_{j-1}, O_{j-2}, r_1 so far */
+	int on;                       /* several ranks, open faces: batched */
+	int entries_max, count;       /* evaluations: room, kept (every rank) */
+	double fits, fits_empty;      /* evaluations that surely fit now, and
+	                               * after a flush (every rank) */
+	int fits_measured;            /* fits is the room measured, not a
+	                               * count down since */
+	size_t terms_max, terms_used; /* this rank's */
+	struct outflow_entry *entries;
+	size_t *ends;                 /* 2 a evaluation: the end of its x-face
+	                               * terms, then of its y-face terms */
+	double *running;              /* 2 a evaluation: sum_x, sum_y */
+	double *terms;
+};
+
+/* Bytes of the batch a kept evaluation takes besides its terms. */
+#define OUTFLOW_ENTRY_BYTES \
+	(sizeof(struct outflow_entry) + 2 * sizeof(size_t) + 2 * sizeof(double))
+
+static void outflow_batch_release(struct ss_stepper *st)
+{
+	struct ss_outflow_batch *b = st->outflow_batch;
+	if (!b)
+		return;
+	ss_free(b->terms);
+	ss_free(b->running);
+	ss_free(b->ends);
+	ss_free(b->entries);
+	ss_free(b);
+	st->outflow_batch = NULL;
+}
+
+/* Evaluations that surely fit in this rank's terms now. */
+static double outflow_fits_here(const struct ss_stepper *st)
+{
+	const struct ss_outflow_batch *b = st->outflow_batch;
+	if (st->open_face_count == 0)
+		return INFINITY;
+	return floor((double)(b->terms_max - b->terms_used) / (double)st->open_face_count);
+}
+
+/* The ledger and, on several ranks with open faces, the batch: a quarter
+ * of outflow_batch_bytes for the evaluations, the rest for the terms, and
+ * one more evaluation's terms (8 B a face of this rank).  Allocates (the
+ * caller agrees on failure). */
+static int outflow_batch_init(struct ss_stepper *st)
+{
+	struct ss_outflow_batch *b = ss_alloc(1, sizeof *b, "outflow ledger");
+	if (!b)
+		return SS_ERR_FAIL;
+	memset(b, 0, sizeof *b);
+	st->outflow_batch = b;
+	b->on = ss_comm_size() > 1 && st->open_face_count_all > 0.0;
+	if (!b->on)
+		return SS_OK;
+	const size_t bytes = st->outflow_batch_bytes ? st->outflow_batch_bytes
+	                                             : SS_OUTFLOW_BATCH_BYTES;
+	size_t entries = bytes / 4 / OUTFLOW_ENTRY_BYTES;
+	entries = entries < 1 ? 1 : entries > (size_t)INT_MAX / 2 ? (size_t)INT_MAX / 2 : entries;
+	const size_t left = bytes > entries * OUTFLOW_ENTRY_BYTES
+	                  ? bytes - entries * OUTFLOW_ENTRY_BYTES : 0;
+	/* and room for one more evaluation's, every face, so that the batch
+	 * is folded only when the terms kept (not the faces) pass the bytes;
+	 * no more than every face of every evaluation */
+	const size_t faces = st->open_face_count;
+	size_t terms = left / sizeof(double) + faces;
+	terms = terms > entries * faces ? entries * faces : terms;
+	b->entries_max = (int)entries;
+	b->terms_max = terms;
+	b->entries = ss_alloc(entries, sizeof *b->entries, "outflow batch");
+	b->ends = ss_alloc(2 * entries, sizeof *b->ends, "outflow batch");
+	b->running = ss_alloc(2 * entries, sizeof *b->running, "outflow batch");
+	b->terms = ss_alloc(terms ? terms : 1, sizeof *b->terms, "outflow batch");
+	if (!b->entries || !b->ends || !b->running || !b->terms)
+		return SS_ERR_FAIL;
+	return SS_OK;
+}
+
+/* After outflow_batch_init on every rank: the room every rank has
+ * (collective). */
+static void outflow_batch_agree(struct ss_stepper *st)
+{
+	struct ss_outflow_batch *b = st->outflow_batch;
+	if (!b->on)
+		return;
+	/* minima as maxima of the negatives: whole numbers, exact */
+	double least[2] = {-outflow_fits_here(st), -(double)b->entries_max};
+	ss_comm_reduce(least, 2, NULL, 0);
+	b->fits = b->fits_empty = -least[0];
+	b->fits_measured = 1;
+	b->entries_max = (int)-least[1];
+}
+
+/* Apply an entry of the ledger with the evaluation's rate r, m^3/s. */
+static void ledger_apply(struct ss_stepper *st, const struct outflow_entry *e, double r)
+{
+	struct ss_outflow_batch *b = st->outflow_batch;
+	if (e->kind == OUTFLOW_EULER) {
+		add_compensated(&st->outflow_sum, &st->outflow_carry, e->tau_mu * r);
+		return;
+	}
+	const struct ss_sweep_stage stage = {
+		.mu = e->mu, .nu = e->nu, .tau_mu = e->tau_mu, .tau_gamma = e->tau_gamma,
+	};
+	const int first = e->kind & OUTFLOW_FIRST;
+	if (first) {
+		b->out_1 = b->out_2 = 0.0;
+		b->out_m0 = r;
+	}
+	const double out_j = ss_sweep_stage_delta(&stage, b->out_1, b->out_2, r, b->out_m0);
+	b->out_2 = first ? 0.0 : b->out_1;
+	b->out_1 = out_j;
+	if (e->kind & OUTFLOW_LAST)
+		add_compensated(&st->outflow_sum, &st->outflow_carry, b->out_1);
+}
+
+/* Fold the batch over the ranks and apply its entries (collective; nothing
+ * when it is empty, which every rank knows alike). */
+static void outflow_flush(struct ss_stepper *st)
+{
+	struct ss_outflow_batch *b = st->outflow_batch;
+	if (!b || b->count == 0)
+		return;
+	const int n = 2 * b->count;
+	double *run = b->running;
+	for (int k = 0; k < n; k++)
+		run[k] = 0.0;
+	ss_comm_fold_start(run, n);
+	size_t m = 0;
+	for (int k = 0; k < b->count; k++) {
+		double sum_x = run[2 * k], sum_y = run[2 * k + 1];
+		for (; m < b->ends[2 * k]; m++)
+			sum_x += b->terms[m];
+		for (; m < b->ends[2 * k + 1]; m++)
+			sum_y += b->terms[m];
+		run[2 * k] = sum_x;
+		run[2 * k + 1] = sum_y;
+	}
+	ss_comm_fold_finish(run, n);
+	for (int k = 0; k < b->count; k++)
+		ledger_apply(st, &b->entries[k], run[2 * k] * st->grid.dy + run[2 * k + 1] * st->grid.dx);
+	b->count = 0;
+	b->terms_used = 0;
+	b->fits = b->fits_empty;
+	b->fits_measured = 1;
+	st->outflow = st->outflow_sum + st->outflow_carry;
+}
+
+/* This rank's non-zero signed fluxes of one axis, in list order, from the
+ * fluxes the sweep just wrote, appended at *used. */
+static void outflow_keep_axis(const struct ss_stepper *st, int axis, double *terms,
+                              size_t *used)
+{
+	size_t n = *used;
+	for (size_t m = 0; m < st->open_face_count; m++) {
+		const struct ss_open_face *f = &st->open_faces[m];
+		if (f->axis != axis)
+			continue;
+		const double flux = st->kernel == SS_KERNEL_FAST ? st->open_flux[m]
+		                  : axis == 0 ? st->flux_x[f->index] : st->flux_y[f->index];
+		const double t = f->sign * flux;
+		if (t != 0.0)
+			terms[n++] = t;
+	}
+	*used = n;
+}
+
+/* The outflow of the fluxes the sweep just wrote, into the ledger with
+ * entry e: at once, or kept in the batch. */
+static void outflow_account(struct ss_stepper *st, const struct outflow_entry *e)
+{
+	struct ss_outflow_batch *b = st->outflow_batch;
+	if (!b->on) {
+		ledger_apply(st, e, outflow_rate(st));
+		return;
+	}
+	if (b->fits < 1.0 && !b->fits_measured && b->count < b->entries_max) {
+		/* the guess ran out (RKL2 stages: no reduction between them):
+		 * ask every rank, one reduction, before folding */
+		double least = -outflow_fits_here(st);
+		ss_comm_reduce(&least, 1, NULL, 0);
+		b->fits = -least;
+	}
+	if (b->count == b->entries_max || b->fits < 1.0)
+		outflow_flush(st);
+	const int k = b->count;
+	outflow_keep_axis(st, 0, b->terms, &b->terms_used);
+	b->ends[2 * k] = b->terms_used;
+	outflow_keep_axis(st, 1, b->terms, &b->terms_used);
+	b->ends[2 * k + 1] = b->terms_used;
+	b->entries[k] = *e;
+	b->count++;
+	b->fits -= 1.0;
+	b->fits_measured = 0;
 }
 
 static int open_faces_build(struct ss_stepper *st)
@@ -378,6 +664,9 @@ int ss_stepper_prepare(struct ss_stepper *st)
 	double none = 0.0;
 	st->open_face_count_all = (double)st->open_face_count;
 	ss_comm_reduce(&none, 0, &st->open_face_count_all, 1);
+	if ((err = ss_comm_agree(outflow_batch_init(st))))
+		return err;
+	outflow_batch_agree(st);
 	if (st->kernel == SS_KERNEL_FAST)
 		ss_sweep_fast_wake_all(&st->fast, g, st->height, st->cell_types);
 	return SS_OK;
@@ -447,45 +736,6 @@ static void sources_update(struct ss_stepper *st)
 	st->source_volume_rate = volume_rate * st->grid.dx * st->grid.dy;
 	if (st->kernel == SS_KERNEL_FAST)
 		ss_sweep_fast_mark_sources(&st->fast, &st->grid, st->source_rate);
-}
-
-/* Neumaier's compensated sum: *sum + *carry holds the total of every term
- * to about one rounding, however many substeps are added up. */
-static void add_compensated(double *sum, double *carry, double term)
-{
-	const double t = *sum + term;
-	if (fabs(*sum) >= fabs(term))
-		*carry += (*sum - t) + term;
-	else
-		*carry += (term - t) + *sum;
-	*sum = t;
-}
-
-/* Volume leaving through open faces per second with the current fluxes;
- * summed in list order, so the same bits for any thread count and kernel
- * (and rank count: the list of the whole grid is the ranks' lists in rank
- * order, and the sums are carried from rank to rank). */
-static double outflow_rate(const struct ss_stepper *st)
-{
-	double sum[2] = {0.0, 0.0};   /* x-faces, y-faces */
-	if (st->open_face_count_all == 0.0)
-		return 0.0;
-	ss_comm_fold_start(sum, 2);
-	/* two sums in registers: sum[f->axis] would go through memory */
-	double sum_x = sum[0], sum_y = sum[1];
-	for (size_t m = 0; m < st->open_face_count; m++) {
-		const struct ss_open_face *f = &st->open_faces[m];
-		const double flux = st->kernel == SS_KERNEL_FAST ? st->open_flux[m]
-		                  : f->axis == 0 ? st->flux_x[f->index] : st->flux_y[f->index];
-		if (f->axis == 0)
-			sum_x += f->sign * flux;
-		else
-			sum_y += f->sign * flux;
-	}
-	sum[0] = sum_x;
-	sum[1] = sum_y;
-	ss_comm_fold_finish(sum, 2);
-	return sum[0] * st->grid.dy + sum[1] * st->grid.dx;
 }
 
 /* The tiles the coming pass sweeps on this rank (the reference sweep:
@@ -596,14 +846,21 @@ static int slopes_settled(struct ss_stepper *st, double s_max, double slope_tol)
 static int step_end(struct ss_stepper *st, const struct ss_advance_options *o,
                     const struct step_start *b, int *steady_candidate)
 {
-	st->outflow = st->outflow_sum + st->outflow_carry;
+	st->outflow = st->outflow_sum + st->outflow_carry;   /* batched: as of the last flush */
 	st->inflow = st->inflow_sum + st->inflow_carry;
 	st->tile_slots += st->tiles_all;
 	/* every rank decides on the same values: a signal reaches the ranks
-	 * at different times */
-	double agree[2] = {st->rate_max, o->stop && *o->stop ? 1.0 : 0.0};
-	ss_comm_reduce(agree, 2, NULL, 0);
+	 * at different times; and the outflow batch's room on every rank
+	 * (a minimum, as the maximum of the negatives) */
+	struct ss_outflow_batch *ob = st->outflow_batch;
+	double agree[3] = {st->rate_max, o->stop && *o->stop ? 1.0 : 0.0,
+	                   ob->on ? -outflow_fits_here(st) : 0.0};
+	ss_comm_reduce(agree, ob->on ? 3 : 2, NULL, 0);
 	st->rate_max = agree[0];
+	if (ob->on) {
+		ob->fits = -agree[2];
+		ob->fits_measured = 1;
+	}
 	if (o->progress)
 		o->progress(o->context, st);
 	if (!isfinite(st->rate_max))
@@ -636,7 +893,8 @@ static void euler_step(struct ss_stepper *st, double dt)
 	}
 	st->seconds_sweep += ss_parallel_wall_seconds() - t0;
 	wake_across(st);
-	add_compensated(&st->outflow_sum, &st->outflow_carry, dt * outflow_rate(st));
+	const struct outflow_entry e = {.kind = OUTFLOW_EULER, .tau_mu = dt};
+	outflow_account(st, &e);
 	add_compensated(&st->inflow_sum, &st->inflow_carry, dt * st->source_volume_rate);
 	st->evaluations++;
 }
@@ -672,7 +930,8 @@ static double rkl2_pass(struct ss_stepper *st, const struct ss_sweep_stage *stag
  * starts from the state step_begin measured.  The outflow of the stages is
  * combined with the stage weights, O_j = mu O_{j-1} + nu O_{j-2} +
  * tau (mu~ out(M(Y_{j-1})) + gamma~ out(M(Y_0))), as the heights are, so
- * that it is the outflow of the super-step's change; the source is
+ * that it is the outflow of the super-step's change (ledger_apply; on
+ * several ranks perhaps later, from the batch); the source is
  * constant over it, so the inflow is tau times its rate.  The ranks agree
  * once a super-step, after the estimate (the stages need nothing summed
  * over them but the outflow).  Returns max |Y_s - Y_0| (as max |D_s|), m
@@ -680,7 +939,7 @@ static double rkl2_pass(struct ss_stepper *st, const struct ss_sweep_stage *stag
  */
 static double rkl2_superstep(struct ss_stepper *st, double tau, int s, double *estimate)
 {
-	double out_1 = 0.0, out_2 = 0.0, out_m0 = 0.0, change = 0.0, awake = 0.0;
+	double change = 0.0, awake = 0.0;
 	for (int j = 1; j <= s; j++) {
 		const struct ss_rkl2_stage k = ss_rkl2_stage(s, j);
 		const struct ss_sweep_stage stage = {
@@ -689,14 +948,13 @@ static double rkl2_superstep(struct ss_stepper *st, double tau, int s, double *e
 			.y0 = st->rkl2_y0, .d1 = st->rkl2_d1, .d2 = st->rkl2_d2, .m0 = st->rkl2_m0,
 		};
 		change = rkl2_pass(st, &stage, j == s, j == 1, &awake);
-		const double out = outflow_rate(st);
-		if (j == 1)
-			out_m0 = out;
-		const double out_j = ss_sweep_stage_delta(&stage, out_1, out_2, out, out_m0);
-		out_2 = j == 1 ? 0.0 : out_1;
-		out_1 = out_j;
+		const struct outflow_entry e = {
+			.mu = stage.mu, .nu = stage.nu, .tau_mu = stage.tau_mu,
+			.tau_gamma = stage.tau_gamma,
+			.kind = OUTFLOW_STAGE | (j == 1 ? OUTFLOW_FIRST : 0) | (j == s ? OUTFLOW_LAST : 0),
+		};
+		outflow_account(st, &e);
 	}
-	add_compensated(&st->outflow_sum, &st->outflow_carry, out_1);
 	add_compensated(&st->inflow_sum, &st->inflow_carry, tau * st->source_volume_rate);
 	/* the error estimate: one more evaluation, at Y_s, that writes nothing;
 	 * the next super-step's first stage evaluates there again, but the
@@ -731,8 +989,8 @@ static void rkl2_control(struct ss_stepper *st, double tau, double estimate,
 		st->rkl2_tau = INFINITY;
 }
 
-enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,
-                                       const struct ss_advance_options *o)
+static enum ss_advance_end advance(struct ss_stepper *st, double t_target,
+                                   const struct ss_advance_options *o)
 {
 	const struct ss_grid *g = &st->grid;
 	const struct ss_closure *c = &st->closure;
@@ -828,6 +1086,16 @@ enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,
 	return SS_ADVANCE_REACHED;
 }
 
+enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,
+                                       const struct ss_advance_options *o)
+{
+	const enum ss_advance_end end = advance(st, t_target, o);
+	/* every rank returns after the same substep: the outflow batch is
+	 * folded here, so that the ledger is current between calls */
+	outflow_flush(st);
+	return end;
+}
+
 /* ss_stepper_max_sand_slope on this rank's faces (the halo filled). */
 static double max_sand_slope_here(const struct ss_stepper *st)
 {
@@ -850,6 +1118,7 @@ void ss_stepper_diagnostics(struct ss_stepper *st, struct ss_diagnostics *d)
 {
 	const struct ss_grid *g = &st->grid;
 	double *row_volume = st->row_scratch, max_height = -INFINITY;
+	outflow_flush(st);   /* empty after ss_stepper_advance; collective */
 
 	/* rows summed in parallel, then the row sums in order: the same bits
 	 * for any thread count */

@@ -6,7 +6,8 @@ build-mpi/sandslide of this checkout, `make MPI=1`; set but empty: skipped)
 and Open MPI's mpirun (MPIRUN, default mpirun.openmpi); each skip says
 which.  The serial binary is conftest's SANDSLIDE; the MPI build's pause
 hook is SANDSLIDE_MPI_PAUSE (default tests/sandslide-pause beside
-SANDSLIDE_MPI; `make MPI=1 test-mpi` builds it).
+SANDSLIDE_MPI), its batch hook SANDSLIDE_MPI_BATCH (tests/sandslide-batch);
+`make MPI=1 test-mpi` builds both.
 
   bit identity     six small cases (64 x 45..48 cells, tiles 16 x 8: six tile
                    rows, the last one short when ny is 45 or 47) covering wall,
@@ -39,7 +40,9 @@ SANDSLIDE_MPI; `make MPI=1 test-mpi` builds it).
   restart          np = 2 cut by a file-size limit (exit 1, one message, the
                    snapshots before it complete), continued by run --restart
                    under np = 3 to the end: every snapshot and the final
-                   restart_state are those of the serial run never cut
+                   restart_state are those of the serial run never cut; the
+                   same with RKL2 cut under np = 3 and continued under np = 4,
+                   both with a small outflow batch (below)
   SIGTERM          to mpirun -np 3 mid-run, its ranks paused after a
                    known substep (build-mpi/tests/sandslide-pause,
                    tests/hooks/pause_step.c: no race with a fast machine):
@@ -55,6 +58,15 @@ SANDSLIDE_MPI; `make MPI=1 test-mpi` builds it).
                    serial run
   ncdump           reads the header and the data of an np = 3 file; its
                    summary is printed once
+  outflow batch    each rank keeps its open faces' fluxes and the ranks fold
+                   them per snapshot or when the batch is full (stepper.h):
+                   the batch shrunk by build-mpi/tests/sandslide-batch
+                   (tests/hooks/batch_step.c) so that it fills between
+                   snapshots, by its count of evaluations (the mixed cases,
+                   both integrators and kernels, np = 3 and 4) or by the
+                   fluxes kept (relax of cases/dem/terrain.asc with open
+                   sides, both integrators, np = 4): every output has the
+                   serial bits
   refusals         more ranks than tile rows: exit 2, one message naming both
                    numbers, no output file
   version          --version of the MPI binary names MPI, printed once under
@@ -64,8 +76,8 @@ Every run gets --threads 1 and --bind-to none, and the Open MPI settings of
 doc/cluster.md#open-mpi-as-root-on-a-small-machine (root, oversubscription of 2 cores,
 yielding when idle, shared memory only).  A run that hangs (a deadlock) is
 killed, all its processes (and what they leave in /dev/shm and mpirun's
-session folder), after 60 s and fails the test.  About 60 mpirun starts:
-31 s on 2 busy cores.
+session folder), after 60 s and fails the test.  About 75 mpirun starts:
+45 s on 2 busy cores.
 """
 import glob
 import json
@@ -89,6 +101,9 @@ MPIRUN = os.environ.get("MPIRUN") or shutil.which("mpirun.openmpi") or shutil.wh
 # the MPI build with the pause hook (tests/hooks/pause_step.c)
 SANDSLIDE_MPI_PAUSE = os.environ.get(
     "SANDSLIDE_MPI_PAUSE", os.path.join(os.path.dirname(SANDSLIDE_MPI), "tests", "sandslide-pause"))
+# the MPI build with the batch hook (tests/hooks/batch_step.c)
+SANDSLIDE_MPI_BATCH = os.environ.get(
+    "SANDSLIDE_MPI_BATCH", os.path.join(os.path.dirname(SANDSLIDE_MPI), "tests", "sandslide-batch"))
 
 pytestmark = [
     # SANDSLIDE_MPI= (empty): not here; `make MPI=1 test-mpi` runs these
@@ -321,12 +336,14 @@ CASES = {
     "bedrock-euler": dict(ny=47, sides=("open", "wall", "wall", "open"), initial=ON_BEDROCK),
     # cut by a file-size limit: about 4800 steps, 301 snapshots of 24 kB
     "long-euler": dict(end=60.0, every=0.2),
+    # the same with RKL2: 361 super-steps, 2923 evaluations
+    "long-rkl2": dict(integrator="rkl2", end=60.0, every=0.2),
     # interrupted and killed: about 240000 steps, several seconds under
     # mpirun even on a quiet machine (the killed job must still be going
     # when it is killed); a snapshot every 160 steps
     "signal-euler": dict(end=3000.0, every=2.0),
 }
-BIT_CASES = [c for c in CASES if c not in ("long-euler", "signal-euler")]
+BIT_CASES = [c for c in CASES if c not in ("long-euler", "long-rkl2", "signal-euler")]
 
 
 def asc_text(h, dx=0.05):
@@ -864,43 +881,68 @@ def ncdump_header(path):
     return r.stdout
 
 
-def test_cut_under_2_ranks_continued_under_3_is_the_uninterrupted_run(tmp_path, serial):
-    """mpirun -np 2 stops at a file-size limit of 6 MiB (about 250 of the 301
-    snapshots: a cut that does not depend on timing) with exit 1, one message
-    and the snapshots before it complete; run --restart under np = 3, without
-    the limit, continues it to the end: every snapshot and the final
-    restart_state are those of the serial run never cut.  The limit is set on
-    the ranks alone (prlimit): Open MPI's own files are larger than 4 MiB."""
-    write_case(tmp_path, "long-euler")
+def cut_and_continue(tmp_path, serial, case, np_cut, np_more, binary=None, env=None):
+    """mpirun -np np_cut of `case` stopped by a file-size limit of 6 MiB
+    (about 250 of the 301 snapshots: a cut that does not depend on timing)
+    with exit 1, one message and the snapshots before it complete; run
+    --restart under np_more, without the limit, continues it to the end:
+    every snapshot and the final restart_state are those of the serial run
+    never cut.  The limit is set on the ranks alone (prlimit): Open MPI's
+    own files are larger than 4 MiB.  binary, env: another build of the MPI
+    binary (a hook) and its environment, for both runs."""
+    write_case(tmp_path, case)
+    binary = binary or SANDSLIDE_MPI
+    env = MPI_ENV if env is None else env
+    what = f"{case} under np = {np_cut} with a 6 MiB file-size limit"
     limit = 6 << 20
-    cmd = [MPIRUN, "-np", "2", "--bind-to", "none", "prlimit", f"--fsize={limit}:{limit}",
-           SANDSLIDE_MPI] + with_threads(["run", "case.ini", "-o", "cut.h5", "-q",
-                                          "--tile", TILE])
-    p = subprocess.Popen(cmd, cwd=tmp_path, env=MPI_ENV, text=True, stdout=subprocess.PIPE,
+    cmd = [MPIRUN, "-np", str(np_cut), "--bind-to", "none", "prlimit",
+           f"--fsize={limit}:{limit}", binary] + with_threads(["run", "case.ini", "-o", "cut.h5",
+                                                              "-q", "--tile", TILE])
+    p = subprocess.Popen(cmd, cwd=tmp_path, env=env, text=True, stdout=subprocess.PIPE,
                          stderr=subprocess.PIPE, stdin=subprocess.DEVNULL,
                          start_new_session=True)
-    r = finish(p, "mpirun -np 2 under a file-size limit", 60)
-    assert r.returncode == 1, \
-        f"np = 2 with a 6 MiB file-size limit: exit {r.returncode}, not 1\n{r.stderr}"
+    r = finish(p, what, 60)
+    assert r.returncode == 1, f"{what}: exit {r.returncode}, not 1\n{r.stderr}"
     ours = [line for line in r.stderr.splitlines() if line.startswith("sandslide:")]
     assert len(ours) == 1 and "cut.h5" in ours[0] and "large" in ours[0].lower(), \
-        f"np = 2 with a file-size limit: one message naming the file expected:\n{r.stderr}"
-    nt = assert_consistent(tmp_path / "cut.h5", "cut by the file-size limit", 2,
-                           CASES["long-euler"]["every"])
+        f"{what}: one message naming the file expected:\n{r.stderr}"
+    nt = assert_consistent(tmp_path / "cut.h5", f"{case} cut by the file-size limit", 2,
+                           CASES[case]["every"])
     with h5open(tmp_path / "cut.h5") as f:
         t_cut = float(f["time"][-1])
-    assert t_cut < 60.0, f"test set-up: the limit did not cut the run (last snapshot t = {t_cut})"
+    assert t_cut < CASES[case]["end"], \
+        f"test set-up: the limit did not cut the run (last snapshot t = {t_cut})"
 
-    mpi_run_ok(3, ["run", "--restart", "cut.h5", "-q"], tmp_path)
-    whole = serial("long-euler")
+    more = finish(start_mpi(np_more, ["run", "--restart", "cut.h5", "-q"], tmp_path, binary, env),
+                  f"run --restart under np = {np_more}", 60)
+    assert more.returncode == 0, \
+        f"run --restart under np = {np_more} exited {more.returncode}\n{more.stderr}"
+    whole = serial(case)
     conftest.assert_same_snapshots(tmp_path / "cut.h5", whole, PHYSICAL)
     with h5open(tmp_path / "cut.h5") as f, h5open(whole) as w:
         assert list(f["time"][()]) == list(w["time"][()]), \
             f"cut after snapshot {nt - 1} (t = {t_cut}), continued: times {f['time'][()]}"
         for k in sorted(set(w.attrs) - {"history"}):
             assert k in f.attrs and same_attr(f.attrs[k], w.attrs[k]), \
-                (f"cut under np = 2, continued under np = 3: root attribute {k} is "
-                 f"{f.attrs.get(k)!r}, uninterrupted serial {w.attrs[k]!r}")
+                (f"{case} cut under np = {np_cut}, continued under np = {np_more}: root "
+                 f"attribute {k} is {f.attrs.get(k)!r}, uninterrupted serial {w.attrs[k]!r}")
+
+
+def test_cut_under_2_ranks_continued_under_3_is_the_uninterrupted_run(tmp_path, serial):
+    """long-euler under np = 2 cut by a file-size limit, continued under
+    np = 3 (cut_and_continue)."""
+    cut_and_continue(tmp_path, serial, "long-euler", 2, 3)
+
+
+def test_rkl2_cut_under_3_ranks_continued_under_4_with_a_small_batch(tmp_path, serial):
+    """long-rkl2 (outflow through the open sides and the drain) under
+    np = 3 cut by a file-size limit, continued under np = 4
+    (cut_and_continue), both with the outflow batch shrunk to SMALL_BATCH
+    bytes, so that it is folded every 3 evaluations as well as at each
+    snapshot: the restart state of the snapshot it was cut after holds the
+    folded outflow, and the run continues from it with the serial bits."""
+    cut_and_continue(tmp_path, serial, "long-rkl2", 3, 4,
+                     binary=hook_binary(SANDSLIDE_MPI_BATCH), env=batch_env(SMALL_BATCH))
 
 
 def start_paused(np_, args, cwd, step):
@@ -1035,7 +1077,78 @@ def test_ncdump_reads_a_file_of_3_ranks(tmp_path):
                                atol=1e-12, equal_nan=True, err_msg="ncdump's heights are not h5py's")
 
 
-# ---- d. refusals and the version ---------------------------------------------------------
+# ---- d. the outflow batch ----------------------------------------------------------------
+
+# Bytes of the outflow batch a rank keeps (stepper.h; SS_OUTFLOW_BATCH_BYTES,
+# 4 MiB, by default), set through the batch hook: 1024 B hold at most 3
+# evaluations and about 100 fluxes besides one evaluation's, so the mixed
+# cases (9 or more evaluations between snapshots) fill the batch by its
+# count of evaluations; 2048 B hold 7 evaluations, and relax of terrain.asc
+# (on np = 4 a rank keeps more than 100 fluxes an evaluation) fills it by
+# the fluxes kept (counted while writing these tests: 1076 of 1084 folds
+# under RKL2, 3640 of 3648 under Euler).
+SMALL_BATCH = 1024
+SMALL_BATCH_TERMS = 2048
+
+
+def batch_env(nbytes):
+    """The environment in which sandslide-batch keeps an outflow batch of
+    nbytes a rank."""
+    return dict(MPI_ENV, SANDSLIDE_TEST_OUTFLOW_BATCH_BYTES=str(nbytes))
+
+
+def batch_run_ok(np_, args, cwd, nbytes):
+    binary = hook_binary(SANDSLIDE_MPI_BATCH)
+    what = f"{' '.join(mpi_command(np_, args, binary))} (batch of {nbytes} B)"
+    r = finish(start_mpi(np_, args, cwd, binary, batch_env(nbytes)), what, 60)
+    assert r.returncode == 0, \
+        f"{what} exited {r.returncode}\nstdout:\n{r.stdout}\nstderr:\n{r.stderr}"
+    return r
+
+
+@pytest.mark.parametrize("flags", [[], ["--reference-kernel"]], ids=["fast", "reference"])
+@pytest.mark.parametrize("np_", [3, 4], ids=["np3", "np4"])
+@pytest.mark.parametrize("case", ["mixed-euler", "mixed-rkl2"])
+def test_a_batch_folded_between_snapshots_keeps_the_serial_bits(tmp_path, serial, case, np_,
+                                                                 flags):
+    """The outflow batch of SMALL_BATCH bytes is folded every 3 evaluations,
+    several times between two snapshots, RKL2 super-steps cut in the
+    middle: every snapshot, the restart state (the ledger's sum and carry)
+    included, has the serial bits."""
+    with h5open(serial(case, *flags)) as f:
+        gaps = np.diff(f["stencil_evaluations"][()])
+        assert gaps.min() >= 9 and f["outflow"][-1] > 0, \
+            f"test set-up: {case} has {gaps.min()} evaluations between snapshots"
+    write_case(tmp_path, case)
+    batch_run_ok(np_, ["run", "case.ini", "-o", "mpi.h5", "-q", "--tile", TILE, *flags],
+                 tmp_path, SMALL_BATCH)
+    assert_same_output(serial(case, *flags), tmp_path / "mpi.h5",
+                       f"{' '.join([case, *flags])} under np = {np_}, batch of {SMALL_BATCH} B")
+
+
+@pytest.mark.parametrize("integrator", ["euler", "rkl2"])
+def test_a_batch_filled_by_its_fluxes_keeps_the_serial_bits(tmp_path, integrator):
+    """relax of cases/dem/terrain.asc (96 x 96 cells of 1 m) with open sides
+    for 2000 s, where sand leaves through more than a hundred open faces of
+    a rank each evaluation: the batch of SMALL_BATCH_TERMS bytes is folded
+    when the fluxes kept fill it, every evaluation or two.  Under np = 4
+    the series is the serial one, bit for bit."""
+    args = ["relax", os.path.join(conftest.CASES, "dem", "terrain.asc"), "-o", "r.h5", "-q",
+            "--sides", "open", "--integrator", integrator, "--max-time", "2000",
+            "--output-every", "250"]
+    for d in ("serial", "mpi"):
+        (tmp_path / d).mkdir()
+    serial_run_ok(args, tmp_path / "serial")
+    batch_run_ok(4, args, tmp_path / "mpi", SMALL_BATCH_TERMS)
+    with h5open(tmp_path / "serial" / "r.h5") as f:
+        assert f["outflow"][-1] > 0 and f["stencil_evaluations"][-1] > 1000, \
+            "test set-up: the terrain's relax lets too little sand out"
+    assert_same_output(tmp_path / "serial" / "r.h5", tmp_path / "mpi" / "r.h5",
+                       f"relax of terrain.asc ({integrator}, open sides) under np = 4, batch "
+                       f"of {SMALL_BATCH_TERMS} B")
+
+
+# ---- e. refusals and the version ---------------------------------------------------------
 
 
 def test_more_ranks_than_tile_rows_are_refused(tmp_path):
