@@ -931,6 +931,59 @@ static void asc_bad_prj_is_refused(void)
 	rmdir(check_file("b.prj"));
 }
 
+/* A window (dem.h) holds exactly the whole raster's rows row_first ..
+ * row_first + rows - 1, with their nodata flags, in every format a rank
+ * reads; rows = 0 is the header alone; a window past the rows is refused. */
+static void windows_are_the_whole_rasters_rows(void)
+{
+	struct rng g = {4242};
+	struct ss_raster a;
+	random_raster(&a, 13, 9, &g, 1);
+	a.png_zmin = -2.0;
+	a.png_zmax = 8.0;
+	const char *names[] = {"w.asc", "w.png", "w.tif"};
+	const int windows[][2] = {{0, 9}, {0, 1}, {3, 4}, {8, 1}, {2, 0}};
+	for (int f = 0; f < 3; f++) {
+		if (f == 2 && !ss_dem_gdal_available())
+			continue;
+		CHECK(ss_dem_write(check_file(names[f]), SS_DEM_AUTO, &a) == SS_OK, "%s written",
+		      names[f]);
+		struct ss_raster whole, w;
+		CHECK(ss_dem_read(check_file(names[f]), NULL, NULL, &whole) == SS_OK, "%s read",
+		      names[f]);
+		for (size_t k = 0; k < sizeof windows / sizeof *windows; k++) {
+			struct ss_dem_read_options o;
+			ss_dem_read_options_init(&o);
+			o.row_first = windows[k][0];
+			o.rows = windows[k][1];
+			const int err = ss_dem_read(check_file(names[f]), NULL, &o, &w);
+			const size_t n = (size_t)w.nx * (size_t)o.rows;
+			const size_t at = (size_t)o.row_first * (size_t)whole.nx;
+			int same = err == SS_OK && w.nx == whole.nx && w.ny == whole.ny &&
+			           w.row_first == o.row_first && w.rows == o.rows &&
+			           (n == 0 || memcmp(w.values, whole.values + at, n * sizeof(double)) == 0);
+			for (size_t m = 0; same && m < n; m++)
+				same = (w.nodata && w.nodata[m]) == (whole.nodata && whole.nodata[at + m]);
+			CHECK(same, "%s: the window of rows %d + %d is not those rows of the whole "
+			      "raster (%d)", names[f], o.row_first, o.rows, err);
+			ss_raster_release(&w);
+		}
+		struct ss_dem_read_options past;
+		ss_dem_read_options_init(&past);
+		past.row_first = 7;
+		past.rows = 3;
+		capture_begin();
+		const int err = ss_dem_read(check_file(names[f]), NULL, &past, &w);
+		const char *msg = capture_end();
+		CHECK(err == SS_ERR_INPUT && strstr(msg, "has 9 rows"),
+		      "%s: rows 7 to 9 of 9 are refused naming the rows: %s", names[f], msg);
+		ss_raster_release(&w);
+		ss_raster_release(&whole);
+		unlink(check_file(names[f]));
+	}
+	ss_raster_release(&a);
+}
+
 int main(void)
 {
 	if (check_scratch_make("test_dem"))
@@ -949,6 +1002,7 @@ int main(void)
 	RUN(writes_are_atomic_and_spare_the_input);
 	RUN(nodata_value_avoids_real_heights);
 	RUN(geotiff_round_trip);
+	RUN(windows_are_the_whole_rasters_rows);
 	RUN(asc_prj_round_trip);
 	RUN(asc_without_crs_has_no_prj);
 	RUN(asc_bad_prj_is_refused);

@@ -94,6 +94,18 @@ static void heights_to_raster(const struct ss_stepper *st, struct ss_raster *r)
 				rows[(size_t)j * g->nx + i] = st->height[ss_grid_index(g, i, j)];
 }
 
+/* The rows of an nx x ny raster that rank `rank`'s slab holds, as the
+ * stepper will split the grid with relax's tiles (stepper.h). */
+static int slab_rows(int nx, int ny, const struct ss_relax_options *o, int rank, int *first,
+                     int *rows)
+{
+	struct ss_grid whole;
+	const int err = ss_grid_init(&whole, nx, ny, 1.0, 1.0, 0.0, 0.0);
+	if (!err)
+		ss_stepper_slab_rows(&whole, o->tile[0], o->tile[1], rank, first, rows);
+	return err;
+}
+
 /* Rows per block of a streamed write: about 4 MiB of heights and flags,
  * what rank 0 holds of the other ranks' rows at a time. */
 static int block_rows(int nx)
@@ -124,13 +136,10 @@ static int write_streamed(const char *path, enum ss_dem_format format, const str
 	double *values = ss_alloc((size_t)block * nx, sizeof *values, "a block of rows");
 	uint8_t *flags = ss_alloc((size_t)block * nx, 1, "a block of nodata flags");
 	err = ss_comm_agree(values && flags ? SS_OK : SS_ERR_FAIL);
-	struct ss_grid whole;
-	if (!err)
-		err = ss_grid_init(&whole, nx, r->ny, 1.0, 1.0, 0.0, 0.0);
 	for (int q = ss_comm_size() - 1; q >= 0 && !err; q--) {   /* north first */
-		int first, rows;
-		ss_stepper_slab_rows(&whole, o->tile[0], o->tile[1], q, &first, &rows);
-		if (me != 0 && me != q)
+		int first = 0, rows = 0;
+		err = slab_rows(nx, r->ny, o, q, &first, &rows);   /* the grid's: it cannot fail */
+		if (err || (me != 0 && me != q))
 			continue;
 		for (int top = first + rows; top > first;) {   /* rows top - n .. top - 1 */
 			const int n = top - first < block ? top - first : block;
@@ -228,12 +237,8 @@ static int read_window(const char *spec, const char *context, struct ss_dem_read
 	if (ss_comm_size() > 1) {
 		opt.rows = 0;
 		int err = ss_dem_read(spec, context, &opt, r);
-		struct ss_grid whole;
 		if (!err)
-			err = ss_grid_init(&whole, r->nx, r->ny, 1.0, 1.0, 0.0, 0.0);
-		if (!err)
-			ss_stepper_slab_rows(&whole, o->tile[0], o->tile[1], ss_comm_rank(),
-			                     &opt.row_first, &opt.rows);
+			err = slab_rows(r->nx, r->ny, o, ss_comm_rank(), &opt.row_first, &opt.rows);
 		ss_raster_release(r);
 		if (err)
 			return err;

@@ -96,6 +96,17 @@ static int rasterize(const struct ss_shape *shape, const struct ss_grid *g, uint
 
 /* ---- from a case ------------------------------------------------------ */
 
+/* SS_ERR_INPUT unless r (what, read from path) is the grid's size. */
+static int check_grid_size(const char *path, const char *where, const char *what,
+                           const struct ss_grid *g, const struct ss_raster *r)
+{
+	if (r->nx == g->global_nx && r->ny == g->global_ny)
+		return SS_OK;
+	return ss_error_input("%s: %s '%s' is %d x %d cells: expected the grid's %lld x %lld "
+	                      "(nx x ny)", where, what, path, r->nx, r->ny, g->global_nx,
+	                      g->global_ny);
+}
+
 /* This rank's rows of the raster `path`, which must be the grid's size
  * (a window, dem.h: no rank holds the whole file).  The header is read
  * first when there are other ranks, so that a file of another size is
@@ -105,13 +116,11 @@ static int read_slab(const char *path, const char *where, const char *what,
 {
 	struct ss_dem_read_options o;
 	ss_dem_read_options_init(&o);
-	if (!ss_grid_is_whole(g)) {
+	if (!ss_grid_is_whole(g)) {   /* the header, then this rank's rows */
 		o.rows = 0;
 		int err = ss_dem_read(path, where, &o, r);
-		if (!err && (r->nx != g->global_nx || r->ny != g->global_ny))
-			err = ss_error_input("%s: %s '%s' is %d x %d cells: expected the grid's "
-			                     "%lld x %lld (nx x ny)", where, what, path, r->nx, r->ny,
-			                     g->global_nx, g->global_ny);
+		if (!err)
+			err = check_grid_size(path, where, what, g, r);
 		ss_raster_release(r);
 		if (err)
 			return err;
@@ -119,11 +128,7 @@ static int read_slab(const char *path, const char *where, const char *what,
 		o.rows = g->ny;
 	}
 	int err = ss_dem_read(path, where, &o, r);
-	if (!err && (r->nx != g->global_nx || r->ny != g->global_ny))
-		err = ss_error_input("%s: %s '%s' is %d x %d cells: expected the grid's "
-		                     "%lld x %lld (nx x ny)", where, what, path, r->nx, r->ny,
-		                     g->global_nx, g->global_ny);
-	return err;
+	return err ? err : check_grid_size(path, where, what, g, r);
 }
 
 static int initial_heights(const struct ss_case *c, struct ss_stepper *st)
