@@ -22,7 +22,7 @@ struct ss_diagnostics {
 /* What a restart needs beyond the heights and the time to continue with the
  * same bits: the counters, the compensated sums of the inflow and outflow
  * and RKL2's next super-step limit (stepper.h), stored with every snapshot
- * (root attribute restart_state, snapshot.h). */
+ * (root attributes restart_state_even and _odd, snapshot.h). */
 struct ss_restart_state {
 	long long steps;
 	double inflow_sum, inflow_carry;    /* m^3 */

@@ -83,9 +83,10 @@ int ss_snapshot_create(struct ss_snapshot **out, const char *path,
 
 /* Append one snapshot (height with the grid's halo layout; walls and
  * cells without data are written as NaN, the _FillValue, so cell_types in
- * the same layout) and,
- * when state is not NULL, the restart state (root attribute
- * restart_state), flush the file and rewrite the XDMF sidecar. */
+ * the same layout) and, when state is not NULL, the restart state (root
+ * attribute restart_state_even or _odd by the snapshot's index), flushed
+ * so that a run killed at any moment leaves every earlier snapshot whole
+ * (doc/output.md#written-as-the-run-goes); then rewrite the XDMF sidecar. */
 int ss_snapshot_append(struct ss_snapshot *s, double time_s, const double *height,
                        const uint8_t *cell_types, const struct ss_diagnostics *d,
                        const struct ss_restart_state *state);

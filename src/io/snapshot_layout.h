@@ -26,12 +26,20 @@
 /* A side longer than this is not a grid sandslide writes (int indices). */
 #define SS_SNAPSHOT_MAX_SIDE (1 << 30)
 
-/* Root attribute restart_state: steps, inflow sum and carry, outflow sum
- * and carry, stencil evaluations, RKL2's next super-step limit (s, or
- * infinity) (diagnostics.h, struct ss_restart_state).  Files written
- * before RKL2 have the first 5. */
+/* Root attributes restart_state_even and restart_state_odd: the restart
+ * state of the last snapshot of even and of odd index (steps, inflow sum
+ * and carry, outflow sum and carry, stencil evaluations, RKL2's next
+ * super-step limit (s, or infinity); diagnostics.h, struct
+ * ss_restart_state).  Files written before the two hold one
+ * restart_state, of the last snapshot; those written before RKL2 have
+ * its first 5 values. */
 #define SS_SNAPSHOT_RESTART_VALUES 7
 #define SS_SNAPSHOT_RESTART_VALUES_OLD 5
+
+static inline const char *ss_snapshot_restart_attribute(long long snapshot)
+{
+	return snapshot % 2 ? "restart_state_odd" : "restart_state_even";
+}
 
 /* The float64 (time) series beside /time; stencil_evaluations
  * (SS_SNAPSHOT_DIAG_EVALUATIONS) is missing from files written before RKL2,

@@ -561,13 +561,15 @@ static int var_read(const struct h5in *in, const struct var *v, const hsize_t *s
 	return err;
 }
 
-/* All n values of the 1-D series name into out; SS_ERR_INPUT naming the
- * series if it is missing or of another length. */
+/* The first n values of the 1-D series name into out; SS_ERR_INPUT naming
+ * the series if it is missing or does not have n or n + 1 (the last one
+ * unfinished: doc/output.md#written-as-the-run-goes) values. */
 static int read_series(const struct h5in *in, const char *name, long long n, double *out)
 {
 	struct var v;
 	int err = var_open(in, name, &v);
-	if (err > 0 || (!err && (v.rank != 1 || v.dims[0] != (hsize_t)n)))
+	if (err > 0 || (!err && (v.rank != 1 || v.dims[0] < (hsize_t)n ||
+	                         v.dims[0] > (hsize_t)n + 1)))
 		err = ss_error_input("'%s' is not a sandslide output file: no /%s (time) of %lld "
 		                     "values", in->name, name, n);
 	const hsize_t start = 0, count = (hsize_t)n;
@@ -607,13 +609,8 @@ static int check_grid(struct ss_snapshot_file *f)
 		return ss_error_input("'%s' is not a sandslide output file: /height has %llu x %llu "
 		                      "cells", h->in.name, (unsigned long long)hd[2],
 		                      (unsigned long long)hd[1]);
-	f->count = (long long)hd[0];
 	f->ny = (int)hd[1];
 	f->nx = (int)hd[2];
-	/* snapshots are written in order: the last one stored, all are */
-	const hsize_t last[3] = {hd[0] - 1, 0, 0}, one[3] = {1, hd[1], hd[2]};
-	if (f->count > 0 && (err = check_chunks(&h->in, &h->height, last, one)))
-		return err;
 	err = var_open(&h->in, "cell_type", &h->cell_type);
 	const hsize_t *cd = h->cell_type.dims;
 	if (err > 0 || (!err && (h->cell_type.rank != 2 || cd[0] != hd[1] || cd[1] != hd[2])))
@@ -621,18 +618,30 @@ static int check_grid(struct ss_snapshot_file *f)
 	return err;
 }
 
-/* /time (time) of as many values as /height has snapshots, into f->time. */
+/* /time (time) into f->time; its length is the count of complete
+ * snapshots.  /height holds as many, or one more that a killed run did not
+ * finish (the writer's append). */
 static int read_times(struct ss_snapshot_file *f)
 {
-	const struct h5in *in = &f->h5->in;
+	const struct ss_snapshot_file_h5 *h = f->h5;
+	const struct h5in *in = &h->in;
 	struct var v;
 	int err = var_open(in, "time", &v);
-	if (err > 0 || (!err && (v.rank != 1 || v.dims[0] != (hsize_t)f->count))) {
+	const hsize_t stored = h->height.dims[0];
+	if (err > 0 || (!err && (v.rank != 1 || v.dims[0] > stored || v.dims[0] + 1 < stored))) {
 		char why[96];
-		snprintf(why, sizeof why, "/time does not match /height (%lld snapshots)", f->count);
+		snprintf(why, sizeof why, "/time does not match /height (%llu snapshots)",
+		         (unsigned long long)stored);
 		err = not_sandslide(in, why);
 	}
+	if (!err)
+		f->count = (long long)v.dims[0];
 	var_close(&v);
+	/* snapshots are written in order: the last one stored, all are */
+	const hsize_t last[3] = {(hsize_t)f->count - 1, 0, 0},
+	              one[3] = {1, h->height.dims[1], h->height.dims[2]};
+	if (!err && f->count > 0)
+		err = check_chunks(in, &h->height, last, one);
 	if (!err && !(f->time = malloc((size_t)(f->count ? f->count : 1) * sizeof *f->time)))
 		err = ss_error_fail("out of memory");
 	return err ? err : read_series(in, "time", f->count, f->time);
@@ -1029,8 +1038,12 @@ static int read_state(struct ss_snapshot_file *f, struct ss_restart_info *r)
 {
 	const struct h5in *in = &f->h5->in;
 	double v[SS_SNAPSHOT_RESTART_VALUES] = {NAN, NAN, NAN, NAN, NAN, NAN, NAN};
-	if (attr_doubles(in->file, "restart_state", SS_SNAPSHOT_RESTART_VALUES, v) &&
-	    !attr_doubles(in->file, "restart_state", SS_SNAPSHOT_RESTART_VALUES_OLD, v)) {
+	/* the last snapshot's by its parity; one restart_state in older files */
+	const char *name = ss_snapshot_restart_attribute(f->count - 1);
+	if (H5Aexists(in->file, name) <= 0)
+		name = "restart_state";
+	if (attr_doubles(in->file, name, SS_SNAPSHOT_RESTART_VALUES, v) &&
+	    !attr_doubles(in->file, name, SS_SNAPSHOT_RESTART_VALUES_OLD, v)) {
 		/* before RKL2: Euler's evaluations are its steps */
 		v[5] = v[0];
 		v[6] = INFINITY;

@@ -583,23 +583,27 @@ static int append_value(hid_t d, long long index, double v)
 	return r < 0 ? -1 : 0;
 }
 
-/* Root attribute restart_state = steps, inflow sum and carry, outflow sum
- * and carry of the last snapshot: a restart continues the compensated sums
- * with the very same bits. */
-static int write_restart_state(hid_t file, const struct ss_restart_state *r)
+/* The restart state of snapshot k (steps, inflow sum and carry, outflow
+ * sum and carry, evaluations, RKL2's next super-step limit): a restart
+ * continues the compensated sums with the very same bits.  Even snapshots
+ * write root attribute restart_state_even, odd ones restart_state_odd, so
+ * that the state of the last complete snapshot is never the one being
+ * written (see append). */
+static int write_restart_state(hid_t file, long long k, const struct ss_restart_state *r)
 {
 	const double v[SS_SNAPSHOT_RESTART_VALUES] = {
 		(double)r->steps, r->inflow_sum, r->inflow_carry, r->outflow_sum,
 		r->outflow_carry, (double)r->evaluations, r->rkl2_tau,
 	};
-	if (H5Aexists(file, "restart_state") > 0) {
-		hid_t a = H5Aopen(file, "restart_state", H5P_DEFAULT);
+	const char *name = ss_snapshot_restart_attribute(k);
+	if (H5Aexists(file, name) > 0) {
+		hid_t a = H5Aopen(file, name, H5P_DEFAULT);
 		const herr_t w = a >= 0 ? H5Awrite(a, H5T_NATIVE_DOUBLE, v) : -1;
 		if (a >= 0)
 			H5Aclose(a);
 		return w < 0;
 	}
-	return attr_doubles(file, "restart_state", v, SS_SNAPSHOT_RESTART_VALUES);
+	return attr_doubles(file, name, v, SS_SNAPSHOT_RESTART_VALUES);
 }
 
 /*
@@ -713,16 +717,23 @@ static int append(struct ss_snapshot *s, double time_s, const double *height,
 		                     "snapshots before it are complete", k, time_s, s->path,
 		                     strerror(e), k);
 	}
+	/* Two flushes, because HDF5 writes the metadata of one flush in no
+	 * promised order and a run can be killed in the middle of it: first
+	 * the heights and the diagnostics, then /time and the restart state.
+	 * /time's length counts the complete snapshots; a run killed in the
+	 * first flush leaves /height or a diagnostic one longer, which readers
+	 * ignore and --restart overwrites.  The restart state goes to one of
+	 * two attributes by k's parity, so the last complete snapshot's stays
+	 * whole whenever the run dies. */
 	hsize_t dims[3] = {(hsize_t)k + 1, (hsize_t)g->global_ny, (hsize_t)g->nx};
-	if (H5Dset_extent(s->height, dims) < 0 || write_heights(s, k, height, cell_types) ||
-	    append_value(s->time, k, time_s))
+	if (H5Dset_extent(s->height, dims) < 0 || write_heights(s, k, height, cell_types))
 		goto fail;
 	for (int m = 0; m < SS_SNAPSHOT_DIAG_COUNT; m++)
 		if (append_value(s->diag[m], k, diag_get(d, m)))
 			goto fail;
-	if (state && write_restart_state(s->file, state))
-		goto fail;
-	if (H5Fflush(s->file, H5F_SCOPE_GLOBAL) < 0)
+	if (H5Fflush(s->file, H5F_SCOPE_GLOBAL) < 0 || append_value(s->time, k, time_s) ||
+	    (state && write_restart_state(s->file, k, state)) ||
+	    H5Fflush(s->file, H5F_SCOPE_GLOBAL) < 0)
 		goto fail;
 	/* the file takes its name only once it holds a complete snapshot, so
 	 * a run killed while it starts leaves no half-written file (and an

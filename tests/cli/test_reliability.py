@@ -10,6 +10,7 @@ import resource
 import signal
 import subprocess
 
+import h5py
 import numpy as np
 import pytest
 
@@ -114,6 +115,40 @@ def test_signal_mid_run_then_restart_matches_an_uninterrupted_run(tmp_path, sig,
     r = run(["run", "--restart", "cut.h5", "-q", "--threads", "1"], cwd=tmp_path)
     assert r.returncode == 0, r.stderr
     assert snapshots(tmp_path / "cut.h5")[-1] == 40.0
+    assert_same_snapshots(tmp_path / "cut.h5", tmp_path / "whole.h5")
+
+
+def test_restart_after_a_kill_while_a_snapshot_was_written(tmp_path):
+    """A run killed while it flushed snapshot k leaves /height and the
+    diagnostics one longer than /time, and may have written half of k's
+    restart state: its attribute (restart_state_odd for odd k) is one the
+    last complete snapshot does not use.  That file reads as k snapshots,
+    and --restart continues it to the bits of an uninterrupted run.  The
+    kill is made by hand, so that no timing decides what it hits."""
+    case = write_case(tmp_path, POUR.replace("[time]\n", "[time]\nintegrator = euler\n"))
+    r = run(["run", case, "-o", "whole.h5", "-q"], cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    with h5open(tmp_path / "whole.h5") as f:
+        steps = f["steps"][:]
+    p = start_paused(["run", case, "-o", "cut.h5", "-q"], tmp_path, int(steps[3] + 10))
+    p.send_signal(signal.SIGINT)
+    p.communicate(timeout=60)
+    assert p.returncode == 130, p.returncode
+    with h5py.File(tmp_path / "cut.h5", "r+") as f:
+        k = f["time"].shape[0]
+        assert k == 5, f"test set-up: the interrupted run wrote {k} snapshots, not 5"
+        assert "restart_state_even" in f.attrs and "restart_state_odd" in f.attrs, \
+            f"the restart state is not in two attributes: {sorted(f.attrs)}"
+        for name in ["height"] + PHYSICAL + ["active_fraction", "wall_seconds",
+                                             "stencil_evaluations"]:
+            f[name].resize(k + 1, axis=0)
+            f[name][k] = 1e9
+        f.attrs["restart_state_even" if k % 2 == 0 else "restart_state_odd"] = np.full(7, 1e9)
+    r = run(["info", "cut.h5"], cwd=tmp_path)
+    assert r.returncode == 0 and re.search(r"snapshots +5,", r.stdout), \
+        f"info does not read the 5 complete snapshots: {r.stdout}{r.stderr}"
+    r = run(["run", "--restart", "cut.h5", "-q"], cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
     assert_same_snapshots(tmp_path / "cut.h5", tmp_path / "whole.h5")
 
 
