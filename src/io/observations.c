@@ -236,7 +236,8 @@ static int read_hdf5(struct ss_observations *o)
 		ss_height_series_release(&s);
 		return ss_error_fail("out of memory");
 	}
-	memcpy(o->time, s.time, (size_t)s.count * sizeof *o->time);
+	if (s.count > 0)            /* s.time is NULL for an empty series */
+		memcpy(o->time, s.time, (size_t)s.count * sizeof *o->time);
 	o->nx = s.nx;
 	o->ny = s.ny;
 	o->dx = s.dx;

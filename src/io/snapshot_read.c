@@ -1357,11 +1357,12 @@ static int series_values(const struct h5in *in, struct ss_height_series *s)
 	}
 	const hsize_t *hd = h.dims;
 	char d[96];
-	if (!err && t.dims[0] != hd[0])
-		err = not_series(in, t.dims[0] > hd[0] ? "/time has more values than /height has "
-		                                         "snapshots"
-		                                       : "/time has fewer values than /height "
-		                                         "has snapshots");
+	if (!err && t.dims[0] != hd[0]) {
+		char why[96];
+		snprintf(why, sizeof why, "/time has %llu values, /height %llu snapshots",
+		         (unsigned long long)t.dims[0], (unsigned long long)hd[0]);
+		err = not_series(in, why);
+	}
 	else if (!err && (hd[1] < 1 || hd[2] < 1 || hd[1] > SS_SNAPSHOT_MAX_SIDE ||
 	                  hd[2] > SS_SNAPSHOT_MAX_SIDE))
 		err = ss_error_input("'%s': /height is %s (time, y, x): expected 1 to %d cells a "
