@@ -82,8 +82,9 @@ static double h_of(int i, int j, int k)
 /*
  * A sandslide output of NX x NY cells of 0.5 m from the corner (-2, 10):
  * a wall at cell (0, 0), the times given, heights h_of, NaN in cell
- * (4, 3) at every time; every height NaN when all_nan, or (with
- * all_nan < 0) cell (2, 1) infinite at the last time.
+ * (4, 3) at every time; every height NaN when all_nan is 1, none but
+ * the wall's when 2, and with all_nan < 0 cell (2, 1) infinite at the
+ * last time.
  */
 static int write_series(const char *path, const double *times, int count, int all_nan)
 {
@@ -105,8 +106,9 @@ static int write_series(const char *path, const double *times, int count, int al
 	for (int k = 0; k < count && !err; k++) {
 		for (int j = 0; j < NY; j++)
 			for (int i = 0; i < NX; i++)
-				h[ss_grid_index(&g, i, j)] = all_nan > 0 || (i == 4 && j == 3) ? NAN
-				                                                               : h_of(i, j, k);
+				h[ss_grid_index(&g, i, j)] =
+					all_nan == 1 || (all_nan != 2 && i == 4 && j == 3) ? NAN
+					                                                   : h_of(i, j, k);
 		if (all_nan < 0 && k == count - 1)
 			h[ss_grid_index(&g, 2, 1)] = INFINITY;
 		struct ss_diagnostics d;
@@ -244,6 +246,41 @@ static void raster_csv_is_read(void)
 	ss_observations_release(&o);
 }
 
+/* Rasters of another format by relative paths: the last snapshot of a
+ * sandslide output (FILE.h5:/height would be /height's raw values, NaN
+ * at walls, which a DEM may not have). */
+static void raster_csv_of_hdf5(void)
+{
+	const double times[2] = {0.0, 1.0};
+	/* a NaN height that is not a wall's is no DEM (dem.h): its message,
+	 * after the CSV's line */
+	CHECK(write_series(check_file("last.h5"), times, 2, 0) == SS_OK, "writing last.h5");
+	csv_refused("h5nan.csv", "time,path\n3,last.h5\n", 2, "last.h5: height nan at column 5");
+	CHECK(write_series(check_file("last.h5"), times, 2, 2) == SS_OK, "writing last.h5");
+	check_write_file(check_file("h5.csv"), "time,path\n3,last.h5\n4,last.h5\n");
+	struct ss_observations o;
+	const int err = ss_observations_read(&o, check_file("h5.csv"));
+	CHECK(err == SS_OK, "%s", ss_error_last_message());
+	if (err)
+		return;
+	CHECK(o.times == 2 && o.nx == NX && o.ny == NY, "%lld times of %d x %d", o.times, o.nx,
+	      o.ny);
+	if (o.times == 2 && o.nx == NX && o.ny == NY) {
+		CHECK(o.dx == 0.5 && o.origin_x == -2.0 && o.origin_y == 10.0,
+		      "the geometry of the first raster: %g %g %g", o.dx, o.origin_x, o.origin_y);
+		for (int k = 0; k < 2; k++) {
+			CHECK(o.height[((size_t)k * NY + 2) * NX + 1] == h_of(1, 2, 1),
+			      "cell (1, 2) of raster %d is %g", k, o.height[((size_t)k * NY + 2) * NX + 1]);
+			CHECK(o.height[((size_t)k * NY + 3) * NX + 4] == h_of(4, 3, 1),
+			      "cell (4, 3) of raster %d is %g", k, o.height[((size_t)k * NY + 3) * NX + 4]);
+		}
+		/* the wall, as a DEM of the file has it (dem.h): 0 m, observed */
+		CHECK(o.height[0] == 0.0 && o.observed == 2 * NX * NY, "the wall is %g, observed %lld",
+		      o.height[0], o.observed);
+	}
+	ss_observations_release(&o);
+}
+
 static void raster_csv_refusals(void)
 {
 	write_asc("a.asc", 10.0);
@@ -355,6 +392,7 @@ int main(void)
 	RUN(hdf5_series_is_read);
 	RUN(hdf5_refusals);
 	RUN(raster_csv_is_read);
+	RUN(raster_csv_of_hdf5);
 	RUN(raster_csv_refusals);
 	RUN(front_csv_is_read);
 	RUN(front_csv_refusals);

@@ -18,7 +18,10 @@
  *       FILE.h5[:/dataset]; dem.h), its path relative to the CSV's folder
  *       unless absolute.  Every raster has the first one's size; the cell
  *       size and corner are the first one's (and must agree where later
- *       ones state theirs).  Nodata cells are not observed.
+ *       ones state theirs).  Nodata cells are not observed; a raster's
+ *       NaN is refused by ss_dem_read.  A sandslide output named as a
+ *       raster is its last snapshot as a DEM: walls at 0 m, observed (name
+ *       the output itself as OBS to have them not observed).
  *
  *   CSV with the header  time,x,y
  *       the front: points (m, the grid's coordinates) on the boundary of
