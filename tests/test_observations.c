@@ -9,7 +9,8 @@
  * public writer (snapshot.h), as tests may not include <hdf5.h>.  HDF5
  * files of another program's layout (only /time and /height, /x of the
  * wrong length, ...) cannot be written without it: they are not covered
- * here.
+ * here.  TEST_OBSERVATIONS_SHOW=1 prints each refusal's message, to read
+ * them.
  */
 #include "check.h"
 
