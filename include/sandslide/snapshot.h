@@ -180,6 +180,44 @@ void ss_snapshot_summary_release(struct ss_snapshot_summary *sum);
 int ss_snapshot_read_field(const char *path, const char *dataset, long long index,
                            int *nx, int *ny, double **values);
 
+/* ---- a series of heights of any HDF5 file ---------------------------- */
+
+/*
+ * /time (time) and /height (time, y, x) of any HDF5 file: a sandslide
+ * output, or a file another program wrote with the same names and no
+ * sandslide attributes (the observations `sandslide fit` reads,
+ * src/io/observations.h).  Optional, and checked when present:
+ *   /x (x), /y (y)   cell centres, m: finite, increasing, evenly spaced
+ *                    (/y south to north, as /height's rows are stored)
+ *   /cell_type (y, x) as doc/output.md: walls (1) and cells without data
+ *                    (3) read as NaN, whatever /height holds there
+ * Sizes are checked against the file (the reader's rules above) and the
+ * heights against the memory available before anything is allocated.
+ * Times and heights are returned as stored: the caller checks their values.
+ */
+struct ss_height_series {
+	int nx, ny;                 /* cells: columns west to east, rows south
+	                             * to north */
+	long long count;            /* times (0: an empty series) */
+	double *time;               /* [count], s, as stored (ss_free); NULL when
+	                             * count is 0 */
+	double *height;             /* [count][ny][nx], south row first, m;
+	                             * NaN where the file has NaN, at walls and
+	                             * at cells without data (ss_free) */
+	double dx, dy;              /* cell size, m: from /x, /y, else the root
+	                             * attributes dx, dy; NAN when neither */
+	double origin_x, origin_y;  /* lower-left corner (edge), m: first centre
+	                             * minus half a cell; NAN without /x, /y */
+};
+
+/* Read path into s.  SS_ERR_INPUT naming the file and what is wrong (not
+ * HDF5, damaged, no /time or /height, sizes that do not match, more than
+ * memory holds); SS_ERR_FAIL when an allocation fails.  s is released on
+ * failure. */
+int ss_snapshot_read_height_series(const char *path, struct ss_height_series *s);
+/* Free what s holds; a zeroed or released s is a no-op. */
+void ss_height_series_release(struct ss_height_series *s);
+
 /* ---- the reader ------------------------------------------------------ */
 
 /*

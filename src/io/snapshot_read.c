@@ -1225,3 +1225,215 @@ int ss_snapshot_read_field(const char *path, const char *dataset, long long inde
 	h5in_close(&in);
 	return err;
 }
+
+/* ---- a series of heights of any file ---------------------------------- */
+
+void ss_height_series_release(struct ss_height_series *s)
+{
+	ss_free(s->time);
+	ss_free(s->height);
+	memset(s, 0, sizeof *s);
+	s->dx = s->dy = s->origin_x = s->origin_y = NAN;
+}
+
+/* "'obs.h5' is not a height series: ..., the layout it needs" */
+static int not_series(const struct h5in *in, const char *why)
+{
+	return ss_error_input("'%s' is not a height series: %s (expected /time (time) in s and "
+	                      "/height (time, y, x) in m, doc/output.md)", in->name, why);
+}
+
+/*
+ * The optional cell centres name (/x or /y) of n cells into *d and
+ * *origin: the spacing and the corner, NAN without them.  They must be
+ * finite, increasing and evenly spaced, as a grid's are: a /y from north
+ * to south would flip every snapshot without a word.
+ */
+static int read_centres(const struct h5in *in, const char *name, int n, double *d,
+                        double *origin)
+{
+	struct var v;
+	*d = *origin = NAN;
+	int err = var_open(in, name, &v);
+	if (err == VAR_MISSING)
+		return SS_OK;
+	if (err > 0 || (!err && (v.rank != 1 || v.dims[0] != (hsize_t)n))) {
+		var_close(&v);
+		return ss_error_input("'%s': /%s is not %d numbers, one per %s of /height", in->name,
+		                      name, n, name[0] == 'x' ? "column" : "row");
+	}
+	double *c = err ? NULL : ss_alloc((size_t)n, sizeof *c, "cell centres");
+	if (!err && !c)
+		err = SS_ERR_FAIL;
+	const hsize_t start = 0, count = (hsize_t)n;
+	if (!err)
+		err = var_read(in, &v, &start, &count, H5T_NATIVE_DOUBLE, c, name);
+	var_close(&v);
+	if (!err && n >= 2) {
+		const double step = c[1] - c[0];
+		if (!(step > 0.0) || !isfinite(step))
+			err = ss_error_input("'%s': /%s does not increase (%s[0] = %g, %s[1] = %g): "
+			                     "cell centres in m, %s", in->name, name, name, c[0], name,
+			                     c[1], name[0] == 'x' ? "west to east"
+			                                          : "south to north (row 0 the south row)");
+		for (int k = 2; k < n && !err; k++) {
+			const double want = c[0] + k * step;
+			if (!isfinite(c[k]) || fabs(c[k] - want) > 1e-6 * step + 1e-12 * fabs(want))
+				err = ss_error_input("'%s': /%s is not increasing evenly (%s %d is %g, "
+				                     "%g expected): cell centres in m, %s", in->name,
+				                     name, name, k, c[k], want,
+				                     name[0] == 'x' ? "west to east"
+				                                    : "south to north (row 0 the south row)");
+		}
+		*d = step;
+	}
+	if (!err && !isfinite(c[0]))
+		err = ss_error_input("'%s': /%s[0] is %g: cell centres in m", in->name, name, c[0]);
+	if (!err)
+		*origin = c[0];     /* a centre: the caller takes half a cell off */
+	ss_free(c);
+	return err;
+}
+
+/* The cell size along name (/x or /y) and the corner: from the centres,
+ * else (one cell, or none given) the root attribute of a sandslide file. */
+static int series_geometry(const struct h5in *in, const char *name, int n, double *d,
+                           double *origin)
+{
+	double first;
+	const int err = read_centres(in, name, n, d, &first);
+	if (err)
+		return err;
+	if (isnan(*d)) {
+		const double a = attr_double(in->file, name[0] == 'x' ? "dx" : "dy");
+		*d = a > 0.0 && isfinite(a) ? a : NAN;
+	}
+	*origin = first - 0.5 * *d;
+	if (!isfinite(*origin))
+		*origin = NAN;
+	return SS_OK;
+}
+
+/* /cell_type, when the file has one: its walls and cells without data
+ * as NaN in every snapshot. */
+static int series_walls(const struct h5in *in, struct ss_height_series *s)
+{
+	struct var v;
+	int err = var_open(in, "cell_type", &v);
+	if (err == VAR_MISSING)
+		return SS_OK;
+	if (err > 0 || (!err && (v.rank != 2 || v.dims[0] != (hsize_t)s->ny ||
+	                         v.dims[1] != (hsize_t)s->nx))) {
+		var_close(&v);
+		return ss_error_input("'%s': /cell_type is not %d x %d numbers (y, x) as /height's "
+		                      "snapshots", in->name, s->nx, s->ny);
+	}
+	const size_t cells = (size_t)s->nx * (size_t)s->ny;
+	uint8_t *types = err ? NULL : ss_alloc(cells, 1, "cell types");
+	if (!err && !types)
+		err = SS_ERR_FAIL;
+	const hsize_t start[2] = {0, 0}, count[2] = {(hsize_t)s->ny, (hsize_t)s->nx};
+	if (!err)
+		err = var_read(in, &v, start, count, H5T_NATIVE_UINT8, types, "/cell_type");
+	var_close(&v);
+	for (size_t k = 0; k < cells && !err; k++) {
+		if (types[k] > SS_SNAPSHOT_CELL_NODATA)
+			err = ss_error_input("'%s': /cell_type holds %d at column %zu, row %zu (from "
+			                     "the south): expected 0 (flow), 1 (wall), 2 (open) or 3 "
+			                     "(no data)", in->name, types[k], k % (size_t)s->nx + 1,
+			                     k / (size_t)s->nx + 1);
+		if (types[k] != SS_CELL_WALL && types[k] != SS_SNAPSHOT_CELL_NODATA)
+			continue;
+		for (long long t = 0; t < s->count; t++)
+			s->height[(size_t)t * cells + k] = NAN;
+	}
+	ss_free(types);
+	return err;
+}
+
+/* /time and /height: their sizes, then (memory allowing) their values. */
+static int series_values(const struct h5in *in, struct ss_height_series *s)
+{
+	struct var h, t;
+	int err = var_open(in, "height", &h);
+	if (err > 0 || (!err && h.rank != 3)) {
+		var_close(&h);
+		return not_series(in, err == VAR_MISSING ? "no /height"
+		                                         : "/height is not (time, y, x) numbers");
+	}
+	if (err)
+		return err;
+	if ((err = var_open(in, "time", &t)) > 0 || (!err && t.rank != 1)) {
+		var_close(&h);
+		var_close(&t);
+		return not_series(in, err == VAR_MISSING ? "no /time" : "/time is not (time) numbers");
+	}
+	const hsize_t *hd = h.dims;
+	char d[96];
+	if (!err && t.dims[0] != hd[0]) {
+		char why[96];
+		snprintf(why, sizeof why, "/time has %llu values, /height %llu snapshots",
+		         (unsigned long long)t.dims[0], (unsigned long long)hd[0]);
+		err = not_series(in, why);
+	}
+	else if (!err && (hd[1] < 1 || hd[2] < 1 || hd[1] > SS_SNAPSHOT_MAX_SIDE ||
+	                  hd[2] > SS_SNAPSHOT_MAX_SIDE))
+		err = ss_error_input("'%s': /height is %s (time, y, x): expected 1 to %d cells a "
+		                     "side", in->name, format_dims(3, hd, d, sizeof d),
+		                     SS_SNAPSHOT_MAX_SIDE);
+	s->count = (long long)hd[0];
+	s->ny = (int)hd[1];
+	s->nx = (int)hd[2];
+	const size_t cells = (size_t)s->nx * (size_t)s->ny;
+	/* the file has been found to hold them; memory need not */
+	const double need = 8.0 * (double)s->count * ((double)cells + 1.0);
+	const double have = ss_memory_available_bytes();
+	if (!err && s->count > 0 && (need > (double)SIZE_MAX / 2 || (have > 0.0 && need > have))) {
+		char b[32], a[32];
+		err = ss_error_input("'%s' holds %lld snapshots of %d x %d cells: they need %s of "
+		                     "memory, more than the %s available", in->name, s->count,
+		                     s->nx, s->ny, ss_format_bytes(need, b),
+		                     ss_format_bytes(have, a));
+	}
+	if (!err && s->count > 0) {
+		s->time = ss_alloc((size_t)s->count, sizeof *s->time, "observation times");
+		s->height = s->time ? ss_alloc((size_t)s->count * cells, sizeof *s->height,
+		                               "observed heights")
+		                    : NULL;
+		if (!s->height)
+			err = SS_ERR_FAIL;
+	}
+	const hsize_t t0 = 0, tn = hd[0];
+	if (!err && s->count > 0)
+		err = var_read(in, &t, &t0, &tn, H5T_NATIVE_DOUBLE, s->time, "/time");
+	for (long long k = 0; k < s->count && !err; k++) {
+		const hsize_t start[3] = {(hsize_t)k, 0, 0}, count[3] = {1, hd[1], hd[2]};
+		char what[64];
+		snprintf(what, sizeof what, "snapshot %lld of /height", k);
+		err = var_read(in, &h, start, count, H5T_NATIVE_DOUBLE,
+		               s->height + (size_t)k * cells, what);
+	}
+	var_close(&t);
+	var_close(&h);
+	return err;
+}
+
+int ss_snapshot_read_height_series(const char *path, struct ss_height_series *s)
+{
+	memset(s, 0, sizeof *s);
+	s->dx = s->dy = s->origin_x = s->origin_y = NAN;
+	struct h5in in;
+	int err = h5in_open(&in, path, NULL, 0);
+	if (!err)
+		err = series_values(&in, s);
+	if (!err)
+		err = series_geometry(&in, "x", s->nx, &s->dx, &s->origin_x);
+	if (!err)
+		err = series_geometry(&in, "y", s->ny, &s->dy, &s->origin_y);
+	if (!err)
+		err = series_walls(&in, s);
+	h5in_close(&in);
+	if (err)
+		ss_height_series_release(s);
+	return err;
+}
