@@ -41,5 +41,6 @@
 #include "sandslide/relax.h"
 #include "sandslide/bench.h"
 #include "sandslide/render.h"
+#include "sandslide/plot.h"
 
 #endif

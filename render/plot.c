@@ -1,0 +1,851 @@
+/*
+ * plot.c - line plots as PNG figures (include/sandslide/plot.h): the
+ * figures of `sandslide fit --plot`.
+ *
+ * A figure keeps copies of what it was given and draws only when written:
+ * each panel into a picture of its own (so nothing of it spills into its
+ * neighbour), which is then copied into the figure's picture and encoded
+ * by png.c.  A panel, top to bottom:
+ *
+ *     title (centred)
+ *     y label (at the left, above the axis: the font cannot be turned)
+ *     +-------------------------------------+
+ *     |  grid, vertical lines, series,      |   the legend in the corner
+ *     |  legend                             |   where it covers least
+ *     +-------------------------------------+
+ *     ticks, tick labels
+ *     x label (centred)
+ *
+ * The axes span the data with 5 % to spare.  Tick steps are 1, 2 or 5
+ * times a power of ten (whole decades on a log axis, or every 2nd, 3rd, 5th
+ * ... decade when they crowd), the finest whose labels keep a gap between
+ * them and that gives at most about 8 ticks.  Everything is sized in
+ * multiples of the font's magnification (ss_render_font_scale), so a
+ * larger panel gets larger text and thicker lines.
+ */
+#include "sandslide/plot.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "internal.h"
+#include "sandslide/error.h"
+#include "sandslide/render.h"
+
+/* ---- the figure: what the caller gave, copied ------------------------- */
+
+struct series {
+	double *x, *y;              /* n each, owned (NULL when n is 0) */
+	long long n;
+	enum ss_plot_style style;
+	int colour;                 /* palette index, any int */
+	char *legend;               /* owned; NULL: no entry */
+};
+
+struct vline {
+	double x;                   /* data units */
+	int colour;
+};
+
+struct panel {
+	char *title, *x_label, *y_label;   /* owned; NULL: none */
+	int log_x;
+	struct series *series;
+	int n_series, cap_series;
+	struct vline *vlines;
+	int n_vlines, cap_vlines;
+};
+
+struct ss_plot {
+	int columns, rows;
+	int panel_w, panel_h;       /* px */
+	struct panel *panels;       /* columns * rows, row by row */
+};
+
+/* Okabe and Ito's colour-blind-safe palette, without its yellow (too pale
+ * on white) and black (the axes' colour). */
+static const uint8_t palette[SS_PLOT_COLOURS][3] = {
+	{0x00, 0x72, 0xb2},   /* blue */
+	{0xd5, 0x5e, 0x00},   /* vermillion */
+	{0x00, 0x9e, 0x73},   /* bluish green */
+	{0xcc, 0x79, 0xa7},   /* reddish purple */
+	{0xe6, 0x9f, 0x00},   /* orange */
+	{0x56, 0xb4, 0xe9},   /* sky blue */
+};
+
+static const uint8_t ink[3] = {0x00, 0x00, 0x00};          /* text, frame, ticks */
+static const uint8_t grid_rgb[3] = {0xe4, 0xe4, 0xe4};     /* grid lines */
+static const uint8_t legend_edge[3] = {0xa0, 0xa0, 0xa0};  /* the legend's frame */
+static const uint8_t white[3] = {0xff, 0xff, 0xff};
+
+void ss_plot_palette(int colour, uint8_t rgb[3])
+{
+	const int k = (colour % SS_PLOT_COLOURS + SS_PLOT_COLOURS) % SS_PLOT_COLOURS;
+	memcpy(rgb, palette[k], 3);
+}
+
+/* A copy of text into *out, NULL for NULL or "". */
+static int copy_text(const char *text, char **out, const char *what)
+{
+	*out = NULL;
+	if (!text || !*text)
+		return SS_OK;
+	const size_t n = strlen(text) + 1;
+	*out = ss_alloc(n, 1, what);
+	if (!*out)
+		return SS_ERR_FAIL;
+	memcpy(*out, text, n);
+	return SS_OK;
+}
+
+int ss_plot_create(struct ss_plot **out, int columns, int rows, int panel_width_px,
+                   int panel_height_px)
+{
+	*out = NULL;
+	if (columns < 1 || rows < 1)
+		return ss_error_input("plot: %d x %d panels: at least 1 column and 1 row are "
+		                      "accepted", columns, rows);
+	if (panel_width_px < SS_PLOT_PANEL_MIN_WIDTH || panel_height_px < SS_PLOT_PANEL_MIN_HEIGHT)
+		return ss_error_input("plot: panels of %d x %d px: at least %d x %d px are accepted",
+		                      panel_width_px, panel_height_px, SS_PLOT_PANEL_MIN_WIDTH,
+		                      SS_PLOT_PANEL_MIN_HEIGHT);
+	if (panel_width_px > SS_PLOT_SIDE_MAX / columns || panel_height_px > SS_PLOT_SIDE_MAX / rows)
+		return ss_error_input("plot: %d x %d panels of %d x %d px: a figure of at most "
+		                      "%d px on each side is accepted", columns, rows,
+		                      panel_width_px, panel_height_px, SS_PLOT_SIDE_MAX);
+	struct ss_plot *p = ss_alloc(1, sizeof *p, "a plot");
+	if (!p)
+		return SS_ERR_FAIL;
+	p->panels = ss_alloc((size_t)columns * (size_t)rows, sizeof *p->panels, "a plot's panels");
+	if (!p->panels) {
+		ss_free(p);
+		return SS_ERR_FAIL;
+	}
+	p->columns = columns;
+	p->rows = rows;
+	p->panel_w = panel_width_px;
+	p->panel_h = panel_height_px;
+	*out = p;
+	return SS_OK;
+}
+
+static void series_release(struct series *s)
+{
+	ss_free(s->x);
+	ss_free(s->y);
+	ss_free(s->legend);
+}
+
+void ss_plot_destroy(struct ss_plot *p)
+{
+	if (!p)
+		return;
+	for (int k = 0; k < p->columns * p->rows; k++) {
+		struct panel *pn = &p->panels[k];
+		ss_free(pn->title);
+		ss_free(pn->x_label);
+		ss_free(pn->y_label);
+		for (int s = 0; s < pn->n_series; s++)
+			series_release(&pn->series[s]);
+		ss_free(pn->series);
+		ss_free(pn->vlines);
+	}
+	ss_free(p->panels);
+	ss_free(p);
+}
+
+static int check_panel(const struct ss_plot *p, int panel, const char *function)
+{
+	const int n = p->columns * p->rows;
+	if (panel < 0 || panel >= n)
+		return ss_error_input("%s: panel %d: panels 0 to %d are accepted (%d x %d)",
+		                      function, panel, n - 1, p->columns, p->rows);
+	return SS_OK;
+}
+
+int ss_plot_panel(struct ss_plot *p, int panel, const char *title, const char *x_label,
+                  const char *y_label, int log_x)
+{
+	int err = check_panel(p, panel, "plot panel");
+	if (err)
+		return err;
+	char *t = NULL, *xl = NULL, *yl = NULL;
+	if ((err = copy_text(title, &t, "a plot title")) ||
+	    (err = copy_text(x_label, &xl, "a plot axis label")) ||
+	    (err = copy_text(y_label, &yl, "a plot axis label"))) {
+		ss_free(t);
+		ss_free(xl);
+		return err;
+	}
+	struct panel *pn = &p->panels[panel];
+	ss_free(pn->title);
+	ss_free(pn->x_label);
+	ss_free(pn->y_label);
+	pn->title = t;
+	pn->x_label = xl;
+	pn->y_label = yl;
+	pn->log_x = log_x != 0;
+	return SS_OK;
+}
+
+/* Room for one more element in *array (*n used of *cap, each size bytes),
+ * doubling it; the array is unchanged on failure. */
+static int grow(void **array, int n, int *cap, size_t size, const char *what)
+{
+	if (n < *cap)
+		return SS_OK;
+	if (*cap > (1 << 28))
+		return ss_error_fail("cannot add to %s: %d of them already", what, n);
+	const int more = *cap ? 2 * *cap : 4;
+	void *a = ss_alloc((size_t)more, size, what);
+	if (!a)
+		return SS_ERR_FAIL;
+	if (n)
+		memcpy(a, *array, (size_t)n * size);
+	ss_free(*array);
+	*array = a;
+	*cap = more;
+	return SS_OK;
+}
+
+/* A value a plot accepts: a gap (NaN, infinite) or finite within range. */
+static int value_ok(double v)
+{
+	return !isfinite(v) || fabs(v) <= SS_PLOT_VALUE_MAX;
+}
+
+int ss_plot_add(struct ss_plot *p, int panel, const double *x, const double *y, long long n,
+                enum ss_plot_style style, int colour, const char *legend)
+{
+	int err = check_panel(p, panel, "plot add");
+	if (err)
+		return err;
+	if (n < 0)
+		return ss_error_input("plot add: %lld points: 0 or more are accepted", n);
+	if (n > 0 && (!x || !y))
+		return ss_error_input("plot add: %lld points without %s: arrays of n values are "
+		                      "accepted (NULL only when n is 0)", n, !x ? "x" : "y");
+	if (style != SS_PLOT_LINE && style != SS_PLOT_MARKERS && style != SS_PLOT_LINE_MARKERS)
+		return ss_error_input("plot add: style %d: SS_PLOT_LINE, SS_PLOT_MARKERS or "
+		                      "SS_PLOT_LINE_MARKERS is accepted", (int)style);
+	for (long long i = 0; i < n; i++)
+		if (!value_ok(x[i]) || !value_ok(y[i]))
+			return ss_error_input("plot add: point %lld is (%g, %g): values up to %g in "
+			                      "magnitude, or NaN for a gap, are accepted", i, x[i], y[i],
+			                      SS_PLOT_VALUE_MAX);
+
+	struct panel *pn = &p->panels[panel];
+	struct series s = {.n = n, .style = style, .colour = colour};
+	if (n > 0) {
+		s.x = ss_alloc((size_t)n, sizeof *s.x, "a plot series");
+		s.y = s.x ? ss_alloc((size_t)n, sizeof *s.y, "a plot series") : NULL;
+		if (!s.y) {
+			series_release(&s);
+			return SS_ERR_FAIL;
+		}
+		memcpy(s.x, x, (size_t)n * sizeof *s.x);
+		memcpy(s.y, y, (size_t)n * sizeof *s.y);
+	}
+	void *array = pn->series;
+	if ((err = copy_text(legend, &s.legend, "a plot legend")) ||
+	    (err = grow(&array, pn->n_series, &pn->cap_series, sizeof *pn->series,
+	                "a plot panel's series"))) {
+		series_release(&s);
+		return err;
+	}
+	pn->series = array;
+	pn->series[pn->n_series++] = s;
+	return SS_OK;
+}
+
+int ss_plot_vline(struct ss_plot *p, int panel, double x, int colour)
+{
+	int err = check_panel(p, panel, "plot vline");
+	if (err)
+		return err;
+	if (!isfinite(x) || fabs(x) > SS_PLOT_VALUE_MAX)
+		return ss_error_input("plot vline: x = %g: a finite value up to %g in magnitude "
+		                      "is accepted", x, SS_PLOT_VALUE_MAX);
+	struct panel *pn = &p->panels[panel];
+	void *array = pn->vlines;
+	if ((err = grow(&array, pn->n_vlines, &pn->cap_vlines, sizeof *pn->vlines,
+	                "a plot panel's vertical lines")))
+		return err;
+	pn->vlines = array;
+	pn->vlines[pn->n_vlines++] = (struct vline){x, colour};
+	return SS_OK;
+}
+
+/* ---- axes: range, ticks and their labels ----------------------------- */
+
+enum { MAX_TICKS = 64, LABEL_SIZE = 32 };
+
+/* One axis of a panel.  Positions along it are linear in t(v): v, or
+ * log10(v) on a log axis. */
+struct axis {
+	int log;
+	double lo, hi;              /* the range in t */
+	int pix0, len;              /* its first pixel and its length, px */
+	int flip;                   /* 1: t grows towards pixel 0 (the y axis) */
+	int n_ticks, n_minor;
+	double tick[MAX_TICKS];     /* values (not t) */
+	char label[MAX_TICKS][LABEL_SIZE];
+	double minor[MAX_TICKS];    /* unlabelled ticks (log axis), values */
+};
+
+static double axis_t(const struct axis *a, double v)
+{
+	return a->log ? log10(v) : v;
+}
+
+/* Pixel of value v (unrounded); v in the range or near it. */
+static double axis_pixel(const struct axis *a, double v)
+{
+	double f = (axis_t(a, v) - a->lo) / (a->hi - a->lo);
+	f = f < -1.0 ? -1.0 : f > 2.0 ? 2.0 : f;   /* keeps the rounding in int */
+	return a->pix0 + (a->flip ? 1.0 - f : f) * (a->len - 1);
+}
+
+static int round_px(double x)
+{
+	return (int)floor(x + 0.5);
+}
+
+/* Whether a point can be drawn: both coordinates finite, x > 0 on log. */
+static int drawable(int log_x, double x, double y)
+{
+	return isfinite(x) && isfinite(y) && (!log_x || x > 0.0);
+}
+
+/* [lo, hi] of what is drawn along an axis (in t), widened by 5 % each
+ * side, or by a tenth of its magnitude (half a decade on a log axis) when
+ * it is a single value; [0, 1] with nothing to draw. */
+static void finish_range(struct axis *a, int any, double lo, double hi)
+{
+	if (!any) {
+		lo = 0.0, hi = 1.0;
+	} else if (lo == hi) {
+		const double d = a->log ? 0.5 : lo != 0.0 ? 0.1 * fabs(lo) : 1.0;
+		lo -= d, hi += d;
+	} else {
+		const double d = 0.05 * (hi - lo);
+		lo -= d, hi += d;
+	}
+	a->lo = lo;
+	a->hi = hi;
+}
+
+static void data_ranges(const struct panel *pn, struct axis *ax, struct axis *ay)
+{
+	double xlo = INFINITY, xhi = -INFINITY, ylo = INFINITY, yhi = -INFINITY;
+	int any_x = 0, any_y = 0;
+	for (int s = 0; s < pn->n_series; s++) {
+		const struct series *sr = &pn->series[s];
+		for (long long i = 0; i < sr->n; i++) {
+			if (!drawable(pn->log_x, sr->x[i], sr->y[i]))
+				continue;
+			const double t = axis_t(ax, sr->x[i]);
+			xlo = fmin(xlo, t), xhi = fmax(xhi, t);
+			ylo = fmin(ylo, sr->y[i]), yhi = fmax(yhi, sr->y[i]);
+			any_x = any_y = 1;
+		}
+	}
+	for (int k = 0; k < pn->n_vlines; k++) {
+		if (pn->log_x && !(pn->vlines[k].x > 0.0))
+			continue;
+		const double t = axis_t(ax, pn->vlines[k].x);
+		xlo = fmin(xlo, t), xhi = fmax(xhi, t);
+		any_x = 1;
+	}
+	finish_range(ax, any_x, xlo, xhi);
+	finish_range(ay, any_y, ylo, yhi);
+}
+
+/* "1.5e-4" from printf's "1.50e-04". */
+static void short_exponent(double v, int digits, char *out, size_t size)
+{
+	char buf[LABEL_SIZE * 2];
+	snprintf(buf, sizeof buf, "%.*e", digits, v);
+	char *e = strchr(buf, 'e');
+	if (!e) {
+		snprintf(out, size, "%s", buf);
+		return;
+	}
+	*e = '\0';
+	const int exponent = atoi(e + 1);
+	if (strchr(buf, '.')) {
+		char *end = buf + strlen(buf) - 1;
+		while (*end == '0')
+			*end-- = '\0';
+		if (*end == '.')
+			*end = '\0';
+	}
+	snprintf(out, size, "%se%d", buf, exponent);
+}
+
+/* A tick of a linear axis: v, a multiple of step, as short as tells it
+ * from its neighbours: fixed decimals ("0.02", "150") while they are few,
+ * else a power of ten ("2e-4", "1.5e5"). */
+static void linear_label(double v, double step, double magnitude, char *out, size_t size)
+{
+	const int e_step = (int)floor(log10(step) + 1e-9);
+	if (fabs(v) < 1e-9 * step) {
+		snprintf(out, size, "0");
+	} else if (e_step >= -3 && magnitude < 1e5) {
+		snprintf(out, size, "%.*f", e_step < 0 ? -e_step : 0, v);
+	} else {
+		int digits = (int)floor(log10(fabs(v)) + 1e-9) - e_step;
+		digits = digits < 0 ? 0 : digits > 8 ? 8 : digits;
+		short_exponent(v, digits, out, size);
+	}
+}
+
+/* A tick of a log axis, m * 10^d with m a whole 1..9: plain from 0.01 to
+ * 9000, else "1e-3", "5e4". */
+static void log_label(int m, int d, char *out, size_t size)
+{
+	if (d >= -2 && d <= 3)
+		snprintf(out, size, "%.*f", d < 0 ? -d : 0, m * pow(10.0, d));
+	else if (m == 1)
+		snprintf(out, size, "1e%d", d);
+	else
+		snprintf(out, size, "%de%d", m, d);
+}
+
+/* Space a tick label needs along the axis, px: its width on the x axis
+ * (plus a gap of three characters), three text heights on the y axis. */
+static int label_room(const struct axis *a, int k)
+{
+	int w = 0;
+	if (a->flip)
+		return 3 * 7 * k;
+	for (int i = 0; i < a->n_ticks; i++) {
+		const int tw = ss_render_text_width(a->label[i], k);
+		w = tw > w ? tw : w;
+	}
+	return w + ss_render_text_width("000", k);
+}
+
+static double tick_spacing_px(const struct axis *a, double step_t)
+{
+	return step_t / (a->hi - a->lo) * (a->len - 1);
+}
+
+/* Ticks at multiples of a 1-2-5 step in value space, the finest that
+ * leaves room between labels and gives no more than about 8 ticks; for a
+ * log axis less than a decade or so wide too (values, then, placed by
+ * their logarithm). */
+static void linear_ticks(struct axis *a, int k)
+{
+	const double vlo = a->log ? pow(10.0, a->lo) : a->lo;
+	const double vhi = a->log ? pow(10.0, a->hi) : a->hi;
+	const double span = vhi - vlo, magnitude = fmax(fabs(vlo), fabs(vhi));
+	a->n_ticks = 0;
+	if (!(span > 0.0) || !isfinite(span))
+		return;
+	const double base = pow(10.0, floor(log10(span / 50.0)));
+	static const double mult[3] = {1.0, 2.0, 5.0};
+	for (int j = 0; j < 3 * 6; j++) {
+		const double step = mult[j % 3] * base * pow(10.0, j / 3);
+		if (!(step > 0.0) || !isfinite(step))
+			return;
+		const double first = ceil(vlo / step - 1e-9), last = floor(vhi / step + 1e-9);
+		if (last - first + 1 > MAX_TICKS)
+			continue;
+		struct axis b = *a;
+		b.n_ticks = 0;
+		for (double i = first; i <= last; i++) {
+			const double v = i * step;
+			if (a->log && !(v > 0.0))
+				continue;
+			b.tick[b.n_ticks] = v;
+			linear_label(v, step, magnitude, b.label[b.n_ticks], LABEL_SIZE);
+			b.n_ticks++;
+		}
+		/* the narrowest gap between ticks: on a log axis, the last two */
+		double gap = tick_spacing_px(&b, step);
+		if (a->log && b.n_ticks >= 2)
+			gap = tick_spacing_px(&b, log10(b.tick[b.n_ticks - 1]) -
+			                              log10(b.tick[b.n_ticks - 2]));
+		const int fits = gap >= label_room(&b, k) && gap >= (a->len - 1) / 8.0;
+		if (fits || j == 3 * 6 - 1) {
+			a->n_ticks = b.n_ticks;
+			memcpy(a->tick, b.tick, sizeof a->tick);
+			memcpy(a->label, b.label, sizeof a->label);
+			return;
+		}
+	}
+}
+
+/* Ticks of a log axis: every `stride`-th decade, the smallest stride whose
+ * labels have room; with a single decade each, also 2 and 5 times them;
+ * failing two ticks, linear_ticks.  Unlabelled minor ticks at 2 .. 9 times
+ * each decade when decades are far enough apart. */
+static void log_ticks(struct axis *a, int k)
+{
+	const int dlo = (int)ceil(a->lo - 1e-9), dhi = (int)floor(a->hi + 1e-9);
+	static const int strides[] = {1, 2, 3, 5, 10, 20, 50, 100, 200};
+	a->n_ticks = a->n_minor = 0;
+	int stride = 0;
+	for (size_t j = 0; j < sizeof strides / sizeof strides[0]; j++) {
+		struct axis b = *a;
+		b.n_ticks = 0;
+		for (int d = dlo; d <= dhi && b.n_ticks < MAX_TICKS; d++) {
+			if (((d % strides[j]) + strides[j]) % strides[j])
+				continue;
+			b.tick[b.n_ticks] = pow(10.0, d);
+			log_label(1, d, b.label[b.n_ticks], LABEL_SIZE);
+			b.n_ticks++;
+		}
+		if (tick_spacing_px(&b, strides[j]) >= label_room(&b, k) &&
+		    tick_spacing_px(&b, strides[j]) >= (a->len - 1) / 10.0) {
+			*a = b;
+			stride = strides[j];
+			break;
+		}
+	}
+	if (stride == 1 && a->n_ticks < 3) {
+		/* a decade or two: 1, 2, 5 times each, if their labels fit */
+		struct axis b = *a;
+		b.n_ticks = 0;
+		for (int d = dlo - 1; d <= dhi && b.n_ticks < MAX_TICKS - 3; d++)
+			for (int m = 1; m <= 5; m += m == 1 ? 1 : 3) {
+				const double t = d + log10(m);
+				if (t < a->lo - 1e-9 || t > a->hi + 1e-9)
+					continue;
+				b.tick[b.n_ticks] = m * pow(10.0, d);
+				log_label(m, d, b.label[b.n_ticks], LABEL_SIZE);
+				b.n_ticks++;
+			}
+		/* the narrowest gap is between 1 and 2 times a decade */
+		if (tick_spacing_px(&b, log10(2.0)) >= label_room(&b, k))
+			*a = b;
+	}
+	if (a->n_ticks < 3) {
+		/* within a decade or so (2 .. 5): 1-2-5 steps of the values, if
+		 * they give more ticks */
+		struct axis b = *a;
+		linear_ticks(&b, k);
+		if (b.n_ticks > a->n_ticks) {
+			*a = b;
+			return;
+		}
+	}
+	if (a->n_ticks < 2)
+		return;
+	if (stride == 1 && tick_spacing_px(a, 1.0) >= 8 * 7 * k)
+		for (int d = dlo - 1; d <= dhi && a->n_minor < MAX_TICKS - 8; d++)
+			for (int m = 2; m <= 9; m++) {
+				const double t = d + log10(m);
+				if (t >= a->lo && t <= a->hi)
+					a->minor[a->n_minor++] = m * pow(10.0, d);
+			}
+}
+
+static void make_ticks(struct axis *a, int k)
+{
+	if (a->log)
+		log_ticks(a, k);
+	else
+		linear_ticks(a, k);
+}
+
+/* ---- pixels ----------------------------------------------------------- */
+
+/* A clip rectangle: pixels [x0, x1) x [y0, y1). */
+struct clip {
+	int x0, y0, x1, y1;
+};
+
+static void put(struct ss_render_image *img, const struct clip *c, int x, int y,
+                const uint8_t rgb[3])
+{
+	if (x < c->x0 || y < c->y0 || x >= c->x1 || y >= c->y1)
+		return;
+	uint8_t *q = img->pixels + (size_t)y * img->row_bytes + 3 * (size_t)x;
+	q[0] = rgb[0], q[1] = rgb[1], q[2] = rgb[2];
+}
+
+static void fill(struct ss_render_image *img, const struct clip *c, int x0, int y0, int x1,
+                 int y1, const uint8_t rgb[3])
+{
+	for (int y = y0; y < y1; y++)
+		for (int x = x0; x < x1; x++)
+			put(img, c, x, y, rgb);
+}
+
+/* A line of `width` px from (x0, y0) to (x1, y1), both ends drawn
+ * (Bresenham, a width x width brush at each step). */
+static void line(struct ss_render_image *img, const struct clip *c, int x0, int y0, int x1,
+                 int y1, int width, const uint8_t rgb[3])
+{
+	const int dx = abs(x1 - x0), dy = -abs(y1 - y0);
+	const int sx = x0 < x1 ? 1 : -1, sy = y0 < y1 ? 1 : -1;
+	const int o = (width - 1) / 2;
+	int err = dx + dy;
+	for (;;) {
+		fill(img, c, x0 - o, y0 - o, x0 - o + width, y0 - o + width, rgb);
+		if (x0 == x1 && y0 == y1)
+			break;
+		const int e2 = 2 * err;
+		if (e2 >= dy)
+			err += dy, x0 += sx;
+		if (e2 <= dx)
+			err += dx, y0 += sy;
+	}
+}
+
+static void disc(struct ss_render_image *img, const struct clip *c, int x, int y, int r,
+                 const uint8_t rgb[3])
+{
+	for (int v = -r; v <= r; v++)
+		for (int u = -r; u <= r; u++)
+			if (u * u + v * v <= r * r + r)   /* + r: rounder than a diamond */
+				put(img, c, x + u, y + v, rgb);
+}
+
+/* ---- a panel ---------------------------------------------------------- */
+
+/* Sizes of a panel's parts, px, in multiples of the font scale k. */
+struct layout {
+	int k, text_h, pad, tick, line_w, marker_r;
+	struct clip whole, area;    /* the panel, and inside its frame */
+};
+
+static struct layout panel_layout(int w, int h)
+{
+	struct layout l;
+	l.k = ss_render_font_scale(w, h);
+	l.text_h = 7 * l.k;
+	l.pad = 4 * l.k;
+	l.tick = 3 * l.k;
+	l.line_w = l.k < 2 ? 1 : 2;
+	l.marker_r = 3 * l.k;
+	l.whole = (struct clip){0, 0, w, h};
+	/* title, gap, y label, gap, frame */
+	l.area.y0 = l.pad + l.text_h + 3 * l.k + l.text_h + 5 * l.k + 1;
+	/* frame, tick, gap, tick labels, gap, x label, pad */
+	l.area.y1 = h - (1 + l.tick + 2 * l.k + l.text_h + 3 * l.k + l.text_h + l.pad);
+	/* the left edge waits for the y labels; at the right, room for half
+	 * the last x tick label */
+	l.area.x0 = 0;
+	l.area.x1 = w - (l.pad + 12 * l.k + 1);
+	return l;
+}
+
+/* Ink in the box [x0, x1) x [y0, y1): what is neither background nor grid. */
+static long ink_in(const struct ss_render_image *img, int x0, int y0, int x1, int y1)
+{
+	long n = 0;
+	for (int y = y0 < 0 ? 0 : y0; y < y1 && y < img->height; y++)
+		for (int x = x0 < 0 ? 0 : x0; x < x1 && x < img->width; x++) {
+			const uint8_t *q = img->pixels + (size_t)y * img->row_bytes + 3 * (size_t)x;
+			n += memcmp(q, white, 3) != 0 && memcmp(q, grid_rgb, 3) != 0;
+		}
+	return n;
+}
+
+/* A legend sample of series s, centred on row y from x0 to x1. */
+static void draw_sample(struct ss_render_image *img, const struct layout *l,
+                        const struct series *s, int x0, int x1, int y)
+{
+	uint8_t rgb[3];
+	ss_plot_palette(s->colour, rgb);
+	if (s->style != SS_PLOT_MARKERS)
+		line(img, &l->whole, x0, y, x1, y, l->line_w, rgb);
+	if (s->style != SS_PLOT_LINE)
+		disc(img, &l->whole, (x0 + x1) / 2, y, l->marker_r, rgb);
+}
+
+/* The legend in the corner of the plot area where it covers the least
+ * already drawn (first of upper right, upper left, lower right, lower left
+ * on a tie). */
+static void draw_legend(struct ss_render_image *img, const struct layout *l,
+                        const struct panel *pn)
+{
+	const int k = l->k, inner = 3 * k, sample_w = 18 * k, row_h = l->text_h + 3 * k;
+	int entries = 0, text_w = 0;
+	for (int s = 0; s < pn->n_series; s++)
+		if (pn->series[s].legend) {
+			const int tw = ss_render_text_width(pn->series[s].legend, k);
+			text_w = tw > text_w ? tw : text_w;
+			entries++;
+		}
+	if (!entries)
+		return;
+	const int box_w = inner + sample_w + 2 * k + text_w + inner;
+	const int box_h = 2 * inner + entries * row_h - 3 * k;
+	const int inset = 4 * k;
+	const int left = l->area.x0 + inset, right = l->area.x1 - inset - box_w;
+	const int top = l->area.y0 + inset, bottom = l->area.y1 - inset - box_h;
+	const int corner_x[4] = {right, left, right, left}, corner_y[4] = {top, top, bottom, bottom};
+	int best = 0;
+	long best_ink = -1;
+	for (int c = 0; c < 4; c++) {
+		const long n = ink_in(img, corner_x[c], corner_y[c], corner_x[c] + box_w,
+		                      corner_y[c] + box_h);
+		if (best_ink < 0 || n < best_ink)
+			best = c, best_ink = n;
+	}
+	const int bx = corner_x[best], by = corner_y[best];
+	fill(img, &l->area, bx, by, bx + box_w, by + box_h, white);
+	fill(img, &l->area, bx, by, bx + box_w, by + 1, legend_edge);
+	fill(img, &l->area, bx, by + box_h - 1, bx + box_w, by + box_h, legend_edge);
+	fill(img, &l->area, bx, by, bx + 1, by + box_h, legend_edge);
+	fill(img, &l->area, bx + box_w - 1, by, bx + box_w, by + box_h, legend_edge);
+	int y = by + inner;
+	for (int s = 0; s < pn->n_series; s++) {
+		const struct series *sr = &pn->series[s];
+		if (!sr->legend)
+			continue;
+		draw_sample(img, l, sr, bx + inner, bx + inner + sample_w, y + l->text_h / 2);
+		ss_render_draw_text(img, bx + inner + sample_w + 2 * k, y, k, sr->legend, ink);
+		y += row_h;
+	}
+}
+
+static void draw_series(struct ss_render_image *img, const struct layout *l,
+                        const struct panel *pn, const struct axis *ax, const struct axis *ay,
+                        const struct series *s)
+{
+	uint8_t rgb[3];
+	ss_plot_palette(s->colour, rgb);
+	if (s->style != SS_PLOT_MARKERS) {
+		int have_prev = 0, px = 0, py = 0;
+		for (long long i = 0; i < s->n; i++) {
+			if (!drawable(pn->log_x, s->x[i], s->y[i])) {
+				have_prev = 0;   /* a gap */
+				continue;
+			}
+			const int x = round_px(axis_pixel(ax, s->x[i]));
+			const int y = round_px(axis_pixel(ay, s->y[i]));
+			if (have_prev)
+				line(img, &l->area, px, py, x, y, l->line_w, rgb);
+			px = x, py = y, have_prev = 1;
+			/* a lone point between gaps: a small dot rather than nothing */
+			const int alone = (i == 0 || !drawable(pn->log_x, s->x[i - 1], s->y[i - 1])) &&
+			                  (i == s->n - 1 || !drawable(pn->log_x, s->x[i + 1], s->y[i + 1]));
+			if (alone)
+				disc(img, &l->area, x, y, l->k, rgb);
+		}
+	}
+	if (s->style != SS_PLOT_LINE)
+		for (long long i = 0; i < s->n; i++)
+			if (drawable(pn->log_x, s->x[i], s->y[i]))
+				disc(img, &l->area, round_px(axis_pixel(ax, s->x[i])),
+				     round_px(axis_pixel(ay, s->y[i])), l->marker_r, rgb);
+}
+
+/* Text centred on x, kept inside the panel. */
+static void text_centred(struct ss_render_image *img, const struct layout *l, int x, int y,
+                         const char *text)
+{
+	const int w = ss_render_text_width(text, l->k);
+	int x0 = x - w / 2;
+	x0 = x0 + w > img->width ? img->width - w : x0;
+	x0 = x0 < 0 ? 0 : x0;
+	ss_render_draw_text(img, x0, y, l->k, text, ink);
+}
+
+/* Panel pn into img (its own picture, the panel's size). */
+static void draw_panel(struct ss_render_image *img, const struct panel *pn)
+{
+	struct layout l = panel_layout(img->width, img->height);
+	const int k = l.k;
+	struct axis ax = {.log = pn->log_x}, ay = {.flip = 1};
+	data_ranges(pn, &ax, &ay);
+	ay.pix0 = l.area.y0;
+	ay.len = l.area.y1 - l.area.y0;
+	make_ticks(&ay, k);
+	int label_w = 0;
+	for (int i = 0; i < ay.n_ticks; i++) {
+		const int tw = ss_render_text_width(ay.label[i], k);
+		label_w = tw > label_w ? tw : label_w;
+	}
+	l.area.x0 = l.pad + label_w + 2 * k + l.tick + 1;
+	ax.pix0 = l.area.x0;
+	ax.len = l.area.x1 - l.area.x0;
+	make_ticks(&ax, k);
+
+	for (int y = 0; y < img->height; y++)
+		memset(img->pixels + (size_t)y * img->row_bytes, 0xff, 3 * (size_t)img->width);
+
+	/* grid, vertical lines, series, legend: inside the frame */
+	for (int i = 0; i < ax.n_ticks; i++) {
+		const int x = round_px(axis_pixel(&ax, ax.tick[i]));
+		fill(img, &l.area, x, l.area.y0, x + 1, l.area.y1, grid_rgb);
+	}
+	for (int i = 0; i < ay.n_ticks; i++) {
+		const int y = round_px(axis_pixel(&ay, ay.tick[i]));
+		fill(img, &l.area, l.area.x0, y, l.area.x1, y + 1, grid_rgb);
+	}
+	for (int v = 0; v < pn->n_vlines; v++) {
+		if (pn->log_x && !(pn->vlines[v].x > 0.0))
+			continue;
+		uint8_t rgb[3];
+		ss_plot_palette(pn->vlines[v].colour, rgb);
+		const int x = round_px(axis_pixel(&ax, pn->vlines[v].x));
+		line(img, &l.area, x, l.area.y0, x, l.area.y1 - 1, l.line_w, rgb);
+	}
+	for (int s = 0; s < pn->n_series; s++)
+		draw_series(img, &l, pn, &ax, &ay, &pn->series[s]);
+	draw_legend(img, &l, pn);
+
+	/* the frame, one px outside the area, ticks outside it */
+	const struct clip *all = &l.whole;
+	const int fx0 = l.area.x0 - 1, fx1 = l.area.x1, fy0 = l.area.y0 - 1, fy1 = l.area.y1;
+	fill(img, all, fx0, fy0, fx1 + 1, fy0 + 1, ink);
+	fill(img, all, fx0, fy1, fx1 + 1, fy1 + 1, ink);
+	fill(img, all, fx0, fy0, fx0 + 1, fy1 + 1, ink);
+	fill(img, all, fx1, fy0, fx1 + 1, fy1 + 1, ink);
+	for (int i = 0; i < ax.n_ticks; i++) {
+		const int x = round_px(axis_pixel(&ax, ax.tick[i]));
+		fill(img, all, x, fy1 + 1, x + 1, fy1 + 1 + l.tick, ink);
+		text_centred(img, &l, x, fy1 + 1 + l.tick + 2 * k, ax.label[i]);
+	}
+	for (int i = 0; i < ax.n_minor; i++) {
+		const int x = round_px(axis_pixel(&ax, ax.minor[i]));
+		fill(img, all, x, fy1 + 1, x + 1, fy1 + 1 + (l.tick + 1) / 2, ink);
+	}
+	for (int i = 0; i < ay.n_ticks; i++) {
+		const int y = round_px(axis_pixel(&ay, ay.tick[i]));
+		fill(img, all, fx0 - l.tick, y, fx0, y + 1, ink);
+		const int tw = ss_render_text_width(ay.label[i], k);
+		ss_render_draw_text(img, fx0 - l.tick - 2 * k - tw, y - l.text_h / 2, k, ay.label[i],
+		                    ink);
+	}
+	if (pn->title)
+		text_centred(img, &l, img->width / 2, l.pad, pn->title);
+	if (pn->y_label)
+		ss_render_draw_text(img, l.pad, l.pad + l.text_h + 3 * k, k, pn->y_label, ink);
+	if (pn->x_label)
+		text_centred(img, &l, (fx0 + fx1) / 2, img->height - l.pad - l.text_h, pn->x_label);
+}
+
+int ss_plot_write_png(const struct ss_plot *p, const char *path)
+{
+	if (!path || !*path)
+		return ss_error_input("plot: no file name: a path for the PNG is accepted");
+	struct ss_render_image fig, panel;
+	int err = ss_render_image_init(&fig, p->columns * p->panel_w, p->rows * p->panel_h, 3, 8);
+	if (err)
+		goto out_release_fig;
+	if ((err = ss_render_image_init(&panel, p->panel_w, p->panel_h, 3, 8)))
+		goto out_release_panel;
+	for (int r = 0; r < p->rows; r++)
+		for (int c = 0; c < p->columns; c++) {
+			draw_panel(&panel, &p->panels[r * p->columns + c]);
+			for (int y = 0; y < p->panel_h; y++)
+				memcpy(fig.pixels + (size_t)(r * p->panel_h + y) * fig.row_bytes +
+				               3 * (size_t)c * (size_t)p->panel_w,
+				       panel.pixels + (size_t)y * panel.row_bytes, panel.row_bytes);
+		}
+	err = ss_render_write_png(&fig, path, 6);
+out_release_panel:
+	ss_render_image_release(&panel);
+out_release_fig:
+	ss_render_image_release(&fig);
+	return err;
+}

@@ -1,0 +1,561 @@
+/*
+ * test_plot.c - pixel-level properties of the line plots (plot.h).
+ *
+ * Every figure is written as a PNG and decoded here with libpng's
+ * simplified API, not with the renderer's code, so what is checked is
+ * what a reader of the file sees.  Series are found by their palette
+ * colour (ss_plot_palette): nothing else in a figure has it.
+ *
+ * SANDSLIDE_PLOT_DEMO=FILE.png also writes the demo figure (two panels: a
+ * front radius over time, a cost along nu on a log axis) there, to look at.
+ */
+#include "check.h"
+
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <png.h>
+
+#include "sandslide/error.h"
+#include "sandslide/plot.h"
+
+/* ---- helpers ---------------------------------------------------------- */
+
+/* A decoded figure, 8-bit RGB, rows from the top. */
+struct pic {
+	int w, h;
+	uint8_t *px;
+};
+
+static int pic_read(const char *path, struct pic *p)
+{
+	png_image im;
+	memset(&im, 0, sizeof im);
+	im.version = PNG_IMAGE_VERSION;
+	p->px = NULL;
+	if (!png_image_begin_read_from_file(&im, path))
+		return -1;
+	im.format = PNG_FORMAT_RGB;
+	p->w = (int)im.width;
+	p->h = (int)im.height;
+	p->px = malloc(PNG_IMAGE_SIZE(im));
+	if (!p->px || !png_image_finish_read(&im, NULL, p->px, 0, NULL)) {
+		png_image_free(&im);
+		free(p->px);
+		p->px = NULL;
+		return -1;
+	}
+	return 0;
+}
+
+static const uint8_t *pic_at(const struct pic *p, int x, int y)
+{
+	return p->px + 3 * ((size_t)y * p->w + x);
+}
+
+static int is_colour(const struct pic *p, int x, int y, int colour)
+{
+	uint8_t rgb[3];
+	ss_plot_palette(colour, rgb);
+	return !memcmp(pic_at(p, x, y), rgb, 3);
+}
+
+/* Bounding box and count of the pixels of a palette colour in the
+ * rectangle [x0, x1) x [y0, y1) of the picture (clipped to it). */
+struct box {
+	int x0, y0, x1, y1;   /* inclusive; x0 > x1 when empty */
+	long n;
+};
+
+static struct box find_in(const struct pic *p, int colour, int x0, int x1, int y0, int y1)
+{
+	struct box b = {p->w, p->h, -1, -1, 0};
+	for (int y = y0 < 0 ? 0 : y0; y < y1 && y < p->h; y++)
+		for (int x = x0 < 0 ? 0 : x0; x < x1 && x < p->w; x++)
+			if (is_colour(p, x, y, colour)) {
+				b.x0 = x < b.x0 ? x : b.x0;
+				b.x1 = x > b.x1 ? x : b.x1;
+				b.y0 = y < b.y0 ? y : b.y0;
+				b.y1 = y > b.y1 ? y : b.y1;
+				b.n++;
+			}
+	return b;
+}
+
+/* The same in columns [x0, x1), all rows. */
+static struct box find_colour(const struct pic *p, int colour, int x0, int x1)
+{
+	return find_in(p, colour, x0, x1, 0, p->h);
+}
+
+/* Markers of a colour, left to right: runs of columns holding it; their
+ * centres (column and row of the middle of each run's box). */
+static int find_blobs(const struct pic *p, int colour, double *cx, double *cy, int max)
+{
+	int n = 0, start = -1;
+	for (int x = 0; x <= p->w; x++) {
+		const int has = x < p->w && find_colour(p, colour, x, x + 1).n > 0;
+		if (has && start < 0)
+			start = x;
+		if (!has && start >= 0) {
+			const struct box b = find_colour(p, colour, start, x);
+			if (n < max) {
+				cx[n] = 0.5 * (b.x0 + b.x1);
+				cy[n] = 0.5 * (b.y0 + b.y1);
+			}
+			n++;
+			start = -1;
+		}
+	}
+	return n;
+}
+
+/* The whole file's bytes (malloc'd) and size; NULL if unreadable. */
+static unsigned char *slurp(const char *path, size_t *size)
+{
+	FILE *f = fopen(path, "rb");
+	if (!f)
+		return NULL;
+	unsigned char *b = NULL;
+	size_t n = 0, cap = 0, got;
+	do {
+		if (n == cap) {
+			cap = cap ? 2 * cap : 1 << 16;
+			unsigned char *more = realloc(b, cap);
+			if (!more) {
+				free(b);
+				fclose(f);
+				return NULL;
+			}
+			b = more;
+		}
+		got = fread(b + n, 1, cap - n, f);
+		n += got;
+	} while (got > 0);
+	fclose(f);
+	*size = n;
+	return b;
+}
+
+static int same_bytes(const char *a, const char *b)
+{
+	size_t na = 0, nb = 0;
+	unsigned char *x = slurp(a, &na), *y = slurp(b, &nb);
+	const int same = x && y && na == nb && !memcmp(x, y, na);
+	free(x);
+	free(y);
+	return same;
+}
+
+/* ---- tests ------------------------------------------------------------ */
+
+/* The figure is columns * width x rows * height px of 8-bit RGB. */
+static void test_size(void)
+{
+	struct ss_plot *p;
+	CHECK(ss_plot_create(&p, 3, 2, 300, 200) == SS_OK, "create 3 x 2 panels of 300 x 200");
+	const double x[3] = {0, 1, 2}, y[3] = {1, 3, 2};
+	CHECK(ss_plot_add(p, 4, x, y, 3, SS_PLOT_LINE_MARKERS, 0, "a") == SS_OK, "add to panel 4");
+	const char *path = check_file("size.png");
+	CHECK(ss_plot_write_png(p, path) == SS_OK, "write %s", path);
+	struct pic pic;
+	CHECK(pic_read(path, &pic) == 0, "libpng reads %s", path);
+	CHECK(pic.px && pic.w == 900 && pic.h == 400, "figure is %d x %d px, not 900 x 400", pic.w,
+	      pic.h);
+	/* panel 4 is row 1, column 1: its data stays in its own rectangle */
+	if (pic.px) {
+		const struct box b = find_colour(&pic, 0, 0, pic.w);
+		CHECK(b.n > 0 && b.x0 >= 300 && b.x1 < 600 && b.y0 >= 200 && b.y1 < 400,
+		      "panel 4's series is in x 300..599, y 200..399: x %d..%d, y %d..%d", b.x0, b.x1,
+		      b.y0, b.y1);
+	}
+	free(pic.px);
+	ss_plot_destroy(p);
+}
+
+/* y = const across the panel is one row of pixels over most of its width. */
+static void test_horizontal_line(void)
+{
+	struct ss_plot *p;
+	CHECK(ss_plot_create(&p, 1, 1, 400, 300) == SS_OK, "create");
+	double x[11], y[11];
+	for (int i = 0; i <= 10; i++)
+		x[i] = i, y[i] = 2.5;
+	CHECK(ss_plot_add(p, 0, x, y, 11, SS_PLOT_LINE, 1, NULL) == SS_OK, "add");
+	const char *path = check_file("hline.png");
+	CHECK(ss_plot_write_png(p, path) == SS_OK, "write");
+	struct pic pic;
+	CHECK(pic_read(path, &pic) == 0, "read");
+	if (pic.px) {
+		const struct box b = find_colour(&pic, 1, 0, pic.w);
+		CHECK(b.n > 0 && b.y0 == b.y1, "the line is in one row: rows %d..%d", b.y0, b.y1);
+		CHECK(b.x1 - b.x0 + 1 >= 0.7 * pic.w, "the line spans %d of %d px", b.x1 - b.x0 + 1,
+		      pic.w);
+		CHECK(b.n == b.x1 - b.x0 + 1, "the line has no holes: %ld px over %d columns", b.n,
+		      b.x1 - b.x0 + 1);
+		/* a single value is the middle of its axis */
+		CHECK(fabs(b.y0 - 0.5 * pic.h) < 0.2 * pic.h, "row %d is near the middle of %d",
+		      b.y0, pic.h);
+	}
+	free(pic.px);
+	ss_plot_destroy(p);
+}
+
+/* A vertical line at x = 2.5 is one column, where the markers at x = 0 and
+ * x = 10 put 2.5, spanning the plot's height, between the grid lines of
+ * two ticks. */
+static void test_vline(void)
+{
+	struct ss_plot *p;
+	CHECK(ss_plot_create(&p, 1, 1, 400, 300) == SS_OK, "create");
+	const double x[2] = {0, 10}, y[2] = {0, 1};
+	CHECK(ss_plot_add(p, 0, x, y, 2, SS_PLOT_MARKERS, 1, NULL) == SS_OK, "add");
+	CHECK(ss_plot_vline(p, 0, 2.5, 2) == SS_OK, "vline");
+	const char *path = check_file("vline.png");
+	CHECK(ss_plot_write_png(p, path) == SS_OK, "write");
+	struct pic pic;
+	CHECK(pic_read(path, &pic) == 0, "read");
+	if (pic.px) {
+		double cx[4], cy[4];
+		const int n = find_blobs(&pic, 1, cx, cy, 4);
+		const struct box v = find_colour(&pic, 2, 0, pic.w);
+		CHECK(n == 2, "two markers: %d", n);
+		CHECK(v.n > 0 && v.x0 == v.x1, "the line is one column: %d..%d", v.x0, v.x1);
+		if (n == 2 && v.n > 0) {
+			const double want = cx[0] + 0.25 * (cx[1] - cx[0]);
+			CHECK_NEAR(v.x0, want, 1.0, "x = 2.5 between the markers at 0 and 10");
+		}
+		CHECK(v.y1 - v.y0 + 1 >= 0.6 * pic.h && v.n == v.y1 - v.y0 + 1,
+		      "the line spans the plot: rows %d..%d, %ld px", v.y0, v.y1, v.n);
+		/* grid lines (the ticks') on either side in the line's middle row */
+		const uint8_t grid[3] = {0xe4, 0xe4, 0xe4};
+		const int row = (v.y0 + v.y1) / 2;
+		int left = -1, right = -1;
+		for (int c = 0; c < pic.w; c++)
+			if (!memcmp(pic_at(&pic, c, row), grid, 3)) {
+				if (c < v.x0)
+					left = c;
+				else if (right < 0)
+					right = c;
+			}
+		CHECK(left >= 0 && right > v.x0, "grid lines left and right of the line: %d, %d",
+		      left, right);
+	}
+	free(pic.px);
+	ss_plot_destroy(p);
+}
+
+/* Markers appear left to right in x order, higher values higher up. */
+static void test_markers_order(void)
+{
+	struct ss_plot *p;
+	CHECK(ss_plot_create(&p, 1, 1, 400, 300) == SS_OK, "create");
+	const double x[4] = {3, 1, 4, 2}, y[4] = {3, 4, 2, 1};
+	CHECK(ss_plot_add(p, 0, x, y, 4, SS_PLOT_MARKERS, 3, NULL) == SS_OK, "add");
+	const char *path = check_file("markers.png");
+	CHECK(ss_plot_write_png(p, path) == SS_OK, "write");
+	struct pic pic;
+	CHECK(pic_read(path, &pic) == 0, "read");
+	if (pic.px) {
+		double cx[8], cy[8];
+		const int n = find_blobs(&pic, 3, cx, cy, 8);
+		CHECK(n == 4, "four markers: %d", n);
+		if (n == 4) {
+			/* left to right: x = 1, 2, 3, 4 with y = 4, 1, 3, 2 */
+			CHECK(cy[0] < cy[2] && cy[2] < cy[3] && cy[3] < cy[1],
+			      "rows by value: y 4 %g, 3 %g, 2 %g, 1 %g", cy[0], cy[2], cy[3], cy[1]);
+			CHECK_NEAR(cx[1] - cx[0], cx[2] - cx[1], 1.0, "equal x steps, equal spacing");
+			CHECK_NEAR(cx[2] - cx[1], cx[3] - cx[2], 1.0, "equal x steps, equal spacing");
+		}
+	}
+	free(pic.px);
+	ss_plot_destroy(p);
+}
+
+/* A NaN (or an infinity) breaks the line: no pixel of its colour between
+ * the points either side of it; the segments up to them are drawn. */
+static void check_gap(double bad, const char *name)
+{
+	struct ss_plot *p;
+	CHECK(ss_plot_create(&p, 1, 1, 400, 300) == SS_OK, "create");
+	double x[11], y[11];
+	for (int i = 0; i <= 10; i++)
+		x[i] = i, y[i] = i;
+	y[5] = bad;
+	CHECK(ss_plot_add(p, 0, x, y, 11, SS_PLOT_LINE, 0, NULL) == SS_OK, "add");
+	const char *path = check_file(name);
+	CHECK(ss_plot_write_png(p, path) == SS_OK, "write");
+	struct pic pic;
+	CHECK(pic_read(path, &pic) == 0, "read");
+	if (pic.px) {
+		const struct box b = find_colour(&pic, 0, 0, pic.w);
+		const double step = (b.x1 - b.x0) / 10.0;   /* px per unit of x */
+		const int c4 = (int)lround(b.x0 + 4 * step), c6 = (int)lround(b.x0 + 6 * step);
+		const struct box gap = find_colour(&pic, 0, c4 + 2, c6 - 1);
+		CHECK(b.n > 0 && gap.n == 0, "%g at x = 5: %ld px in columns %d..%d", bad, gap.n,
+		      c4 + 2, c6 - 2);
+		const struct box before = find_colour(&pic, 0, c4 - 3, c4 - 1);
+		const struct box after = find_colour(&pic, 0, c6 + 2, c6 + 4);
+		CHECK(before.n > 0 && after.n > 0, "segments up to x = 4 and from x = 6: %ld, %ld px",
+		      before.n, after.n);
+	}
+	free(pic.px);
+	ss_plot_destroy(p);
+}
+
+static void test_nan_breaks_line(void)
+{
+	check_gap(NAN, "nan.png");
+	check_gap(INFINITY, "inf.png");
+}
+
+/* On a log x axis 1, 10 and 100 are equally spaced; x <= 0 is not drawn
+ * and does not stretch the axis. */
+static void test_log_x(void)
+{
+	struct ss_plot *p;
+	CHECK(ss_plot_create(&p, 1, 1, 400, 300) == SS_OK, "create");
+	CHECK(ss_plot_panel(p, 0, "log", "x", "y", 1) == SS_OK, "panel");
+	const double x[5] = {1, 0, 10, -5, 100}, y[5] = {1, 1, 1, 1, 1};
+	CHECK(ss_plot_add(p, 0, x, y, 5, SS_PLOT_MARKERS, 4, NULL) == SS_OK, "add");
+	const char *path = check_file("log.png");
+	CHECK(ss_plot_write_png(p, path) == SS_OK, "write");
+	struct pic pic;
+	CHECK(pic_read(path, &pic) == 0, "read");
+	if (pic.px) {
+		double cx[8], cy[8];
+		const int n = find_blobs(&pic, 4, cx, cy, 8);
+		CHECK(n == 3, "three markers (x = 0 and -5 not drawn): %d", n);
+		if (n == 3) {
+			CHECK_NEAR(cx[1] - cx[0], cx[2] - cx[1], 1.0, "1 -> 10 as wide as 10 -> 100");
+			CHECK(cx[2] - cx[0] >= 0.6 * pic.w, "1 .. 100 spans the axis: %g of %d px",
+			      cx[2] - cx[0], pic.w);
+		}
+	}
+	free(pic.px);
+	ss_plot_destroy(p);
+}
+
+/* The legend goes to the corner where it covers no data: with a line
+ * along the top and down the right side, the lower left. */
+static void test_legend_corner(void)
+{
+	struct ss_plot *p;
+	CHECK(ss_plot_create(&p, 1, 1, 400, 300) == SS_OK, "create");
+	const double x[3] = {0, 10, 10}, y[3] = {10, 10, 0};
+	CHECK(ss_plot_add(p, 0, x, y, 3, SS_PLOT_LINE, 0, "edge") == SS_OK, "add");
+	const char *path = check_file("legend.png");
+	CHECK(ss_plot_write_png(p, path) == SS_OK, "write");
+	struct pic pic;
+	CHECK(pic_read(path, &pic) == 0, "read");
+	if (pic.px) {
+		/* the legend's sample: the colour away from the data's two lines
+		 * (the top row and the right column of the data) */
+		const struct box all = find_colour(&pic, 0, 0, pic.w);
+		const struct box sample = find_in(&pic, 0, 0, all.x1 - 5, all.y0 + 5, pic.h);
+		CHECK(sample.n > 0 && sample.y0 == sample.y1 && sample.x1 < pic.w / 2,
+		      "one sample row in the left half: rows %d..%d, x up to %d", sample.y0,
+		      sample.y1, sample.x1);
+		CHECK(sample.y1 > pic.h / 2, "the sample is in the lower half: row %d of %d", sample.y1,
+		      pic.h);
+	}
+	free(pic.px);
+	ss_plot_destroy(p);
+}
+
+/* A panel with nothing to draw has its axes and title, and no colour. */
+static void test_empty_panel(void)
+{
+	struct ss_plot *p;
+	CHECK(ss_plot_create(&p, 2, 1, 300, 200) == SS_OK, "create");
+	CHECK(ss_plot_panel(p, 1, "empty", "x", "y", 1) == SS_OK, "panel");
+	const char *path = check_file("empty.png");
+	CHECK(ss_plot_write_png(p, path) == SS_OK, "write");
+	struct pic pic;
+	CHECK(pic_read(path, &pic) == 0, "read");
+	if (pic.px) {
+		long colour = 0, dark_top = 0, dark = 0;
+		for (int y = 0; y < pic.h; y++)
+			for (int x = 0; x < pic.w; x++) {
+				const uint8_t *q = pic_at(&pic, x, y);
+				colour += q[0] != q[1] || q[1] != q[2];
+				dark += x >= 300 && q[0] == 0;
+				dark_top += x >= 300 && y < 15 && q[0] == 0;
+			}
+		CHECK(colour == 0, "no coloured pixel: %ld", colour);
+		CHECK(dark_top > 0, "the title is drawn at the top");
+		CHECK(dark > 2 * 200, "the frame and ticks are drawn: %ld black px", dark);
+	}
+	free(pic.px);
+	ss_plot_destroy(p);
+}
+
+/* The demo of sandslide fit --plot: fronts over time and a cost along nu. */
+static struct ss_plot *demo_figure(void)
+{
+	struct ss_plot *p;
+	if (ss_plot_create(&p, 2, 1, 640, 480) != SS_OK)
+		return NULL;
+	ss_plot_panel(p, 0, "front radius", "time (s)", "radius (m)", 0);
+	ss_plot_panel(p, 1, "cost along nu", "nu (m^2/s)", "cost [-]", 1);
+	double t[41], r[3][41], to[9], ro[9];
+	for (int i = 0; i <= 40; i++) {
+		t[i] = 0.05 * i;
+		r[0][i] = 0.12 + 0.30 * (1 - exp(-2.2 * t[i]));
+		r[1][i] = 0.12 + 0.27 * (1 - exp(-2.8 * t[i]));
+		r[2][i] = 0.12 + 0.29 * (1 - exp(-2.0 * t[i])) * (1 - 0.05 * t[i]);
+	}
+	for (int i = 0; i < 9; i++) {
+		to[i] = 0.25 * i;
+		ro[i] = 0.12 + 0.29 * (1 - exp(-2.3 * to[i])) + 0.006 * ((i * 7) % 5 - 2);
+	}
+	ss_plot_add(p, 0, to, ro, 9, SS_PLOT_MARKERS, 5, "observed");
+	ss_plot_add(p, 0, t, r[0], 41, SS_PLOT_LINE, 0, "coulomb");
+	ss_plot_add(p, 0, t, r[1], 41, SS_PLOT_LINE, 1, "bingham");
+	ss_plot_add(p, 0, t, r[2], 41, SS_PLOT_LINE, 2, "casson");
+	double nu[25], cost[25];
+	for (int i = 0; i < 25; i++) {
+		nu[i] = pow(10.0, -3.0 + 3.0 * i / 24.0);
+		const double d = log10(nu[i] / 0.03);
+		cost[i] = 0.002 + 0.01 * d * d;
+	}
+	ss_plot_add(p, 1, nu, cost, 25, SS_PLOT_LINE_MARKERS, 0, "coulomb");
+	ss_plot_vline(p, 1, 0.03, 1);
+	return p;
+}
+
+/* The same figure written twice, or built twice, gives the same bytes. */
+static void test_deterministic(void)
+{
+	struct ss_plot *p = demo_figure(), *q = demo_figure();
+	CHECK(p && q, "demo figures made");
+	if (!p || !q) {
+		ss_plot_destroy(p);
+		ss_plot_destroy(q);
+		return;
+	}
+	const char *a = check_file("demo_a.png"), *b = check_file("demo_b.png");
+	CHECK(ss_plot_write_png(p, a) == SS_OK, "write a");
+	CHECK(ss_plot_write_png(p, b) == SS_OK, "write b");
+	CHECK(same_bytes(a, b), "written twice: the same bytes");
+	const char *c = check_file("demo_c.png");
+	CHECK(ss_plot_write_png(q, c) == SS_OK, "write c");
+	CHECK(same_bytes(a, c), "built twice: the same bytes");
+	struct pic pic;
+	CHECK(pic_read(a, &pic) == 0 && pic.w == 1280 && pic.h == 480, "demo is 1280 x 480");
+	free(pic.px);
+	const char *demo = getenv("SANDSLIDE_PLOT_DEMO");
+	if (demo && *demo) {
+		CHECK(ss_plot_write_png(p, demo) == SS_OK, "write the demo to %s", demo);
+		printf("  demo figure: %s\n", demo);
+	}
+	ss_plot_destroy(p);
+	ss_plot_destroy(q);
+}
+
+/* A status and that the last message mentions `part`. */
+static int refused(int status, int want, const char *part)
+{
+	const int ok = status == want && strstr(ss_error_last_message(), part) != NULL;
+	if (!ok)
+		fprintf(stderr, "  status %d (want %d), message \"%s\" (want \"%s\" in it)\n", status,
+		        want, ss_error_last_message(), part);
+	return ok;
+}
+
+/* Bad arguments are refused with a message saying what is accepted, and
+ * leave the figure as it was: it draws the same bytes after them. */
+static void test_bad_input(void)
+{
+	ss_error_set_quiet(1);
+	struct ss_plot *p = NULL;
+	CHECK(refused(ss_plot_create(&p, 0, 1, 300, 200), SS_ERR_INPUT, "at least 1 column") &&
+	          !p, "0 columns");
+	CHECK(refused(ss_plot_create(&p, 1, 1, 100, 200), SS_ERR_INPUT, "at least 200 x 150") &&
+	          !p, "panel too narrow");
+	CHECK(refused(ss_plot_create(&p, 100, 1, 300, 200), SS_ERR_INPUT, "at most 16384") && !p,
+	      "figure too wide");
+
+	p = demo_figure();
+	CHECK(p != NULL, "demo figure");
+	if (!p) {
+		ss_error_set_quiet(0);
+		return;
+	}
+	const char *before = check_file("bad_before.png");
+	CHECK(ss_plot_write_png(p, before) == SS_OK, "write before");
+	const double x[2] = {1, 2}, y[2] = {3, 4}, huge[2] = {1, 1e308};
+	CHECK(refused(ss_plot_panel(p, 2, "t", "x", "y", 0), SS_ERR_INPUT, "panels 0 to 1"),
+	      "panel 2 of 2");
+	CHECK(refused(ss_plot_panel(p, -1, "t", "x", "y", 0), SS_ERR_INPUT, "panel -1"),
+	      "panel -1");
+	CHECK(refused(ss_plot_add(p, 5, x, y, 2, SS_PLOT_LINE, 0, "z"), SS_ERR_INPUT, "panel 5"),
+	      "add to panel 5");
+	CHECK(refused(ss_plot_add(p, 0, x, y, -1, SS_PLOT_LINE, 0, "z"), SS_ERR_INPUT,
+	              "0 or more"), "n = -1");
+	CHECK(refused(ss_plot_add(p, 0, NULL, y, 2, SS_PLOT_LINE, 0, "z"), SS_ERR_INPUT,
+	              "without x"), "x NULL");
+	CHECK(refused(ss_plot_add(p, 0, x, y, 2, (enum ss_plot_style)7, 0, "z"), SS_ERR_INPUT,
+	              "style 7"), "style 7");
+	CHECK(refused(ss_plot_add(p, 0, x, huge, 2, SS_PLOT_LINE, 0, "z"), SS_ERR_INPUT,
+	              "point 1"), "y = 1e308");
+	CHECK(refused(ss_plot_vline(p, 0, NAN, 0), SS_ERR_INPUT, "finite"), "vline at NaN");
+	CHECK(refused(ss_plot_vline(p, 9, 1.0, 0), SS_ERR_INPUT, "panel 9"), "vline in panel 9");
+	CHECK(refused(ss_plot_write_png(p, "/nonexistent/dir/x.png"), SS_ERR_FAIL,
+	              "/nonexistent/dir/x.png"), "unwritable path");
+	CHECK(strstr(ss_error_last_message(), "No such file or directory") != NULL,
+	      "the system's reason: \"%s\"", ss_error_last_message());
+	const char *after = check_file("bad_after.png");
+	CHECK(ss_plot_write_png(p, after) == SS_OK, "write after");
+	CHECK(same_bytes(before, after), "the refused calls changed nothing");
+	/* and an empty series is no error */
+	CHECK(ss_plot_add(p, 0, NULL, NULL, 0, SS_PLOT_LINE, 0, NULL) == SS_OK, "n = 0 accepted");
+	ss_plot_destroy(p);
+	ss_plot_destroy(NULL);
+	ss_error_set_quiet(0);
+}
+
+/* Colours wrap round the palette, negative ones too, and differ within it. */
+static void test_palette(void)
+{
+	uint8_t a[3], b[3];
+	ss_plot_palette(0, a);
+	ss_plot_palette(SS_PLOT_COLOURS, b);
+	CHECK(!memcmp(a, b, 3), "colour %d is colour 0", SS_PLOT_COLOURS);
+	ss_plot_palette(-1, a);
+	ss_plot_palette(SS_PLOT_COLOURS - 1, b);
+	CHECK(!memcmp(a, b, 3), "colour -1 is colour %d", SS_PLOT_COLOURS - 1);
+	int distinct = 1;
+	for (int i = 0; i < SS_PLOT_COLOURS; i++)
+		for (int j = i + 1; j < SS_PLOT_COLOURS; j++) {
+			ss_plot_palette(i, a);
+			ss_plot_palette(j, b);
+			distinct &= abs(a[0] - b[0]) + abs(a[1] - b[1]) + abs(a[2] - b[2]) > 60;
+		}
+	CHECK(distinct, "the palette's colours are far apart");
+}
+
+int main(void)
+{
+	if (check_scratch_make("test_plot"))
+		return 1;
+	RUN(test_size);
+	RUN(test_horizontal_line);
+	RUN(test_vline);
+	RUN(test_markers_order);
+	RUN(test_nan_breaks_line);
+	RUN(test_log_x);
+	RUN(test_legend_corner);
+	RUN(test_empty_panel);
+	RUN(test_deterministic);
+	RUN(test_bad_input);
+	RUN(test_palette);
+	char cmd[600];
+	snprintf(cmd, sizeof cmd, "rm -rf '%s'", check_scratch());
+	if (system(cmd) != 0)
+		fprintf(stderr, "could not remove %s\n", check_scratch());
+	return check_report();
+}
