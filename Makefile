@@ -66,12 +66,14 @@ DEB_libpng := libpng-dev
 # zlib (libpng's own compressor) deflates the heights of render --html
 DEB_zlib   := zlib1g-dev
 DEB_inih   := libinih-dev
+# NLopt: the bounded derivative-free search of `sandslide fit` (BOBYQA)
+DEB_nlopt  := libnlopt-dev
 ifeq ($(MPI),1)
   PC_HDF5  := hdf5-openmpi
 else
   PC_HDF5  := hdf5-serial
 endif
-PC_MODULES := $(PC_HDF5) libpng zlib inih
+PC_MODULES := $(PC_HDF5) libpng zlib inih nlopt
 DEB_BUILD  := pkg-config $(foreach m,$(PC_MODULES),$(DEB_$(m)))
 ifeq ($(MPI),1)
   DEB_BUILD += openmpi-bin libopenmpi-dev

@@ -39,6 +39,7 @@
 
 #include "sandslide/run.h"
 #include "sandslide/relax.h"
+#include "sandslide/fit.h"
 #include "sandslide/bench.h"
 #include "sandslide/render.h"
 #include "sandslide/plot.h"

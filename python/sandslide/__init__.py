@@ -228,6 +228,55 @@ def run(case, out, set=None, *, unset=None, threads=None, force=False):
     return json.loads(summary.value.decode())
 
 
+def _fit_bound(name, bounds):
+    """--param's word for one entry of fit's params: (lo, hi) or
+    (lo, hi, "log"), or the word itself."""
+    if isinstance(bounds, str):
+        return f"{name}={bounds}"
+    lo, hi, *scale = bounds
+    return f"{name}={_word(lo)}:{_word(hi)}" + (f":{scale[0]}" if scale else "")
+
+
+def fit(case, observations, params, closures=None, *, cost=None, threshold=None,
+        out=None, plot=None, threads=None, force=False, **options):
+    """Fit a closure and its parameters to observations, as `sandslide fit
+    CASE OBS --param ...` does (doc/fit.md).
+
+    case: the case file (geometry, walls, sources, initial state).
+    observations: a height series (.h5 in sandslide's layout), a CSV
+    "time,path" of rasters, or a CSV "time,x,y" of front points.  params:
+    {"nu": (0.01, 1, "log"), "repose_angle": (30, 40)} (or "LO:HI[:log]"
+    strings).  closures: "all", a list of names, or None for the case's.
+    cost: "height", "support" or "both" (default by the observations);
+    threshold: the support's, m.  out, plot: FIT.json and FIT.png to write.
+    Other keyword options of `sandslide fit --help` by name, e.g.
+    grid_points=5, max_runs=40, profile_points=9, support_weight=0.5.
+
+    Returns the report as a dict: "best" {"closure", "params", "cost"},
+    "closures" (each with "params", "uncertainty", "identifiable", "cost",
+    "aic", "evaluations", "profile"), "indistinguishable", "verdict",
+    "cost_functional", "observations", "forward_runs", "seconds".
+    """
+    if isinstance(closures, (list, tuple)):
+        closures = ",".join(closures)
+    report = ctypes.create_string_buffer(1 << 20)   # profiles of 4 closures: tens of kB
+    with _native.lock, _native.Options("fit") as o:
+        o.set("case", os.fspath(case))
+        o.set("observations", os.fspath(observations))
+        for name, bounds in params.items():
+            o.set("param", _fit_bound(name, bounds))
+        for key, value in [("closures", closures), ("cost", cost), ("threshold", threshold),
+                           ("output", out), ("plot", plot), ("threads", threads)]:
+            if value is not None:
+                o.set(key, value if isinstance(value, str) else _word(value))
+        if force:
+            o.set("force", "1")
+        for key, value in options.items():
+            o.set(key, _word(value))
+        _native.check(_native.lib.ss_fit_run_json(o.ptr, report, len(report)))
+    return json.loads(report.value.decode())
+
+
 def open(path, **kwargs):
     """The output of a run (or of relax -o OUT.h5) as an xarray Dataset:
     height(time, y, x), time, x, y, the diagnostics, the case in the

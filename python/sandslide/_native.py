@@ -82,8 +82,8 @@ def _load():
 
 lib = _load()
 
-# What the module calls, with the types of relax.h, run.h, error.h and
-# version.h.  A library older than this module lacks some of them.
+# What the module calls, with the types of relax.h, run.h, fit.h, error.h
+# and version.h.  A library older than this module lacks some of them.
 _P, _S, _I, _D, _Z = ctypes.c_void_p, ctypes.c_char_p, ctypes.c_int, ctypes.c_double, \
     ctypes.c_size_t
 _PROTOTYPES = {
@@ -99,6 +99,10 @@ _PROTOTYPES = {
     "ss_run_options_set": (_I, [_P, _S, _S]),
     "ss_run_case_json": (_I, [_P, _P, _Z]),
     "ss_option_table_json": (_I, [_P, _P, _Z]),
+    "ss_fit_options_create": (_P, []),
+    "ss_fit_options_destroy": (None, [_P]),
+    "ss_fit_options_set": (_I, [_P, _S, _S]),
+    "ss_fit_run_json": (_I, [_P, _P, _Z]),
 }
 for _name, (_res, _args) in _PROTOTYPES.items():
     try:
@@ -123,8 +127,8 @@ def option_table(command):
     try:
         return ctypes.addressof(ctypes.c_char.in_dll(lib, f"ss_{command}_option_table"))
     except ValueError:
-        raise ValueError(f"sandslide: no options of a command {command!r}: expected relax or "
-                         f"run") from None
+        raise ValueError(f"sandslide: no options of a command {command!r}: expected relax, "
+                         f"run or fit") from None
 
 
 def last_message():
@@ -141,7 +145,7 @@ def check(status):
 
 
 class Options:
-    """Heap options of the library (relax or run), destroyed on exit."""
+    """Heap options of the library (relax, run or fit), destroyed on exit."""
 
     def __init__(self, kind):
         self._create = getattr(lib, f"ss_{kind}_options_create")

@@ -23,6 +23,7 @@
 #include "sandslide/comm.h"
 #include "sandslide/cpu.h"
 #include "sandslide/error.h"
+#include "sandslide/fit.h"
 #include "sandslide/parallel.h"
 #include "sandslide/relax.h"
 #include "sandslide/render.h"
@@ -44,6 +45,7 @@ static const char usage_main[] =
 	"  relax DEM        relax a DEM to the repose angle (terrain in, terrain out)\n"
 	"  render FILE.h5   draw snapshots as PNG frames (and a video)\n"
 	"  bench            measure the sweep's throughput on synthetic surfaces\n"
+	"  fit CASE.ini OBS find the closure and parameters that reproduce observations\n"
 	"\n"
 	"  sandslide --version    print the version\n"
 	"  sandslide CMD --help   options of a command (also: sandslide help CMD)\n";
@@ -382,6 +384,78 @@ static int cmd_info(int argc, char **argv)
 	return 0;
 }
 
+/* ---- fit ------------------------------------------------------------------ */
+
+struct fit_cli {
+	int quiet;
+	int json;
+};
+
+static const struct ss_option fit_cli_options[] = {
+	{.name = "quiet", .alias = "-q", .kind = SS_OPTION_FLAG,
+	 .offset = offsetof(struct fit_cli, quiet), .help = "no progress line and no summary"},
+	{.name = "json", .kind = SS_OPTION_FLAG, .offset = offsetof(struct fit_cli, json),
+	 .help = "print the report (JSON) instead of the summary"},
+};
+static const struct ss_option_table fit_cli_table = {"fit", fit_cli_options, 2, NULL, 0};
+
+static int cmd_fit(int argc, char **argv)
+{
+	struct ss_fit_options o;
+	struct fit_cli cli = {0, 0};
+	const char *args[2] = {NULL, NULL};
+	struct cli_list params = {calloc((size_t)argc, sizeof(char *)), 0};
+	if (!params.v)
+		return ss_status_exit_code(ss_error_fail("out of memory"));
+	ss_fit_options_init(&o);
+	struct cli_command cmd = {
+		.usage = "usage: sandslide fit CASE.ini OBS --param NAME=LO:HI[:log] ... "
+		         "[-o FIT.json]\n"
+		         "                     [--closures all|LIST] [--cost NAME] [--plot FIT.png]\n",
+		.intro = "Finds the closure and parameters with which CASE.ini reproduces the\n"
+		         "observations OBS: a series of heights (OBS.h5 in sandslide's layout, or\n"
+		         "a CSV time,path of rasters) or the front of the sand (a CSV time,x,y),\n"
+		         "with their uncertainty and whether the data identify them\n"
+		         "(doc/fit.md).\n",
+		.groups = {{&ss_fit_option_table, &o, 0}, {&fit_cli_table, &cli, 0}},
+		.outro = "Ctrl-C (SIGINT) or SIGTERM stop the fit; the report of the best so far is\n"
+		         "written and the exit status is 130 or 143.\n"
+		         "Exit status: 0 done, 1 failure while fitting, 2 bad input.\n",
+		.what = "case file or observations", .args = args, .max_args = 2, .list = &params,
+	};
+	int status = cli_parse(&cmd, argc, argv, 2);
+	if (status == CLI_GO_ON && !args[1])
+		status = cli_usage_error(&cmd, "fit needs a case file and observations");
+	for (int k = 0; status == CLI_GO_ON && k < params.n; k++) {
+		if (o.param_count == SS_FIT_MAX_PARAMS)
+			status = cli_usage_error(&cmd, "at most %d --param", SS_FIT_MAX_PARAMS);
+		else if (ss_fit_param_parse(params.v[k], &o.params[o.param_count++]))
+			status = 2;
+	}
+	if (status == CLI_GO_ON) {
+		char *report = NULL, *summary = NULL;
+		o.case_path = args[0];
+		o.observations = args[1];
+		const volatile sig_atomic_t *stop = NULL;
+		ss_progress_fn *shown = watch(cli.quiet || cli.json, &stop);
+		o.stop_signal = stop;
+		o.progress = shown ? cli_print_fit_progress : NULL;
+		const int err = ss_fit_run(&o, &report, &summary);
+		cli_progress_done();
+		if (!err && cli.json)
+			fputs(report, stdout);
+		else if (!err && !cli.quiet && summary)
+			printf("%s", summary);
+		if (!err && !cli.quiet && !cli.json && o.output)
+			printf("wrote %s%s%s\n", o.output, o.plot ? " and " : "", o.plot ? o.plot : "");
+		free(report);
+		free(summary);
+		status = exit_status(err);
+	}
+	free(params.v);
+	return status;
+}
+
 /* ---- main ----------------------------------------------------------------- */
 
 static int main_usage_error(const char *fmt, const char *arg)
@@ -405,7 +479,7 @@ static int command(int argc, char **argv)
 		int (*run)(int argc, char **argv);
 	} commands[] = {
 		{"run", cmd_run}, {"info", cmd_info}, {"bench", cmd_bench},
-		{"render", cmd_render}, {"relax", cmd_relax},
+		{"render", cmd_render}, {"relax", cmd_relax}, {"fit", cmd_fit},
 	};
 	ss_snapshot_library_init();
 	if (ss_cpu_init())   /* SANDSLIDE_CPU, on every rank before anything runs */
@@ -420,7 +494,7 @@ static int command(int argc, char **argv)
 				return commands[k].run(3, args);
 			}
 		return main_usage_error("help: unknown command '%s': expected run, relax, info, "
-		                        "render or bench", argv[2]);
+		                        "render, bench or fit", argv[2]);
 	}
 	if (!strcmp(cmd, "-h") || !strcmp(cmd, "--help") || !strcmp(cmd, "help")) {
 		fputs(usage_main, stdout);
@@ -445,7 +519,7 @@ static int command(int argc, char **argv)
 	for (int k = 0; k < COUNT(commands); k++)
 		if (!strcmp(cmd, commands[k].name))
 			return commands[k].run(argc, argv);
-	return main_usage_error("unknown command '%s': expected run, relax, info, render or bench",
+	return main_usage_error("unknown command '%s': expected run, relax, info, render, bench or fit",
 	                        cmd);
 }
 

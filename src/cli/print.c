@@ -54,6 +54,20 @@ void cli_print_progress(void *context, const struct ss_progress *p)
 	fflush(stderr);
 }
 
+void cli_print_fit_progress(void *context, const struct ss_fit_progress *p)
+{
+	(void)context;
+	const double now = ss_parallel_wall_seconds();
+	if (now - progress.last_print < 0.25)
+		return;
+	progress.last_print = now;
+	progress.shown = 1;
+	fprintf(stderr, "\r  fitting %s (%d of %d): %-11s %lld forward runs, best cost %.4g   ",
+	        p->closure, p->closure_index + 1, p->closure_count, p->stage, p->runs,
+	        p->best_cost);
+	fflush(stderr);
+}
+
 void cli_progress_done(void)
 {
 	if (progress.shown)

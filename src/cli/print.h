@@ -8,6 +8,7 @@
 #define SANDSLIDE_CLI_PRINT_H
 
 #include "sandslide/bench.h"
+#include "sandslide/fit.h"
 #include "sandslide/progress.h"
 #include "sandslide/relax.h"
 #include "sandslide/render.h"
@@ -18,6 +19,8 @@
  * process shows one; context is unused). */
 void cli_print_progress(void *context, const struct ss_progress *p);
 /* End the progress line, if one was shown. */
+/* fit's progress line (fit.h), on stderr, at most four times a second. */
+void cli_print_fit_progress(void *context, const struct ss_fit_progress *p);
 void cli_progress_done(void);
 
 /* How a run or a relaxation ended: the interruption on stderr, else (and

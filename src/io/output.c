@@ -203,3 +203,35 @@ int ss_output_claim(struct ss_output_claim **out, const char *path)
 	*out = NULL;
 	return ss_comm_agree(ss_comm_rank() == 0 ? rank0_claim(out, path) : SS_OK);
 }
+
+int ss_output_write_text(const char *path, const char *text)
+{
+	const size_t n = strlen(path) + 16;
+	char *tmp = malloc(n);
+	if (!tmp)
+		return ss_error_fail("out of memory");
+	snprintf(tmp, n, "%s.tmpXXXXXX", path);
+	const int fd = mkstemp(tmp);
+	FILE *f = fd >= 0 ? fdopen(fd, "w") : NULL;
+	int bad = !f;
+	if (f) {
+		const size_t len = strlen(text);
+		bad = fwrite(text, 1, len, f) != len;
+		bad = fclose(f) != 0 || bad;
+	} else if (fd >= 0) {
+		close(fd);
+	}
+	const int e = errno;
+	/* mkstemp made it 0600: the mode a plain fopen would give */
+	const mode_t mask = umask(0);
+	umask(mask);
+	if (!bad && chmod(tmp, 0666 & ~mask) == 0 && rename(tmp, path) == 0) {
+		free(tmp);
+		return SS_OK;
+	}
+	const int why = bad ? e : errno;
+	if (fd >= 0)
+		remove(tmp);
+	free(tmp);
+	return ss_error_fail("cannot write '%s': %s", path, strerror(why));
+}

@@ -31,6 +31,11 @@ int ss_output_make_folder(const char *path);
  * --force to replace it" followed by hint (may be NULL). */
 int ss_output_check_absent(const char *path, int force, const char *hint);
 
+/* The whole of text as the file path, written to a temporary file beside
+ * it and renamed over it, so that a reader sees the old file or the new
+ * one, never half of one.  SS_ERR_FAIL names the path and the reason. */
+int ss_output_write_text(const char *path, const char *text);
+
 struct ss_output_claim;
 
 /* Claim path for this process (its folder must exist).  SS_ERR_INPUT when a

@@ -384,6 +384,40 @@ def test_run_writes_the_series_with_overrides(tmp_path, case):
     assert s["end"] == "done" and s["notes"] == [], s
 
 
+def test_fit_finds_nu_and_returns_the_clis_report(tmp_path):
+    """sandslide.fit on a twin of the cone (nu = 0.2): the report is the
+    command line's (timings aside), and bad words raise the CLI's message."""
+    cone = open(os.path.join(ROOT, "cases", "cone.ini")).read()
+    for old, new in [("nx = 81", "nx = 41"), ("ny = 81", "ny = 41"), ("dx = 0.03 ", "dx = 0.06 "),
+                     ("origin = -1.215 -1.215", "origin = -1.23 -1.23"),
+                     ("end = steady", "end = 4 ;"), ("max_time = 300", ""),
+                     ("steady_tol = 1e-7", "")]:
+        cone = cone.replace(old, new)
+    (tmp_path / "cone.ini").write_text(cone)
+    sandslide.run(tmp_path / "cone.ini", tmp_path / "twin.h5", set={"model.nu": 0.2}, threads=1)
+    report = sandslide.fit(tmp_path / "cone.ini", tmp_path / "twin.h5",
+                           {"nu": (0.01, 1, "log")}, closures=["coulomb", "casson"],
+                           out=tmp_path / "fit.json", threads=1, profile_points=5)
+    assert report["best"]["closure"] == "coulomb", report["verdict"]
+    assert abs(report["best"]["params"]["nu"] / 0.2 - 1) < 0.02, report["best"]
+    assert [c["closure"] for c in report["closures"]] == ["coulomb", "casson"]
+    assert len(report["closures"][0]["profile"]["nu"]["values"]) == 5, "profile_points=5"
+    out = cli(["fit", "cone.ini", "twin.h5", "--param", "nu=0.01:1:log", "--closures",
+               "coulomb,casson", "--threads", "1", "--profile-points", "5", "--json"],
+              tmp_path)
+    want = json.loads(out.stdout)
+    for r in (report, want):   # the paths as given, and the timings, differ
+        for key in ("seconds", "seconds_per_run", "case"):
+            r.pop(key)
+        r["observations"].pop("path")
+    assert report == want, "sandslide.fit's report is not the command line's"
+    with pytest.raises(sandslide.InputError, match="nux"):
+        sandslide.fit(tmp_path / "cone.ini", tmp_path / "twin.h5", {"nux": "1:2"})
+    with pytest.raises(sandslide.InputError, match="grid.points|grid_points"):
+        sandslide.fit(tmp_path / "cone.ini", tmp_path / "twin.h5", {"nu": "0.1:1"},
+                      grid_points=-3)
+
+
 # Debian's netCDF4 warns that it was built against another numpy
 @pytest.mark.filterwarnings("ignore:numpy.ndarray size changed")
 def test_open_gives_a_dataset(tmp_path, case):

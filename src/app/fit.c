@@ -1,0 +1,1231 @@
+/*
+ * fit.c - `sandslide fit` (fit.h): forward runs through the library, the
+ * cost functionals, the search (a coarse grid, then NLopt's BOBYQA), the
+ * uncertainty and the identifiability verdicts, the comparison of the
+ * closures.  doc/fit.md gives the equations this file computes (F0-F10).
+ *
+ * Every parameter is searched in a unit coordinate u in [0, 1]:
+ * value = lo + u (hi - lo), or lo (hi / lo)^u on a log scale, so that one
+ * step, one tolerance and one covariance serve parameters of any unit.
+ */
+#include "sandslide/fit.h"
+
+#include <errno.h>
+#include <math.h>
+#include <nlopt.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "app/drive.h"
+#include "app/fit_cost.h"
+#include "base/strings.h"
+#include "io/observations.h"
+#include "io/output.h"
+#include "model/setup.h"
+#include "sandslide/case.h"
+#include "sandslide/closure.h"
+#include "sandslide/comm.h"
+#include "sandslide/error.h"
+#include "sandslide/parallel.h"
+#include "sandslide/plot.h"
+#include "sandslide/stepper.h"
+
+enum { PROFILE_MAX = 33, CLOSURES = 4, FRONT_SAMPLES = 4, TRACE_TIMES = 40 };
+
+/* How a forward run ended. */
+enum { RUN_DONE, RUN_CUT, RUN_STOPPED };
+
+/* One closure's fit. */
+struct closure_fit {
+	enum ss_closure_kind kind;
+	int param[SS_FIT_MAX_PARAMS];   /* indices into the options' params */
+	int p;                          /* how many apply to this closure */
+	double u[SS_FIT_MAX_PARAMS];    /* the best point so far */
+	double cost;                    /* its cost (INFINITY: none yet) */
+	long long runs, cut_short;
+	int searched;                   /* the search finished (not stopped) */
+	int assessed;                   /* uncertainty and profiles done */
+	double std_u[SS_FIT_MAX_PARAMS]; /* Gauss-Newton standard deviation in u
+	                                  * (INFINITY: J^T J singular) */
+	double noise;                   /* cost of pure noise used, s^2 (F7) */
+	int profile_n;
+	double profile_u[SS_FIT_MAX_PARAMS][PROFILE_MAX];
+	double profile_cost[SS_FIT_MAX_PARAMS][PROFILE_MAX];
+	int identifiable[SS_FIT_MAX_PARAMS];
+	char why[SS_FIT_MAX_PARAMS][200];
+	double aic;
+	double trace_radius[TRACE_TIMES]; /* the front's equivalent radius, m */
+	int traced;
+};
+
+struct fit {
+	const struct ss_fit_options *o;
+	struct ss_case base;            /* the case as given */
+	struct ss_observations obs;
+	enum ss_fit_cost cost;
+	int nx, ny;
+	size_t cells;
+	double dx, dy, origin_x, origin_y;
+	uint8_t *flow;                  /* [cells] 1 on the case's flow cells */
+	double *floor;                  /* [cells] m: thickness = height - floor */
+	double relief;                  /* m: the thickest sand observed or initial */
+	double threshold;               /* m, theta of F2 */
+	double *chi_obs;                /* [times][cells] observed support (F2, F3) */
+	uint8_t *support_seen;          /* [times][cells] where chi_obs is known */
+	double *radius_obs;             /* [times] equivalent radius, m (F4) */
+	double *area_obs;               /* [times] support area, m^2 */
+	double speed_scale;             /* m/s: the fastest observed front */
+	long long height_count;         /* observed heights on flow cells */
+	long long area_count, speed_count;
+	long long residual_count;       /* M */
+	double cost_floor;              /* the least noise a cost is read with (F7) */
+	double *sim;                    /* [cells] a forward run's heights */
+	double *thickness, *chi_sim;    /* [cells] its thickness and support */
+	double *residuals;              /* [M] */
+	double *jacobian;               /* [M][p] */
+	double trace_time[TRACE_TIMES];
+	enum ss_integrator integrator;  /* the case's, resolved */
+	long long runs;
+	double run_seconds;
+	int interrupted;
+	int failed;                     /* a forward run failed: the status */
+	struct closure_fit fits[CLOSURES];
+	int fit_count;
+	int current;                    /* the closure being fitted */
+	const char *stage;
+	double started;
+};
+
+/* ---- parameters ----------------------------------------------------------- */
+
+static double value_of(const struct ss_fit_param *p, double u)
+{
+	return p->log ? p->lo * pow(p->hi / p->lo, u) : p->lo + u * (p->hi - p->lo);
+}
+
+/* Which [model] keys a closure takes (doc/case-file.md#model). */
+static int param_applies(const char *name, enum ss_closure_kind kind)
+{
+	if (!strcmp(name, "nu") || !strcmp(name, "repose_angle"))
+		return 1;
+	if (!strcmp(name, "gamma") || !strcmp(name, "consistency"))
+		return kind == SS_CLOSURE_HERSCHEL_BULKLEY;
+	if (!strcmp(name, "viscosity"))
+		return kind == SS_CLOSURE_BINGHAM || kind == SS_CLOSURE_CASSON;
+	if (!strcmp(name, "delta"))
+		return kind != SS_CLOSURE_COULOMB;
+	return 0;
+}
+
+/* The overrides that set closure cf at u: "model.closure=NAME" and one per
+ * parameter, each value written to read back to the same double. */
+static int overrides_of(const struct fit *f, const struct closure_fit *cf, const double *u,
+                        char text[][96], const char *ov[])
+{
+	int n = 0;
+	if (f->integrator == SS_INTEGRATOR_RKL2 && f->base.model.rkl2_tol > f->o->rkl2_tol) {
+		char num[SS_REAL_TEXT_SIZE];
+		snprintf(text[n], 96, "time.rkl2_tol=%s", ss_real_text(f->o->rkl2_tol, num));
+		ov[n] = text[n];
+		n++;
+	}
+	snprintf(text[n], 96, "model.closure=%s", ss_closure_name(cf->kind));
+	ov[n] = text[n];
+	n++;
+	for (int k = 0; k < cf->p; k++) {
+		const struct ss_fit_param *p = &f->o->params[cf->param[k]];
+		char num[SS_REAL_TEXT_SIZE];
+		snprintf(text[n], 96, "model.%s=%s", p->name, ss_real_text(value_of(p, u[k]), num));
+		ov[n] = text[n];
+		n++;
+	}
+	return n;
+}
+
+/* ---- the forward model ---------------------------------------------------- */
+
+/* The interior heights of st, south row first, into out. */
+static void copy_heights(const struct ss_stepper *st, double *out)
+{
+	const struct ss_grid *g = &st->grid;
+	for (int j = 0; j < g->ny; j++) {
+		const double *row = st->height + ss_grid_index(g, 0, j);
+		memcpy(out + (size_t)j * g->nx, row, (size_t)g->nx * sizeof *out);
+	}
+}
+
+/* The stepper of the case with the overrides ov[0..n-1], prepared at t = 0. */
+static int make_stepper(const struct fit *f, const char *const *ov, int n,
+                        struct ss_stepper *st)
+{
+	struct ss_case c;
+	int err = ss_case_parse(&c, f->base.path, f->base.text, ov, n);
+	if (!err)
+		err = ss_setup_stepper(&c, 0, 0, SS_KERNEL_FAST, st);
+	ss_case_release(&c);
+	return err;
+}
+
+/* The simulated support of heights h into f->chi_sim: per cell for a
+ * height series (compared cell by cell with the observed heights'), as a
+ * front sees it for a front (F3). */
+static void simulated_support(const struct fit *f, const double *h)
+{
+	if (f->obs.kind == SS_OBSERVED_HEIGHTS) {
+		for (size_t c = 0; c < f->cells; c++)
+			f->chi_sim[c] = f->flow[c] ? ss_fit_support_indicator(h[c] - f->floor[c],
+			                                                      f->threshold) : 0.0;
+		return;
+	}
+	for (size_t c = 0; c < f->cells; c++)
+		f->thickness[c] = f->flow[c] ? h[c] - f->floor[c] : 0.0;
+	ss_fit_support_fraction(f->thickness, f->nx, f->ny, f->threshold, FRONT_SAMPLES,
+	                        f->chi_sim);
+	for (size_t c = 0; c < f->cells; c++)
+		f->chi_sim[c] *= f->flow[c];
+}
+
+/* The area of f->chi_sim, m^2 (F4). */
+static double support_area(const struct fit *f)
+{
+	double area = 0.0;
+	for (size_t c = 0; c < f->cells; c++)
+		area += f->chi_sim[c];
+	return area * f->dx * f->dy;
+}
+
+/*
+ * The residuals of time k for heights h, appended at r (when not NULL);
+ * returns their sum of squares.  *radius_prev carries the simulated
+ * front's equivalent radius from time k - 1 for the speed term.
+ *
+ *   height   r = (h - h_obs) w_h            over observed flow cells       (F1)
+ *   support  r = |S_sim (+) S_obs| / A_obs w_a   at each time               (F3)
+ *            r = (v_sim - v_obs) / v_max w_v     between consecutive times (F4)
+ *
+ * with the weights that make the cost a mean of each block (F5).
+ */
+static double residuals_at(const struct fit *f, long long k, const double *h, double *r,
+                           long long *at, double *radius_prev)
+{
+	double sum = 0.0;
+	const int heights = f->cost == SS_FIT_COST_HEIGHT || f->cost == SS_FIT_COST_BOTH;
+	const int support = f->cost == SS_FIT_COST_SUPPORT || f->cost == SS_FIT_COST_BOTH;
+	const double block = f->cost == SS_FIT_COST_BOTH ? f->o->support_weight : 1.0;
+	if (heights) {
+		const double w = (f->cost == SS_FIT_COST_BOTH ? 1.0 / f->relief : 1.0) /
+		                 sqrt((double)f->height_count);
+		const double *obs = f->obs.height + (size_t)k * f->cells;
+		for (size_t c = 0; c < f->cells; c++)
+			if (f->flow[c] && isfinite(obs[c])) {
+				const double e = (h[c] - obs[c]) * w;
+				sum += e * e;
+				if (r)
+					r[(*at)++] = e;
+			}
+	}
+	if (support) {
+		const double *chi = f->chi_obs + (size_t)k * f->cells;
+		const uint8_t *seen = f->support_seen + (size_t)k * f->cells;
+		simulated_support(f, h);
+		double mismatch = 0.0;
+		for (size_t c = 0; c < f->cells; c++)
+			if (seen[c])
+				mismatch += fabs(f->chi_sim[c] - chi[c]);
+		mismatch *= f->dx * f->dy;
+		if (f->area_obs[k] > 0.0) {
+			const double e = mismatch / f->area_obs[k] * sqrt(block / (double)f->area_count);
+			sum += e * e;
+			if (r)
+				r[(*at)++] = e;
+		}
+		const double radius = sqrt(support_area(f) / M_PI);
+		if (k > 0 && f->speed_count > 0) {
+			const double dt = f->obs.time[k] - f->obs.time[k - 1];
+			const double v_sim = (radius - *radius_prev) / dt;
+			const double v_obs = (f->radius_obs[k] - f->radius_obs[k - 1]) / dt;
+			const double e = (v_sim - v_obs) / f->speed_scale *
+			                 sqrt(block / (double)f->speed_count);
+			sum += e * e;
+			if (r)
+				r[(*at)++] = e;
+		}
+		*radius_prev = radius;
+	}
+	return sum;
+}
+
+/*
+ * One forward run of closure cf at u through every observation time: the
+ * cost (F5) into *cost and, with r, the residuals.  With a finite cut the
+ * run stops as soon as the sum so far passes it (*how RUN_CUT, *cost that
+ * lower bound): safe where only "is it better than the best?" is asked,
+ * since every time adds a non-negative term.  RUN_STOPPED: the stop signal.
+ */
+static int forward(struct fit *f, struct closure_fit *cf, const double *u, double cut,
+                   double *r, double *cost, int *how)
+{
+	char text[SS_FIT_MAX_PARAMS + 2][96];
+	const char *ov[SS_FIT_MAX_PARAMS + 2];
+	const int n = overrides_of(f, cf, u, text, ov);
+	struct ss_stepper st;
+	const double t0 = ss_parallel_wall_seconds();
+	int err = make_stepper(f, ov, n, &st);
+	*how = RUN_DONE;
+	*cost = 0.0;
+	if (err)
+		return err;
+	struct ss_advance_options adv = {.stop = f->o->stop_signal};
+	long long at = 0;
+	double radius_prev = 0.0;
+	for (long long k = 0; k < f->obs.times; k++) {
+		const double t = f->obs.time[k];
+		const enum ss_advance_end e = t > st.time ? ss_stepper_advance(&st, t, &adv)
+		                                          : SS_ADVANCE_REACHED;
+		if (e == SS_ADVANCE_INTERRUPTED) {
+			*how = RUN_STOPPED;
+			break;
+		}
+		if (e != SS_ADVANCE_REACHED) {
+			char list[512] = "";
+			struct ss_strbuf b = {list, sizeof list, 0};
+			for (int m = n - cf->p; m < n; m++)
+				ss_strbuf_printf(&b, "%s%s", m > n - cf->p ? ", " : "", ov[m] + 6);
+			err = ss_error_fail("the forward run of %s at %s stopped at t = %g s before "
+			                    "the observation at %g s: %s", ss_closure_name(cf->kind),
+			                    list, st.time, t,
+			                    e == SS_ADVANCE_NONFINITE ? "a height became non-finite"
+			                                              : "its time step vanished");
+			break;
+		}
+		copy_heights(&st, f->sim);
+		*cost += residuals_at(f, k, f->sim, r, &at, &radius_prev);
+		if (*cost > cut) {
+			*how = RUN_CUT;
+			break;
+		}
+	}
+	ss_stepper_release(&st);
+	f->runs++;
+	cf->runs++;
+	cf->cut_short += *how == RUN_CUT;
+	f->run_seconds += ss_parallel_wall_seconds() - t0;
+	if (*how == RUN_STOPPED)
+		f->interrupted = 1;
+	if (f->o->progress) {
+		const struct ss_fit_progress p = {
+			ss_closure_name(cf->kind), f->stage, f->current, f->fit_count, f->runs, cf->cost,
+		};
+		f->o->progress(f->o->progress_context, &p);
+	}
+	return err;
+}
+
+/* A forward run that keeps the best point: the cost, or INFINITY once the
+ * fit is stopped or failed. */
+static double evaluate(struct fit *f, struct closure_fit *cf, const double *u, double cut)
+{
+	if (f->interrupted || f->failed)
+		return INFINITY;
+	double cost;
+	int how;
+	const int err = forward(f, cf, u, cut, NULL, &cost, &how);
+	if (err) {
+		f->failed = err;
+		return INFINITY;
+	}
+	if (how != RUN_DONE)
+		return how == RUN_CUT ? cost : INFINITY;
+	if (cost < cf->cost) {
+		cf->cost = cost;
+		memcpy(cf->u, u, (size_t)cf->p * sizeof *u);
+	}
+	return cost;
+}
+
+/* ---- the search ----------------------------------------------------------- */
+
+struct search {
+	struct fit *f;
+	struct closure_fit *cf;
+	nlopt_opt opt;
+};
+
+static double objective(unsigned n, const double *u, double *gradient, void *data)
+{
+	(void)n;
+	(void)gradient;   /* BOBYQA asks for none */
+	struct search *s = data;
+	const double cost = evaluate(s->f, s->cf, u, INFINITY);
+	if (s->f->interrupted || s->f->failed)
+		nlopt_force_stop(s->opt);
+	return cost;
+}
+
+/* The coarse grid's points per parameter (F6). */
+static int grid_points(const struct fit *f, int p)
+{
+	static const int by_count[SS_FIT_MAX_PARAMS + 1] = {1, 7, 4, 3, 2};
+	return f->o->grid_points > 0 ? f->o->grid_points : by_count[p];
+}
+
+/* The coarse grid (runs cut at the best so far: only the ranking counts),
+ * then BOBYQA from its best point and, with two or more parameters, from
+ * the best point that is not next to it. */
+static int search(struct fit *f, struct closure_fit *cf)
+{
+	const int p = cf->p, g = grid_points(f, p);
+	long long total = 1;
+	for (int k = 0; k < p; k++)
+		total *= g;
+	double best = INFINITY, second = INFINITY;
+	long long best_at = -1, second_at = -1;
+	f->stage = "grid";
+	for (long long m = 0; m < total && !f->interrupted && !f->failed; m++) {
+		double u[SS_FIT_MAX_PARAMS];
+		for (long long k = 0, rest = m; k < p; k++, rest /= g)
+			u[k] = (rest % g + 0.5) / g;
+		const double cost = evaluate(f, cf, u, best);
+		if (cost < best) {
+			second = best;
+			second_at = best_at;
+			best = cost;
+			best_at = m;
+		} else if (cost < second) {
+			second = cost;
+			second_at = m;
+		}
+	}
+	(void)second;
+	/* a second start only where it is not the first's neighbour */
+	long long starts[2] = {best_at, -1};
+	if (p >= 2 && second_at >= 0) {
+		int far = 0;
+		for (long long k = 0, a = best_at, b = second_at; k < p; k++, a /= g, b /= g)
+			far |= llabs(a % g - b % g) > 1;
+		if (far)
+			starts[1] = second_at;
+	}
+	f->stage = "search";
+	for (int s = 0; s < 2 && starts[s] >= 0 && !f->interrupted && !f->failed; s++) {
+		double u[SS_FIT_MAX_PARAMS], lo[SS_FIT_MAX_PARAMS], hi[SS_FIT_MAX_PARAMS],
+		       step[SS_FIT_MAX_PARAMS], found;
+		for (long long k = 0, rest = starts[s]; k < p; k++, rest /= g) {
+			u[k] = (rest % g + 0.5) / g;
+			lo[k] = 0.0;
+			hi[k] = 1.0;
+			step[k] = 0.5 / g;
+		}
+		nlopt_opt opt = nlopt_create(NLOPT_LN_BOBYQA, (unsigned)p);
+		if (!opt)
+			return ss_error_fail("out of memory");
+		struct search data = {f, cf, opt};
+		nlopt_set_lower_bounds(opt, lo);
+		nlopt_set_upper_bounds(opt, hi);
+		nlopt_set_min_objective(opt, objective, &data);
+		nlopt_set_initial_step(opt, step);
+		nlopt_set_xtol_abs1(opt, 1e-4);
+		nlopt_set_ftol_rel(opt, 1e-10);
+		nlopt_set_maxeval(opt, f->o->max_runs);
+		const nlopt_result res = nlopt_optimize(opt, u, &found);
+		nlopt_destroy(opt);
+		if (res < 0 && res != NLOPT_FORCED_STOP && res != NLOPT_ROUNDOFF_LIMITED)
+			return ss_error_fail("NLopt's BOBYQA failed for %s (NLopt status %d)",
+			                     ss_closure_name(cf->kind), (int)res);
+	}
+	if (f->failed)
+		return f->failed;
+	cf->searched = !f->interrupted;
+	return SS_OK;
+}
+
+/* ---- how sure ------------------------------------------------------------- */
+
+/* Solve the p x p symmetric system a x = b in place by Gaussian elimination
+ * with partial pivoting; -1 when a pivot falls below tiny times the
+ * largest diagonal (singular for these data). */
+static int invert(int p, double a[SS_FIT_MAX_PARAMS][SS_FIT_MAX_PARAMS],
+                  double inv[SS_FIT_MAX_PARAMS][SS_FIT_MAX_PARAMS])
+{
+	double scale = 0.0;
+	for (int i = 0; i < p; i++) {
+		scale = fmax(scale, fabs(a[i][i]));
+		for (int j = 0; j < p; j++)
+			inv[i][j] = i == j;
+	}
+	if (!(scale > 0.0))
+		return -1;
+	for (int c = 0; c < p; c++) {
+		int piv = c;
+		for (int i = c + 1; i < p; i++)
+			if (fabs(a[i][c]) > fabs(a[piv][c]))
+				piv = i;
+		if (fabs(a[piv][c]) < 1e-12 * scale)
+			return -1;
+		for (int j = 0; j < p; j++) {
+			double t = a[c][j];
+			a[c][j] = a[piv][j];
+			a[piv][j] = t;
+			t = inv[c][j];
+			inv[c][j] = inv[piv][j];
+			inv[piv][j] = t;
+		}
+		for (int i = 0; i < p; i++) {
+			if (i == c)
+				continue;
+			const double m = a[i][c] / a[c][c];
+			for (int j = 0; j < p; j++) {
+				a[i][j] -= m * a[c][j];
+				inv[i][j] -= m * inv[c][j];
+			}
+		}
+	}
+	for (int i = 0; i < p; i++)
+		for (int j = 0; j < p; j++)
+			inv[i][j] /= a[i][i];
+	return 0;
+}
+
+/* The residuals at u into r (a full run); -1 when stopped or failed. */
+static int residuals(struct fit *f, struct closure_fit *cf, const double *u, double *r)
+{
+	double cost;
+	int how;
+	const int err = forward(f, cf, u, INFINITY, r, &cost, &how);
+	if (err)
+		f->failed = err;
+	return err || how != RUN_DONE ? -1 : 0;
+}
+
+/*
+ * The Gauss-Newton covariance of the best point (F7): J by central
+ * differences of the residuals in u (one-sided at a bound), the noise s^2
+ * from the residuals (at least cost_floor), C = s^2 / (M - p) (J^T J)^-1.
+ */
+static int covariance(struct fit *f, struct closure_fit *cf)
+{
+	const int p = cf->p;
+	const long long m = f->residual_count;
+	const double h = 0.02;
+	f->stage = "uncertainty";
+	for (int k = 0; k < p; k++) {
+		double up[SS_FIT_MAX_PARAMS], down[SS_FIT_MAX_PARAMS];
+		memcpy(up, cf->u, sizeof up);
+		memcpy(down, cf->u, sizeof down);
+		up[k] = fmin(cf->u[k] + h, 1.0);
+		down[k] = fmax(cf->u[k] - h, 0.0);
+		double *col = f->jacobian + (size_t)k * m;
+		if (residuals(f, cf, up, col) || residuals(f, cf, down, f->residuals))
+			return -1;
+		for (long long i = 0; i < m; i++)
+			col[i] = (col[i] - f->residuals[i]) / (up[k] - down[k]);
+	}
+	double jtj[SS_FIT_MAX_PARAMS][SS_FIT_MAX_PARAMS], inv[SS_FIT_MAX_PARAMS][SS_FIT_MAX_PARAMS];
+	for (int a = 0; a < p; a++)
+		for (int b = 0; b < p; b++) {
+			double s = 0.0;
+			const double *ja = f->jacobian + (size_t)a * m, *jb = f->jacobian + (size_t)b * m;
+			for (long long i = 0; i < m; i++)
+				s += ja[i] * jb[i];
+			jtj[a][b] = s;
+		}
+	cf->noise = fmax(cf->cost, f->cost_floor);
+	const double s2 = cf->noise / (double)(m > p ? m - p : 1);
+	if (invert(p, jtj, inv)) {
+		for (int k = 0; k < p; k++)
+			cf->std_u[k] = INFINITY;
+	} else {
+		for (int k = 0; k < p; k++)
+			cf->std_u[k] = inv[k][k] > 0.0 ? sqrt(s2 * inv[k][k]) : INFINITY;
+	}
+	return 0;
+}
+
+/*
+ * The cost along each parameter, the others at the best point (F8), and
+ * the verdicts (F9): a parameter is identified when its 95 % interval
+ * covers less than half the range searched and the cost along it rises
+ * above the noise: by chi^2_1(0.95) = 3.84 in units of s^2 / (M - p).
+ */
+static int profiles(struct fit *f, struct closure_fit *cf)
+{
+	const int n = f->o->profile_points;
+	f->stage = "profile";
+	cf->profile_n = n;
+	for (int k = 0; k < cf->p; k++)
+		for (int i = 0; i < n; i++) {
+			double u[SS_FIT_MAX_PARAMS];
+			memcpy(u, cf->u, sizeof u);
+			u[k] = n > 1 ? (double)i / (n - 1) : 0.5;
+			cf->profile_u[k][i] = u[k];
+			double cost;
+			int how;
+			const int err = forward(f, cf, u, INFINITY, NULL, &cost, &how);
+			if (err) {
+				f->failed = err;
+				return -1;
+			}
+			if (how != RUN_DONE)
+				return -1;
+			cf->profile_cost[k][i] = cost;
+		}
+	const long long m = f->residual_count;
+	const double s2 = cf->noise / (double)(m > cf->p ? m - cf->p : 1);
+	for (int k = 0; k < cf->p; k++) {
+		const struct ss_fit_param *p = &f->o->params[cf->param[k]];
+		double rise = 0.0;
+		for (int i = 0; i < n; i++)
+			rise = fmax(rise, cf->profile_cost[k][i] - cf->cost);
+		const double width = 2.0 * 1.96 * cf->std_u[k];
+		if (!(rise > 3.84 * s2)) {
+			cf->identifiable[k] = 0;
+			snprintf(cf->why[k], sizeof cf->why[k],
+			         "the cost changes by less than the noise over the whole range of %s: "
+			         "these observations do not see it", p->name);
+		} else if (!(width < 0.5)) {
+			cf->identifiable[k] = 0;
+			snprintf(cf->why[k], sizeof cf->why[k],
+			         "its 95 %% interval spans %s of the range searched",
+			         isfinite(width) ? "more than half" : "all");
+		} else {
+			cf->identifiable[k] = 1;
+			cf->why[k][0] = '\0';
+		}
+	}
+	return 0;
+}
+
+/* ---- set-up --------------------------------------------------------------- */
+
+static int parse_closures(struct fit *f)
+{
+	const char *list = f->o->closures;
+	if (!list || !*list) {
+		f->fits[f->fit_count++].kind = f->base.model.closure;
+		return SS_OK;
+	}
+	if (!strcmp(list, "all")) {
+		for (int k = 0; k < CLOSURES; k++)
+			f->fits[f->fit_count++].kind = (enum ss_closure_kind)k;
+		return SS_OK;
+	}
+	char word[64];
+	for (const char *s = list; *s;) {
+		const size_t len = strcspn(s, ",");
+		snprintf(word, sizeof word, "%.*s", (int)len, s);
+		enum ss_closure_kind kind;
+		if (len >= sizeof word || ss_closure_parse(word, &kind))
+			return ss_error_input("--closures '%s': '%s' is not a closure: expected all, or "
+			                      "a comma-separated list of %s", list, word,
+			                      SS_CLOSURE_NAMES);
+		for (int k = 0; k < f->fit_count; k++)
+			if (f->fits[k].kind == kind)
+				return ss_error_input("--closures '%s': %s is named twice", list, word);
+		f->fits[f->fit_count++].kind = kind;
+		s += len + (s[len] == ',');
+	}
+	return SS_OK;
+}
+
+/* Each closure's parameters: those of --param it takes.  A closure that
+ * takes none, nu and delta together, or a name given twice is refused. */
+static int assign_params(struct fit *f)
+{
+	const struct ss_fit_options *o = f->o;
+	if (o->param_count < 1)
+		return ss_error_input("fit needs at least one --param NAME=LO:HI[:log], e.g. "
+		                      "--param nu=0.01:1:log");
+	int nu = 0, derived = 0;
+	for (int k = 0; k < o->param_count; k++) {
+		for (int m = 0; m < k; m++)
+			if (!strcmp(o->params[k].name, o->params[m].name))
+				return ss_error_input("--param %s is given twice", o->params[k].name);
+		nu |= !strcmp(o->params[k].name, "nu");
+		derived |= !strcmp(o->params[k].name, "delta") ||
+		           !strcmp(o->params[k].name, "viscosity") ||
+		           !strcmp(o->params[k].name, "consistency");
+	}
+	if (nu && derived)
+		return ss_error_input("--param nu and the sliding layer's parameters (delta, "
+		                      "viscosity, consistency) exclude each other: nu is derived "
+		                      "from them (doc/model.md#nu-from-the-sliding-layer)");
+	for (int c = 0; c < f->fit_count; c++) {
+		struct closure_fit *cf = &f->fits[c];
+		cf->cost = INFINITY;
+		for (int k = 0; k < o->param_count; k++)
+			if (param_applies(o->params[k].name, cf->kind))
+				cf->param[cf->p++] = k;
+		if (cf->p == 0)
+			return ss_error_input("%s takes none of the parameters given (%s%s): it takes "
+			                      "nu and repose_angle%s", ss_closure_name(cf->kind),
+			                      o->params[0].name, o->param_count > 1 ? ", ..." : "",
+			                      cf->kind == SS_CLOSURE_COULOMB ? ""
+			                      : ", and the sliding layer's parameters");
+	}
+	return SS_OK;
+}
+
+/* The observations against the case's grid. */
+static int check_grid(const struct fit *f)
+{
+	const struct ss_observations *b = &f->obs;
+	const struct ss_case *c = &f->base;
+	if (b->kind != SS_OBSERVED_HEIGHTS)
+		return SS_OK;
+	if (b->nx != c->nx || b->ny != c->ny)
+		return ss_error_input("'%s' has %d x %d cells: the case's grid is %d x %d (%s)",
+		                      b->path, b->nx, b->ny, c->nx, c->ny, c->path);
+	if ((isfinite(b->dx) && fabs(b->dx - c->dx) > 1e-6 * c->dx) ||
+	    (isfinite(b->dy) && fabs(b->dy - c->dy) > 1e-6 * c->dy))
+		return ss_error_input("'%s' has cells of %g x %g m: the case's are %g x %g m (%s)",
+		                      b->path, b->dx, b->dy, c->dx, c->dy, c->path);
+	if ((isfinite(b->origin_x) && fabs(b->origin_x - c->origin_x) > 1e-3 * c->dx) ||
+	    (isfinite(b->origin_y) && fabs(b->origin_y - c->origin_y) > 1e-3 * c->dy))
+		return ss_error_input("'%s' has its lower-left corner at (%g, %g) m: the case's is "
+		                      "at (%g, %g) m (%s)", b->path, b->origin_x, b->origin_y,
+		                      c->origin_x, c->origin_y, c->path);
+	return SS_OK;
+}
+
+/* The case's flow cells, the floor that thickness is measured from (the
+ * bedrock, or the initial state's lowest height), the relief. */
+static int measure_initial(struct fit *f)
+{
+	struct ss_stepper st;
+	int err = make_stepper(f, NULL, 0, &st);
+	if (err)
+		return err;
+	const struct ss_grid *g = &st.grid;
+	double lowest = INFINITY, thickest = 0.0;
+	copy_heights(&st, f->sim);
+	for (int j = 0; j < g->ny; j++)
+		for (int i = 0; i < g->nx; i++) {
+			const ptrdiff_t at = ss_grid_index(g, i, j);
+			const size_t c = (size_t)j * g->nx + i;
+			f->flow[c] = ss_cell_type_get(st.cell_types, at) == SS_CELL_FLOW;
+			if (f->flow[c])
+				lowest = fmin(lowest, f->sim[c]);
+		}
+	for (size_t c = 0; c < f->cells; c++) {
+		const ptrdiff_t at = ss_grid_index(g, (int)(c % g->nx), (int)(c / g->nx));
+		f->floor[c] = st.bedrock && isfinite(st.bedrock[at]) ? st.bedrock[at] : lowest;
+		if (f->flow[c])
+			thickest = fmax(thickest, f->sim[c] - f->floor[c]);
+	}
+	f->integrator = st.integrator;
+	ss_stepper_release(&st);
+	if (!isfinite(lowest))
+		return ss_error_input("%s has no flow cell: nothing to fit", f->base.path);
+	if (f->obs.kind == SS_OBSERVED_HEIGHTS)
+		for (long long k = 0; k < f->obs.times; k++)
+			for (size_t c = 0; c < f->cells; c++) {
+				const double h = f->obs.height[(size_t)k * f->cells + c];
+				if (f->flow[c] && isfinite(h))
+					thickest = fmax(thickest, h - f->floor[c]);
+			}
+	f->relief = thickest;
+	return SS_OK;
+}
+
+/* The observed support at every time (F2, F3), its area and equivalent
+ * radius, the front's speed scale. */
+static int observe_support(struct fit *f)
+{
+	const struct ss_observations *b = &f->obs;
+	for (long long k = 0; k < b->times; k++) {
+		double *chi = f->chi_obs + (size_t)k * f->cells;
+		uint8_t *seen = f->support_seen + (size_t)k * f->cells;
+		if (b->kind == SS_OBSERVED_HEIGHTS) {
+			const double *h = b->height + (size_t)k * f->cells;
+			for (size_t c = 0; c < f->cells; c++) {
+				seen[c] = f->flow[c] && isfinite(h[c]);
+				chi[c] = seen[c] ? ss_fit_support_indicator(h[c] - f->floor[c], f->threshold)
+				                 : 0.0;
+			}
+		} else {
+			const long long first = b->first_point[k];
+			if (ss_fit_front_support(b->point_x + first, b->point_y + first,
+			                         b->first_point[k + 1] - first, f->nx, f->ny,
+			                         f->origin_x, f->origin_y, f->dx, f->dy, FRONT_SAMPLES,
+			                         chi) < 0.0)
+				return ss_error_fail("out of memory");
+			for (size_t c = 0; c < f->cells; c++)
+				seen[c] = f->flow[c];
+		}
+		double area = 0.0;
+		for (size_t c = 0; c < f->cells; c++)
+			area += seen[c] ? chi[c] : 0.0;
+		f->area_obs[k] = area * f->dx * f->dy;
+		f->radius_obs[k] = sqrt(f->area_obs[k] / M_PI);
+		f->area_count += f->area_obs[k] > 0.0;
+	}
+	f->speed_scale = 0.0;
+	for (long long k = 1; k < b->times; k++)
+		f->speed_scale = fmax(f->speed_scale, fabs(f->radius_obs[k] - f->radius_obs[k - 1]) /
+		                                      (b->time[k] - b->time[k - 1]));
+	f->speed_count = f->speed_scale > 0.0 ? b->times - 1 : 0;
+	if (f->area_count == 0 && f->cost != SS_FIT_COST_HEIGHT)
+		return ss_error_input("'%s': no sand thicker than the threshold %g m at any time: "
+		                      "the support cost has nothing to compare (give a smaller "
+		                      "--threshold)", b->path, f->threshold);
+	return SS_OK;
+}
+
+static int prepare(struct fit *f)
+{
+	const struct ss_fit_options *o = f->o;
+	int err;
+	if (!o->case_path || !o->observations)
+		return ss_error_input("fit needs a case file and observations: sandslide fit "
+		                      "CASE.ini OBS -o FIT.json");
+	if ((err = ss_case_load(&f->base, o->case_path, NULL, 0)) || (err = parse_closures(f)) ||
+	    (err = assign_params(f)))
+		return err;
+	if (o->output && ((err = ss_output_check_folder(o->output, 0)) ||
+	                  (err = ss_output_check_absent(o->output, o->force, NULL))))
+		return err;
+	if (o->plot && ((err = ss_output_check_folder(o->plot, 0)) ||
+	                (err = ss_output_check_absent(o->plot, o->force, NULL))))
+		return err;
+	if ((err = ss_observations_read(&f->obs, o->observations)) || (err = check_grid(f)))
+		return err;
+	f->nx = f->base.nx;
+	f->ny = f->base.ny;
+	f->cells = (size_t)f->nx * (size_t)f->ny;
+	f->dx = f->base.dx;
+	f->dy = f->base.dy;
+	f->origin_x = f->base.origin_x;
+	f->origin_y = f->base.origin_y;
+	f->cost = o->cost != SS_FIT_COST_AUTO ? o->cost
+	          : f->obs.kind == SS_OBSERVED_FRONT ? SS_FIT_COST_SUPPORT : SS_FIT_COST_HEIGHT;
+	if (f->obs.kind == SS_OBSERVED_FRONT && f->cost != SS_FIT_COST_SUPPORT)
+		return ss_error_input("'%s' holds a front, not heights: only --cost support "
+		                      "compares it", f->obs.path);
+	const size_t times = (size_t)f->obs.times;
+	if (!(f->flow = ss_alloc(f->cells, 1, "flow cells")) ||
+	    !(f->floor = ss_alloc(f->cells, sizeof *f->floor, "the floor")) ||
+	    !(f->sim = ss_alloc(f->cells, sizeof *f->sim, "simulated heights")) ||
+	    !(f->thickness = ss_alloc(f->cells, sizeof *f->thickness, "simulated heights")) ||
+	    !(f->chi_sim = ss_alloc(f->cells, sizeof *f->chi_sim, "simulated support")))
+		return SS_ERR_FAIL;
+	if ((err = measure_initial(f)))
+		return err;
+	f->threshold = isnan(o->threshold) ? 0.02 * f->relief : o->threshold;
+	if (f->cost != SS_FIT_COST_HEIGHT && !(f->threshold > 0.0))
+		return ss_error_input("the support needs a threshold: the initial state and the "
+		                      "observations hold no sand above the floor; give "
+		                      "--threshold M");
+	/* the observed support: the support cost's, and the plot's front */
+	if (f->threshold > 0.0) {
+		if (!(f->chi_obs = ss_alloc(times * f->cells, sizeof *f->chi_obs, "observed support")) ||
+		    !(f->support_seen = ss_alloc(times * f->cells, 1, "observed support")) ||
+		    !(f->area_obs = ss_alloc(times, sizeof *f->area_obs, "support areas")) ||
+		    !(f->radius_obs = ss_alloc(times, sizeof *f->radius_obs, "support radii")))
+			return SS_ERR_FAIL;
+		if ((err = observe_support(f)))
+			return err;
+	}
+	if (f->cost == SS_FIT_COST_HEIGHT || f->cost == SS_FIT_COST_BOTH) {
+		for (size_t k = 0; k < times * f->cells; k++)
+			f->height_count += f->flow[k % f->cells] && isfinite(f->obs.height[k]);
+		if (f->height_count == 0)
+			return ss_error_input("'%s' observes no flow cell of the case (%s)", f->obs.path,
+			                      f->base.path);
+		if (f->cost == SS_FIT_COST_BOTH && !(f->relief > 0.0))
+			return ss_error_input("--cost both scales heights by the relief, and '%s' and "
+			                      "the initial state hold no sand above the floor",
+			                      f->obs.path);
+	}
+	f->residual_count = (f->cost != SS_FIT_COST_SUPPORT ? f->height_count : 0) +
+	                    (f->cost != SS_FIT_COST_HEIGHT ? f->area_count + f->speed_count : 0);
+	/* the least noise: 0.1 % of the relief in height, 0.1 % of the area */
+	const double floor_h = 1e-3 * f->relief, floor_s = 1e-3;
+	f->cost_floor = f->cost == SS_FIT_COST_HEIGHT ? floor_h * floor_h
+	                : f->cost == SS_FIT_COST_SUPPORT ? floor_s * floor_s
+	                : 1e-6 + o->support_weight * floor_s * floor_s;
+	int most = 0;
+	for (int c = 0; c < f->fit_count; c++)
+		most = f->fits[c].p > most ? f->fits[c].p : most;
+	if (!(f->residuals = ss_alloc((size_t)f->residual_count, sizeof *f->residuals,
+	                              "residuals")) ||
+	    !(f->jacobian = ss_alloc((size_t)f->residual_count * (size_t)most,
+	                             sizeof *f->jacobian, "the Jacobian")))
+		return SS_ERR_FAIL;
+	for (int k = 0; k < TRACE_TIMES; k++)
+		f->trace_time[k] = f->obs.time[f->obs.times - 1] * k / (TRACE_TIMES - 1);
+	return SS_OK;
+}
+
+static void release(struct fit *f)
+{
+	ss_case_release(&f->base);
+	ss_observations_release(&f->obs);
+	ss_free(f->flow);
+	ss_free(f->floor);
+	ss_free(f->sim);
+	ss_free(f->thickness);
+	ss_free(f->chi_sim);
+	ss_free(f->chi_obs);
+	ss_free(f->support_seen);
+	ss_free(f->area_obs);
+	ss_free(f->radius_obs);
+	ss_free(f->residuals);
+	ss_free(f->jacobian);
+}
+
+/* ---- the front over time, for the plot ------------------------------------ */
+
+/* The equivalent radius of the best run of cf at the trace times. */
+static int trace(struct fit *f, struct closure_fit *cf)
+{
+	char text[SS_FIT_MAX_PARAMS + 2][96];
+	const char *ov[SS_FIT_MAX_PARAMS + 2];
+	const int n = overrides_of(f, cf, cf->u, text, ov);
+	struct ss_stepper st;
+	int err = make_stepper(f, ov, n, &st);
+	if (err)
+		return err;
+	f->stage = "front";
+	struct ss_advance_options adv = {.stop = f->o->stop_signal};
+	for (int k = 0; k < TRACE_TIMES; k++) {
+		const double t = f->trace_time[k];
+		if (t > st.time && ss_stepper_advance(&st, t, &adv) != SS_ADVANCE_REACHED)
+			break;
+		copy_heights(&st, f->sim);
+		simulated_support(f, f->sim);
+		cf->trace_radius[k] = sqrt(support_area(f) / M_PI);
+		cf->traced = k + 1;
+	}
+	ss_stepper_release(&st);
+	return SS_OK;
+}
+
+/* ---- the figure ----------------------------------------------------------- */
+
+/*
+ * FIT.png: the front's equivalent radius over time, observed (markers) and
+ * of each closure's best run (lines); then for each parameter the cost
+ * along it (F8), one line per closure that takes it, and a vertical line
+ * at the best closure's value.
+ */
+static int plot(const struct fit *f, int best, const char *path)
+{
+	const struct ss_fit_options *o = f->o;
+	const int panels = 1 + o->param_count;
+	const int columns = panels < 3 ? panels : 3, rows = (panels + columns - 1) / columns;
+	struct ss_plot *fig = NULL;
+	int err = ss_plot_create(&fig, columns, rows, 480, 360);
+	if (!err)
+		err = ss_plot_panel(fig, 0, "front: equivalent radius", "time (s)", "radius (m)", 0);
+	if (!err && f->radius_obs)
+		err = ss_plot_add(fig, 0, f->obs.time, f->radius_obs, f->obs.times, SS_PLOT_MARKERS,
+		                  0, "observed");
+	for (int c = 0; c < f->fit_count && !err; c++) {
+		const struct closure_fit *cf = &f->fits[c];
+		if (cf->traced)
+			err = ss_plot_add(fig, 0, f->trace_time, cf->trace_radius, cf->traced,
+			                  SS_PLOT_LINE, c + 1, ss_closure_name(cf->kind));
+	}
+	for (int k = 0; k < o->param_count && !err; k++) {
+		const struct ss_fit_param *p = &o->params[k];
+		char title[96];
+		snprintf(title, sizeof title, "cost along %s", p->name);
+		err = ss_plot_panel(fig, 1 + k, title, p->name, "cost", p->log);
+		for (int c = 0; c < f->fit_count && !err; c++) {
+			const struct closure_fit *cf = &f->fits[c];
+			for (int m = 0; m < cf->p && !err; m++) {
+				if (cf->param[m] != k || !cf->assessed)
+					continue;
+				double x[PROFILE_MAX];
+				for (int i = 0; i < cf->profile_n; i++)
+					x[i] = value_of(p, cf->profile_u[m][i]);
+				err = ss_plot_add(fig, 1 + k, x, cf->profile_cost[m], cf->profile_n,
+				                  SS_PLOT_LINE_MARKERS, c + 1, ss_closure_name(cf->kind));
+				if (!err && c == best)
+					err = ss_plot_vline(fig, 1 + k, value_of(p, cf->u[m]), c + 1);
+			}
+		}
+	}
+	if (!err)
+		err = ss_plot_write_png(fig, path);
+	ss_plot_destroy(fig);
+	return err;
+}
+
+/* ---- the report ----------------------------------------------------------- */
+
+static const char *cost_name(enum ss_fit_cost c)
+{
+	return c == SS_FIT_COST_HEIGHT ? "height" : c == SS_FIT_COST_SUPPORT ? "support" : "both";
+}
+
+static void json_value(struct ss_strbuf *b, const struct ss_fit_param *p, double u)
+{
+	ss_strbuf_json_number(b, value_of(p, u), 10);
+}
+
+static void json_closure(struct ss_strbuf *b, const struct fit *f, const struct closure_fit *cf,
+                         double best_aic)
+{
+	const struct ss_fit_param *params = f->o->params;
+	ss_strbuf_printf(b, "    {\"closure\": \"%s\", \"params\": {", ss_closure_name(cf->kind));
+	for (int k = 0; k < cf->p; k++) {
+		ss_strbuf_printf(b, "%s\"%s\": ", k ? ", " : "", params[cf->param[k]].name);
+		json_value(b, &params[cf->param[k]], cf->u[k]);
+	}
+	ss_strbuf_printf(b, "},\n     \"cost\": ");
+	ss_strbuf_json_number(b, cf->cost, 10);
+	ss_strbuf_printf(b, ", \"aic\": ");
+	ss_strbuf_json_number(b, cf->aic, 10);
+	ss_strbuf_printf(b, ", \"delta_aic\": ");
+	ss_strbuf_json_number(b, cf->aic - best_aic, 6);
+	ss_strbuf_printf(b, ", \"evaluations\": %lld, \"cut_short\": %lld, \"searched\": %s",
+	                 cf->runs, cf->cut_short, cf->searched ? "true" : "false");
+	ss_strbuf_printf(b, ",\n     \"uncertainty\": {");
+	for (int k = 0; cf->assessed && k < cf->p; k++) {
+		const struct ss_fit_param *p = &params[cf->param[k]];
+		const double lo_u = fmax(cf->u[k] - 1.96 * cf->std_u[k], 0.0),
+		             hi_u = fmin(cf->u[k] + 1.96 * cf->std_u[k], 1.0);
+		const double v = value_of(p, cf->u[k]);
+		/* dvalue/du: (hi - lo), or value ln(hi / lo) on a log scale */
+		const double slope = p->log ? v * log(p->hi / p->lo) : p->hi - p->lo;
+		ss_strbuf_printf(b, "%s\"%s\": {\"std\": ", k ? ", " : "", p->name);
+		ss_strbuf_json_number(b, isfinite(cf->std_u[k]) ? cf->std_u[k] * slope : NAN, 6);
+		ss_strbuf_printf(b, ", \"low\": ");
+		ss_strbuf_json_number(b, isfinite(cf->std_u[k]) ? value_of(p, lo_u) : p->lo, 10);
+		ss_strbuf_printf(b, ", \"high\": ");
+		ss_strbuf_json_number(b, isfinite(cf->std_u[k]) ? value_of(p, hi_u) : p->hi, 10);
+		ss_strbuf_printf(b, ", \"method\": \"gauss-newton, 95 %%\"}");
+	}
+	ss_strbuf_printf(b, "},\n     \"identifiable\": {");
+	for (int k = 0; cf->assessed && k < cf->p; k++)
+		ss_strbuf_printf(b, "%s\"%s\": %s", k ? ", " : "", params[cf->param[k]].name,
+		                 cf->identifiable[k] ? "true" : "false");
+	ss_strbuf_printf(b, "}, \"why\": {");
+	for (int k = 0, first = 1; cf->assessed && k < cf->p; k++)
+		if (!cf->identifiable[k]) {
+			ss_strbuf_printf(b, "%s\"%s\": ", first ? "" : ", ", params[cf->param[k]].name);
+			ss_strbuf_json_string(b, cf->why[k]);
+			first = 0;
+		}
+	ss_strbuf_printf(b, "},\n     \"profile\": {");
+	for (int k = 0; cf->assessed && k < cf->p; k++) {
+		const struct ss_fit_param *p = &params[cf->param[k]];
+		ss_strbuf_printf(b, "%s\"%s\": {\"values\": [", k ? ", " : "", p->name);
+		for (int i = 0; i < cf->profile_n; i++) {
+			ss_strbuf_printf(b, i ? ", " : "");
+			json_value(b, p, cf->profile_u[k][i]);
+		}
+		ss_strbuf_printf(b, "], \"costs\": [");
+		for (int i = 0; i < cf->profile_n; i++) {
+			ss_strbuf_printf(b, i ? ", " : "");
+			ss_strbuf_json_number(b, cf->profile_cost[k][i], 8);
+		}
+		ss_strbuf_printf(b, "]}");
+	}
+	ss_strbuf_printf(b, "}}");
+}
+
+/* The closures within 2 of the least AIC cannot be told apart (F10). */
+static void format_report(struct ss_strbuf *b, const struct fit *f, int best)
+{
+	const struct ss_fit_options *o = f->o;
+	const struct closure_fit *top = best >= 0 ? &f->fits[best] : NULL;
+	ss_strbuf_printf(b, "{\n  \"case\": ");
+	ss_strbuf_json_string(b, f->base.path);
+	ss_strbuf_printf(b, ",\n  \"observations\": {\"path\": ");
+	ss_strbuf_json_string(b, f->obs.path);
+	ss_strbuf_printf(b, ", \"kind\": \"%s\", \"times\": %lld, \"first_time\": ",
+	                 f->obs.kind == SS_OBSERVED_FRONT ? "front" : "heights", f->obs.times);
+	ss_strbuf_json_number(b, f->obs.time[0], 17);
+	ss_strbuf_printf(b, ", \"last_time\": ");
+	ss_strbuf_json_number(b, f->obs.time[f->obs.times - 1], 17);
+	if (f->obs.kind == SS_OBSERVED_FRONT)
+		ss_strbuf_printf(b, ", \"points\": %lld}", f->obs.points);
+	else
+		ss_strbuf_printf(b, ", \"observed_values\": %lld}", f->obs.observed);
+	ss_strbuf_printf(b, ",\n  \"cost_functional\": {\"name\": \"%s\", \"residuals\": %lld, "
+	                 "\"threshold_m\": ", cost_name(f->cost), f->residual_count);
+	ss_strbuf_json_number(b, f->threshold, 10);
+	ss_strbuf_printf(b, ", \"relief_m\": ");
+	ss_strbuf_json_number(b, f->relief, 10);
+	ss_strbuf_printf(b, ", \"support_weight\": ");
+	ss_strbuf_json_number(b, f->cost == SS_FIT_COST_BOTH ? o->support_weight : NAN, 10);
+	ss_strbuf_printf(b, ", \"noise_floor\": ");
+	ss_strbuf_json_number(b, f->cost_floor, 6);
+	ss_strbuf_printf(b, ", \"doc\": \"doc/fit.md#cost-functionals\"}");
+	ss_strbuf_printf(b, ",\n  \"best\": ");
+	if (top) {
+		ss_strbuf_printf(b, "{\"closure\": \"%s\", \"params\": {", ss_closure_name(top->kind));
+		for (int k = 0; k < top->p; k++) {
+			ss_strbuf_printf(b, "%s\"%s\": ", k ? ", " : "", o->params[top->param[k]].name);
+			json_value(b, &o->params[top->param[k]], top->u[k]);
+		}
+		ss_strbuf_printf(b, "}, \"cost\": ");
+		ss_strbuf_json_number(b, top->cost, 10);
+		ss_strbuf_printf(b, "}");
+	} else {
+		ss_strbuf_printf(b, "null");
+	}
+	ss_strbuf_printf(b, ",\n  \"closures\": [\n");
+	int listed = 0;
+	for (int c = 0; c < f->fit_count; c++) {
+		if (!isfinite(f->fits[c].cost))
+			continue;
+		ss_strbuf_printf(b, listed ? ",\n" : "");
+		json_closure(b, f, &f->fits[c], top ? top->aic : NAN);
+		listed++;
+	}
+	ss_strbuf_printf(b, "\n  ],\n  \"indistinguishable\": [");
+	int ties = 0;
+	for (int c = 0; top && c < f->fit_count; c++)
+		if (isfinite(f->fits[c].cost) && f->fits[c].aic - top->aic < 2.0)
+			ss_strbuf_printf(b, "%s\"%s\"", ties++ ? ", " : "", ss_closure_name(f->fits[c].kind));
+	ss_strbuf_printf(b, "],\n  \"verdict\": ");
+	char verdict[600];
+	struct ss_strbuf v = {verdict, sizeof verdict, 0};
+	if (!top)
+		ss_strbuf_printf(&v, "no forward run finished");
+	else if (ties > 1)
+		ss_strbuf_printf(&v, "these data cannot tell the closures apart: %d are within 2 of "
+		                 "the least AIC (%s best)", ties, ss_closure_name(top->kind));
+	else
+		ss_strbuf_printf(&v, "%s fits best%s", ss_closure_name(top->kind),
+		                 f->fit_count > 1 ? ", by more than 2 in AIC" : "");
+	for (int c = 0; c < f->fit_count; c++) {
+		const struct closure_fit *cf = &f->fits[c];
+		for (int k = 0; cf->assessed && k < cf->p; k++) {
+			const struct ss_fit_param *p = &o->params[cf->param[k]];
+			if (!cf->identifiable[k])
+				ss_strbuf_printf(&v, "; %s: %s not identifiable", ss_closure_name(cf->kind),
+				                 p->name);
+			/* Herschel-Bulkley with gamma = 1 is Bingham exactly (closure.h) */
+			if (cf->kind == SS_CLOSURE_HERSCHEL_BULKLEY && !strcmp(p->name, "gamma") &&
+			    fabs(value_of(p, cf->u[k]) - 1.0) <
+			    1.96 * cf->std_u[k] * (p->log ? log(p->hi / p->lo) : p->hi - p->lo))
+				ss_strbuf_printf(&v, "; herschel-bulkley's gamma is 1 within its "
+				                 "uncertainty: it is bingham");
+		}
+	}
+	ss_strbuf_json_string(b, verdict);
+	ss_strbuf_printf(b, ",\n  \"integrator\": \"%s\", \"rkl2_tol\": ",
+	                 ss_integrator_name(f->integrator));
+	ss_strbuf_json_number(b, f->integrator == SS_INTEGRATOR_RKL2
+	                         ? fmin(f->base.model.rkl2_tol, o->rkl2_tol) : NAN, 10);
+	ss_strbuf_printf(b, ", \"forward_runs\": %lld, \"seconds\": ", f->runs);
+	ss_strbuf_json_number(b, ss_parallel_wall_seconds() - f->started, 4);
+	ss_strbuf_printf(b, ", \"seconds_per_run\": ");
+	ss_strbuf_json_number(b, f->runs ? f->run_seconds / (double)f->runs : NAN, 4);
+	ss_strbuf_printf(b, ", \"threads\": %d, \"interrupted\": %s\n}\n", ss_parallel_max_threads(),
+	                 f->interrupted ? "true" : "false");
+}
+
+/* What the command line prints: a line per closure, the verdict. */
+static void format_summary(struct ss_strbuf *b, const struct fit *f, int best)
+{
+	const struct ss_fit_options *o = f->o;
+	for (int c = 0; c < f->fit_count; c++) {
+		const struct closure_fit *cf = &f->fits[c];
+		if (!isfinite(cf->cost))
+			continue;
+		ss_strbuf_printf(b, "%-16s", ss_closure_name(cf->kind));
+		for (int k = 0; k < cf->p; k++) {
+			const struct ss_fit_param *p = &o->params[cf->param[k]];
+			ss_strbuf_printf(b, " %s = %.4g", p->name, value_of(p, cf->u[k]));
+			if (cf->assessed && isfinite(cf->std_u[k]))
+				ss_strbuf_printf(b, " (%.4g .. %.4g)",
+				                 value_of(p, fmax(cf->u[k] - 1.96 * cf->std_u[k], 0.0)),
+				                 value_of(p, fmin(cf->u[k] + 1.96 * cf->std_u[k], 1.0)));
+			if (cf->assessed && !cf->identifiable[k])
+				ss_strbuf_printf(b, " not identifiable");
+		}
+		ss_strbuf_printf(b, ", cost %.4g, AIC %+.1f%s, %lld runs\n", cf->cost,
+		                 cf->aic - f->fits[best].aic, c == best ? " (best)" : "", cf->runs);
+	}
+	ss_strbuf_printf(b, "%lld forward runs, %.3g s each, %.1f s in all%s\n", f->runs,
+	                 f->runs ? f->run_seconds / (double)f->runs : 0.0,
+	                 ss_parallel_wall_seconds() - f->started,
+	                 f->interrupted ? "; interrupted: the best so far" : "");
+}
+
+/* A formatter's text, measured first, then written. */
+static int text_of(void (*format)(struct ss_strbuf *, const struct fit *, int),
+                   const struct fit *f, int best, char **out)
+{
+	struct ss_strbuf b = {NULL, 0, 0};
+	format(&b, f, best);
+	char *text = malloc(b.len + 1);
+	if (!text)
+		return ss_error_fail("out of memory");
+	b = (struct ss_strbuf){text, b.len + 1, 0};
+	format(&b, f, best);
+	*out = text;
+	return SS_OK;
+}
+
+/* ---- the fit -------------------------------------------------------------- */
+
+static int fit_all(struct fit *f)
+{
+	int err = SS_OK;
+	for (int c = 0; c < f->fit_count && !err && !f->interrupted; c++) {
+		struct closure_fit *cf = &f->fits[c];
+		f->current = c;
+		if ((err = search(f, cf)) || !cf->searched)
+			break;
+		if (!covariance(f, cf) && !profiles(f, cf))
+			cf->assessed = 1;
+		if (f->failed)
+			err = f->failed;
+		if (!err && !f->interrupted && f->o->plot)
+			err = trace(f, cf);
+	}
+	/* AIC = M ln(cost) + 2 (p + 1): the Gaussian likelihood with the noise
+	 * unknown, one more parameter than the closure's (F10) */
+	for (int c = 0; c < f->fit_count; c++) {
+		struct closure_fit *cf = &f->fits[c];
+		cf->aic = (double)f->residual_count * log(fmax(cf->cost, f->cost_floor)) +
+		          2.0 * (cf->p + 1);
+	}
+	return err;
+}
+
+int ss_fit_run(const struct ss_fit_options *o, char **report, char **summary)
+{
+	*report = NULL;
+	if (summary)
+		*summary = NULL;
+	if (ss_comm_size() > 1)
+		return ss_error_input("fit runs on one rank: start it without mpirun");
+	struct fit f;
+	memset(&f, 0, sizeof f);
+	f.o = o;
+	f.started = ss_parallel_wall_seconds();
+	ss_drive_set_threads(o->threads);
+	int err = prepare(&f);
+	if (!err)
+		err = fit_all(&f);
+	int best = -1;
+	for (int c = 0; c < f.fit_count; c++)
+		if (isfinite(f.fits[c].cost) && (best < 0 || f.fits[c].aic < f.fits[best].aic))
+			best = c;
+	if (!err)
+		err = text_of(format_report, &f, best, report);
+	if (!err && summary && best >= 0)
+		err = text_of(format_summary, &f, best, summary);
+	if (!err && o->output)
+		err = ss_output_write_text(o->output, *report);
+	if (!err && o->plot && best >= 0)
+		err = plot(&f, best, o->plot);
+	if (err) {
+		free(*report);
+		*report = NULL;
+		if (summary) {
+			free(*summary);
+			*summary = NULL;
+		}
+	}
+	release(&f);
+	return err;
+}

@@ -1,0 +1,265 @@
+"""sandslide fit (doc/fit.md): twin experiments.
+
+Observations are made by `sandslide run` with known parameters, then
+degraded (Gaussian height noise, missing cells, a subset of the times, or
+only the front traced from them), and the fit must find what made them:
+the closure, nu within 5 % and the angle within 0.1 degree where the data
+identify them, and "not identifiable" where they cannot (nu from states at
+rest).  The cone is cases/cone.ini on a 41 x 41 grid (dx = 6 cm): a
+forward run to t = 12 s takes about 10 ms.
+"""
+import json
+import os
+import signal
+import subprocess
+import time
+
+import h5py
+import numpy as np
+import pytest
+
+from conftest import CASES, SANDSLIDE, edit, run, run_ok
+
+TIMING_KEYS = {"seconds", "seconds_per_run"}
+
+
+def cone_case(path, end=12, every=1):
+    """cases/cone.ini at 41 x 41 cells, run to `end` seconds."""
+    text = open(os.path.join(CASES, "cone.ini")).read()
+    text = edit(text, "nx = 81", "nx = 41")
+    text = edit(text, "ny = 81", "ny = 41")
+    text = edit(text, "dx = 0.03 ", "dx = 0.06 ")
+    text = edit(text, "origin = -1.215 -1.215", "origin = -1.23 -1.23")
+    text = "\n".join(line for line in text.splitlines()
+                     if not line.startswith(("end =", "steady_tol", "max_time", "output_every")))
+    text = edit(text, "[time]\n", f"[time]\nend = {end}\noutput_every = {every}\n")
+    path.write_text(text + "\n")
+    return path
+
+
+def twin(tmp_path, name, *sets, end=12, every=1):
+    """A run of the cone with --set overrides: the truth."""
+    case = cone_case(tmp_path / f"{name}.ini", end, every)
+    run_ok(["run", str(case), "-o", str(tmp_path / f"{name}.h5"), "-q"] +
+           [w for s in sets for w in ("--set", s)])
+    return tmp_path / f"{name}.h5"
+
+
+def degrade(src, dst, times, sigma=0.0, missing=0.0, seed=1):
+    """The snapshots at `times` with N(0, sigma) noise and a fraction
+    `missing` of the values NaN, as a plain HDF5 file (/time, /height, /x,
+    /y, no sandslide attributes)."""
+    rng = np.random.default_rng(seed)
+    with h5py.File(src, "r") as f:
+        t, h, x, y = f["time"][:], f["height"][:], f["x"][:], f["y"][:]
+    idx = [int(np.argmin(abs(t - s))) for s in times]
+    assert np.allclose(t[idx], times), f"test set-up: no snapshots at {times} in {src}"
+    h = h[idx] + rng.normal(0.0, sigma, h[idx].shape) if sigma else h[idx]
+    h[rng.random(h.shape) < missing] = np.nan
+    with h5py.File(dst, "w") as g:
+        g["time"], g["height"], g["x"], g["y"] = t[idx], h, x, y
+    return dst
+
+
+def trace_front(src, dst, times, threshold, points=180):
+    """The front of the sand at `times`: `points` points where the
+    thickness (bilinear between cell centres) falls to `threshold`, along
+    rays from the cone's centre, as a CSV time,x,y."""
+    with h5py.File(src, "r") as f:
+        t, h, x, y = f["time"][:], np.nan_to_num(f["height"][:]), f["x"][:], f["y"][:]
+    lines = ["time,x,y"]
+    for s in times:
+        d = h[int(np.argmin(abs(t - s)))]
+
+        def at(px, py):
+            fx, fy = (px - x[0]) / (x[1] - x[0]), (py - y[0]) / (y[1] - y[0])
+            i, j = int(fx), int(fy)
+            a, b = fx - i, fy - j
+            return ((1 - a) * (1 - b) * d[j, i] + a * (1 - b) * d[j, i + 1] +
+                    (1 - a) * b * d[j + 1, i] + a * b * d[j + 1, i + 1])
+        for q in range(points):
+            c, sn = np.cos(2 * np.pi * q / points), np.sin(2 * np.pi * q / points)
+            lo, hi = 0.0, 1.2     # bisection: thicker than threshold at lo, not at hi
+            for _ in range(40):
+                mid = 0.5 * (lo + hi)
+                lo, hi = (mid, hi) if at(mid * c, mid * sn) > threshold else (lo, mid)
+            lines.append(f"{s!r},{lo * c!r},{lo * sn!r}")
+    dst.write_text("\n".join(lines) + "\n")
+    return dst
+
+
+def fit(tmp_path, case, obs, *args):
+    r = run(["fit", str(case), str(obs), "--json", "--threads", "2"] + list(args),
+            cwd=tmp_path, timeout=600)
+    assert r.returncode == 0, f"sandslide fit failed ({r.returncode}): {r.stderr}"
+    return json.loads(r.stdout)
+
+
+def closure_of(report, name):
+    return next(c for c in report["closures"] if c["closure"] == name)
+
+
+def test_transient_cone_gives_closure_nu_and_angle(tmp_path):
+    """Casson, nu = 0.13 m^2/s, 33 degrees, observed during the collapse
+    with 2 mm noise, a fifth of the values missing and six of the 13
+    snapshots: all four closures fitted, Casson is best by more than 2 in
+    AIC, nu within 5 %, the angle within 0.1 degree, both identifiable."""
+    truth = twin(tmp_path, "truth", "model.closure=casson", "model.nu=0.13",
+                 "model.repose_angle=33")
+    obs = degrade(truth, tmp_path / "scan.h5", [1, 2, 3, 5, 8, 12], sigma=0.002, missing=0.2)
+    report = fit(tmp_path, tmp_path / "truth.ini", obs, "--param", "nu=0.01:1:log",
+                 "--param", "repose_angle=30:40", "--closures", "all",
+                 "-o", "fit.json", "--plot", "fit.png")
+    assert report == json.loads((tmp_path / "fit.json").read_text()), \
+        "FIT.json is not the report --json printed"
+    best = report["best"]
+    assert best["closure"] == "casson", f"the best closure is {best}, not casson"
+    assert abs(best["params"]["nu"] / 0.13 - 1) < 0.05, f"nu {best['params']['nu']}, not 0.13"
+    assert abs(best["params"]["repose_angle"] - 33) < 0.1, \
+        f"angle {best['params']['repose_angle']}, not 33"
+    assert report["indistinguishable"] == ["casson"], report["verdict"]
+    c = closure_of(report, "casson")
+    assert c["identifiable"] == {"nu": True, "repose_angle": True}, c["why"]
+    for name, true in [("nu", 0.13), ("repose_angle", 33)]:
+        u = c["uncertainty"][name]
+        assert u["low"] < c["params"][name] < u["high"], f"{name}'s interval {u}"
+        assert u["std"] > 0, f"{name}'s std {u['std']}"
+    assert {x["closure"] for x in report["closures"]} == \
+        {"coulomb", "bingham", "herschel-bulkley", "casson"}
+    assert all(x["delta_aic"] > 2 for x in report["closures"] if x["closure"] != "casson")
+    # the noise: the best cost is the noise's variance, sigma^2
+    assert 0.8 * 0.002 ** 2 < best["cost"] < 1.2 * 0.002 ** 2, f"cost {best['cost']}"
+    assert report["forward_runs"] == sum(x["evaluations"] for x in report["closures"])
+    assert report["observations"]["times"] == 6
+    png = (tmp_path / "fit.png").read_bytes()
+    assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 5000, "fit.png is not a figure"
+
+
+def test_end_states_do_not_identify_nu(tmp_path):
+    """States at rest (t = 150 and 200 s; the cone is still after 20 s)
+    see the angle but not nu: the time scale L^2 / nu has gone."""
+    truth = twin(tmp_path, "rest", "model.nu=0.13", "model.repose_angle=34", end=200,
+                 every=50)
+    obs = degrade(truth, tmp_path / "rest_scan.h5", [150, 200], sigma=0.002, missing=0.2)
+    report = fit(tmp_path, tmp_path / "rest.ini", obs, "--param", "nu=0.05:0.5:log",
+                 "--param", "repose_angle=30:40")
+    c = closure_of(report, "coulomb")
+    assert c["identifiable"] == {"nu": False, "repose_angle": True}, c
+    assert "nu" in c["why"] and "noise" in c["why"]["nu"], c["why"]
+    assert abs(c["params"]["repose_angle"] - 34) < 0.1, c["params"]
+    assert "nu not identifiable" in report["verdict"], report["verdict"]
+    costs = c["profile"]["nu"]["costs"]
+    assert max(costs) - min(costs) < 0.01 * min(costs), \
+        f"the cost along nu is not flat at rest: {costs}"
+
+
+def test_front_points_alone_recover_nu(tmp_path):
+    """Only the front, traced where the sand is 2 cm thick at eight times
+    of the collapse (180 points each): the support cost alone finds nu."""
+    truth = twin(tmp_path, "spread", "model.nu=0.13", every=0.1)
+    front = trace_front(truth, tmp_path / "front.csv",
+                        [0, 0.2, 0.4, 0.6, 0.8, 1.0, 1.5, 2.0], threshold=0.02)
+    report = fit(tmp_path, tmp_path / "spread.ini", front, "--param", "nu=0.01:1:log",
+                 "--threshold", "0.02")
+    assert report["cost_functional"]["name"] == "support"
+    assert report["observations"]["kind"] == "front"
+    nu = report["best"]["params"]["nu"]
+    assert abs(nu / 0.13 - 1) < 0.05, f"nu {nu} from the front, not 0.13"
+    assert closure_of(report, "coulomb")["identifiable"] == {"nu": True}
+
+
+def test_same_fit_twice_gives_the_same_report(tmp_path):
+    truth = twin(tmp_path, "again", "model.nu=0.2")
+    obs = degrade(truth, tmp_path / "again_scan.h5", [1, 2, 4], sigma=0.001)
+    args = ["--param", "nu=0.01:1:log", "--closures", "coulomb,bingham"]
+    a = fit(tmp_path, tmp_path / "again.ini", obs, *args, "--threads", "1")
+    b = fit(tmp_path, tmp_path / "again.ini", obs, *args)
+    for r in (a, b):
+        for key in TIMING_KEYS | {"threads"}:
+            r.pop(key)
+    assert a == b, "the same fit on 1 and 2 threads gave two reports"
+
+
+def test_summary_and_outputs(tmp_path):
+    """Without --json: a line per closure and where the report went; an
+    existing FIT.json is refused without --force."""
+    truth = twin(tmp_path, "sum", "model.nu=0.2")
+    obs = degrade(truth, tmp_path / "sum_scan.h5", [1, 2, 4])
+    args = ["fit", "sum.ini", "sum_scan.h5", "--param", "nu=0.01:1:log", "-o", "f.json"]
+    r = run_ok(args, cwd=tmp_path)
+    first = r.stdout.splitlines()[0]
+    assert first.startswith("coulomb") and (" nu = 0.19" in first or " nu = 0.2" in first), \
+        r.stdout
+    assert "wrote f.json" in r.stdout, r.stdout
+    r = run(args, cwd=tmp_path)
+    assert r.returncode == 2 and "f.json" in r.stderr and "--force" in r.stderr, r.stderr
+    run_ok(args + ["--force", "-q"], cwd=tmp_path)
+
+
+def write_h5(path, time, height, x=None, y=None):
+    with h5py.File(path, "w") as g:
+        g["time"], g["height"] = np.asarray(time, float), np.asarray(height, float)
+        if x is not None:
+            g["x"], g["y"] = x, y
+
+
+@pytest.mark.parametrize("what", ["times out of order", "another grid", "empty csv",
+                                  "nan everywhere", "header only", "too few front points",
+                                  "not a file"])
+def test_bad_observations_exit_2_naming_the_file(tmp_path, what):
+    cone_case(tmp_path / "c.ini")
+    cells = np.zeros((2, 41, 41))
+    name = {"empty csv": "obs.csv", "header only": "obs.csv",
+            "too few front points": "obs.csv"}.get(what, "obs.h5")
+    obs = tmp_path / name
+    if what == "times out of order":
+        write_h5(obs, [2.0, 1.0], cells)
+    elif what == "another grid":
+        write_h5(obs, [1.0, 2.0], np.zeros((2, 40, 41)))
+    elif what == "nan everywhere":
+        write_h5(obs, [1.0, 2.0], np.full((2, 41, 41), np.nan))
+    elif what == "empty csv":
+        obs.write_text("")
+    elif what == "header only":
+        obs.write_text("time,x,y\n")
+    elif what == "too few front points":
+        obs.write_text("time,x,y\n1,0,0\n1,1,0\n")
+    r = run(["fit", "c.ini", name, "--param", "nu=0.01:1:log"], cwd=tmp_path)
+    assert r.returncode == 2, (what, r.returncode, r.stderr)
+    assert name in r.stderr and r.stderr.count("\n") == 1, (what, r.stderr)
+
+
+@pytest.mark.parametrize("args, says", [
+    ([], "--param"),
+    (["--param", "nux=1:2"], "nux"),
+    (["--param", "nu=2:1"], "LO < HI"),
+    (["--param", "nu=0:1:log"], "LO > 0"),
+    (["--param", "nu=0.1:1", "--param", "nu=0.2:1"], "twice"),
+    (["--param", "gamma=0.5:2"], "coulomb takes none"),
+    (["--param", "nu=0.1:1", "--param", "delta=0.01:0.1", "--closures", "bingham"],
+     "exclude each other"),
+    (["--param", "nu=0.1:1", "--closures", "coulomb,mud"], "mud"),
+    (["--param", "nu=0.1:1", "--cost", "area"], "--cost"),
+])
+def test_bad_options_exit_2(tmp_path, args, says):
+    truth = twin(tmp_path, "o", "model.nu=0.2")
+    r = run(["fit", "o.ini", str(truth)] + args, cwd=tmp_path)
+    assert r.returncode == 2 and says in r.stderr, (args, r.stderr)
+
+
+def test_interrupt_writes_the_best_so_far(tmp_path):
+    """SIGINT stops the fit between forward runs: exit 130 and FIT.json
+    with "interrupted": true and the best point so far."""
+    truth = twin(tmp_path, "int", "model.nu=0.2")
+    obs = degrade(truth, tmp_path / "int_scan.h5", [1, 2, 4, 8, 12])
+    p = subprocess.Popen([SANDSLIDE, "fit", "int.ini", "int_scan.h5", "--param",
+                          "nu=0.01:1:log", "--param", "repose_angle=30:40", "--closures", "all",
+                          "--grid-points", "50", "-o", "f.json", "--threads", "1"],
+                         cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    time.sleep(1.0)   # 2500 grid points per closure: minutes, unless stopped
+    p.send_signal(signal.SIGINT)
+    out, err = p.communicate(timeout=60)
+    assert p.returncode == 130, (p.returncode, err)
+    report = json.loads((tmp_path / "f.json").read_text())
+    assert report["interrupted"] is True
+    assert report["forward_runs"] > 0 and report["best"]["closure"] == "coulomb", report
