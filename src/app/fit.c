@@ -95,6 +95,9 @@ struct fit {
 	int current;                    /* the closure being fitted */
 	const char *stage;
 	double started;
+	double seconds;                 /* the whole fit, when it reports: once,
+	                                 * for the measuring and the writing pass
+	                                 * of text_of to agree */
 };
 
 /* ---- parameters ----------------------------------------------------------- */
@@ -1114,7 +1117,7 @@ static void format_report(struct ss_strbuf *b, const struct fit *f, int best)
 	ss_strbuf_json_number(b, f->integrator == SS_INTEGRATOR_RKL2
 	                         ? fmin(f->base.model.rkl2_tol, o->rkl2_tol) : NAN, 10);
 	ss_strbuf_printf(b, ", \"forward_runs\": %lld, \"seconds\": ", f->runs);
-	ss_strbuf_json_number(b, ss_parallel_wall_seconds() - f->started, 4);
+	ss_strbuf_json_number(b, f->seconds, 4);
 	ss_strbuf_printf(b, ", \"seconds_per_run\": ");
 	ss_strbuf_json_number(b, f->runs ? f->run_seconds / (double)f->runs : NAN, 4);
 	ss_strbuf_printf(b, ", \"threads\": %d, \"interrupted\": %s\n}\n", ss_parallel_max_threads(),
@@ -1145,7 +1148,7 @@ static void format_summary(struct ss_strbuf *b, const struct fit *f, int best)
 	}
 	ss_strbuf_printf(b, "%lld forward runs, %.3g s each, %.1f s in all%s\n", f->runs,
 	                 f->runs ? f->run_seconds / (double)f->runs : 0.0,
-	                 ss_parallel_wall_seconds() - f->started,
+	                 f->seconds,
 	                 f->interrupted ? "; interrupted: the best so far" : "");
 }
 
@@ -1158,8 +1161,11 @@ static int text_of(void (*format)(struct ss_strbuf *, const struct fit *, int),
 	char *text = malloc(b.len + 1);
 	if (!text)
 		return ss_error_fail("out of memory");
-	b = (struct ss_strbuf){text, b.len + 1, 0};
+	const size_t len = b.len;
+	b = (struct ss_strbuf){text, len + 1, 0};
 	format(&b, f, best);
+	if (b.len != len)   /* a formatter must print the same text twice */
+		SS_BUG("the fit's text was %zu bytes, then %zu", len, b.len);
 	*out = text;
 	return SS_OK;
 }
@@ -1210,6 +1216,7 @@ int ss_fit_run(const struct ss_fit_options *o, char **report, char **summary)
 	for (int c = 0; c < f.fit_count; c++)
 		if (isfinite(f.fits[c].cost) && (best < 0 || f.fits[c].aic < f.fits[best].aic))
 			best = c;
+	f.seconds = ss_parallel_wall_seconds() - f.started;
 	if (!err)
 		err = text_of(format_report, &f, best, report);
 	if (!err && summary && best >= 0)
