@@ -378,12 +378,14 @@ endif
 # when something was skipped, each skip saying why; a program or test
 # function that made no check fails), the fuzz corpora replayed, then the
 # CLI/file tests and the Python module's with pytest (-rs: every skip
-# prints its reason).  test_mpi.py is left to test-mpi.  CLI_TESTS names
-# the CLI test files to run (CI's MPI part runs those that read and write
-# files with the distributed build's HDF5: .ci/run).
+# prints its reason).  test_mpi.py is left to test-mpi.  C_TESTS and
+# CLI_TESTS name the C programs (their names: test_api ...) and the CLI
+# test files (pytest's arguments) to run, all of them by default; .ci/run
+# narrows them where another part of CI runs the rest.
+C_TESTS   ?= $(notdir $(TEST_BIN))
 CLI_TESTS ?= tests/cli
 test check: all $(TEST_BIN) $(HOOK_BIN) headers-check check-layering $(FUZZ_REPLAY)
-	@fail=0; for t in $(TEST_BIN); do \
+	@fail=0; for t in $(addprefix $(BUILD)/tests/,$(C_TESTS)); do \
 	  echo "== $$t"; OMP_NUM_THREADS=$${OMP_NUM_THREADS:-2} ./$$t || fail=1; \
 	done; \
 	echo "== tests/fuzz (corpora and regressions replayed)"; ( $(FUZZ_REPLAY_RUN) ) || fail=1; \

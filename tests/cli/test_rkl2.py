@@ -404,6 +404,10 @@ def synthetic_dem(shape, cellsize):
 @pytest.mark.parametrize("shape", ["pyramid", "slope"])
 def test_steady_means_no_face_above_the_angle_on_coarse_cells(tmp_path, shape, cellsize,
                                                               integrator):
+    if integrator == "euler" and cellsize != 50.0 and \
+            float(os.environ.get("SANDSLIDE_TEST_SCALE") or 1) < 1:
+        pytest.skip("SANDSLIDE_TEST_SCALE < 1 (the sanitizers): Euler's thousands of "
+                    "steps on 50 m cells only; `make test` runs every cell size")
     h0 = synthetic_dem(shape, cellsize)
     write_asc(tmp_path / "dem.asc", h0, cellsize)
     r = run(["relax", "dem.asc", "-o", "out.asc", "--angle", "30", "--report", "r.json",
