@@ -194,6 +194,9 @@ int ss_snapshot_read_field(const char *path, const char *dataset, long long inde
  * Sizes are checked against the file (the reader's rules above) and the
  * heights against the memory available before anything is allocated.
  * Times and heights are returned as stored: the caller checks their values.
+ * /height may hold one snapshot more than /time (a run killed while it
+ * wrote one: doc/output.md#written-as-the-run-goes); /time counts those
+ * read.
  */
 struct ss_height_series {
 	int nx, ny;                 /* cells: columns west to east, rows south

@@ -1370,7 +1370,10 @@ static int series_values(const struct h5in *in, struct ss_height_series *s)
 	}
 	const hsize_t *hd = h.dims;
 	char d[96];
-	if (!err && t.dims[0] != hd[0]) {
+	/* a sandslide output killed while it wrote a snapshot has one more
+	 * /height than /time (doc/output.md#written-as-the-run-goes): /time
+	 * counts the complete ones */
+	if (!err && t.dims[0] != hd[0] && t.dims[0] + 1 != hd[0]) {
 		char why[96];
 		snprintf(why, sizeof why, "/time has %llu values, /height %llu snapshots",
 		         (unsigned long long)t.dims[0], (unsigned long long)hd[0]);
@@ -1381,7 +1384,7 @@ static int series_values(const struct h5in *in, struct ss_height_series *s)
 		err = ss_error_input("'%s': /height is %s (time, y, x): expected 1 to %d cells a "
 		                     "side", in->name, format_dims(3, hd, d, sizeof d),
 		                     SS_SNAPSHOT_MAX_SIDE);
-	s->count = (long long)hd[0];
+	s->count = (long long)(err ? hd[0] : t.dims[0]);
 	s->ny = (int)hd[1];
 	s->nx = (int)hd[2];
 	const size_t cells = (size_t)s->nx * (size_t)s->ny;
@@ -1403,7 +1406,7 @@ static int series_values(const struct h5in *in, struct ss_height_series *s)
 		if (!s->height)
 			err = SS_ERR_FAIL;
 	}
-	const hsize_t t0 = 0, tn = hd[0];
+	const hsize_t t0 = 0, tn = (hsize_t)s->count;
 	if (!err && s->count > 0)
 		err = var_read(in, &t, &t0, &tn, H5T_NATIVE_DOUBLE, s->time, "/time");
 	for (long long k = 0; k < s->count && !err; k++) {

@@ -216,6 +216,21 @@ def test_rasters_listed_in_a_csv(tmp_path):
     assert abs(a["best"]["params"]["nu"] / 0.2 - 1) < 0.02, a["best"]
 
 
+def test_an_unfinished_snapshot_is_not_observed(tmp_path):
+    """A run killed while it flushed a snapshot leaves /height one longer
+    than /time (doc/output.md#written-as-the-run-goes): fit reads the
+    snapshots /time counts, as sandslide's other readers do."""
+    truth = twin(tmp_path, "kill", "model.nu=0.2")
+    obs = degrade(truth, tmp_path / "kill_scan.h5", [1, 2, 4])
+    with h5py.File(tmp_path / "killed.h5", "w") as g, h5py.File(obs, "r") as f:
+        g["time"] = f["time"][:2]
+        g["height"], g["x"], g["y"] = f["height"][:], f["x"][:], f["y"][:]
+    report = fit(tmp_path, tmp_path / "kill.ini", tmp_path / "killed.h5", "--param",
+                 "nu=0.01:1:log", "--profile-points", "3")
+    assert report["observations"]["times"] == 2 and report["observations"]["last_time"] == 2, \
+        report["observations"]
+
+
 def test_same_fit_twice_gives_the_same_report(tmp_path):
     truth = twin(tmp_path, "again", "model.nu=0.2")
     obs = degrade(truth, tmp_path / "again_scan.h5", [1, 2, 4], sigma=0.001)
