@@ -380,8 +380,8 @@ endif
 # CLI/file tests and the Python module's with pytest (-rs: every skip
 # prints its reason).  test_mpi.py is left to test-mpi.  C_TESTS and
 # CLI_TESTS name the C programs (their names: test_api ...) and the CLI
-# test files (pytest's arguments) to run, all of them by default; .ci/run
-# narrows them where another part of CI runs the rest.
+# test files (pytest's arguments; empty: none) to run, all of them by
+# default; .ci/run narrows them where another part of CI runs the rest.
 C_TESTS   ?= $(notdir $(TEST_BIN))
 CLI_TESTS ?= tests/cli
 test check: all $(TEST_BIN) $(HOOK_BIN) headers-check check-layering $(FUZZ_REPLAY)
@@ -389,8 +389,8 @@ test check: all $(TEST_BIN) $(HOOK_BIN) headers-check check-layering $(FUZZ_REPL
 	  echo "== $$t"; OMP_NUM_THREADS=$${OMP_NUM_THREADS:-2} ./$$t || fail=1; \
 	done; \
 	echo "== tests/fuzz (corpora and regressions replayed)"; ( $(FUZZ_REPLAY_RUN) ) || fail=1; \
-	echo "== tests/cli (pytest)"; \
-	SANDSLIDE_MPI= SANDSLIDE=$(abspath $(BUILD)/sandslide) SANDSLIDE_NAN=$(abspath $(HOOK_NAN)) \
+	[ -z "$(CLI_TESTS)" ] || echo "== tests/cli (pytest)"; \
+	[ -z "$(CLI_TESTS)" ] || SANDSLIDE_MPI= SANDSLIDE=$(abspath $(BUILD)/sandslide) SANDSLIDE_NAN=$(abspath $(HOOK_NAN)) \
 	  SANDSLIDE_PAUSE=$(abspath $(HOOK_PAUSE)) \
 	  SANDSLIDE_MAKEFLAGS="BUILD=$(BUILD) SANITIZE=$(SANITIZE) MPI=$(MPI) OPENMP=$(OPENMP) GDAL=$(GDAL)" \
 	  SANDSLIDE_CC="$(CC)" SANDSLIDE_LDFLAGS="$(ALL_LDFLAGS)" SANDSLIDE_PY_PRELOAD="$(PY_PRELOAD)" \
