@@ -25,6 +25,7 @@
  *   struct rng, rng_next/uniform/int   splitmix64: reproducible random states
  *   check_scratch_make(name)           a mkdtemp folder /tmp/NAME.XXXXXX for files
  *   check_scratch(), check_file(name)  its path, and a file's path in it
+ *   check_scratch_remove()             remove it and the files in it
  *   check_write_file(path, text)       text into a new file (exits 2 if it cannot)
  *
  * Each CHECK counts as one check; a test function may make many.  Nothing
@@ -35,11 +36,14 @@
 #ifndef SANDSLIDE_TESTS_CHECK_H
 #define SANDSLIDE_TESTS_CHECK_H
 
+#include <dirent.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 /* The scratch folder of a test program (one per program). */
 static inline char *check_scratch(void)
@@ -66,6 +70,19 @@ static inline const char *check_file(const char *name)
 	k ^= 1;
 	snprintf(buf[k], sizeof buf[k], "%s/%s", check_scratch(), name);
 	return buf[k];
+}
+
+/* Remove the scratch folder and the files in it (not folders in it). */
+static inline void check_scratch_remove(void)
+{
+	DIR *d = opendir(check_scratch());
+	for (struct dirent *e; d && (e = readdir(d));) {
+		if (strcmp(e->d_name, ".") && strcmp(e->d_name, ".."))
+			unlink(check_file(e->d_name));
+	}
+	if (d)
+		closedir(d);
+	rmdir(check_scratch());
 }
 
 static inline void check_write_file(const char *path, const char *text)

@@ -58,18 +58,6 @@ static int exists(const char *path)
 	return access(path, F_OK) == 0;
 }
 
-static void remove_dir(void)
-{
-	DIR *d = opendir(check_scratch());
-	for (struct dirent *e; d && (e = readdir(d));) {
-		if (strcmp(e->d_name, ".") && strcmp(e->d_name, ".."))
-			unlink(check_file(e->d_name));
-	}
-	if (d)
-		closedir(d);
-	rmdir(check_scratch());
-}
-
 /* stderr into a file while a call is expected to fail, so the messages
  * can be checked (and do not clutter the test output). */
 static int saved_stderr = -1;
@@ -1006,6 +994,6 @@ int main(void)
 	RUN(asc_prj_round_trip);
 	RUN(asc_without_crs_has_no_prj);
 	RUN(asc_bad_prj_is_refused);
-	remove_dir();
+	check_scratch_remove();
 	return check_report();
 }

@@ -14,7 +14,6 @@
  */
 #include "check.h"
 
-#include <dirent.h>
 #include <stdarg.h>
 #include <string.h>
 #include <unistd.h>
@@ -23,18 +22,6 @@
 #include "sandslide/error.h"
 #include "sandslide/grid.h"
 #include "sandslide/snapshot.h"
-
-static void remove_dir(void)
-{
-	DIR *d = opendir(check_scratch());
-	for (struct dirent *e; d && (e = readdir(d));) {
-		if (strcmp(e->d_name, ".") && strcmp(e->d_name, ".."))
-			unlink(check_file(e->d_name));
-	}
-	if (d)
-		closedir(d);
-	rmdir(check_scratch());
-}
 
 /* ss_observations_read of a file that must be refused: SS_ERR_INPUT, a
  * released struct, and a message holding each of the strings given
@@ -398,6 +385,6 @@ int main(void)
 	RUN(front_csv_is_read);
 	RUN(front_csv_refusals);
 	RUN(unknown_files);
-	remove_dir();
+	check_scratch_remove();
 	return check_report();
 }

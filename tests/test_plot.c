@@ -553,9 +553,6 @@ int main(void)
 	RUN(test_deterministic);
 	RUN(test_bad_input);
 	RUN(test_palette);
-	char cmd[600];
-	snprintf(cmd, sizeof cmd, "rm -rf '%s'", check_scratch());
-	if (system(cmd) != 0)
-		fprintf(stderr, "could not remove %s\n", check_scratch());
+	check_scratch_remove();
 	return check_report();
 }
