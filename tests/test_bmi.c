@@ -291,6 +291,109 @@ static void set_value_round_trips(void)
 	ss_bmi_destroy(m);
 }
 
+/* The issue's bits: set_value at t = 0, then update_until(T), gives what
+ * `sandslide run` writes at T for the same case whose initial file holds
+ * the heights set.  (Square cells: the case's initial file must have
+ * dx = dy, setup.c, where the .asc reader takes dx and dy.) */
+static void set_then_run_is_a_run_from_a_file(void)
+{
+	char square[1024];
+	const char *dy = strstr(case_text, "dy = 0.12\n");
+	snprintf(square, sizeof square, "%.*sdy = 0.1\n%s", (int)(dy - case_text), case_text,
+	         dy + strlen("dy = 0.12\n"));
+	check_write_file(check_file("square.ini"), square);
+	double h[NX * NY];
+	struct rng r = {27};
+	for (int c = 0; c < NX * NY; c++)
+		h[c] = 0.2 + 0.15 * rng_uniform(&r);   /* slopes past the repose angle */
+	FILE *f = fopen(check_file("bumps.asc"), "w");
+	CHECK(f != NULL, "bumps.asc");
+	if (!f)
+		return;
+	fprintf(f, "ncols %d\nnrows %d\nxllcorner 2\nyllcorner -1\ncellsize 0.1\n", NX, NY);
+	for (int j = NY - 1; j >= 0; j--)           /* north row first */
+		for (int i = 0; i < NX; i++)
+			fprintf(f, "%.17g%s", h[j * NX + i], i == NX - 1 ? "\n" : " ");
+	fclose(f);
+	struct ss_run_options *o = ss_run_options_create();
+	CHECK(o != NULL, "run options");
+	if (!o)
+		return;
+	char json[8192];
+	CHECK(ss_run_options_set(o, "case", check_file("square.ini")) == SS_OK &&
+	      ss_run_options_set(o, "output", check_file("bumps.h5")) == SS_OK &&
+	      ss_run_options_set(o, "set", "initial.type=file") == SS_OK &&
+	      ss_run_options_set(o, "set", "initial.file=bumps.asc") == SS_OK &&
+	      ss_run_options_set(o, "set", "time.end=0.5") == SS_OK &&
+	      ss_run_options_set(o, "set", "time.output_every=0.5") == SS_OK, "options");
+	CHECK(ss_run_case_json(o, json, sizeof json) == SS_OK, "%s", ss_error_last_message());
+	ss_run_options_destroy(o);
+	struct ss_height_series hs;
+	CHECK(ss_snapshot_read_height_series(check_file("bumps.h5"), &hs) == SS_OK, "%s",
+	      ss_error_last_message());
+	CHECK(hs.count == 2 && hs.time[1] == 0.5, "%lld snapshots", hs.count);
+	CHECK(hs.count >= 1 && same_bits(hs.height, h, NX * NY), "run read the file's bits");
+	struct Bmi *m = ss_bmi_create();
+	if (m && m->initialize(m, check_file("square.ini")) != BMI_SUCCESS) {
+		ss_bmi_destroy(m);
+		m = NULL;
+	}
+	CHECK(m != NULL, "initialize");
+	double got[NX * NY];
+	if (m && hs.count == 2) {
+		CHECK(m->set_value(m, ELEV, h) == BMI_SUCCESS, "set_value");
+		CHECK(m->update_until(m, 0.5) == BMI_SUCCESS, "update_until");
+		CHECK(m->get_value(m, ELEV, got) == BMI_SUCCESS &&
+		      same_bits(got, hs.height + NX * NY, NX * NY),
+		      "set_value + update_until(0.5) is not run's bits from the file");
+		CHECK(!same_bits(got, h, NX * NY), "the bumps moved");
+	}
+	ss_height_series_release(&hs);
+	ss_bmi_destroy(m);
+	remove(check_file("square.ini"));
+	remove(check_file("bumps.asc"));
+	remove(check_file("bumps.h5"));
+	remove(check_file("bumps.xmf"));
+	remove(check_file("bumps.h5.aux.xml"));
+}
+
+/* Wall cells keep their heights: a set changes, and counts, flow cells
+ * only. */
+static void set_value_leaves_walls(void)
+{
+	check_write_file(check_file("walled.ini"), "[grid]\nnx = 6\nny = 4\ndx = 0.5\n\n"
+	                 "[model]\nclosure = coulomb\nrepose_angle = 35\nnu = 0.1\n\n"
+	                 "[time]\nend = steady\nmax_time = 30\noutput_every = 2\n\n"
+	                 "[initial]\ntype = flat\nheight = 0.2\n\n"
+	                 "[wall pillar]\nrect = 0 0 1 1\n");
+	struct Bmi *m = ss_bmi_create();
+	CHECK(m != NULL, "create");
+	if (!m)
+		return;
+	CHECK(m->initialize(m, check_file("walled.ini")) == BMI_SUCCESS, "%s",
+	      ss_error_last_message());
+	double end = 0, before[24], h[24], back[24];
+	CHECK(m->get_end_time(m, &end) == BMI_SUCCESS && end == 30, "end = steady: max_time %g",
+	      end);
+	CHECK(m->get_value(m, ELEV, before) == BMI_SUCCESS, "get_value");
+	for (int c = 0; c < 24; c++)
+		h[c] = 0.5;
+	CHECK(m->set_value(m, ELEV, h) == BMI_SUCCESS, "set");
+	CHECK(m->get_value(m, ELEV, back) == BMI_SUCCESS, "get");
+	int walls = 0;
+	for (int c = 0; c < 24; c++) {
+		const int wall = c % 6 < 2 && c / 6 < 2;   /* rect 0 0 1 1 of 0.5 m cells */
+		walls += wall;
+		CHECK(back[c] == (wall ? before[c] : 0.5), "cell %d: %g", c, back[c]);
+	}
+	CHECK(walls == 4, "four wall cells");
+	CHECK_REL(ss_bmi_external_volume(m), 20 * 0.3 * 0.25, 1e-12, "flow cells counted only");
+	m->finalize(m);
+	CHECK(ss_bmi_external_volume(m) == 0.0, "0 after finalize");
+	ss_bmi_destroy(m);
+	remove(check_file("walled.ini"));
+}
+
 int main(void)
 {
 	if (check_scratch_make("ss_test_bmi"))
@@ -305,6 +408,8 @@ int main(void)
 	RUN(value_is_what_run_writes);
 	RUN(update_until_is_the_library);
 	RUN(set_value_round_trips);
+	RUN(set_then_run_is_a_run_from_a_file);
+	RUN(set_value_leaves_walls);
 	remove(check_file("cone.ini"));
 	rmdir(check_scratch());
 	return check_report();
