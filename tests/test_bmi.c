@@ -23,6 +23,12 @@
 #define NX 14
 #define NY 10
 #define ELEV "land_surface__elevation"
+#define VOLUME "sand__volume"
+#define INFLOW "sand__time_integral_of_source_volume_flux"
+#define OUTFLOW "sand__time_integral_of_outflow_volume_flux"
+#define SLOPE "sand_surface__max_of_slope_angle"
+#define NOUT 5
+static const char *const outputs[NOUT] = {ELEV, VOLUME, INFLOW, OUTFLOW, SLOPE};
 
 /* A cone slumping towards an open east side: heights change every step. */
 static const char *case_text =
@@ -84,15 +90,20 @@ static void info(void)
 	CHECK(m != NULL, "initialize");
 	if (!m)
 		return;
-	char name[BMI_MAX_COMPONENT_NAME], var[BMI_MAX_VAR_NAME];
-	char *names[1] = {var};
+	char name[BMI_MAX_COMPONENT_NAME], var[NOUT][BMI_MAX_VAR_NAME];
+	char *names[NOUT];
+	for (int v = 0; v < NOUT; v++)
+		names[v] = var[v];
 	int in = 0, out = 0;
 	CHECK(m->get_component_name(m, name) == BMI_SUCCESS && !strcmp(name, "sandslide"), "name");
 	CHECK(m->get_input_item_count(m, &in) == BMI_SUCCESS && in == 1, "%d inputs", in);
-	CHECK(m->get_output_item_count(m, &out) == BMI_SUCCESS && out == 1, "%d outputs", out);
-	CHECK(m->get_input_var_names(m, names) == BMI_SUCCESS && !strcmp(var, ELEV), "%s", var);
-	var[0] = 0;
-	CHECK(m->get_output_var_names(m, names) == BMI_SUCCESS && !strcmp(var, ELEV), "%s", var);
+	CHECK(m->get_output_item_count(m, &out) == BMI_SUCCESS && out == NOUT, "%d outputs", out);
+	CHECK(m->get_input_var_names(m, names) == BMI_SUCCESS && !strcmp(var[0], ELEV), "%s",
+	      var[0]);
+	var[0][0] = 0;
+	CHECK(m->get_output_var_names(m, names) == BMI_SUCCESS, "output names");
+	for (int v = 0; v < NOUT; v++)
+		CHECK(!strcmp(var[v], outputs[v]), "output %d: %s", v, var[v]);
 	ss_bmi_destroy(m);
 }
 
@@ -135,6 +146,22 @@ static void vars(void)
 	CHECK(m->get_var_itemsize(m, ELEV, &v) == BMI_SUCCESS && v == 8, "itemsize %d", v);
 	CHECK(m->get_var_nbytes(m, ELEV, &v) == BMI_SUCCESS && v == NX * NY * 8, "nbytes %d", v);
 	CHECK(m->get_var_grid(m, ELEV, &v) == BMI_SUCCESS && v == 0, "grid %d", v);
+	/* the read-only diagnostics: scalars on grid 1 */
+	const char *units[NOUT] = {"m", "m3", "m3", "m3", "deg"};
+	for (int k = 1; k < NOUT; k++) {
+		CHECK(m->get_var_grid(m, outputs[k], &v) == BMI_SUCCESS && v == 1, "%s: grid %d",
+		      outputs[k], v);
+		CHECK(m->get_var_units(m, outputs[k], s) == BMI_SUCCESS && !strcmp(s, units[k]),
+		      "%s: %s", outputs[k], s);
+		CHECK(m->get_var_type(m, outputs[k], s) == BMI_SUCCESS && !strcmp(s, "double"),
+		      "%s: %s", outputs[k], s);
+		CHECK(m->get_var_nbytes(m, outputs[k], &v) == BMI_SUCCESS && v == 8, "%s: %d",
+		      outputs[k], v);
+		CHECK(m->get_var_itemsize(m, outputs[k], &v) == BMI_SUCCESS && v == 8, "%s: %d",
+		      outputs[k], v);
+		CHECK(m->get_var_location(m, outputs[k], s) == BMI_SUCCESS && !strcmp(s, "node"),
+		      "%s: %s", outputs[k], s);
+	}
 	v = 7;
 	CHECK(m->get_var_type(m, "sea_water__depth", s) == BMI_FAILURE, "an unknown name");
 	CHECK(m->get_var_grid(m, "sea_water__depth", &v) == BMI_FAILURE && v == 7, "untouched");
@@ -162,7 +189,13 @@ static void grid(void)
 	/* the centre of the south-west cell, as the HDF5 output's y[0], x[0] */
 	CHECK(m->get_grid_origin(m, 0, origin) == BMI_SUCCESS && origin[0] == -1 + 0.5 * 0.12 &&
 	      origin[1] == 2 + 0.5 * 0.1, "origin %.17g %.17g", origin[0], origin[1]);
-	CHECK(m->get_grid_rank(m, 1, &rank) == BMI_FAILURE, "grid 1");
+	CHECK(m->get_grid_type(m, 1, type) == BMI_SUCCESS && !strcmp(type, "scalar"), "grid 1: %s",
+	      type);
+	CHECK(m->get_grid_rank(m, 1, &rank) == BMI_SUCCESS && rank == 0, "grid 1: rank %d", rank);
+	CHECK(m->get_grid_size(m, 1, &size) == BMI_SUCCESS && size == 1, "grid 1: size %d", size);
+	CHECK(m->get_grid_shape(m, 1, shape) == BMI_FAILURE, "a scalar has no shape");
+	CHECK(m->get_grid_rank(m, 2, &rank) == BMI_FAILURE && rank == 0, "grid 2");
+	CHECK(m->get_grid_size(m, -1, &size) == BMI_FAILURE, "grid -1");
 	CHECK(m->get_grid_x(m, 0, x) == BMI_FAILURE, "get_grid_x: not rectilinear");
 	CHECK(m->get_grid_node_count(m, 0, &size) == BMI_FAILURE, "not unstructured");
 	ss_bmi_destroy(m);
@@ -194,7 +227,7 @@ static void value_is_what_run_writes(void)
 		      fabs(origin[1] - (hs.origin_x + 0.05)) < 1e-12,
 		      "origin %g %g, the file's first centre %g %g", origin[0], origin[1],
 		      hs.origin_y + 0.06, hs.origin_x + 0.05);
-	double h[NX * NY];
+	double h[NX * NY], volume0 = 0.0;
 	for (long long k = 0; m && k < hs.count; k++) {
 		if (k > 0)
 			CHECK(m->update(m) == BMI_SUCCESS, "update %lld", k);
@@ -204,6 +237,22 @@ static void value_is_what_run_writes(void)
 		CHECK(m->get_value(m, ELEV, h) == BMI_SUCCESS, "get_value");
 		CHECK(same_bits(h, hs.height + k * NX * NY, NX * NY),
 		      "the heights at %g s are not run's", t);
+		/* the diagnostics between updates change no bits of what follows */
+		double vol = -1, in = -1, out = -1, slope = -1, sum = 0.0;
+		CHECK(m->get_value(m, VOLUME, &vol) == BMI_SUCCESS &&
+		      m->get_value(m, INFLOW, &in) == BMI_SUCCESS &&
+		      m->get_value(m, OUTFLOW, &out) == BMI_SUCCESS &&
+		      m->get_value(m, SLOPE, &slope) == BMI_SUCCESS, "diagnostics");
+		for (int c = 0; c < NX * NY; c++)
+			sum += h[c] * 0.1 * 0.12;
+		CHECK_REL(vol, sum, 1e-12, "volume at %g s", t);
+		if (k == 0)
+			volume0 = vol;
+		CHECK(in == 0.0 && out >= 0.0 && (k == 0 || slope < 50.0) && slope > 0.0,
+		      "inflow %g, outflow %g, slope %g deg", in, out, slope);
+		CHECK_NEAR(vol + out, volume0, 1e-12, "the balance at %g s: %g + %g", t, vol, out);
+		if (k == hs.count - 1)
+			CHECK(out > 0.0, "sand left through the open side");
 	}
 	CHECK(hs.count == 5 && !same_bits(hs.height, hs.height + 4 * NX * NY, NX * NY),
 	      "the cone moved (the comparison means something)");
@@ -237,6 +286,8 @@ static void update_until_is_the_library(void)
 	CHECK(m != NULL, "initialize");
 	if (!m)
 		return;
+	double vol;
+	CHECK(m->get_value(m, VOLUME, &vol) == BMI_SUCCESS, "a diagnostic first");
 	CHECK(m->update_until(m, T) == BMI_SUCCESS, "update_until");
 	CHECK(m->get_value(m, ELEV, got) == BMI_SUCCESS && same_bits(got, want, NX * NY),
 	      "update_until(%g) is not the stepper's bits", T);
@@ -285,6 +336,13 @@ static void set_value_round_trips(void)
 	CHECK(m->set_value_at_indices(m, ELEV, inds, 2, two) == BMI_SUCCESS, "at indices");
 	CHECK(m->get_value_at_indices(m, ELEV, back, inds, 2) == BMI_SUCCESS && back[0] == 9.0 &&
 	      back[1] == 9.0, "at indices round-trip");
+	double vol = 1.0;
+	CHECK(m->set_value(m, VOLUME, &vol) == BMI_FAILURE, "a diagnostic is read-only");
+	int zero[2] = {0, 0}, one = 1;
+	double vols[2] = {-1, -2};
+	CHECK(m->get_value_at_indices(m, VOLUME, vols, zero, 2) == BMI_SUCCESS && vols[0] > 0.0 &&
+	      vols[0] == vols[1], "a scalar at index 0");
+	CHECK(m->get_value_at_indices(m, VOLUME, vols, &one, 1) == BMI_FAILURE, "a scalar at 1");
 	void *p = NULL;
 	CHECK(m->get_value_ptr(m, ELEV, &p) == BMI_FAILURE && p == NULL, "no pointer (halo)");
 	CHECK(m->update(m) == BMI_SUCCESS, "update after a set: %s", ss_error_last_message());

@@ -63,6 +63,15 @@
  *                       set adds (or removes) on flow cells is counted in
  *                       ss_bmi_external_volume, not in the stepper's
  *                       inflow (doc/bmi-status.md).
+ *   read-only diagnostics, output only, double, location "node", each on
+ *   grid 1 ("scalar": rank 0, size 1, no shape, spacing or origin), the
+ *   values of ss_stepper_diagnostics (diagnostics.h) now:
+ *     sand__volume                                m3   sand on flow cells
+ *     sand__time_integral_of_source_volume_flux   m3   added by sources
+ *     sand__time_integral_of_outflow_volume_flux  m3   left by open sides
+ *     sand_surface__max_of_slope_angle            deg  steepest sand face
+ *   (names in the CSDMS Standard Names' pattern, chosen here; the
+ *   outputs are listed elevation first, then these in this order).
  *
  * A call with an unknown name, a wrong grid or index, or (for the
  * *_at_indices calls) a count out of range returns BMI_FAILURE and

@@ -16,6 +16,22 @@
 
 #define ELEVATION "land_surface__elevation"
 
+/* The variables: the elevation on grid 0 (in and out), and read-only
+ * diagnostics of the whole model on grid 1 (a scalar), from
+ * ss_stepper_diagnostics. */
+enum var_id { VAR_ELEVATION, VAR_VOLUME, VAR_INFLOW, VAR_OUTFLOW, VAR_SLOPE, VAR_COUNT };
+
+static const struct var {
+	const char *name, *units;
+	int grid;
+} vars[VAR_COUNT] = {
+	[VAR_ELEVATION] = {ELEVATION, "m", 0},
+	[VAR_VOLUME] = {"sand__volume", "m3", 1},
+	[VAR_INFLOW] = {"sand__time_integral_of_source_volume_flux", "m3", 1},
+	[VAR_OUTFLOW] = {"sand__time_integral_of_outflow_volume_flux", "m3", 1},
+	[VAR_SLOPE] = {"sand_surface__max_of_slope_angle", "deg", 1},
+};
+
 /* What initialize builds and finalize releases. */
 struct bmi_state {
 	struct ss_stepper st;
@@ -33,6 +49,15 @@ static struct bmi_state *state(struct Bmi *self)
 static int is_elevation(const char *name)
 {
 	return name && strcmp(name, ELEVATION) == 0;
+}
+
+/* The variable called name, or NULL. */
+static const struct var *find_var(const char *name)
+{
+	for (int v = 0; name && v < VAR_COUNT; v++)
+		if (!strcmp(name, vars[v].name))
+			return &vars[v];
+	return NULL;
 }
 
 /* ---- initialize, run, finalize ------------------------------------------ */
@@ -129,7 +154,7 @@ static int bmi_get_component_name(struct Bmi *self, char *name)
 	return BMI_SUCCESS;
 }
 
-static int one_item(struct Bmi *self, int *count)
+static int bmi_get_input_item_count(struct Bmi *self, int *count)
 {
 	if (!state(self) || !count)
 		return BMI_FAILURE;
@@ -137,7 +162,15 @@ static int one_item(struct Bmi *self, int *count)
 	return BMI_SUCCESS;
 }
 
-static int one_name(struct Bmi *self, char **names)
+static int bmi_get_output_item_count(struct Bmi *self, int *count)
+{
+	if (!state(self) || !count)
+		return BMI_FAILURE;
+	*count = VAR_COUNT;
+	return BMI_SUCCESS;
+}
+
+static int bmi_get_input_var_names(struct Bmi *self, char **names)
 {
 	if (!state(self) || !names || !names[0])
 		return BMI_FAILURE;
@@ -145,20 +178,33 @@ static int one_name(struct Bmi *self, char **names)
 	return BMI_SUCCESS;
 }
 
+static int bmi_get_output_var_names(struct Bmi *self, char **names)
+{
+	if (!state(self) || !names)
+		return BMI_FAILURE;
+	for (int v = 0; v < VAR_COUNT; v++)
+		if (!names[v])
+			return BMI_FAILURE;
+	for (int v = 0; v < VAR_COUNT; v++)
+		strcpy(names[v], vars[v].name);
+	return BMI_SUCCESS;
+}
+
 /* ---- variable information ----------------------------------------------- */
 
 static int bmi_get_var_grid(struct Bmi *self, const char *name, int *grid)
 {
-	if (!state(self) || !is_elevation(name) || !grid)
+	const struct var *v = find_var(name);
+	if (!state(self) || !v || !grid)
 		return BMI_FAILURE;
-	*grid = 0;
+	*grid = v->grid;
 	return BMI_SUCCESS;
 }
 
-/* text into out for the elevation */
+/* text into out for a known variable */
 static int var_text(struct Bmi *self, const char *name, char *out, const char *text)
 {
-	if (!state(self) || !is_elevation(name) || !out)
+	if (!state(self) || !find_var(name) || !out)
 		return BMI_FAILURE;
 	strcpy(out, text);
 	return BMI_SUCCESS;
@@ -171,7 +217,8 @@ static int bmi_get_var_type(struct Bmi *self, const char *name, char *type)
 
 static int bmi_get_var_units(struct Bmi *self, const char *name, char *units)
 {
-	return var_text(self, name, units, "m");
+	const struct var *v = find_var(name);
+	return var_text(self, name, units, v ? v->units : "");
 }
 
 static int bmi_get_var_location(struct Bmi *self, const char *name, char *location)
@@ -181,7 +228,7 @@ static int bmi_get_var_location(struct Bmi *self, const char *name, char *locati
 
 static int bmi_get_var_itemsize(struct Bmi *self, const char *name, int *size)
 {
-	if (!state(self) || !is_elevation(name) || !size)
+	if (!state(self) || !find_var(name) || !size)
 		return BMI_FAILURE;
 	*size = (int)sizeof(double);
 	return BMI_SUCCESS;
@@ -190,9 +237,10 @@ static int bmi_get_var_itemsize(struct Bmi *self, const char *name, int *size)
 static int bmi_get_var_nbytes(struct Bmi *self, const char *name, int *nbytes)
 {
 	struct bmi_state *s = state(self);
-	if (!s || !is_elevation(name) || !nbytes)
+	const struct var *v = find_var(name);
+	if (!s || !v || !nbytes)
 		return BMI_FAILURE;
-	*nbytes = s->cells * (int)sizeof(double);
+	*nbytes = (v->grid == 0 ? s->cells : 1) * (int)sizeof(double);
 	return BMI_SUCCESS;
 }
 
@@ -228,11 +276,29 @@ static ptrdiff_t at_of(const struct ss_stepper *st, int c)
 	return ss_grid_index(&st->grid, c % st->grid.nx, c / st->grid.nx);
 }
 
+/* The diagnostic v (not the elevation) of the current state. */
+static double diagnostic(struct bmi_state *s, const struct var *v)
+{
+	struct ss_diagnostics d;
+	ss_stepper_diagnostics(&s->st, &d);
+	switch (v - vars) {
+	case VAR_VOLUME: return d.volume;
+	case VAR_INFLOW: return d.inflow;
+	case VAR_OUTFLOW: return d.outflow;
+	default: return d.max_slope_deg;
+	}
+}
+
 static int bmi_get_value(struct Bmi *self, const char *name, void *dest)
 {
 	struct bmi_state *s = state(self);
-	if (!s || !is_elevation(name) || !dest)
+	const struct var *v = find_var(name);
+	if (!s || !v || !dest)
 		return BMI_FAILURE;
+	if (v->grid == 1) {
+		*(double *)dest = diagnostic(s, v);
+		return BMI_SUCCESS;
+	}
 	const struct ss_grid *g = &s->st.grid;
 	double *out = dest;
 	for (int j = 0; j < g->ny; j++)
@@ -264,9 +330,23 @@ static int bmi_get_value_at_indices(struct Bmi *self, const char *name, void *de
                                     int count)
 {
 	struct bmi_state *s = state(self);
-	if (!s || !is_elevation(name) || (count > 0 && !dest) || !indices_ok(s, inds, count))
+	const struct var *v = find_var(name);
+	if (!s || !v || (count > 0 && !dest))
 		return BMI_FAILURE;
 	double *out = dest;
+	if (v->grid == 1) {   /* a scalar: index 0 only */
+		if (count < 0 || (count > 0 && !inds))
+			return BMI_FAILURE;
+		for (int k = 0; k < count; k++)
+			if (inds[k] != 0)
+				return BMI_FAILURE;
+		const double x = count > 0 ? diagnostic(s, v) : 0.0;
+		for (int k = 0; k < count; k++)
+			out[k] = x;
+		return BMI_SUCCESS;
+	}
+	if (!indices_ok(s, inds, count))
+		return BMI_FAILURE;
 	for (int k = 0; k < count; k++)
 		out[k] = s->st.height[at_of(&s->st, inds[k])];
 	return BMI_SUCCESS;
@@ -326,28 +406,29 @@ static int bmi_set_value_at_indices(struct Bmi *self, const char *name, int *ind
 
 /* ---- grid ----------------------------------------------------------------- */
 
+/* Grid 0: the raster; grid 1: a scalar (the diagnostics). */
 static int bmi_get_grid_rank(struct Bmi *self, int grid, int *rank)
 {
-	if (!state(self) || grid != 0 || !rank)
+	if (!state(self) || (grid != 0 && grid != 1) || !rank)
 		return BMI_FAILURE;
-	*rank = 2;
+	*rank = grid == 0 ? 2 : 0;
 	return BMI_SUCCESS;
 }
 
 static int bmi_get_grid_size(struct Bmi *self, int grid, int *size)
 {
 	struct bmi_state *s = state(self);
-	if (!s || grid != 0 || !size)
+	if (!s || (grid != 0 && grid != 1) || !size)
 		return BMI_FAILURE;
-	*size = s->cells;
+	*size = grid == 0 ? s->cells : 1;
 	return BMI_SUCCESS;
 }
 
 static int bmi_get_grid_type(struct Bmi *self, int grid, char *type)
 {
-	if (!state(self) || grid != 0 || !type)
+	if (!state(self) || (grid != 0 && grid != 1) || !type)
 		return BMI_FAILURE;
-	strcpy(type, "uniform_rectilinear");
+	strcpy(type, grid == 0 ? "uniform_rectilinear" : "scalar");
 	return BMI_SUCCESS;
 }
 
@@ -408,10 +489,10 @@ struct Bmi *ss_bmi_register(struct Bmi *m)
 	m->update_until = bmi_update_until;
 	m->finalize = bmi_finalize;
 	m->get_component_name = bmi_get_component_name;
-	m->get_input_item_count = one_item;
-	m->get_output_item_count = one_item;
-	m->get_input_var_names = one_name;
-	m->get_output_var_names = one_name;
+	m->get_input_item_count = bmi_get_input_item_count;
+	m->get_output_item_count = bmi_get_output_item_count;
+	m->get_input_var_names = bmi_get_input_var_names;
+	m->get_output_var_names = bmi_get_output_var_names;
 	m->get_var_grid = bmi_get_var_grid;
 	m->get_var_type = bmi_get_var_type;
 	m->get_var_units = bmi_get_var_units;
