@@ -353,12 +353,15 @@ static void set_value_round_trips(void)
  * `sandslide run` writes at T for the same case whose initial file holds
  * the heights set.  (Square cells: the case's initial file must have
  * dx = dy, setup.c, where the .asc reader takes dx and dy.) */
-static void set_then_run_is_a_run_from_a_file(void)
+static void set_then_run_with(const char *integrator)
 {
 	char square[1024];
 	const char *dy = strstr(case_text, "dy = 0.12\n");
-	snprintf(square, sizeof square, "%.*sdy = 0.1\n%s", (int)(dy - case_text), case_text,
-	         dy + strlen("dy = 0.12\n"));
+	const char *every = strstr(case_text, "output_every = 0.25\n");
+	snprintf(square, sizeof square, "%.*sdy = 0.1\n%.*sintegrator = %s\n%s",
+	         (int)(dy - case_text), case_text,
+	         (int)(every - dy - strlen("dy = 0.12\n")), dy + strlen("dy = 0.12\n"),
+	         integrator, every);
 	check_write_file(check_file("square.ini"), square);
 	double h[NX * NY];
 	struct rng r = {27};
@@ -403,7 +406,8 @@ static void set_then_run_is_a_run_from_a_file(void)
 		CHECK(m->update_until(m, 0.5) == BMI_SUCCESS, "update_until");
 		CHECK(m->get_value(m, ELEV, got) == BMI_SUCCESS &&
 		      same_bits(got, hs.height + NX * NY, NX * NY),
-		      "set_value + update_until(0.5) is not run's bits from the file");
+		      "%s: set_value + update_until(0.5) is not run's bits from the file",
+		      integrator);
 		CHECK(!same_bits(got, h, NX * NY), "the bumps moved");
 	}
 	ss_height_series_release(&hs);
@@ -413,6 +417,12 @@ static void set_then_run_is_a_run_from_a_file(void)
 	remove(check_file("bumps.h5"));
 	remove(check_file("bumps.xmf"));
 	remove(check_file("bumps.h5.aux.xml"));
+}
+
+static void set_then_run_is_a_run_from_a_file(void)
+{
+	set_then_run_with("euler");
+	set_then_run_with("rkl2");
 }
 
 /* Wall cells keep their heights: a set changes, and counts, flow cells
