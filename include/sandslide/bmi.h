@@ -75,8 +75,8 @@
  *
  * A call with an unknown name, a wrong grid or index, or (for the
  * *_at_indices calls) a count out of range returns BMI_FAILURE and
- * changes nothing.  The library prints nothing of its own here: errors go
- * through error.h (ss_error_last_message).
+ * changes nothing.  Why goes through error.h, the library's one error
+ * printer (ss_error_set_quiet, ss_error_last_message).
  */
 #ifndef SANDSLIDE_BMI_H
 #define SANDSLIDE_BMI_H
