@@ -43,5 +43,6 @@
 #include "sandslide/bench.h"
 #include "sandslide/render.h"
 #include "sandslide/plot.h"
+#include "sandslide/bmi.h"
 
 #endif

@@ -1,0 +1,550 @@
+/*
+ * bmi.c - sandslide behind the CSDMS Basic Model Interface (bmi.h): a case
+ * file set up as `sandslide run` sets it up, stepped without output, its
+ * heights read and written as one uniform_rectilinear grid.
+ */
+#include "sandslide/bmi.h"
+
+#include <limits.h>
+#include <math.h>
+#include <string.h>
+
+#include "model/setup.h"
+#include "sandslide/case.h"
+#include "sandslide/error.h"
+#include "sandslide/stepper.h"
+
+#define ELEVATION "land_surface__elevation"
+
+/* The variables: the elevation on grid 0 (in and out), and read-only
+ * diagnostics of the whole model on grid 1 (a scalar), from
+ * ss_stepper_diagnostics. */
+enum var_id { VAR_ELEVATION, VAR_VOLUME, VAR_INFLOW, VAR_OUTFLOW, VAR_SLOPE, VAR_COUNT };
+
+static const struct var {
+	const char *name, *units;
+	int grid;
+} vars[VAR_COUNT] = {
+	[VAR_ELEVATION] = {ELEVATION, "m", 0},
+	[VAR_VOLUME] = {"sand__volume", "m3", 1},
+	[VAR_INFLOW] = {"sand__time_integral_of_source_volume_flux", "m3", 1},
+	[VAR_OUTFLOW] = {"sand__time_integral_of_outflow_volume_flux", "m3", 1},
+	[VAR_SLOPE] = {"sand_surface__max_of_slope_angle", "deg", 1},
+};
+
+/* What initialize builds and finalize releases. */
+struct bmi_state {
+	struct ss_stepper st;
+	double end;          /* s: the case's end, or max_time when steady */
+	double step;         /* s: the case's output_every */
+	double external;     /* m^3 added by set_value on flow cells */
+	int cells;           /* nx * ny (fits an int: checked) */
+};
+
+static struct bmi_state *state(struct Bmi *self)
+{
+	return self ? self->data : NULL;
+}
+
+static int is_elevation(const char *name)
+{
+	return name && strcmp(name, ELEVATION) == 0;
+}
+
+/* The variable called name, or NULL. */
+static const struct var *find_var(const char *name)
+{
+	for (int v = 0; name && v < VAR_COUNT; v++)
+		if (!strcmp(name, vars[v].name))
+			return &vars[v];
+	return NULL;
+}
+
+/* ---- initialize, run, finalize ------------------------------------------ */
+
+static int bmi_initialize(struct Bmi *self, const char *config_file)
+{
+	if (!self || self->data) {
+		if (self)
+			ss_error_input("BMI initialize: already initialized (finalize first)");
+		return BMI_FAILURE;
+	}
+	if (!config_file)
+		return ss_error_input("BMI initialize: no case file given"), BMI_FAILURE;
+	struct bmi_state *s = ss_alloc(1, sizeof *s, "the BMI state");
+	if (!s)
+		return BMI_FAILURE;
+	struct ss_case c;
+	int err = ss_case_load(&c, config_file, NULL, 0);
+	if (!err && (double)c.nx * c.ny * sizeof(double) > INT_MAX)
+		err = ss_error_input("BMI initialize: %s: %d x %d cells is more than the BMI's int "
+		                     "sizes can count", config_file, c.nx, c.ny);
+	if (!err)
+		err = ss_setup_stepper(&c, 0, 0, SS_KERNEL_FAST, &s->st);
+	if (!err) {
+		s->end = c.steady ? c.model.max_time : c.end;
+		s->step = c.output_every;
+		s->cells = c.nx * c.ny;
+	}
+	ss_case_release(&c);
+	if (err) {
+		ss_free(s);
+		return BMI_FAILURE;
+	}
+	self->data = s;
+	return BMI_SUCCESS;
+}
+
+/* Advance to t (> the current time); BMI_FAILURE if the stepper stopped
+ * short (a non-finite height, a vanished time step). */
+static int advance_to(struct bmi_state *s, double t)
+{
+	const struct ss_advance_options o = {0};   /* no steady stop: driven */
+	const enum ss_advance_end e = ss_stepper_advance(&s->st, t, &o);
+	if (e == SS_ADVANCE_REACHED)
+		return BMI_SUCCESS;
+	ss_error_fail("BMI: the model stopped at t = %g s before %g s: %s", s->st.time, t,
+	              e == SS_ADVANCE_NONFINITE ? "a height became non-finite"
+	                                        : "its time step vanished");
+	return BMI_FAILURE;
+}
+
+/* One time step: to the next multiple of output_every when the time is on
+ * one (so k updates reach k * output_every as `sandslide run` does),
+ * otherwise by output_every. */
+static int bmi_update(struct Bmi *self)
+{
+	struct bmi_state *s = state(self);
+	if (!s)
+		return BMI_FAILURE;
+	const double t = s->st.time;
+	const double k = nearbyint(t / s->step);
+	const double target = k * s->step == t ? (k + 1.0) * s->step : t + s->step;
+	return advance_to(s, target);
+}
+
+static int bmi_update_until(struct Bmi *self, double then)
+{
+	struct bmi_state *s = state(self);
+	if (!s || !isfinite(then) || then < s->st.time)
+		return BMI_FAILURE;
+	if (then == s->st.time)
+		return BMI_SUCCESS;
+	return advance_to(s, then);
+}
+
+static int bmi_finalize(struct Bmi *self)
+{
+	struct bmi_state *s = state(self);
+	if (!s)
+		return BMI_FAILURE;
+	ss_stepper_release(&s->st);
+	ss_free(s);
+	self->data = NULL;
+	return BMI_SUCCESS;
+}
+
+/* ---- exchange items ----------------------------------------------------- */
+
+static int bmi_get_component_name(struct Bmi *self, char *name)
+{
+	if (!state(self) || !name)
+		return BMI_FAILURE;
+	strcpy(name, "sandslide");
+	return BMI_SUCCESS;
+}
+
+static int bmi_get_input_item_count(struct Bmi *self, int *count)
+{
+	if (!state(self) || !count)
+		return BMI_FAILURE;
+	*count = 1;
+	return BMI_SUCCESS;
+}
+
+static int bmi_get_output_item_count(struct Bmi *self, int *count)
+{
+	if (!state(self) || !count)
+		return BMI_FAILURE;
+	*count = VAR_COUNT;
+	return BMI_SUCCESS;
+}
+
+static int bmi_get_input_var_names(struct Bmi *self, char **names)
+{
+	if (!state(self) || !names || !names[0])
+		return BMI_FAILURE;
+	strcpy(names[0], ELEVATION);
+	return BMI_SUCCESS;
+}
+
+static int bmi_get_output_var_names(struct Bmi *self, char **names)
+{
+	if (!state(self) || !names)
+		return BMI_FAILURE;
+	for (int v = 0; v < VAR_COUNT; v++)
+		if (!names[v])
+			return BMI_FAILURE;
+	for (int v = 0; v < VAR_COUNT; v++)
+		strcpy(names[v], vars[v].name);
+	return BMI_SUCCESS;
+}
+
+/* ---- variable information ----------------------------------------------- */
+
+static int bmi_get_var_grid(struct Bmi *self, const char *name, int *grid)
+{
+	const struct var *v = find_var(name);
+	if (!state(self) || !v || !grid)
+		return BMI_FAILURE;
+	*grid = v->grid;
+	return BMI_SUCCESS;
+}
+
+/* text into out for a known variable */
+static int var_text(struct Bmi *self, const char *name, char *out, const char *text)
+{
+	if (!state(self) || !find_var(name) || !out)
+		return BMI_FAILURE;
+	strcpy(out, text);
+	return BMI_SUCCESS;
+}
+
+static int bmi_get_var_type(struct Bmi *self, const char *name, char *type)
+{
+	return var_text(self, name, type, "double");
+}
+
+static int bmi_get_var_units(struct Bmi *self, const char *name, char *units)
+{
+	const struct var *v = find_var(name);
+	return var_text(self, name, units, v ? v->units : "");
+}
+
+static int bmi_get_var_location(struct Bmi *self, const char *name, char *location)
+{
+	return var_text(self, name, location, "node");
+}
+
+static int bmi_get_var_itemsize(struct Bmi *self, const char *name, int *size)
+{
+	if (!state(self) || !find_var(name) || !size)
+		return BMI_FAILURE;
+	*size = (int)sizeof(double);
+	return BMI_SUCCESS;
+}
+
+static int bmi_get_var_nbytes(struct Bmi *self, const char *name, int *nbytes)
+{
+	struct bmi_state *s = state(self);
+	const struct var *v = find_var(name);
+	if (!s || !v || !nbytes)
+		return BMI_FAILURE;
+	*nbytes = (v->grid == 0 ? s->cells : 1) * (int)sizeof(double);
+	return BMI_SUCCESS;
+}
+
+/* ---- time ----------------------------------------------------------------- */
+
+static int time_value(struct Bmi *self, double *out, int which)
+{
+	struct bmi_state *s = state(self);
+	if (!s || !out)
+		return BMI_FAILURE;
+	*out = which == 0 ? s->st.time : which == 1 ? 0.0 : which == 2 ? s->end : s->step;
+	return BMI_SUCCESS;
+}
+
+static int bmi_get_current_time(struct Bmi *self, double *t) { return time_value(self, t, 0); }
+static int bmi_get_start_time(struct Bmi *self, double *t) { return time_value(self, t, 1); }
+static int bmi_get_end_time(struct Bmi *self, double *t) { return time_value(self, t, 2); }
+static int bmi_get_time_step(struct Bmi *self, double *t) { return time_value(self, t, 3); }
+
+static int bmi_get_time_units(struct Bmi *self, char *units)
+{
+	if (!state(self) || !units)
+		return BMI_FAILURE;
+	strcpy(units, "s");
+	return BMI_SUCCESS;
+}
+
+/* ---- getters and setters -------------------------------------------------- */
+
+/* The halo index of the flat [y][x] index c. */
+static ptrdiff_t at_of(const struct ss_stepper *st, int c)
+{
+	return ss_grid_index(&st->grid, c % st->grid.nx, c / st->grid.nx);
+}
+
+/* The diagnostic v (not the elevation) of the current state. */
+static double diagnostic(struct bmi_state *s, const struct var *v)
+{
+	struct ss_diagnostics d;
+	ss_stepper_diagnostics(&s->st, &d);
+	switch (v - vars) {
+	case VAR_VOLUME: return d.volume;
+	case VAR_INFLOW: return d.inflow;
+	case VAR_OUTFLOW: return d.outflow;
+	default: return d.max_slope_deg;
+	}
+}
+
+static int bmi_get_value(struct Bmi *self, const char *name, void *dest)
+{
+	struct bmi_state *s = state(self);
+	const struct var *v = find_var(name);
+	if (!s || !v || !dest)
+		return BMI_FAILURE;
+	if (v->grid == 1) {
+		*(double *)dest = diagnostic(s, v);
+		return BMI_SUCCESS;
+	}
+	const struct ss_grid *g = &s->st.grid;
+	double *out = dest;
+	for (int j = 0; j < g->ny; j++)
+		memcpy(out + (size_t)j * g->nx, s->st.height + ss_grid_index(g, 0, j),
+		       (size_t)g->nx * sizeof *out);
+	return BMI_SUCCESS;
+}
+
+/* The heights live with a halo ring: no contiguous [y][x] array to point
+ * at. */
+static int bmi_get_value_ptr(struct Bmi *self, const char *name, void **dest_ptr)
+{
+	(void)self, (void)name, (void)dest_ptr;
+	return BMI_FAILURE;
+}
+
+/* inds[0..count-1] all in [0, cells), count >= 0 */
+static int indices_ok(const struct bmi_state *s, const int *inds, int count)
+{
+	if (count < 0 || (count > 0 && !inds))
+		return 0;
+	for (int k = 0; k < count; k++)
+		if (inds[k] < 0 || inds[k] >= s->cells)
+			return 0;
+	return 1;
+}
+
+static int bmi_get_value_at_indices(struct Bmi *self, const char *name, void *dest, int *inds,
+                                    int count)
+{
+	struct bmi_state *s = state(self);
+	const struct var *v = find_var(name);
+	if (!s || !v || (count > 0 && !dest))
+		return BMI_FAILURE;
+	double *out = dest;
+	if (v->grid == 1) {   /* a scalar: index 0 only */
+		if (count < 0 || (count > 0 && !inds))
+			return BMI_FAILURE;
+		for (int k = 0; k < count; k++)
+			if (inds[k] != 0)
+				return BMI_FAILURE;
+		const double x = count > 0 ? diagnostic(s, v) : 0.0;
+		for (int k = 0; k < count; k++)
+			out[k] = x;
+		return BMI_SUCCESS;
+	}
+	if (!indices_ok(s, inds, count))
+		return BMI_FAILURE;
+	for (int k = 0; k < count; k++)
+		out[k] = s->st.height[at_of(&s->st, inds[k])];
+	return BMI_SUCCESS;
+}
+
+/* Set the flow cells among inds[0..count-1] (NULL: every cell in order)
+ * to src[0..count-1], after checking every value; the volume added goes to
+ * s->external.  An index given twice is written twice, in order: the last
+ * value stays, and each write's change is counted, so the sum is the net
+ * change. */
+static int set_heights(struct bmi_state *s, const int *inds, int count, const double *src)
+{
+	struct ss_stepper *st = &s->st;
+	for (int k = 0; k < count; k++) {
+		const ptrdiff_t at = at_of(st, inds ? inds[k] : k);
+		if (ss_cell_type_get(st->cell_types, at) != SS_CELL_FLOW)
+			continue;
+		if (!isfinite(src[k])) {
+			ss_error_input("BMI set_value: " ELEVATION " item %d is not finite", k);
+			return BMI_FAILURE;
+		}
+		if (st->bedrock && src[k] < st->bedrock[at]) {
+			ss_error_input("BMI set_value: " ELEVATION " item %d, %g m, is below the "
+			               "bedrock, %g m", k, src[k], st->bedrock[at]);
+			return BMI_FAILURE;
+		}
+	}
+	double added = 0.0;
+	for (int k = 0; k < count; k++) {
+		const ptrdiff_t at = at_of(st, inds ? inds[k] : k);
+		if (ss_cell_type_get(st->cell_types, at) != SS_CELL_FLOW)
+			continue;
+		added += src[k] - st->height[at];
+		st->height[at] = src[k];
+	}
+	s->external += added * st->grid.dx * st->grid.dy;
+	ss_stepper_heights_changed(st);
+	return BMI_SUCCESS;
+}
+
+static int bmi_set_value(struct Bmi *self, const char *name, void *src)
+{
+	struct bmi_state *s = state(self);
+	if (!s || !is_elevation(name) || !src)
+		return BMI_FAILURE;
+	return set_heights(s, NULL, s->cells, src);
+}
+
+static int bmi_set_value_at_indices(struct Bmi *self, const char *name, int *inds, int count,
+                                    void *src)
+{
+	struct bmi_state *s = state(self);
+	if (!s || !is_elevation(name) || (count > 0 && !src) || !indices_ok(s, inds, count))
+		return BMI_FAILURE;
+	return set_heights(s, inds, count, src);
+}
+
+/* ---- grid ----------------------------------------------------------------- */
+
+/* Grid 0: the raster; grid 1: a scalar (the diagnostics). */
+static int bmi_get_grid_rank(struct Bmi *self, int grid, int *rank)
+{
+	if (!state(self) || (grid != 0 && grid != 1) || !rank)
+		return BMI_FAILURE;
+	*rank = grid == 0 ? 2 : 0;
+	return BMI_SUCCESS;
+}
+
+static int bmi_get_grid_size(struct Bmi *self, int grid, int *size)
+{
+	struct bmi_state *s = state(self);
+	if (!s || (grid != 0 && grid != 1) || !size)
+		return BMI_FAILURE;
+	*size = grid == 0 ? s->cells : 1;
+	return BMI_SUCCESS;
+}
+
+static int bmi_get_grid_type(struct Bmi *self, int grid, char *type)
+{
+	if (!state(self) || (grid != 0 && grid != 1) || !type)
+		return BMI_FAILURE;
+	strcpy(type, grid == 0 ? "uniform_rectilinear" : "scalar");
+	return BMI_SUCCESS;
+}
+
+static int bmi_get_grid_shape(struct Bmi *self, int grid, int *shape)
+{
+	struct bmi_state *s = state(self);
+	if (!s || grid != 0 || !shape)
+		return BMI_FAILURE;
+	shape[0] = s->st.grid.ny;
+	shape[1] = s->st.grid.nx;
+	return BMI_SUCCESS;
+}
+
+static int bmi_get_grid_spacing(struct Bmi *self, int grid, double *spacing)
+{
+	struct bmi_state *s = state(self);
+	if (!s || grid != 0 || !spacing)
+		return BMI_FAILURE;
+	spacing[0] = s->st.grid.dy;
+	spacing[1] = s->st.grid.dx;
+	return BMI_SUCCESS;
+}
+
+/* The centre of cell (0, 0), [y, x]: the HDF5 output's y[0] and x[0]. */
+static int bmi_get_grid_origin(struct Bmi *self, int grid, double *origin)
+{
+	struct bmi_state *s = state(self);
+	if (!s || grid != 0 || !origin)
+		return BMI_FAILURE;
+	const struct ss_grid *g = &s->st.grid;
+	origin[0] = g->origin_y + 0.5 * g->dy;
+	origin[1] = g->origin_x + 0.5 * g->dx;
+	return BMI_SUCCESS;
+}
+
+/* Not a grid sandslide has: rectilinear, curvilinear, unstructured. */
+static int no_grid_doubles(struct Bmi *self, int grid, double *v)
+{
+	(void)self, (void)grid, (void)v;
+	return BMI_FAILURE;
+}
+
+static int no_grid_ints(struct Bmi *self, int grid, int *v)
+{
+	(void)self, (void)grid, (void)v;
+	return BMI_FAILURE;
+}
+
+/* ---- registration --------------------------------------------------------- */
+
+struct Bmi *ss_bmi_register(struct Bmi *m)
+{
+	if (!m)
+		return NULL;
+	m->data = NULL;
+	m->initialize = bmi_initialize;
+	m->update = bmi_update;
+	m->update_until = bmi_update_until;
+	m->finalize = bmi_finalize;
+	m->get_component_name = bmi_get_component_name;
+	m->get_input_item_count = bmi_get_input_item_count;
+	m->get_output_item_count = bmi_get_output_item_count;
+	m->get_input_var_names = bmi_get_input_var_names;
+	m->get_output_var_names = bmi_get_output_var_names;
+	m->get_var_grid = bmi_get_var_grid;
+	m->get_var_type = bmi_get_var_type;
+	m->get_var_units = bmi_get_var_units;
+	m->get_var_itemsize = bmi_get_var_itemsize;
+	m->get_var_nbytes = bmi_get_var_nbytes;
+	m->get_var_location = bmi_get_var_location;
+	m->get_current_time = bmi_get_current_time;
+	m->get_start_time = bmi_get_start_time;
+	m->get_end_time = bmi_get_end_time;
+	m->get_time_units = bmi_get_time_units;
+	m->get_time_step = bmi_get_time_step;
+	m->get_value = bmi_get_value;
+	m->get_value_ptr = bmi_get_value_ptr;
+	m->get_value_at_indices = bmi_get_value_at_indices;
+	m->set_value = bmi_set_value;
+	m->set_value_at_indices = bmi_set_value_at_indices;
+	m->get_grid_rank = bmi_get_grid_rank;
+	m->get_grid_size = bmi_get_grid_size;
+	m->get_grid_type = bmi_get_grid_type;
+	m->get_grid_shape = bmi_get_grid_shape;
+	m->get_grid_spacing = bmi_get_grid_spacing;
+	m->get_grid_origin = bmi_get_grid_origin;
+	m->get_grid_x = no_grid_doubles;
+	m->get_grid_y = no_grid_doubles;
+	m->get_grid_z = no_grid_doubles;
+	m->get_grid_node_count = no_grid_ints;
+	m->get_grid_edge_count = no_grid_ints;
+	m->get_grid_face_count = no_grid_ints;
+	m->get_grid_edge_nodes = no_grid_ints;
+	m->get_grid_face_edges = no_grid_ints;
+	m->get_grid_face_nodes = no_grid_ints;
+	m->get_grid_nodes_per_face = no_grid_ints;
+	return m;
+}
+
+struct Bmi *ss_bmi_create(void)
+{
+	struct Bmi *m = ss_alloc(1, sizeof *m, "a BMI model");
+	return m ? ss_bmi_register(m) : NULL;
+}
+
+void ss_bmi_destroy(struct Bmi *m)
+{
+	if (!m)
+		return;
+	if (m->data)
+		bmi_finalize(m);
+	ss_free(m);
+}
+
+double ss_bmi_external_volume(const struct Bmi *m)
+{
+	const struct bmi_state *s = m ? m->data : NULL;
+	return s ? s->external : 0.0;
+}
