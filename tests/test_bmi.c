@@ -27,8 +27,11 @@
 #define INFLOW "sand__time_integral_of_source_volume_flux"
 #define OUTFLOW "sand__time_integral_of_outflow_volume_flux"
 #define SLOPE "sand_surface__max_of_slope_angle"
-#define NOUT 5
-static const char *const outputs[NOUT] = {ELEV, VOLUME, INFLOW, OUTFLOW, SLOPE};
+#define EXTERNAL "sand__external_volume_change"
+#define RATE "land_surface__net_deposition_rate"
+#define BEDROCK "bedrock_surface__elevation"
+#define NOUT 6
+static const char *const outputs[NOUT] = {ELEV, VOLUME, INFLOW, OUTFLOW, EXTERNAL, SLOPE};
 
 /* A cone slumping towards an open east side: heights change every step. */
 static const char *case_text =
@@ -54,6 +57,18 @@ static void stepper_heights(const struct ss_stepper *st, double *out)
 	for (int j = 0; j < st->grid.ny; j++)
 		for (int i = 0; i < st->grid.nx; i++)
 			out[j * st->grid.nx + i] = st->height[ss_grid_index(&st->grid, i, j)];
+}
+
+/* A scalar output now (NAN if the call fails). */
+static double scalar(struct Bmi *m, const char *name)
+{
+	double x = NAN;
+	return m->get_value(m, name, &x) == BMI_SUCCESS ? x : NAN;
+}
+
+static double external(struct Bmi *m)
+{
+	return scalar(m, EXTERNAL);
 }
 
 static int same_bits(const double *a, const double *b, int n)
@@ -96,10 +111,10 @@ static void info(void)
 		names[v] = var[v];
 	int in = 0, out = 0;
 	CHECK(m->get_component_name(m, name) == BMI_SUCCESS && !strcmp(name, "sandslide"), "name");
-	CHECK(m->get_input_item_count(m, &in) == BMI_SUCCESS && in == 1, "%d inputs", in);
+	CHECK(m->get_input_item_count(m, &in) == BMI_SUCCESS && in == 2, "%d inputs", in);
 	CHECK(m->get_output_item_count(m, &out) == BMI_SUCCESS && out == NOUT, "%d outputs", out);
-	CHECK(m->get_input_var_names(m, names) == BMI_SUCCESS && !strcmp(var[0], ELEV), "%s",
-	      var[0]);
+	CHECK(m->get_input_var_names(m, names) == BMI_SUCCESS && !strcmp(var[0], ELEV) &&
+	      !strcmp(var[1], RATE), "%s, %s", var[0], var[1]);
 	var[0][0] = 0;
 	CHECK(m->get_output_var_names(m, names) == BMI_SUCCESS, "output names");
 	for (int v = 0; v < NOUT; v++)
@@ -147,7 +162,7 @@ static void vars(void)
 	CHECK(m->get_var_nbytes(m, ELEV, &v) == BMI_SUCCESS && v == NX * NY * 8, "nbytes %d", v);
 	CHECK(m->get_var_grid(m, ELEV, &v) == BMI_SUCCESS && v == 0, "grid %d", v);
 	/* the read-only diagnostics: scalars on grid 1 */
-	const char *units[NOUT] = {"m", "m3", "m3", "m3", "deg"};
+	const char *units[NOUT] = {"m", "m3", "m3", "m3", "m3", "deg"};
 	for (int k = 1; k < NOUT; k++) {
 		CHECK(m->get_var_grid(m, outputs[k], &v) == BMI_SUCCESS && v == 1, "%s: grid %d",
 		      outputs[k], v);
@@ -166,6 +181,9 @@ static void vars(void)
 	CHECK(m->get_var_type(m, "sea_water__depth", s) == BMI_FAILURE, "an unknown name");
 	CHECK(m->get_var_grid(m, "sea_water__depth", &v) == BMI_FAILURE && v == 7, "untouched");
 	CHECK(m->get_var_nbytes(m, NULL, &v) == BMI_FAILURE, "no name");
+	CHECK(m->get_var_units(m, RATE, s) == BMI_SUCCESS && !strcmp(s, "m s-1"), "%s", s);
+	CHECK(m->get_var_grid(m, RATE, &v) == BMI_SUCCESS && v == 0, "rate grid %d", v);
+	CHECK(m->get_var_grid(m, BEDROCK, &v) == BMI_FAILURE, "no bedrock in this case");
 	ss_bmi_destroy(m);
 }
 
@@ -317,7 +335,7 @@ static void set_value_round_trips(void)
 	double added = 0.0;
 	for (int c = 0; c < NX * NY; c++)
 		added += (h[c] - before[c]) * 0.1 * 0.12;
-	CHECK_REL(ss_bmi_external_volume(m), added, 1e-12, "the volume set");
+	CHECK_REL(external(m), added, 1e-12, "the volume set");
 	double bad[NX * NY];
 	memcpy(bad, h, sizeof bad);
 	bad[5] = NAN;
@@ -331,7 +349,7 @@ static void set_value_round_trips(void)
 	      "get at an index past the end");
 	CHECK(m->get_value(m, ELEV, back) == BMI_SUCCESS && same_bits(back, h, NX * NY),
 	      "refused sets changed nothing");
-	CHECK_REL(ss_bmi_external_volume(m), added, 1e-12, "nor the volume");
+	CHECK_REL(external(m), added, 1e-12, "nor the volume");
 	inds[1] = 4;
 	CHECK(m->set_value_at_indices(m, ELEV, inds, 2, two) == BMI_SUCCESS, "at indices");
 	CHECK(m->get_value_at_indices(m, ELEV, back, inds, 2) == BMI_SUCCESS && back[0] == 9.0 &&
@@ -455,11 +473,131 @@ static void set_value_leaves_walls(void)
 		CHECK(back[c] == (wall ? before[c] : 0.5), "cell %d: %g", c, back[c]);
 	}
 	CHECK(walls == 4, "four wall cells");
-	CHECK_REL(ss_bmi_external_volume(m), 20 * 0.3 * 0.25, 1e-12, "flow cells counted only");
-	m->finalize(m);
-	CHECK(ss_bmi_external_volume(m) == 0.0, "0 after finalize");
+	CHECK_REL(external(m), 20 * 0.3 * 0.25, 1e-12, "flow cells counted only");
 	ss_bmi_destroy(m);
 	remove(check_file("walled.ini"));
+}
+
+/* The deposition rate is a source: a rate field on a rectangle gives the
+ * bits of the same case with a source pouring that rate there, its volume
+ * is the inflow, and the ledger closes: volume = initial + inflow -
+ * outflow + external. */
+static void rate_is_a_source(void)
+{
+	static const char *walled =
+		"[grid]\nnx = 14\nny = 10\ndx = 0.1\n\n"
+		"[model]\nclosure = coulomb\nrepose_angle = 35\nnu = 0.1\n\n"
+		"[time]\nend = 2\noutput_every = 0.5\n\n"
+		"[boundary]\nwest = wall\neast = open\nsouth = wall\nnorth = wall\n\n"
+		"[initial]\ntype = flat\nheight = 0.05\n";
+	char poured[1024];
+	snprintf(poured, sizeof poured, "%s\n[source pour]\nrect = 0.3 0.2 0.7 0.6\n"
+	         "rate = 0.02\nstart = 0\nstop = 100\n", walled);
+	check_write_file(check_file("flat.ini"), walled);
+	check_write_file(check_file("poured.ini"), poured);
+	struct ss_case c;
+	struct ss_stepper st;
+	int err = ss_case_load(&c, check_file("poured.ini"), NULL, 0);
+	CHECK(!err, "%s", ss_error_last_message());
+	if (err)
+		return;
+	err = ss_setup_stepper(&c, 0, 0, SS_KERNEL_FAST, &st);
+	ss_case_release(&c);
+	CHECK(!err, "%s", ss_error_last_message());
+	if (err)
+		return;
+	const struct ss_advance_options o = {0};
+	CHECK(ss_stepper_advance(&st, 1.5, &o) == SS_ADVANCE_REACHED, "the poured case");
+	double want[NX * NY], got[NX * NY], rate[NX * NY], before[NX * NY];
+	stepper_heights(&st, want);
+	/* the source's cells, as the stepper has them: rate / 0.02 */
+	for (int j = 0; j < NY; j++)
+		for (int i = 0; i < NX; i++) {
+			const double *r = st.source_rate;
+			rate[j * NX + i] = r && r[ss_grid_index(&st.grid, i, j)] > 0.0 ? 0.02 : 0.0;
+		}
+	const double inflow = st.inflow;
+	ss_stepper_release(&st);
+
+	struct Bmi *m = ss_bmi_create();
+	CHECK(m && m->initialize(m, check_file("flat.ini")) == BMI_SUCCESS, "%s",
+	      ss_error_last_message());
+	if (!m || !m->data) {
+		ss_bmi_destroy(m);
+		return;
+	}
+	const double v0 = scalar(m, VOLUME);
+	double back[NX * NY];
+	CHECK(m->set_value(m, RATE, rate) == BMI_SUCCESS, "%s", ss_error_last_message());
+	CHECK(m->get_value(m, RATE, back) == BMI_SUCCESS && same_bits(back, rate, NX * NY),
+	      "the rate set is the rate got");
+	CHECK(m->update_until(m, 1.5) == BMI_SUCCESS, "update_until");
+	CHECK(m->get_value(m, ELEV, got) == BMI_SUCCESS && same_bits(got, want, NX * NY),
+	      "a rate field is not the bits of a source of that rate");
+	CHECK(scalar(m, INFLOW) == inflow, "inflow %.17g, the source's %.17g", scalar(m, INFLOW),
+	      inflow);
+	CHECK_REL(inflow, 0.02 * 1.5 * 0.4 * 0.4, 1e-12, "the rate's volume is the inflow");
+	/* refused rates change neither the field nor what follows */
+	double bad[NX * NY];
+	memcpy(bad, rate, sizeof bad);
+	bad[3 * NX + 4] = INFINITY;
+	CHECK(m->set_value(m, RATE, bad) == BMI_FAILURE, "an infinite rate");
+	int at = 3 * NX + 4;
+	double nan = NAN;
+	CHECK(m->set_value_at_indices(m, RATE, &at, 1, &nan) == BMI_FAILURE, "a NaN rate");
+	CHECK(m->get_value(m, RATE, back) == BMI_SUCCESS && same_bits(back, rate, NX * NY),
+	      "a refused rate changed the field");
+	/* the ledger with all three: a rate, an external set, the outflow */
+	CHECK(m->get_value(m, ELEV, before) == BMI_SUCCESS, "get");
+	for (int k = 0; k < NX * NY; k++)     /* a steep step by the open side */
+		before[k] += k % NX >= NX - 3 ? 0.2 : 0.01;
+	CHECK(m->set_value(m, ELEV, before) == BMI_SUCCESS, "set");
+	for (int k = 0; k < NX * NY; k++)
+		rate[k] = k % NX == NX - 2 ? -0.001 : rate[k];   /* erosion, no bedrock */
+	CHECK(m->set_value(m, RATE, rate) == BMI_SUCCESS, "a negative rate without bedrock: %s",
+	      ss_error_last_message());
+	CHECK(m->update_until(m, 4.0) == BMI_SUCCESS, "update_until 4");
+	const double v = scalar(m, VOLUME), in = scalar(m, INFLOW), out = scalar(m, OUTFLOW),
+	             ext = scalar(m, EXTERNAL);
+	CHECK(out > 0.0 && ext > 0.0, "outflow %g, external %g", out, ext);
+	CHECK_REL(v, v0 + in - out + ext, 1e-12, "volume %.17g = %.17g + %.17g - %.17g + %.17g",
+	          v, v0, in, out, ext);
+	ss_bmi_destroy(m);
+	remove(check_file("flat.ini"));
+	remove(check_file("poured.ini"));
+}
+
+/* A case with a bedrock: the bedrock is an output, and a negative rate
+ * (erosion, which has no floor at the rock) is refused. */
+static void bedrock_and_erosion(void)
+{
+	check_write_file(check_file("rock.asc"), "ncols 4\nnrows 3\nxllcorner 0\n"
+	                 "yllcorner 0\ncellsize 1\n0 0 0 0\n0 0.1 0.1 0\n0 0 0 0\n");
+	check_write_file(check_file("rock.ini"), "[grid]\nnx = 4\nny = 3\ndx = 1\n\n"
+	                 "[model]\nclosure = coulomb\nrepose_angle = 35\nnu = 0.1\n\n"
+	                 "[time]\nend = 10\noutput_every = 1\n\n"
+	                 "[initial]\ntype = flat\nheight = 0.3\nbedrock = rock.asc\n");
+	struct Bmi *m = ss_bmi_create();
+	CHECK(m && m->initialize(m, check_file("rock.ini")) == BMI_SUCCESS, "%s",
+	      ss_error_last_message());
+	if (!m || !m->data) {
+		ss_bmi_destroy(m);
+		return;
+	}
+	int n = 0, grid = -1;
+	CHECK(m->get_output_item_count(m, &n) == BMI_SUCCESS && n == NOUT + 1, "%d outputs", n);
+	CHECK(m->get_var_grid(m, BEDROCK, &grid) == BMI_SUCCESS && grid == 0, "bedrock grid");
+	double rock[12], rate[12] = {0};
+	CHECK(m->get_value(m, BEDROCK, rock) == BMI_SUCCESS && rock[0] == 0.0 &&
+	      rock[5] == 0.1 && rock[6] == 0.1, "bedrock %g %g %g", rock[0], rock[5], rock[6]);
+	rate[5] = -1e-3;
+	CHECK(m->set_value(m, RATE, rate) == BMI_FAILURE, "erosion over a bedrock");
+	rate[5] = 1e-3;
+	CHECK(m->set_value(m, RATE, rate) == BMI_SUCCESS, "deposition over a bedrock");
+	CHECK(m->set_value(m, BEDROCK, rock) == BMI_FAILURE, "the bedrock is an output only");
+	ss_bmi_destroy(m);
+	remove(check_file("rock.asc"));
+	remove(check_file("rock.ini"));
 }
 
 int main(void)
@@ -478,6 +616,8 @@ int main(void)
 	RUN(set_value_round_trips);
 	RUN(set_then_run_is_a_run_from_a_file);
 	RUN(set_value_leaves_walls);
+	RUN(rate_is_a_source);
+	RUN(bedrock_and_erosion);
 	remove(check_file("cone.ini"));
 	rmdir(check_scratch());
 	return check_report();

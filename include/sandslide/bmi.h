@@ -60,18 +60,38 @@
  *                       keep their heights: the boundary holds them); a
  *                       non-finite value, or one below the bedrock, is
  *                       BMI_FAILURE and nothing changes.  The volume the
- *                       set adds (or removes) on flow cells is counted in
- *                       ss_bmi_external_volume, not in the stepper's
- *                       inflow (doc/bmi-status.md).
+ *                       set adds (or removes, < 0) on flow cells is booked
+ *                       in the stepper's ledger as external
+ *                       (ss_stepper_book_external), the output
+ *                       sand__external_volume_change.
+ *   land_surface__net_deposition_rate
+ *                       m s-1, double, grid 0, location "node", input (and
+ *                       readable with get_value): a source added to dh/dt
+ *                       of every flow cell from the next update on, until
+ *                       set again (0 until set), with the case's own
+ *                       sources (ss_stepper_set_rate_field: the same bits
+ *                       as a case source of that rate on those cells).  Its
+ *                       volume is inflow.  Negative is erosion, refused in
+ *                       a case with a bedrock (nothing stops erosion at the
+ *                       rock); a non-finite rate is refused.  Values on
+ *                       wall and open cells are kept but do nothing.
+ *   bedrock_surface__elevation
+ *                       m, double, grid 0, output, only in a case with a
+ *                       bedrock ([initial] bedrock): NaN on wall and open
+ *                       cells.
  *   read-only diagnostics, output only, double, location "node", each on
  *   grid 1 ("scalar": rank 0, size 1, no shape, spacing or origin), the
  *   values of ss_stepper_diagnostics (diagnostics.h) now:
  *     sand__volume                                m3   sand on flow cells
- *     sand__time_integral_of_source_volume_flux   m3   added by sources
+ *     sand__time_integral_of_source_volume_flux   m3   added by sources and
+ *                                                      the deposition rate
  *     sand__time_integral_of_outflow_volume_flux  m3   left by open sides
+ *     sand__external_volume_change                m3   set_value's changes
  *     sand_surface__max_of_slope_angle            deg  steepest sand face
- *   (names in the CSDMS Standard Names' pattern, chosen here; the
- *   outputs are listed elevation first, then these in this order).
+ *   so that volume = initial volume + source - outflow + external, to
+ *   rounding.  (Names in the CSDMS Standard Names' object__quantity
+ *   pattern, chosen here; the outputs are listed in this order: the
+ *   elevation, the bedrock when there is one, then these.)
  *
  * A call with an unknown name, a wrong grid or index, or (for the
  * *_at_indices calls) a count out of range returns BMI_FAILURE and
@@ -184,11 +204,6 @@ struct Bmi *ss_bmi_register(struct Bmi *model);
  * initialize was called without finalize. */
 struct Bmi *ss_bmi_create(void);
 void ss_bmi_destroy(struct Bmi *model);
-
-/* The volume that set_value and set_value_at_indices of
- * land_surface__elevation added to the flow cells since initialize (m^3;
- * negative: removed); 0 before initialize. */
-double ss_bmi_external_volume(const struct Bmi *model);
 
 #if defined(__cplusplus)
 }

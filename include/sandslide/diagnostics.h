@@ -10,6 +10,9 @@ struct ss_diagnostics {
 	double volume;          /* sand on flow cells, sum h dx dy, m^3 */
 	double inflow;          /* cumulative volume added by sources, m^3 */
 	double outflow;         /* cumulative volume that left through open cells, m^3 */
+	double external;        /* cumulative volume put in (or taken out, < 0)
+	                         * by writing heights from outside (the BMI's
+	                         * set_value), m^3; 0 in a run */
 	double max_height;      /* highest flow cell, m */
 	double max_slope_deg;   /* steepest face in sand, degrees: bare bedrock
 	                         * does not count (ss_stepper_max_sand_slope) */

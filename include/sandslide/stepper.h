@@ -151,7 +151,12 @@ struct ss_stepper {
 	                               * (reference kernel only) */
 	double *flux_x, *flux_y;      /* m^2/s per face (reference kernel only) */
 	double *open_flux;            /* m^2/s per open face (fast kernel only) */
-	double *source_rate;          /* m/s, with halo; NULL without sources */
+	double *source_rate;          /* m/s, with halo: the sources that are on
+	                               * plus the rate field; NULL when neither
+	                               * was ever set */
+	double *rate_field;           /* m/s, with halo: a source field set from
+	                               * outside (ss_stepper_set_rate_field; the
+	                               * BMI's deposition rate); NULL: none */
 	double *bedrock;              /* m, with halo; NULL without bedrock
 	                               * (-infinity where no sand lies: walls,
 	                               * open cells, open and wall ghosts) */
@@ -163,7 +168,11 @@ struct ss_stepper {
 	struct ss_source *sources;
 	int source_count;
 	uint64_t sources_on;          /* bit k: source k is active now */
-	double source_rate_max;       /* largest rate of any cell now, m/s */
+	int rate_field_on;            /* rate_field has a non-zero cell */
+	int source_field_on;          /* source_rate is added by the sweep now
+	                               * (a source on, or the rate field) */
+	int source_field_stale;       /* rebuild source_rate at the next step */
+	double source_rate_max;       /* largest |rate| of any cell now, m/s */
 	double source_volume_rate;    /* sum of rate dx dy now, m^3/s */
 
 	struct ss_open_face *open_faces;
@@ -189,6 +198,10 @@ struct ss_stepper {
 	int last_stages;              /* s of the last super-step */
 	double inflow, outflow;       /* cumulative, m^3 */
 	double inflow_sum, inflow_carry;   /* compensated partial sums of them */
+	double external;              /* cumulative volume the caller put in or
+	                               * took out by writing heights, m^3
+	                               * (ss_stepper_book_external) */
+	double external_sum, external_carry;
 	double outflow_sum, outflow_carry; /* (on several ranks: see below) */
 	size_t outflow_batch_bytes;   /* set before ss_stepper_prepare; 0:
 	                               * SS_OUTFLOW_BATCH_BYTES (below) */
@@ -254,6 +267,24 @@ double ss_stepper_memory_bytes(const struct ss_grid *g, enum ss_integrator integ
  * Cells that are not flow cells are ignored. */
 int ss_stepper_add_source(struct ss_stepper *st, const uint8_t *mask,
                           double rate, double start, double stop);
+
+/*
+ * A source field set from outside (the BMI's deposition rate): rate (nx *
+ * ny values, m/s, row-major, south row first) is added to dh/dt of every
+ * flow cell from now on, with the case's sources, until set again (NULL:
+ * none).  Other cells are ignored.  Its volume counts as inflow; the time
+ * step keeps the source rule (stepper.h's top) with the largest |rate|.
+ * A negative rate erodes: refused (SS_ERR_INPUT) on a stepper with a
+ * bedrock, which has no rule to stop erosion at the rock; also refused: a
+ * rate that is not finite.  Nothing is changed when it is refused.  Call
+ * after ss_stepper_prepare, between calls of ss_stepper_advance.
+ */
+int ss_stepper_set_rate_field(struct ss_stepper *st, const double *rate);
+
+/* Book volume_m3 (signed) put on the grid from outside, by writing heights
+ * between calls of ss_stepper_advance, into st->external (compensated, as
+ * the inflow is), so that volume = initial + inflow - outflow + external. */
+void ss_stepper_book_external(struct ss_stepper *st, double volume_m3);
 
 /* A non-erodible bedrock (nx * ny values, m, row-major, south row first):
  * only the sand above it moves, each face limited by the thickness of the

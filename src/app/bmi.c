@@ -15,21 +15,30 @@
 #include "sandslide/stepper.h"
 
 #define ELEVATION "land_surface__elevation"
+#define RATE "land_surface__net_deposition_rate"
 
-/* The variables: the elevation on grid 0 (in and out), and read-only
- * diagnostics of the whole model on grid 1 (a scalar), from
- * ss_stepper_diagnostics. */
-enum var_id { VAR_ELEVATION, VAR_VOLUME, VAR_INFLOW, VAR_OUTFLOW, VAR_SLOPE, VAR_COUNT };
+/* The variables: the elevation and the deposition rate (the inputs) and
+ * the bedrock on grid 0, and read-only diagnostics of the whole model on
+ * grid 1 (a scalar), from ss_stepper_diagnostics.  The bedrock is there
+ * only when the case has one. */
+enum var_id {
+	VAR_ELEVATION, VAR_RATE, VAR_BEDROCK, VAR_VOLUME, VAR_INFLOW, VAR_OUTFLOW,
+	VAR_EXTERNAL, VAR_SLOPE, VAR_COUNT
+};
 
 static const struct var {
 	const char *name, *units;
 	int grid;
+	int input, output;
 } vars[VAR_COUNT] = {
-	[VAR_ELEVATION] = {ELEVATION, "m", 0},
-	[VAR_VOLUME] = {"sand__volume", "m3", 1},
-	[VAR_INFLOW] = {"sand__time_integral_of_source_volume_flux", "m3", 1},
-	[VAR_OUTFLOW] = {"sand__time_integral_of_outflow_volume_flux", "m3", 1},
-	[VAR_SLOPE] = {"sand_surface__max_of_slope_angle", "deg", 1},
+	[VAR_ELEVATION] = {ELEVATION, "m", 0, 1, 1},
+	[VAR_RATE] = {RATE, "m s-1", 0, 1, 0},
+	[VAR_BEDROCK] = {"bedrock_surface__elevation", "m", 0, 0, 1},
+	[VAR_VOLUME] = {"sand__volume", "m3", 1, 0, 1},
+	[VAR_INFLOW] = {"sand__time_integral_of_source_volume_flux", "m3", 1, 0, 1},
+	[VAR_OUTFLOW] = {"sand__time_integral_of_outflow_volume_flux", "m3", 1, 0, 1},
+	[VAR_EXTERNAL] = {"sand__external_volume_change", "m3", 1, 0, 1},
+	[VAR_SLOPE] = {"sand_surface__max_of_slope_angle", "deg", 1, 0, 1},
 };
 
 /* What initialize builds and finalize releases. */
@@ -37,7 +46,8 @@ struct bmi_state {
 	struct ss_stepper st;
 	double end;          /* s: the case's end, or max_time when steady */
 	double step;         /* s: the case's output_every */
-	double external;     /* m^3 added by set_value on flow cells */
+	double *rate;        /* m/s, ny * nx [y][x]: the deposition rate set
+	                      * (the stepper's rate field), 0 until set */
 	int cells;           /* nx * ny (fits an int: checked) */
 };
 
@@ -46,16 +56,16 @@ static struct bmi_state *state(struct Bmi *self)
 	return self ? self->data : NULL;
 }
 
-static int is_elevation(const char *name)
+static int present(const struct bmi_state *s, int v)
 {
-	return name && strcmp(name, ELEVATION) == 0;
+	return v != VAR_BEDROCK || (s && s->st.bedrock);
 }
 
-/* The variable called name, or NULL. */
-static const struct var *find_var(const char *name)
+/* The variable called name that this model has, or NULL. */
+static const struct var *find_var_of(const struct bmi_state *s, const char *name)
 {
 	for (int v = 0; name && v < VAR_COUNT; v++)
-		if (!strcmp(name, vars[v].name))
+		if (!strcmp(name, vars[v].name) && present(s, v))
 			return &vars[v];
 	return NULL;
 }
@@ -76,9 +86,12 @@ static int bmi_initialize(struct Bmi *self, const char *config_file)
 		return BMI_FAILURE;
 	struct ss_case c;
 	int err = ss_case_load(&c, config_file, NULL, 0);
+	const size_t cells = err ? 0 : (size_t)c.nx * (size_t)c.ny;
 	if (!err && (double)c.nx * c.ny * sizeof(double) > INT_MAX)
 		err = ss_error_input("BMI initialize: %s: %d x %d cells is more than the BMI's int "
 		                     "sizes can count", config_file, c.nx, c.ny);
+	if (!err && !(s->rate = ss_alloc(cells, sizeof(double), "the BMI's deposition rate")))
+		err = SS_ERR_FAIL;
 	if (!err)
 		err = ss_setup_stepper(&c, 0, 0, SS_KERNEL_FAST, &s->st);
 	if (!err) {
@@ -88,6 +101,7 @@ static int bmi_initialize(struct Bmi *self, const char *config_file)
 	}
 	ss_case_release(&c);
 	if (err) {
+		ss_free(s->rate);
 		ss_free(s);
 		return BMI_FAILURE;
 	}
@@ -139,6 +153,7 @@ static int bmi_finalize(struct Bmi *self)
 	if (!s)
 		return BMI_FAILURE;
 	ss_stepper_release(&s->st);
+	ss_free(s->rate);
 	ss_free(s);
 	self->data = NULL;
 	return BMI_SUCCESS;
@@ -154,11 +169,26 @@ static int bmi_get_component_name(struct Bmi *self, char *name)
 	return BMI_SUCCESS;
 }
 
+/* The names of the variables that are inputs (or outputs) of this model,
+ * in the table's order, into names (NULL: only counted). */
+static int list_vars(const struct bmi_state *s, int outputs, char **names)
+{
+	int n = 0;
+	for (int v = 0; v < VAR_COUNT; v++) {
+		if (!present(s, v) || !(outputs ? vars[v].output : vars[v].input))
+			continue;
+		if (names)
+			strcpy(names[n], vars[v].name);
+		n++;
+	}
+	return n;
+}
+
 static int bmi_get_input_item_count(struct Bmi *self, int *count)
 {
 	if (!state(self) || !count)
 		return BMI_FAILURE;
-	*count = 1;
+	*count = list_vars(state(self), 0, NULL);
 	return BMI_SUCCESS;
 }
 
@@ -166,35 +196,39 @@ static int bmi_get_output_item_count(struct Bmi *self, int *count)
 {
 	if (!state(self) || !count)
 		return BMI_FAILURE;
-	*count = VAR_COUNT;
+	*count = list_vars(state(self), 1, NULL);
+	return BMI_SUCCESS;
+}
+
+/* names[k] must be room for BMI_MAX_VAR_NAME bytes, for each name */
+static int var_names(struct Bmi *self, int outputs, char **names)
+{
+	const struct bmi_state *s = state(self);
+	if (!s || !names)
+		return BMI_FAILURE;
+	const int n = list_vars(s, outputs, NULL);
+	for (int k = 0; k < n; k++)
+		if (!names[k])
+			return BMI_FAILURE;
+	list_vars(s, outputs, names);
 	return BMI_SUCCESS;
 }
 
 static int bmi_get_input_var_names(struct Bmi *self, char **names)
 {
-	if (!state(self) || !names || !names[0])
-		return BMI_FAILURE;
-	strcpy(names[0], ELEVATION);
-	return BMI_SUCCESS;
+	return var_names(self, 0, names);
 }
 
 static int bmi_get_output_var_names(struct Bmi *self, char **names)
 {
-	if (!state(self) || !names)
-		return BMI_FAILURE;
-	for (int v = 0; v < VAR_COUNT; v++)
-		if (!names[v])
-			return BMI_FAILURE;
-	for (int v = 0; v < VAR_COUNT; v++)
-		strcpy(names[v], vars[v].name);
-	return BMI_SUCCESS;
+	return var_names(self, 1, names);
 }
 
 /* ---- variable information ----------------------------------------------- */
 
 static int bmi_get_var_grid(struct Bmi *self, const char *name, int *grid)
 {
-	const struct var *v = find_var(name);
+	const struct var *v = find_var_of(state(self), name);
 	if (!state(self) || !v || !grid)
 		return BMI_FAILURE;
 	*grid = v->grid;
@@ -204,7 +238,7 @@ static int bmi_get_var_grid(struct Bmi *self, const char *name, int *grid)
 /* text into out for a known variable */
 static int var_text(struct Bmi *self, const char *name, char *out, const char *text)
 {
-	if (!state(self) || !find_var(name) || !out)
+	if (!state(self) || !find_var_of(state(self), name) || !out)
 		return BMI_FAILURE;
 	strcpy(out, text);
 	return BMI_SUCCESS;
@@ -217,7 +251,7 @@ static int bmi_get_var_type(struct Bmi *self, const char *name, char *type)
 
 static int bmi_get_var_units(struct Bmi *self, const char *name, char *units)
 {
-	const struct var *v = find_var(name);
+	const struct var *v = find_var_of(state(self), name);
 	return var_text(self, name, units, v ? v->units : "");
 }
 
@@ -228,7 +262,7 @@ static int bmi_get_var_location(struct Bmi *self, const char *name, char *locati
 
 static int bmi_get_var_itemsize(struct Bmi *self, const char *name, int *size)
 {
-	if (!state(self) || !find_var(name) || !size)
+	if (!state(self) || !find_var_of(state(self), name) || !size)
 		return BMI_FAILURE;
 	*size = (int)sizeof(double);
 	return BMI_SUCCESS;
@@ -237,7 +271,7 @@ static int bmi_get_var_itemsize(struct Bmi *self, const char *name, int *size)
 static int bmi_get_var_nbytes(struct Bmi *self, const char *name, int *nbytes)
 {
 	struct bmi_state *s = state(self);
-	const struct var *v = find_var(name);
+	const struct var *v = find_var_of(state(self), name);
 	if (!s || !v || !nbytes)
 		return BMI_FAILURE;
 	*nbytes = (v->grid == 0 ? s->cells : 1) * (int)sizeof(double);
@@ -285,25 +319,38 @@ static double diagnostic(struct bmi_state *s, const struct var *v)
 	case VAR_VOLUME: return d.volume;
 	case VAR_INFLOW: return d.inflow;
 	case VAR_OUTFLOW: return d.outflow;
+	case VAR_EXTERNAL: return d.external;
 	default: return d.max_slope_deg;
+	}
+}
+
+/* The grid-0 variable v at the flat [y][x] index c: the bedrock is NaN
+ * where no sand can lie (walls, open cells: the stepper's -infinity). */
+static double grid_value(const struct bmi_state *s, const struct var *v, int c)
+{
+	switch (v - vars) {
+	case VAR_RATE: return s->rate[c];
+	case VAR_BEDROCK: {
+		const double b = s->st.bedrock[at_of(&s->st, c)];
+		return isinf(b) ? NAN : b;
+	}
+	default: return s->st.height[at_of(&s->st, c)];
 	}
 }
 
 static int bmi_get_value(struct Bmi *self, const char *name, void *dest)
 {
 	struct bmi_state *s = state(self);
-	const struct var *v = find_var(name);
+	const struct var *v = find_var_of(state(self), name);
 	if (!s || !v || !dest)
 		return BMI_FAILURE;
 	if (v->grid == 1) {
 		*(double *)dest = diagnostic(s, v);
 		return BMI_SUCCESS;
 	}
-	const struct ss_grid *g = &s->st.grid;
 	double *out = dest;
-	for (int j = 0; j < g->ny; j++)
-		memcpy(out + (size_t)j * g->nx, s->st.height + ss_grid_index(g, 0, j),
-		       (size_t)g->nx * sizeof *out);
+	for (int c = 0; c < s->cells; c++)
+		out[c] = grid_value(s, v, c);
 	return BMI_SUCCESS;
 }
 
@@ -330,7 +377,7 @@ static int bmi_get_value_at_indices(struct Bmi *self, const char *name, void *de
                                     int count)
 {
 	struct bmi_state *s = state(self);
-	const struct var *v = find_var(name);
+	const struct var *v = find_var_of(state(self), name);
 	if (!s || !v || (count > 0 && !dest))
 		return BMI_FAILURE;
 	double *out = dest;
@@ -348,15 +395,15 @@ static int bmi_get_value_at_indices(struct Bmi *self, const char *name, void *de
 	if (!indices_ok(s, inds, count))
 		return BMI_FAILURE;
 	for (int k = 0; k < count; k++)
-		out[k] = s->st.height[at_of(&s->st, inds[k])];
+		out[k] = grid_value(s, v, inds[k]);
 	return BMI_SUCCESS;
 }
 
 /* Set the flow cells among inds[0..count-1] (NULL: every cell in order)
- * to src[0..count-1], after checking every value; the volume added goes to
- * s->external.  An index given twice is written twice, in order: the last
- * value stays, and each write's change is counted, so the sum is the net
- * change. */
+ * to src[0..count-1], after checking every value; the volume added is
+ * booked in the stepper's external ledger.  An index given twice is
+ * written twice, in order: the last value stays, and each write's change
+ * is counted, so the sum is the net change. */
 static int set_heights(struct bmi_state *s, const int *inds, int count, const double *src)
 {
 	struct ss_stepper *st = &s->st;
@@ -382,26 +429,59 @@ static int set_heights(struct bmi_state *s, const int *inds, int count, const do
 		added += src[k] - st->height[at];
 		st->height[at] = src[k];
 	}
-	s->external += added * st->grid.dx * st->grid.dy;
+	ss_stepper_book_external(st, added * st->grid.dx * st->grid.dy);
 	ss_stepper_heights_changed(st);
 	return BMI_SUCCESS;
+}
+
+/* The deposition rate at inds (NULL: every cell) becomes src; the stepper
+ * takes the whole field (ss_stepper_set_rate_field checks it: finite, not
+ * negative over a bedrock).  Refused: the field is as it was. */
+static int set_rate(struct bmi_state *s, const int *inds, int count, const double *src)
+{
+	double *saved = ss_alloc((size_t)s->cells, sizeof(double), "the deposition rate");
+	if (!saved)
+		return BMI_FAILURE;
+	memcpy(saved, s->rate, (size_t)s->cells * sizeof(double));
+	for (int k = 0; k < count; k++)
+		s->rate[inds ? inds[k] : k] = src[k];
+	const int err = ss_stepper_set_rate_field(&s->st, s->rate);
+	if (err)
+		memcpy(s->rate, saved, (size_t)s->cells * sizeof(double));
+	ss_free(saved);
+	return err ? BMI_FAILURE : BMI_SUCCESS;
+}
+
+/* The input variable called name: elevation or rate, else NULL. */
+static const struct var *find_input(const struct bmi_state *s, const char *name)
+{
+	const struct var *v = find_var_of(s, name);
+	if (v && !v->input) {
+		ss_error_input("BMI set_value: %s is an output only", name);
+		return NULL;
+	}
+	return v;
 }
 
 static int bmi_set_value(struct Bmi *self, const char *name, void *src)
 {
 	struct bmi_state *s = state(self);
-	if (!s || !is_elevation(name) || !src)
+	const struct var *v = find_input(s, name);
+	if (!s || !v || !src)
 		return BMI_FAILURE;
-	return set_heights(s, NULL, s->cells, src);
+	return v == &vars[VAR_RATE] ? set_rate(s, NULL, s->cells, src)
+	                            : set_heights(s, NULL, s->cells, src);
 }
 
 static int bmi_set_value_at_indices(struct Bmi *self, const char *name, int *inds, int count,
                                     void *src)
 {
 	struct bmi_state *s = state(self);
-	if (!s || !is_elevation(name) || (count > 0 && !src) || !indices_ok(s, inds, count))
+	const struct var *v = find_input(s, name);
+	if (!s || !v || (count > 0 && !src) || !indices_ok(s, inds, count))
 		return BMI_FAILURE;
-	return set_heights(s, inds, count, src);
+	return v == &vars[VAR_RATE] ? set_rate(s, inds, count, src)
+	                            : set_heights(s, inds, count, src);
 }
 
 /* ---- grid ----------------------------------------------------------------- */
@@ -541,10 +621,4 @@ void ss_bmi_destroy(struct Bmi *m)
 	if (m->data)
 		bmi_finalize(m);
 	ss_free(m);
-}
-
-double ss_bmi_external_volume(const struct Bmi *m)
-{
-	const struct bmi_state *s = m ? m->data : NULL;
-	return s ? s->external : 0.0;
 }

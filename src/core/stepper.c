@@ -138,6 +138,7 @@ void ss_stepper_release(struct ss_stepper *st)
 	ss_free(st->rkl2_y0);
 	ss_free(st->bedrock);
 	ss_free(st->source_rate);
+	ss_free(st->rate_field);
 	ss_free(st->edges_in);
 	ss_free(st->row_scratch);
 	ss_free(st->flux_y);
@@ -692,8 +693,9 @@ double ss_stepper_next_source_event(const struct ss_stepper *st, double t)
 	return next;
 }
 
-/* Rebuild the source field when the set of active sources changes; sources
- * are summed in file order, so the field has the same bits every run. */
+/* Rebuild the source field when the set of active sources changes or the
+ * rate field was set; sources are summed in file order and the rate field
+ * last, so the field has the same bits every run. */
 static void sources_update(struct ss_stepper *st)
 {
 	uint64_t on = 0;
@@ -702,12 +704,14 @@ static void sources_update(struct ss_stepper *st)
 		if (s->start <= st->time && st->time < s->stop && s->cell_count_all > 0)
 			on |= UINT64_C(1) << k;
 	}
-	if (on == st->sources_on)
+	if (on == st->sources_on && !st->source_field_stale)
 		return;
 	st->sources_on = on;
+	st->source_field_stale = 0;
+	st->source_field_on = on || st->rate_field_on;
 	st->source_rate_max = 0.0;
 	st->source_volume_rate = 0.0;
-	if (!on) {
+	if (!st->source_field_on) {
 		if (st->kernel == SS_KERNEL_FAST)
 			ss_sweep_fast_mark_sources(&st->fast, &st->grid, NULL);
 		return;
@@ -721,6 +725,9 @@ static void sources_update(struct ss_stepper *st)
 		for (size_t m = 0; m < s->cell_count; m++)
 			st->source_rate[s->cells[m]] += s->rate;
 	}
+	if (st->rate_field_on)
+		for (size_t k = 0; k < n; k++)
+			st->source_rate[k] += st->rate_field[k];
 	/* the volume rate in storage order, deterministic: on several ranks
 	 * one fold carried from rank to rank (the ghost rows between add
 	 * zeros, which change no bit of a sum that starts at +0) */
@@ -728,7 +735,7 @@ static void sources_update(struct ss_stepper *st)
 	ss_comm_fold_start(&volume_rate, 1);
 	for (size_t k = 0; k < n; k++) {
 		volume_rate += st->source_rate[k];
-		rate_max = fmax(rate_max, st->source_rate[k]);
+		rate_max = fmax(rate_max, fabs(st->source_rate[k]));
 	}
 	ss_comm_fold_finish(&volume_rate, 1);
 	ss_comm_reduce(&rate_max, 1, NULL, 0);
@@ -736,6 +743,53 @@ static void sources_update(struct ss_stepper *st)
 	st->source_volume_rate = volume_rate * st->grid.dx * st->grid.dy;
 	if (st->kernel == SS_KERNEL_FAST)
 		ss_sweep_fast_mark_sources(&st->fast, &st->grid, st->source_rate);
+}
+
+int ss_stepper_set_rate_field(struct ss_stepper *st, const double *rate)
+{
+	const struct ss_grid *g = &st->grid;
+	const size_t n = ss_grid_storage_cells(g);
+	int any = 0;
+	if (rate) {
+		/* every value checked before any is kept */
+		for (int j = 0; j < g->ny; j++)
+			for (int i = 0; i < g->nx; i++) {
+				const double r = rate[(size_t)j * g->nx + i];
+				const size_t k = ss_grid_index(g, i, j);
+				if (ss_cell_type_get(st->cell_types, k) != SS_CELL_FLOW)
+					continue;
+				if (!isfinite(r))
+					return ss_error_input("rate field: cell (%d, %d) is %g m/s: "
+					                      "expected a finite rate", i, j, r);
+				if (r < 0.0 && st->bedrock)
+					return ss_error_input("rate field: cell (%d, %d) is %g m/s: a "
+					                      "negative rate (erosion) needs a model "
+					                      "without a bedrock", i, j, r);
+				any |= r != 0.0;
+			}
+		if (!st->source_rate &&
+		    !(st->source_rate = ss_alloc(n, sizeof(double), "source rates")))
+			return SS_ERR_FAIL;
+		if (!st->rate_field &&
+		    !(st->rate_field = ss_alloc(n, sizeof(double), "the rate field")))
+			return SS_ERR_FAIL;
+		memset(st->rate_field, 0, n * sizeof(double));
+		for (int j = 0; j < g->ny; j++)
+			for (int i = 0; i < g->nx; i++) {
+				const size_t k = ss_grid_index(g, i, j);
+				if (ss_cell_type_get(st->cell_types, k) == SS_CELL_FLOW)
+					st->rate_field[k] = rate[(size_t)j * g->nx + i];
+			}
+	}
+	st->rate_field_on = any;
+	st->source_field_stale = 1;
+	return SS_OK;
+}
+
+void ss_stepper_book_external(struct ss_stepper *st, double volume_m3)
+{
+	add_compensated(&st->external_sum, &st->external_carry, volume_m3);
+	st->external = st->external_sum + st->external_carry;
 }
 
 /* The tiles the coming pass sweeps on this rank (the reference sweep:
@@ -880,7 +934,7 @@ static void euler_step(struct ss_stepper *st, double dt)
 	st->tile_sweeps += st->tiles_awake;
 	if (st->kernel == SS_KERNEL_FAST) {
 		st->rate_max = ss_sweep_fast_step(&st->fast, g, &st->face_rule, dt,
-		                                  st->sources_on ? st->source_rate : NULL,
+		                                  st->source_field_on ? st->source_rate : NULL,
 		                                  st->bedrock, st->cell_types, st->height,
 		                                  st->open_flux);
 	} else {
@@ -888,7 +942,7 @@ static void euler_step(struct ss_stepper *st, double dt)
 			ss_sweep_limit(g, &st->tiling, dt, st->height, st->bedrock,
 			               st->flux_x, st->flux_y);
 		st->rate_max = ss_sweep_update(g, &st->tiling, dt, st->flux_x, st->flux_y,
-		                               st->sources_on ? st->source_rate : NULL,
+		                               st->source_field_on ? st->source_rate : NULL,
 		                               st->cell_type_bytes, st->height);
 	}
 	st->seconds_sweep += ss_parallel_wall_seconds() - t0;
@@ -907,7 +961,7 @@ static double rkl2_pass(struct ss_stepper *st, const struct ss_sweep_stage *stag
                         int measured, double *awake)
 {
 	const struct ss_grid *g = &st->grid;
-	const double *src = st->sources_on ? st->source_rate : NULL;
+	const double *src = st->source_field_on ? st->source_rate : NULL;
 	*awake += measured ? st->tiles_awake_here : measure_stage(st);
 	const double t1 = ss_parallel_wall_seconds();
 	double change;
@@ -1033,9 +1087,9 @@ static enum ss_advance_end advance(struct ss_stepper *st, double t_target,
 		double dt = lambda > 0.0 ? st->cfl / (2.0 * lambda * inv_d2) : INFINITY;
 		/* RKL2: stable for every state its stages can reach, also when
 		 * a source is about to raise a flat state past the onset */
-		if (rkl2 && !polish && (lambda > 0.0 || st->sources_on))
+		if (rkl2 && !polish && (lambda > 0.0 || st->source_field_on))
 			dt = fmin(tau_stages, st->rkl2_tau);
-		if (st->sources_on && source_rise / st->source_rate_max < dt)
+		if (st->source_field_on && source_rise / st->source_rate_max < dt)
 			dt = source_rise / st->source_rate_max;
 
 		if (isinf(dt)) {
@@ -1152,6 +1206,7 @@ void ss_stepper_diagnostics(struct ss_stepper *st, struct ss_diagnostics *d)
 	d->volume = volume * g->dx * g->dy;
 	d->inflow = st->inflow;
 	d->outflow = st->outflow;
+	d->external = st->external;
 	d->max_height = max_height;
 	d->max_slope_deg = atan(s_max) * (180.0 / M_PI);
 	d->steps = (double)st->steps;
