@@ -90,6 +90,9 @@ DEB_TEST   := python3-h5py python3-pytest netcdf-bin gdal-bin python3-gdal \
 # render --html's page is tested in headless Chromium through selenium
 # (tests/cli/test_html.py), its screenshot read with PIL
 DEB_TEST   += chromium chromium-driver python3-selenium python3-pil
+# the coupled BMI example's --png (python/examples/wind_deposition.py; its
+# test draws the picture when matplotlib is there)
+DEB_TEST   += python3-matplotlib
 # The benchmarks' real DEMs (tools/real_dems.py, read by
 # tools/time_to_solution.py --workloads relax): the Debian packages that
 # ship them, the reader of R's data files, h5py for the outputs.  About
