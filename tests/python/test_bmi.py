@@ -218,7 +218,8 @@ def test_time(bmi):
 # ---- vars --------------------------------------------------------------------
 
 def test_vars(bmi):
-    units = {ELEV: "m", "sand__volume": "m3", "sand__time_integral_of_source_volume_flux": "m3",
+    units = {ELEV: "m", RATE: "m s-1", "sand__external_volume_change": "m3",
+             "sand__volume": "m3", "sand__time_integral_of_source_volume_flux": "m3",
              "sand__time_integral_of_outflow_volume_flux": "m3",
              "sand_surface__max_of_slope_angle": "deg"}
     for name in set(bmi.get_input_var_names() + bmi.get_output_var_names()):
@@ -427,3 +428,67 @@ def test_set_value_then_update_until_is_a_run_from_a_file(tmp_path, integrator):
     assert same_bits(got, series[1].ravel()), \
         f"{integrator}: set_value + update_until(0.5) is not run's bits from the file"
     assert not same_bits(got, h.ravel()), "the bumps moved"
+
+
+# ---- the deposition rate, the ledger, the bedrock -------------------------------
+
+RATE = "land_surface__net_deposition_rate"
+SCALARS = ("sand__volume", "sand__time_integral_of_source_volume_flux",
+           "sand__time_integral_of_outflow_volume_flux", "sand__external_volume_change")
+
+
+def scalars(m):
+    return [float(m.get_value(n, np.empty(1))[0]) for n in SCALARS]
+
+
+def test_the_rate_input_and_the_ledger(bmi):
+    assert bmi.get_input_var_names() == (ELEV, RATE)
+    assert RATE not in bmi.get_output_var_names()
+    assert bmi.get_var_units(RATE) == "m s-1" and bmi.get_var_grid(RATE) == 0
+    assert bmi.get_var_location(RATE) == "node"
+    assert np.all(bmi.get_value(RATE, np.ones(NX * NY)) == 0.0)      # 0 until set
+    v0 = scalars(bmi)[0]
+    rate = np.zeros((NY, NX))
+    rate[2:5, 3:6] = 1e-3                            # [y][x], row 0 south
+    bmi.set_value(RATE, rate)
+    assert same_bits(bmi.get_value(RATE, np.empty((NY, NX))), rate)
+    bad = rate.copy()
+    bad[4, 4] = np.nan
+    with pytest.raises(sandslide.InputError, match="rate"):
+        bmi.set_value(RATE, bad)
+    with pytest.raises(sandslide.InputError, match="139 items"):
+        bmi.set_value(RATE, rate.ravel()[:-1])
+    assert same_bits(bmi.get_value(RATE, np.empty((NY, NX))), rate), "refused: unchanged"
+    bmi.update()
+    volume, inflow, outflow, external = scalars(bmi)
+    assert inflow == pytest.approx(9 * 1e-3 * 0.25 * DX * DY, rel=1e-12)
+    assert external == 0.0
+    bmi.set_value(ELEV, heights(bmi) + 0.01)         # every cell is a flow cell here
+    volume, inflow, outflow, external = scalars(bmi)
+    assert external == pytest.approx(0.01 * NX * NY * DX * DY, rel=1e-12)
+    bmi.update()
+    volume, inflow, outflow, external = scalars(bmi)
+    assert outflow > 0.0
+    assert volume - v0 == pytest.approx(inflow - outflow + external, rel=1e-12, abs=1e-15)
+
+
+def test_a_bedrock_is_an_output(tmp_path):
+    (tmp_path / "rock.asc").write_text("ncols 4\nnrows 3\nxllcorner 0\nyllcorner 0\n"
+                                       "cellsize 1\n0 0 0 0\n0 0.1 0.1 0\n0 0 0 0\n")
+    (tmp_path / "rock.ini").write_text(
+        "[grid]\nnx = 4\nny = 3\ndx = 1\n\n[model]\nclosure = coulomb\nrepose_angle = 35\n"
+        "nu = 0.1\n\n[time]\nend = 10\noutput_every = 1\n\n"
+        "[initial]\ntype = flat\nheight = 0.3\nbedrock = rock.asc\n")
+    with SandslideBmi() as m:
+        m.initialize(str(tmp_path / "rock.ini"))
+        assert m.get_output_var_names()[:2] == (ELEV, "bedrock_surface__elevation")
+        rock = m.get_value("bedrock_surface__elevation", np.empty((3, 4)))
+        assert rock[1, 1] == 0.1 and rock[1, 2] == 0.1 and rock[0, 0] == 0.0
+        rate = np.zeros(12)
+        rate[5] = -1e-3
+        with pytest.raises(sandslide.InputError):     # erosion over a bedrock
+            m.set_value(RATE, rate)
+        with pytest.raises(sandslide.InputError, match="output only"):
+            m.set_value("bedrock_surface__elevation", rock)
+        with pytest.raises(sandslide.InputError, match="below the bedrock"):
+            m.set_value(ELEV, np.full(12, 0.05))
