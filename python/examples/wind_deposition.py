@@ -121,7 +121,7 @@ def check(r):
     volume, outflow = r["sand__volume"], r["sand__time_integral_of_outflow_volume_flux"]
     held = volume - r["v0"] + outflow - r["sand__external_volume_change"]
     # Both sides are sums of roundings: the ledgers are compensated sums
-    # (exact to an ulp or so), the volume a plain sum over the 768 cells;
+    # (exact to an ulp or so), the volume a plain sum over the 480 cells;
     # doc/model.md#conservation asks 1e-12 of the poured volume of any run.
     tol = 1e-12 * r["delivered"]
     assert abs(held - r["delivered"]) <= tol, \
