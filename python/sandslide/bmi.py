@@ -165,21 +165,23 @@ class SandslideBmi(_Base):
 
     # ---- calling C --------------------------------------------------------
 
+    # The C functions that report every failure through error.h, once the
+    # checks here have passed (bmi.c): the case file, the stepper, the
+    # values set.  For the others a message is used only if the call left
+    # a new one (the last message may be an older call's).
+    _REPORTS = {"initialize", "update", "update_until", "set_value", "set_value_at_indices"}
+
     def _call(self, func, *args, error=InputError, what=None):
-        """The C function func(self, *args); error(message) on BMI_FAILURE.
-        The library's message is used when the call left a new one (the C
-        BMI reports through error.h on the failures that Python cannot
-        check beforehand: the case file, the stepper, the values set)."""
+        """The C function func(self, *args); error(message) on BMI_FAILURE,
+        with the library's message where it gave one."""
         with _native.lock:
             before = _native.last_message()
             status = getattr(self._c, func)(self._self, *args)
             after = _native.last_message()
         if status == BMI_SUCCESS:
             return
-        text = f"BMI {what or func}: failed"
-        if after and after != before:
-            text = after
-        raise error(text)
+        fresh = after and (func in self._REPORTS or after != before)
+        raise error(after if fresh else f"BMI {what or func}: failed")
 
     def _ready(self, func):
         if self._vars is None:

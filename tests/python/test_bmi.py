@@ -145,8 +145,9 @@ def test_bootstrap(case, tmp_path):
     with pytest.raises(sandslide.InputError, match="not initialized"):
         m.update()
     m.finalize()                                     # a no-op before initialize
-    with pytest.raises(sandslide.InputError, match="missing.ini"):
-        m.initialize(str(tmp_path / "missing.ini"))
+    for _ in range(2):                               # the message both times
+        with pytest.raises(sandslide.InputError, match="cannot open case file .*missing.ini"):
+            m.initialize(str(tmp_path / "missing.ini"))
     with pytest.raises(sandslide.InputError, match="not initialized"):
         m.get_component_name()                       # nothing kept of it
     assert m.initialize(str(case)) is None
