@@ -31,8 +31,6 @@ except ImportError:   # not on PYTHONPATH: this checkout's
     import sandslide
 from sandslide.bmi import SandslideBmi, UnsupportedError
 
-h5py = pytest.importorskip("h5py")
-
 ELEV = "land_surface__elevation"
 NX, NY, DX, DY = 14, 10, 0.1, 0.12
 # A cone slumping towards an open east side (heights change every step);
@@ -265,6 +263,7 @@ def test_grid(bmi, tmp_path, case):
     origin = np.empty(2)
     assert bmi.get_grid_origin(0, origin) is origin
     # the centre of the south-west cell: the HDF5 output's y[0], x[0]
+    h5py = pytest.importorskip("h5py")
     sandslide.run(case, tmp_path / "cone.h5", threads=1)
     with h5py.File(tmp_path / "cone.h5", "r") as f:
         assert origin[0] == pytest.approx(f["y"][0], abs=1e-12)
@@ -384,6 +383,7 @@ def test_a_refused_set_changes_nothing(case):
 # ---- the bits ----------------------------------------------------------------
 
 def test_k_updates_are_what_run_writes(bmi, case, tmp_path):
+    h5py = pytest.importorskip("h5py")
     sandslide.run(case, tmp_path / "cone.h5", threads=1)
     with h5py.File(tmp_path / "cone.h5", "r") as f:
         times, series = f["time"][:], f["height"][:]
@@ -415,6 +415,7 @@ def test_set_value_then_update_until_is_a_run_from_a_file(tmp_path, integrator):
     rng = np.random.default_rng(27)
     h = 0.2 + 0.15 * rng.random((NY, NX))            # slopes past the repose angle
     write_asc(tmp_path / "bumps.asc", h, DX, 2, -1)
+    h5py = pytest.importorskip("h5py")
     sandslide.run(square, tmp_path / "bumps.h5", threads=1,
                   set={"initial.type": "file", "initial.file": "bumps.asc",
                        "time.end": 0.5, "time.output_every": 0.5})
