@@ -92,6 +92,9 @@ DEB_TEST   := python3-h5py python3-pytest netcdf-bin gdal-bin python3-gdal \
 # render --html's page is tested in headless Chromium through selenium
 # (tests/cli/test_html.py), its screenshot read with PIL
 DEB_TEST   += chromium chromium-driver python3-selenium python3-pil
+# `pip install .` into a fresh virtual environment, offline, with Debian's
+# build tools (tests/python/test_pip.py; pyproject.toml, setup.py)
+DEB_TEST   += python3-pip python3-venv python3-setuptools python3-wheel
 # The benchmarks' real DEMs (tools/real_dems.py, read by
 # tools/time_to_solution.py --workloads relax): the Debian packages that
 # ship them, the reader of R's data files, h5py for the outputs.  About
