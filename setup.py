@@ -24,6 +24,7 @@ The environment reaches make as for any build (CFLAGS, GDAL=0, OPENMP=0).
 """
 import os
 import re
+import shutil
 
 from setuptools import setup
 from setuptools.command.build_py import build_py
@@ -62,6 +63,9 @@ class build_py_with_library(build_py):
         except ExecError as e:
             raise ExecError(f"{e}: building libsandslide failed (`make deps` installs the "
                             f"Debian packages building needs; README.md#install)") from None
+        # the package afresh: a module deleted from python/sandslide must
+        # not live on in the wheel from an earlier build
+        shutil.rmtree(os.path.join(self.build_lib, "sandslide"), ignore_errors=True)
         super().run()
         self.copy_file(os.path.realpath(os.path.join(HERE, "build", SONAME)),
                        self._library_path(), preserve_mode=True)

@@ -147,6 +147,13 @@ def test_the_wheel_is_for_this_platform(venv):
     lib = os.path.join(venv["site"], "sandslide", SONAME)
     assert os.path.isfile(lib) and not os.path.islink(lib), \
         f"the wheel did not put the library into the package as a file: {lib}"
+    with open(os.path.join(venv["site"], dist[0], "RECORD")) as f:
+        held = sorted(line.split(",")[0] for line in f
+                      if line.startswith("sandslide/") and "__pycache__" not in line)
+    expect = sorted([f"sandslide/{n}" for n in os.listdir(os.path.join(ROOT, "python", "sandslide"))
+                     if n.endswith(".py")] + [f"sandslide/{SONAME}"])
+    assert held == expect, f"the wheel holds {held}, expected the checkout's module and " \
+                           f"the library: {expect}"
 
 
 def test_the_installed_module_stands_on_its_own(venv):
