@@ -14,7 +14,7 @@ leaves nothing of it in the venv.
 
 pip (23) builds in the checkout itself, not in a copy: setup.py's `make
 lib` finds build/ up to date and compiles nothing, so the test takes
-about 10 s (5 s of them the venv's own pip) once `make` has run; on a
+about 12 s (5 s of them the venv's own pip) once `make` has run; on a
 checkout never built it first builds the library (about a minute on
 2 cores).  pip runs with no configuration file and no cache, so neither
 the user's settings nor an old wheel get in.  Skipped, saying why, when
