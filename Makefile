@@ -1,6 +1,8 @@
 # sandslide - plain GNU Makefile.
 #
 #   make            build build/sandslide, build/libsandslide.a and .so
+#   make lib        only the shared library build/libsandslide.so.0 (what
+#                   the Python module loads; pip's build runs it, setup.py)
 #   make deps       install the Debian packages building and running need
 #   make deps-test  add those the test suite needs (pytest, GDAL's tools,
 #                   xarray, CDO, ParaView, Chromium and selenium for the
@@ -90,6 +92,9 @@ DEB_TEST   := python3-h5py python3-pytest netcdf-bin gdal-bin python3-gdal \
 # render --html's page is tested in headless Chromium through selenium
 # (tests/cli/test_html.py), its screenshot read with PIL
 DEB_TEST   += chromium chromium-driver python3-selenium python3-pil
+# `pip install .` into a fresh virtual environment, offline, with Debian's
+# build tools (tests/python/test_pip.py; pyproject.toml, setup.py)
+DEB_TEST   += python3-pip python3-venv python3-setuptools python3-wheel
 # The benchmarks' real DEMs (tools/real_dems.py, read by
 # tools/time_to_solution.py --workloads relax): the Debian packages that
 # ship them, the reader of R's data files, h5py for the outputs.  About
@@ -226,11 +231,12 @@ TEST_SRC := $(wildcard tests/test_*.c)
 TEST_BIN := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
 HEADERS  := $(wildcard include/sandslide/*.h)
 
-.PHONY: all deps deps-test deps-bench deps-slurm test check demo clean headers-check check-layering help \
+.PHONY: all lib deps deps-test deps-bench deps-slurm test check demo clean headers-check check-layering help \
         install uninstall
 SONAME   := libsandslide.so.$(SOVERSION)
 SHLIB    := libsandslide.so.$(VERSION)
 all: $(BUILD)/sandslide $(BUILD)/libsandslide.a $(BUILD)/libsandslide.so
+lib: $(BUILD)/libsandslide.so
 
 # A flags stamp: objects rebuild when the flags change (git's GIT-CFLAGS).
 STAMP := $(ALL_CFLAGS) $(PATHFLAGS_avx2) $(PATHFLAGS_avx512) $(ALL_LDFLAGS) $(LIBS)
