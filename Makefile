@@ -388,8 +388,10 @@ endif
 # CLI_TESTS name the C programs (their names: test_api ...) and the CLI
 # test files (pytest's arguments; empty: none) to run, all of them by
 # default; .ci/run narrows them where another part of CI runs the rest.
+# PY_TESTS: the Python module's (pytest's arguments).
 C_TESTS   ?= $(notdir $(TEST_BIN))
 CLI_TESTS ?= tests/cli
+PY_TESTS  ?= tests/python
 test check: all $(TEST_BIN) $(HOOK_BIN) headers-check check-layering $(FUZZ_REPLAY)
 	@fail=0; for t in $(addprefix $(BUILD)/tests/,$(C_TESTS)); do \
 	  echo "== $$t"; OMP_NUM_THREADS=$${OMP_NUM_THREADS:-2} ./$$t || fail=1; \
@@ -404,7 +406,7 @@ test check: all $(TEST_BIN) $(HOOK_BIN) headers-check check-layering $(FUZZ_REPL
 	echo "== tests/python (pytest)"; \
 	$(PY_SAN_ENV) SANDSLIDE=$(abspath $(BUILD)/sandslide) \
 	  SANDSLIDE_LIBRARY=$(abspath $(BUILD)/$(SONAME)) PYTHONPATH=python \
-	  $(PYTHON) -m pytest -q -rs tests/python || fail=1; \
+	  $(PYTHON) -m pytest -q -rs $(PY_TESTS) || fail=1; \
 	exit $$fail
 
 # The distributed tests (make MPI=1 test-mpi): the C test of the halo and
