@@ -1,6 +1,8 @@
 # sandslide - plain GNU Makefile.
 #
 #   make            build build/sandslide, build/libsandslide.a and .so
+#   make lib        only the shared library build/libsandslide.so.0 (what
+#                   the Python module loads; pip's build runs it, setup.py)
 #   make deps       install the Debian packages building and running need
 #   make deps-test  add those the test suite needs (pytest, GDAL's tools,
 #                   xarray, CDO, ParaView, Chromium and selenium for the
@@ -93,6 +95,9 @@ DEB_TEST   += chromium chromium-driver python3-selenium python3-pil
 # the coupled BMI example's --png (python/examples/wind_deposition.py; its
 # test draws the picture when matplotlib is there)
 DEB_TEST   += python3-matplotlib
+# `pip install .` into a fresh virtual environment, offline, with Debian's
+# build tools (tests/python/test_pip.py; pyproject.toml, setup.py)
+DEB_TEST   += python3-pip python3-venv python3-setuptools python3-wheel
 # The benchmarks' real DEMs (tools/real_dems.py, read by
 # tools/time_to_solution.py --workloads relax): the Debian packages that
 # ship them, the reader of R's data files, h5py for the outputs.  About
@@ -229,11 +234,12 @@ TEST_SRC := $(wildcard tests/test_*.c)
 TEST_BIN := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
 HEADERS  := $(wildcard include/sandslide/*.h)
 
-.PHONY: all deps deps-test deps-bench deps-slurm test check demo clean headers-check check-layering help \
+.PHONY: all lib deps deps-test deps-bench deps-slurm test check demo clean headers-check check-layering help \
         install uninstall
 SONAME   := libsandslide.so.$(SOVERSION)
 SHLIB    := libsandslide.so.$(VERSION)
 all: $(BUILD)/sandslide $(BUILD)/libsandslide.a $(BUILD)/libsandslide.so
+lib: $(BUILD)/libsandslide.so
 
 # A flags stamp: objects rebuild when the flags change (git's GIT-CFLAGS).
 STAMP := $(ALL_CFLAGS) $(PATHFLAGS_avx2) $(PATHFLAGS_avx512) $(ALL_LDFLAGS) $(LIBS)
@@ -385,8 +391,10 @@ endif
 # CLI_TESTS name the C programs (their names: test_api ...) and the CLI
 # test files (pytest's arguments; empty: none) to run, all of them by
 # default; .ci/run narrows them where another part of CI runs the rest.
+# PY_TESTS: the Python module's (pytest's arguments).
 C_TESTS   ?= $(notdir $(TEST_BIN))
 CLI_TESTS ?= tests/cli
+PY_TESTS  ?= tests/python
 test check: all $(TEST_BIN) $(HOOK_BIN) headers-check check-layering $(FUZZ_REPLAY)
 	@fail=0; for t in $(addprefix $(BUILD)/tests/,$(C_TESTS)); do \
 	  echo "== $$t"; OMP_NUM_THREADS=$${OMP_NUM_THREADS:-2} ./$$t || fail=1; \
@@ -401,7 +409,7 @@ test check: all $(TEST_BIN) $(HOOK_BIN) headers-check check-layering $(FUZZ_REPL
 	echo "== tests/python (pytest)"; \
 	$(PY_SAN_ENV) SANDSLIDE=$(abspath $(BUILD)/sandslide) \
 	  SANDSLIDE_LIBRARY=$(abspath $(BUILD)/$(SONAME)) PYTHONPATH=python \
-	  $(PYTHON) -m pytest -q -rs tests/python || fail=1; \
+	  $(PYTHON) -m pytest -q -rs $(PY_TESTS) || fail=1; \
 	exit $$fail
 
 # The distributed tests (make MPI=1 test-mpi): the C test of the halo and

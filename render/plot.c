@@ -363,16 +363,17 @@ static void data_ranges(const struct panel *pn, struct axis *ax, struct axis *ay
 	finish_range(ay, any_y, ylo, yhi);
 }
 
-/* "1.5e-4" from printf's "1.50e-04". */
-static void short_exponent(double v, int digits, char *out, size_t size)
+/* "1.5e-4" from printf's "1.50e-04"; returns the length snprintf gives
+ * (a label is at most "-1.23456789e-308", digits <= 8, well within its
+ * room: a cut would be a bug, and returning the count tells the compiler
+ * that one was thought of). */
+static int short_exponent(double v, int digits, char *out, size_t size)
 {
 	char buf[LABEL_SIZE * 2];
 	snprintf(buf, sizeof buf, "%.*e", digits, v);
 	char *e = strchr(buf, 'e');
-	if (!e) {
-		snprintf(out, size, "%s", buf);
-		return;
-	}
+	if (!e)
+		return snprintf(out, size, "%s", buf);
 	*e = '\0';
 	const int exponent = atoi(e + 1);
 	if (strchr(buf, '.')) {
@@ -382,7 +383,7 @@ static void short_exponent(double v, int digits, char *out, size_t size)
 		if (*end == '.')
 			*end = '\0';
 	}
-	snprintf(out, size, "%se%d", buf, exponent);
+	return snprintf(out, size, "%se%d", buf, exponent);
 }
 
 /* A tick of a linear axis: v, a multiple of step, as short as tells it

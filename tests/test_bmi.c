@@ -15,6 +15,7 @@
 #include "model/setup.h"
 #include "sandslide/bmi.h"
 #include "sandslide/case.h"
+#include "sandslide/relax.h"
 #include "sandslide/error.h"
 #include "sandslide/run.h"
 #include "sandslide/snapshot.h"
@@ -600,6 +601,101 @@ static void bedrock_and_erosion(void)
 	remove(check_file("rock.ini"));
 }
 
+/* A BMI config naming a case is that case; one naming a DEM is set up as
+ * relax sets it up: update_until(T) gives the bits of relax with
+ * max_time T on the same heights.  Bad configs fail and keep nothing. */
+static void config_names_a_case_or_a_dem(void)
+{
+	enum { DX = 12, DY = 9 };
+	double dem[DX * DY];
+	for (int j = 0; j < DY; j++)
+		for (int i = 0; i < DX; i++) {
+			const double r = hypot(i - 5.5, j - 4.0);
+			dem[j * DX + i] = 0.1 + fmax(0.0, 1.2 * (3.0 - r)) * 0.5;   /* 50 deg flanks */
+		}
+	FILE *f = fopen(check_file("pile.asc"), "w");
+	CHECK(f != NULL, "pile.asc");
+	if (!f)
+		return;
+	fprintf(f, "ncols %d\nnrows %d\nxllcorner 100\nyllcorner 200\ncellsize 0.5\n", DX, DY);
+	for (int j = DY - 1; j >= 0; j--)           /* north row first */
+		for (int i = 0; i < DX; i++)
+			fprintf(f, "%.17g%s", dem[j * DX + i], i == DX - 1 ? "\n" : " ");
+	fclose(f);
+	check_write_file(check_file("dem.cfg"), "; a DEM\n[bmi]\ndem = pile.asc\n"
+	                 "time_step = 0.5\nend = 3\nangle = 33\nnu = 0.1\nsides = open\n");
+	struct Bmi *m = ss_bmi_create();
+	CHECK(m && m->initialize(m, check_file("dem.cfg")) == BMI_SUCCESS, "%s",
+	      ss_error_last_message());
+	if (!m || !m->data) {
+		ss_bmi_destroy(m);
+		return;
+	}
+	int shape[2] = {0, 0};
+	double spacing[2], origin[2], step = 0, end = 0;
+	CHECK(m->get_grid_shape(m, 0, shape) == BMI_SUCCESS && shape[0] == DY && shape[1] == DX,
+	      "shape %d x %d", shape[0], shape[1]);
+	CHECK(m->get_grid_spacing(m, 0, spacing) == BMI_SUCCESS && spacing[0] == 0.5 &&
+	      spacing[1] == 0.5, "spacing");
+	CHECK(m->get_grid_origin(m, 0, origin) == BMI_SUCCESS && origin[0] == 200.25 &&
+	      origin[1] == 100.25, "origin %g %g", origin[0], origin[1]);
+	CHECK(m->get_time_step(m, &step) == BMI_SUCCESS && step == 0.5, "step %g", step);
+	CHECK(m->get_end_time(m, &end) == BMI_SUCCESS && end == 3, "end %g", end);
+	double got[DX * DY], want[DX * DY];
+	CHECK(m->update_until(m, 1.0) == BMI_SUCCESS, "update_until");
+	CHECK(m->get_value(m, ELEV, got) == BMI_SUCCESS, "get_value");
+	ss_bmi_destroy(m);
+	struct ss_relax_options *o = ss_relax_options_create();
+	CHECK(o && !ss_relax_options_set(o, "angle", "33") && !ss_relax_options_set(o, "nu", "0.1") &&
+	      !ss_relax_options_set(o, "sides", "open") &&
+	      !ss_relax_options_set(o, "max-time", "1"), "relax options");
+	CHECK(o && ss_relax_heights(o, DX, DY, 0.5, 0.5, dem, NULL, want, NULL, 0) == SS_OK, "%s",
+	      ss_error_last_message());
+	ss_relax_options_destroy(o);
+	CHECK(same_bits(got, want, DX * DY), "the DEM's update_until(1) is not relax's "
+	      "--max-time 1");
+	CHECK(!same_bits(got, dem, DX * DY), "the pile slid");
+
+	/* a config naming a case is the case */
+	check_write_file(check_file("case.cfg"), "[bmi]\ncase = cone.ini\n");
+	struct Bmi *a = started(), *b = ss_bmi_create();
+	CHECK(b && b->initialize(b, check_file("case.cfg")) == BMI_SUCCESS, "%s",
+	      ss_error_last_message());
+	double ha[NX * NY], hb[NX * NY];
+	if (a && b && b->data) {
+		CHECK(a->update(a) == BMI_SUCCESS && b->update(b) == BMI_SUCCESS, "update");
+		CHECK(a->get_value(a, ELEV, ha) == BMI_SUCCESS &&
+		      b->get_value(b, ELEV, hb) == BMI_SUCCESS && same_bits(ha, hb, NX * NY),
+		      "case = cone.ini is not cone.ini");
+	}
+	ss_bmi_destroy(a);
+	ss_bmi_destroy(b);
+
+	/* refused, each with nothing kept */
+	static const char *const bad[] = {
+		"[bmi]\ndem = pile.asc\n",                                   /* no time_step */
+		"[bmi]\ndem = pile.asc\ncase = cone.ini\ntime_step = 1\n",     /* both */
+		"[bmi]\ndem = pile.asc\ntime_step = 1\nangel = 33\n",          /* unknown key */
+		"[bmi]\ndem = pile.asc\ntime_step = -1\n",
+		"[bmi]\ndem = pile.asc\ntime_step = 1\noutput = x.h5\n",
+		"[bmi]\ncase = cone.ini\nangle = 33\n",
+		"[bmi]\ndem = missing.asc\ntime_step = 1\n",
+		"[bmi]\nend = 3\n",
+		"[bmi]\ncase = cone.ini\n[grid]\nnx = 3\n",
+	};
+	for (size_t k = 0; k < sizeof bad / sizeof *bad; k++) {
+		check_write_file(check_file("bad.cfg"), bad[k]);
+		m = ss_bmi_create();
+		CHECK(m && m->initialize(m, check_file("bad.cfg")) == BMI_FAILURE && !m->data,
+		      "config %zu accepted: %s", k, bad[k]);
+		ss_bmi_destroy(m);
+	}
+	remove(check_file("bad.cfg"));
+	remove(check_file("case.cfg"));
+	remove(check_file("dem.cfg"));
+	remove(check_file("pile.asc"));
+}
+
 int main(void)
 {
 	if (check_scratch_make("ss_test_bmi"))
@@ -618,6 +714,7 @@ int main(void)
 	RUN(set_value_leaves_walls);
 	RUN(rate_is_a_source);
 	RUN(bedrock_and_erosion);
+	RUN(config_names_a_case_or_a_dem);
 	remove(check_file("cone.ini"));
 	rmdir(check_scratch());
 	return check_report();

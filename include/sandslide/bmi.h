@@ -19,12 +19,19 @@
  * The model:
  *   initialize(config)  config is a case file path (doc/case-file.md), read
  *                       with ss_case_load and set up as `sandslide run` sets
- *                       it up (fast kernel, default tiles, one rank).  Any
- *                       call before initialize, or a second initialize
- *                       before finalize, returns BMI_FAILURE.
+ *                       it up (fast kernel, default tiles, one rank); or a
+ *                       BMI config, an INI file whose one section [bmi]
+ *                       names a case (case = room.ini) or a DEM (dem =
+ *                       terrain.tif, time_step and end in s, and relax's
+ *                       options by name: angle = 33), set up as `sandslide
+ *                       relax` sets it up, its CRS check included (bmi.c,
+ *                       doc/bmi.md).  Any call before initialize, or a
+ *                       second initialize before finalize, returns
+ *                       BMI_FAILURE.
  *   time                seconds ("s"); start 0; end the case's [time] end,
- *                       or its max_time with end = steady; the time step is
- *                       the case's output_every.  update advances by one
+ *                       or its max_time with end = steady (a DEM: end, else
+ *                       max_time, else infinity); the time step is the
+ *                       case's output_every (a DEM: time_step).  update advances by one
  *                       step: from a time on a multiple k * output_every to
  *                       (k + 1) * output_every (not clipped at the end: a
  *                       framework may drive the model past it), as `sandslide

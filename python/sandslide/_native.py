@@ -9,10 +9,12 @@ layouts change between versions of the library, names and strings do not.
 The library is looked for in this order, the first that loads wins:
   1. the path in the environment variable SANDSLIDE_LIBRARY (when set, it
      must load: a wrong path is an error, not a reason to try others);
-  2. _library.PATH, written by `make install` beside this file;
-  3. the build tree of a checkout: ../../build/libsandslide.so.0 from
+  2. libsandslide.so.0 beside this file: the copy a wheel carries
+     (`pip install .`, setup.py);
+  3. _library.PATH, written by `make install` beside this file;
+  4. the build tree of a checkout: ../../build/libsandslide.so.0 from
      this folder (PYTHONPATH=python);
-  4. ctypes.util.find_library("sandslide") (the loader's paths).
+  5. ctypes.util.find_library("sandslide") (the loader's paths).
 """
 import ctypes
 import ctypes.util
@@ -42,7 +44,7 @@ class RunError(Error, RuntimeError):
 def _candidates():
     """(description, path or name) in the order they are tried."""
     here = os.path.dirname(os.path.abspath(__file__))
-    out = []
+    out = [("the wheel's copy (pip install)", os.path.join(here, SONAME))]
     try:
         from . import _library
         out.append(("_library.PATH (make install)", _library.PATH))

@@ -5,13 +5,19 @@
  */
 #include "sandslide/bmi.h"
 
+#include <ini.h>
 #include <limits.h>
 #include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
+#include "base/strings.h"
 #include "model/setup.h"
 #include "sandslide/case.h"
+#include "sandslide/dem.h"
 #include "sandslide/error.h"
+#include "sandslide/relax.h"
 #include "sandslide/stepper.h"
 
 #define ELEVATION "land_surface__elevation"
@@ -72,6 +78,209 @@ static const struct var *find_var_of(const struct bmi_state *s, const char *name
 
 /* ---- initialize, run, finalize ------------------------------------------ */
 
+/*
+ * The config initialize takes (doc/bmi.md#the-config): a case file, or an
+ * INI file whose only section, [bmi], names a case file or a DEM:
+ *
+ *     [bmi]
+ *     dem = terrain.tif    ; a raster relax reads, set up as `sandslide relax`
+ *     time_step = 10       ; s: what update advances (needed with dem)
+ *     end = 600            ; s: the end time (default: max_time, else none)
+ *     angle = 33           ; any other key: relax's option of that name
+ *
+ * or `case = room.ini` alone.  File names are relative to the config's
+ * folder.  A file without a [bmi] section is a case file.
+ */
+#define CONFIG_MAX_KEYS 64
+
+struct config {
+	const char *path;
+	int bmi_section, other_section;   /* seen */
+	int count;
+	char *key[CONFIG_MAX_KEYS], *value[CONFIG_MAX_KEYS];
+	int err;                          /* out of memory, too many keys */
+};
+
+static int config_handler(void *user, const char *section, const char *key, const char *value)
+{
+	struct config *c = user;
+	if (strcmp(section, "bmi") != 0) {
+		c->other_section = 1;
+		return 1;
+	}
+	c->bmi_section = 1;
+	if (c->err)
+		return 1;
+	if (c->count == CONFIG_MAX_KEYS) {
+		c->err = ss_error_input("%s: more than %d keys in [bmi]", c->path, CONFIG_MAX_KEYS);
+		return 1;
+	}
+	c->key[c->count] = strdup(key);
+	c->value[c->count] = strdup(value);
+	if (!c->key[c->count] || !c->value[c->count]) {
+		free(c->key[c->count]);
+		free(c->value[c->count]);
+		c->err = ss_error_fail("%s: out of memory", c->path);
+		return 1;
+	}
+	c->count++;
+	return 1;
+}
+
+static void config_release(struct config *c)
+{
+	for (int k = 0; k < c->count; k++) {
+		free(c->key[k]);
+		free(c->value[k]);
+	}
+	c->count = 0;
+}
+
+/* The value of key in [bmi], or NULL. */
+static const char *config_get(const struct config *c, const char *key)
+{
+	for (int k = 0; k < c->count; k++)
+		if (!strcmp(c->key[k], key))
+			return c->value[k];
+	return NULL;
+}
+
+/* name resolved against the config's folder into out. */
+static int config_path(const struct config *c, const char *name, char *out, size_t size)
+{
+	const char *slash = strrchr(c->path, '/');
+	const int dir = name[0] == '/' || !slash ? 0 : (int)(slash - c->path) + 1;
+	if (snprintf(out, size, "%.*s%s", dir, c->path, name) >= (int)size)
+		return ss_error_input("%s: the file name '%s' is too long", c->path, name);
+	return SS_OK;
+}
+
+/* A case file into s (as `sandslide run` sets it up). */
+static int setup_case(struct bmi_state *s, const char *path)
+{
+	struct ss_case c;
+	int err = ss_case_load(&c, path, NULL, 0);
+	if (err)
+		return err;
+	if ((double)c.nx * c.ny * sizeof(double) > INT_MAX)
+		err = ss_error_input("BMI initialize: %s: %d x %d cells is more than the BMI's int "
+		                     "sizes can count", path, c.nx, c.ny);
+	if (!err)
+		err = ss_setup_stepper(&c, 0, 0, SS_KERNEL_FAST, &s->st);
+	if (!err) {
+		s->end = c.steady ? c.model.max_time : c.end;
+		s->step = c.output_every;
+	}
+	ss_case_release(&c);
+	return err;
+}
+
+/* A DEM and relax's options by name into s (as `sandslide relax` sets
+ * it up: its CRS check, nodata, sides, bedrock). */
+static int setup_dem(struct bmi_state *s, const struct config *cf)
+{
+	const char *step = config_get(cf, "time_step"), *end = config_get(cf, "end");
+	if (!step)
+		return ss_error_input("%s: [bmi] with dem needs time_step (s: what update "
+		                      "advances)", cf->path);
+	if (ss_parse_real(step, 0.0, INFINITY, &s->step) || !(s->step > 0.0))
+		return ss_error_input("%s: [bmi] time_step '%s': expected seconds > 0", cf->path,
+		                      step);
+	if (end && (ss_parse_real(end, 0.0, INFINITY, &s->end) || !(s->end > 0.0)))
+		return ss_error_input("%s: [bmi] end '%s': expected seconds > 0", cf->path, end);
+	struct ss_relax_options *o = ss_relax_options_create();
+	if (!o)
+		return SS_ERR_FAIL;
+	char path[4096];
+	int err = SS_OK;
+	for (int k = 0; !err && k < cf->count; k++) {
+		const char *key = cf->key[k], *value = cf->value[k];
+		if (!strcmp(key, "time_step") || !strcmp(key, "end"))
+			continue;
+		if (!strcmp(key, "case"))
+			err = ss_error_input("%s: [bmi] names a case or a dem, not both", cf->path);
+		else if (!strcmp(key, "output") || !strcmp(key, "report") ||
+		         !strcmp(key, "threads") || !strcmp(key, "force") ||
+		         !strcmp(key, "output_every") || !strcmp(key, "output-every"))
+			err = ss_error_input("%s: [bmi] %s: not a BMI setting (the BMI writes no "
+			                     "files; threads: OMP_NUM_THREADS)", cf->path, key);
+		else if (!strcmp(key, "dem") || !strcmp(key, "bedrock")) {
+			if (!(err = config_path(cf, value, path, sizeof path)))
+				err = ss_relax_options_set(o, key, path);
+		} else {
+			/* its message names the key and what it accepts */
+			err = ss_relax_options_set(o, key, value);
+		}
+	}
+	const int pour = o->sand_shape.kind != SS_SHAPE_NONE;
+	if (!err && (pour != !isnan(o->sand_rate) || pour != !isnan(o->sand_duration)))
+		err = ss_error_input("%s: [bmi] add_sand, sand_rate and sand_duration go together",
+		                     cf->path);
+	struct ss_raster dem = {0}, rock = {0};
+	if (!err)
+		err = ss_dem_read(o->dem, NULL, &o->read, &dem);
+	if (!err && (double)dem.nx * dem.ny * sizeof(double) > INT_MAX)
+		err = ss_error_input("BMI initialize: %s: %d x %d cells is more than the BMI's int "
+		                     "sizes can count", o->dem, dem.nx, dem.ny);
+	if (!err && o->bedrock && !(err = ss_dem_read(o->bedrock, "bedrock", &o->read, &rock)) &&
+	    (rock.nx != dem.nx || rock.ny != dem.ny))
+		err = ss_error_input("%s: bedrock %s is %d x %d cells: expected the DEM's %d x %d",
+		                     cf->path, o->bedrock, rock.nx, rock.ny, dem.nx, dem.ny);
+	if (!err) {
+		const struct ss_raster_setup rs = {
+			.model = &o->model, .name = o->dem, .heights = &dem,
+			.dx = o->read.cellsize, .sides = o->sides, .nodata_type = o->nodata_type,
+			.open_level = o->open_level, .bedrock = o->bedrock ? &rock : NULL,
+			.tile_nx = o->tile[0], .tile_ny = o->tile[1],
+			.pour = pour ? &o->sand_shape : NULL, .pour_rate = o->sand_rate,
+			.pour_duration = o->sand_duration,
+		};
+		err = ss_setup_stepper_from_raster(&rs, &s->st);
+	}
+	if (!err && !end)
+		s->end = isfinite(o->model.max_time) ? o->model.max_time : INFINITY;
+	ss_raster_release(&dem);
+	ss_raster_release(&rock);
+	ss_relax_options_destroy(o);
+	return err;
+}
+
+/* The model config_file describes (above) into s. */
+static int setup(struct bmi_state *s, const char *config_file)
+{
+	struct config cf = {.path = config_file};
+	const int line = ini_parse(config_file, config_handler, &cf);
+	int err = cf.err;
+	if (!err && line < 0)
+		err = ss_error_input("BMI initialize: cannot read '%s'", config_file);
+	if (!err && !cf.bmi_section) {
+		config_release(&cf);   /* a case file */
+		return setup_case(s, config_file);
+	}
+	if (!err && line > 0)
+		err = ss_error_input("%s:%d: not a line of an INI file", config_file, line);
+	if (!err && cf.other_section)
+		err = ss_error_input("%s: a BMI config has one section, [bmi] (a case file has "
+		                     "none)", config_file);
+	const char *case_name = config_get(&cf, "case"), *dem = config_get(&cf, "dem");
+	if (!err && !case_name == !dem)
+		err = ss_error_input("%s: [bmi] needs case = CASE.ini or dem = DEM", config_file);
+	if (!err && case_name) {
+		char path[4096];
+		if (cf.count > 1)
+			err = ss_error_input("%s: [bmi] with case takes no other key: the case "
+			                     "file says the rest", config_file);
+		if (!err)
+			err = config_path(&cf, case_name, path, sizeof path);
+		if (!err)
+			err = setup_case(s, path);
+	} else if (!err) {
+		err = setup_dem(s, &cf);
+	}
+	config_release(&cf);
+	return err;
+}
+
 static int bmi_initialize(struct Bmi *self, const char *config_file)
 {
 	if (!self || self->data) {
@@ -80,28 +289,20 @@ static int bmi_initialize(struct Bmi *self, const char *config_file)
 		return BMI_FAILURE;
 	}
 	if (!config_file)
-		return ss_error_input("BMI initialize: no case file given"), BMI_FAILURE;
+		return ss_error_input("BMI initialize: no config file given"), BMI_FAILURE;
 	struct bmi_state *s = ss_alloc(1, sizeof *s, "the BMI state");
 	if (!s)
 		return BMI_FAILURE;
-	struct ss_case c;
-	int err = ss_case_load(&c, config_file, NULL, 0);
-	const size_t cells = err ? 0 : (size_t)c.nx * (size_t)c.ny;
-	if (!err && (double)c.nx * c.ny * sizeof(double) > INT_MAX)
-		err = ss_error_input("BMI initialize: %s: %d x %d cells is more than the BMI's int "
-		                     "sizes can count", config_file, c.nx, c.ny);
-	if (!err && !(s->rate = ss_alloc(cells, sizeof(double), "the BMI's deposition rate")))
-		err = SS_ERR_FAIL;
-	if (!err)
-		err = ss_setup_stepper(&c, 0, 0, SS_KERNEL_FAST, &s->st);
+	int err = setup(s, config_file);
 	if (!err) {
-		s->end = c.steady ? c.model.max_time : c.end;
-		s->step = c.output_every;
-		s->cells = c.nx * c.ny;
+		s->cells = s->st.grid.nx * s->st.grid.ny;
+		if (!(s->rate = ss_alloc((size_t)s->cells, sizeof(double),
+		                         "the BMI's deposition rate"))) {
+			ss_stepper_release(&s->st);
+			err = SS_ERR_FAIL;
+		}
 	}
-	ss_case_release(&c);
 	if (err) {
-		ss_free(s->rate);
 		ss_free(s);
 		return BMI_FAILURE;
 	}
