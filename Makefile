@@ -92,6 +92,9 @@ DEB_TEST   := python3-h5py python3-pytest netcdf-bin gdal-bin python3-gdal \
 # render --html's page is tested in headless Chromium through selenium
 # (tests/cli/test_html.py), its screenshot read with PIL
 DEB_TEST   += chromium chromium-driver python3-selenium python3-pil
+# the coupled BMI example's --png (python/examples/wind_deposition.py; its
+# test draws the picture when matplotlib is there)
+DEB_TEST   += python3-matplotlib
 # `pip install .` into a fresh virtual environment, offline, with Debian's
 # build tools (tests/python/test_pip.py; pyproject.toml, setup.py)
 DEB_TEST   += python3-pip python3-venv python3-setuptools python3-wheel
