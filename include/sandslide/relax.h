@@ -32,6 +32,7 @@
 #include "sandslide/progress.h"
 #include "sandslide/shape.h"
 #include "sandslide/stepper.h"
+#include "sandslide/watch.h"
 
 struct ss_relax_options {
 	const char *dem;                  /* input: path or FILE.h5[:/dataset] */
@@ -104,6 +105,11 @@ void ss_relax_options_destroy(struct ss_relax_options *o);
  * expected degrees in (0, 90)"), options unchanged.  Keys other than the
  * text ones work on any options. */
 int ss_relax_options_set(struct ss_relax_options *o, const char *key, const char *value);
+
+/* Attach watch w (watch.h) to options o: its stop flag becomes their
+ * stop_signal and its callback their progress, replacing any set; w NULL
+ * detaches (no stop signal, no progress).  w must outlive the call. */
+void ss_relax_options_set_watch(struct ss_relax_options *o, struct ss_watch *w);
 
 /* The words of --sides ("wall" or "open": periodic sides make no sense for
  * a DEM) and --nodata ("wall" or "open"); 0, or -1 if word is not one. */

@@ -36,6 +36,7 @@
 #include "sandslide/shape.h"
 #include "sandslide/case.h"
 #include "sandslide/progress.h"
+#include "sandslide/watch.h"
 
 #include "sandslide/run.h"
 #include "sandslide/relax.h"

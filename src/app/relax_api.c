@@ -12,6 +12,14 @@
 
 #include "base/strings.h"
 #include "sandslide/error.h"
+#include "sandslide/watch.h"
+
+void ss_relax_options_set_watch(struct ss_relax_options *o, struct ss_watch *w)
+{
+	o->stop_signal = w ? ss_watch_stop_flag(w) : NULL;
+	o->progress = w ? ss_watch_progress : NULL;
+	o->progress_context = w;
+}
 
 int ss_relax_report_json(const struct ss_relax_options *o, const struct ss_relax_report *r,
                          char *buf, size_t size)

@@ -13,11 +13,15 @@
 #include <string.h>
 #include <sys/resource.h>
 
-/* The last message of this process: in a distributed run only rank 0
+/* The last message of the calling thread: calls on different data may run
+ * at the same time in different threads (the Python module), and each
+ * caller reads its own call's message.  In a distributed run only rank 0
  * prints, and ss_comm_agree has it printed there when another rank failed
- * first (comm.h). */
-static char last_message[SS_ERROR_MESSAGE_MAX];
-/* Set by a program that shows the messages itself (the Python module). */
+ * first (comm.h).  OpenMP's worker threads report nothing: errors are
+ * raised outside the parallel regions. */
+static _Thread_local char last_message[SS_ERROR_MESSAGE_MAX];
+/* Set by a program that shows the messages itself (the Python module):
+ * once, before any call, for the whole process. */
 static int quiet;
 
 void ss_error_set_quiet(int on)
