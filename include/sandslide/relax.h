@@ -173,4 +173,11 @@ int ss_relax_heights(const struct ss_relax_options *o, int nx, int ny, double dx
                      const double *heights, const double *bedrock, double *relaxed,
                      char *report_json, size_t report_size);
 
+/* ss_relax_run with the report as JSON (ss_relax_report_json) into
+ * report_json (report_size bytes): `sandslide relax DEM -o OUT` for
+ * foreign callers, the options (dem, output, force, ...) set by name.  The
+ * files are read, checked (a DEM in degrees is refused) and written as the
+ * command line reads, checks and writes them. */
+int ss_relax_file_json(const struct ss_relax_options *o, char *report_json, size_t report_size);
+
 #endif

@@ -156,3 +156,10 @@ int ss_relax_heights(const struct ss_relax_options *o, int nx, int ny, double dx
 	ss_raster_release(&in);
 	return err;
 }
+
+int ss_relax_file_json(const struct ss_relax_options *o, char *report_json, size_t report_size)
+{
+	struct ss_relax_report r;
+	const int err = ss_relax_run(o, &r);
+	return err ? err : ss_relax_report_json(o, &r, report_json, report_size);
+}
