@@ -317,40 +317,67 @@ def call(options, attach, function, args, *, progress=None, keywords=None, hdf5=
     the worker since it is per thread."""
     watch = Watch()
     attach(options.ptr, watch.ptr)
-    done = {}
+    done = {"status": SS_ERR_FAIL, "message": "sandslide: the call did not return"}
+    # Held while the worker lives, released by it as its last act.  Not
+    # Thread.join: a KeyboardInterrupt inside join() can leave the Thread
+    # marked stopped while it still runs (CPython gh-90882), and the options
+    # would then be freed under the library.  An interrupted acquire() does
+    # not take the lock.
+    running = threading.Lock()
+    running.acquire()
+    # "new" until the worker enters the library ("running"), or "cancelled"
+    # by this thread first (Ctrl-C inside Thread.start): under gate, so that
+    # exactly one of the two happens and this thread knows which.
+    state = ["new"]
+    gate = threading.Lock()
 
     def work():
-        done["status"], done["message"] = SS_ERR_FAIL, "sandslide: the call did not return"
-        status = function(*args)
-        done["status"] = status
-        done["message"] = last_message() if status != SS_OK else ""
+        try:
+            with gate:
+                if state[0] == "cancelled":
+                    return
+                state[0] = "running"
+            status = function(*args)
+            done["status"] = status
+            done["message"] = last_message() if status != SS_OK else ""
+        finally:
+            running.release()
+
+    def wait():
+        """Until the worker is done, in slices; True when Ctrl-C came."""
+        interrupted = False
+        while True:
+            try:
+                if running.acquire(timeout=0.1):
+                    return interrupted
+                if bar is not None and not interrupted:
+                    bar.update(watch.read())
+            except KeyboardInterrupt:
+                # stop the library; a second Ctrl-C while it finishes its
+                # substep changes nothing (it owns the memory and the files)
+                interrupted = True
+                watch.stop()
 
     worker = threading.Thread(target=work, name="sandslide-call", daemon=True)
     bar = None
-    interrupted = False
+    interrupted = finished = False
     locked = hdf5 and not HDF5_THREADSAFE
     if locked:
         hdf5_lock.acquire()
     try:
         bar = Progress(progress) if progress else None
         worker.start()
-        try:
-            while worker.is_alive():
-                worker.join(0.1)
-                if bar is not None:
-                    bar.update(watch.read())
-        except KeyboardInterrupt:
-            interrupted = True
-            watch.stop()
-            while worker.is_alive():
-                try:
-                    worker.join(0.1)
-                except KeyboardInterrupt:
-                    pass
+        interrupted = wait()
+        finished = True
     finally:
-        if worker.is_alive():    # only after an exception other than Ctrl-C
-            watch.stop()
-            worker.join()
+        if not finished:   # an exception in this thread before wait() was done
+            with gate:
+                if state[0] == "new":
+                    state[0] = "cancelled"
+                inside = state[0] == "running"
+            if inside:
+                watch.stop()
+                wait()
         if bar is not None:
             bar.close()
         attach(options.ptr, None)
