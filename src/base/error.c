@@ -125,7 +125,7 @@ void ss_free(void *p)
 
 const char *ss_format_bytes(double bytes, char buf[32])
 {
-	static const char *unit[] = {"B", "KiB", "MiB", "GiB", "TiB", "PiB"};
+	static const char *const unit[] = {"B", "KiB", "MiB", "GiB", "TiB", "PiB"};
 	int u = 0;
 	while (bytes >= 1024.0 && u < 5) {
 		bytes /= 1024.0;
