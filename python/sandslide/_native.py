@@ -272,8 +272,12 @@ class Progress:
         end = f" / {e:.6g} s" if math.isfinite(e) else " s (until steady)"
         return f"t = {t:.6g}{end}, {steps} steps"
 
-    def update(self, reading):
+    def update(self, reading, last=False):
+        """Show reading (Watch.read); last: the call's final one, shown
+        whatever the time since the line before."""
         n, t, e, steps, f, runs = reading
+        if last:
+            f = 1.0   # done, whatever the estimate said
         if n == 0:
             return
         detail = self._detail(t, e, steps, runs)
@@ -284,7 +288,7 @@ class Progress:
             self.bar.refresh()
             return
         now = time.monotonic()
-        if now - self.last < 0.25:
+        if now - self.last < 0.25 and not last:
             return
         self.last = now
         pct = "   ?%" if math.isnan(f) else f"{100 * f:4.0f}%"
@@ -369,6 +373,8 @@ def call(options, attach, function, args, *, progress=None, keywords=None, hdf5=
         worker.start()
         interrupted = wait()
         finished = True
+        if bar is not None and not interrupted and done["status"] == SS_OK:
+            bar.update(watch.read(), last=True)
     finally:
         if not finished:   # an exception in this thread before wait() was done
             with gate:
