@@ -22,6 +22,8 @@ library finishes its substep and writes what it has, and the call raises
 KeyboardInterrupt.  Calls on different data may run at the same time in
 different threads (doc/python.md#threads).
 """
+from __future__ import annotations   # the hints read as written, in help()
+
 import ctypes
 import functools
 import json
@@ -29,9 +31,14 @@ import numbers
 import os
 import tempfile
 import textwrap
-from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
+from typing import TYPE_CHECKING, Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
+import numpy.typing  # noqa: F401  (np.typing in the hints)
+
+if TYPE_CHECKING:   # the hints' other types; neither is needed to run
+    import osgeo.gdal
+    import xarray
 
 from ._native import Error, InputError, RunError  # noqa: F401  (the API)
 from . import _native
@@ -40,7 +47,7 @@ from . import _native
 __all__ = ["relax", "relax_raster", "run", "fit", "options", "version", "Error",
            "InputError", "RunError", "__version__"]
 
-PathLike = Union[str, "os.PathLike[str]"]
+PathLike = Union[str, os.PathLike]
 
 
 def version() -> str:
@@ -222,10 +229,10 @@ def _tile_word(tile):
     return "x".join(str(int(n)) for n in tile) if isinstance(tile, (tuple, list)) else tile
 
 
-def relax(heights: "np.typing.ArrayLike", dx: float, dy: Optional[float] = None,
+def relax(heights: np.typing.ArrayLike, dx: float, dy: Optional[float] = None,
           angle: Optional[float] = None, closure: Optional[str] = None,
           nu: Optional[float] = None, sides: Optional[str] = None,
-          bedrock: "Optional[np.typing.ArrayLike]" = None, tol: Optional[float] = None,
+          bedrock: Optional[np.typing.ArrayLike] = None, tol: Optional[float] = None,
           threads: Optional[int] = None, *, gamma: Optional[float] = None,
           slope_tol: Optional[float] = None, integrator: Optional[str] = None,
           rkl2_max_stages: Optional[int] = None, rkl2_tol: Optional[float] = None,
@@ -402,7 +409,8 @@ def run(case: PathLike, out: PathLike,
 
     Examples
     --------
-    >>> s = sandslide.run("cases/cone.ini", "out/cone.h5", set={{"time.end": 2}})
+    >>> s = sandslide.run("cases/cone.ini", "out/cone.h5",
+    ...                   set={{"time.end": 2}})      # doctest: +SKIP
     >>> s["end"], s["snapshots"]                  # doctest: +SKIP
     ('done', 5)
     """
@@ -449,7 +457,7 @@ def _is_gdal_dataset(source):
         type(source).__module__.split(".")[0] == "osgeo"
 
 
-def relax_raster(source: Union[PathLike, "osgeo.gdal.Dataset"], output: PathLike, *,
+def relax_raster(source: Union[str, os.PathLike, osgeo.gdal.Dataset], output: PathLike, *,
                  force: bool = False, bedrock: Optional[PathLike] = None,
                  threads: Optional[int] = None, progress: bool = False,
                  **relax_keywords: Any) -> Dict[str, Any]:
@@ -504,14 +512,16 @@ def relax_raster(source: Union[PathLike, "osgeo.gdal.Dataset"], output: PathLike
     The library reads, checks and writes the files itself, as the command
     line does: the output's bits equal ``sandslide relax`` on the same
     file, and nodata cells stay nodata (walls by default, nodata="open"
-    lets sand out there).  The output is never the input.  {interrupt}
+    lets sand out there).
+
+    {interrupt}
 
     Examples
     --------
     >>> report = sandslide.relax_raster("terrain.tif", "terrain-relaxed.tif",
     ...                                 angle=33)          # doctest: +SKIP
     >>> from osgeo import gdal
-    >>> ds = gdal.Open("terrain.tif")
+    >>> ds = gdal.Open("terrain.tif")                        # doctest: +SKIP
     >>> report = sandslide.relax_raster(ds, "relaxed.tif", force=True)  # doctest: +SKIP
     """
     keywords = _keywords("relax", rename=(("dem", "source"),))
@@ -685,7 +695,7 @@ fit.__doc__ = fit.__doc__.format(
                                      "best so far"))
 
 
-def open(path: PathLike, *, timedelta: bool = False, **kwargs: Any) -> "xarray.Dataset":
+def open(path: PathLike, *, timedelta: bool = False, **kwargs: Any) -> xarray.Dataset:
     """The output of a run (or of ``relax -o OUT.h5``) as an xarray Dataset.
 
     Parameters
