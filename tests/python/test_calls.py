@@ -148,6 +148,28 @@ def test_two_threads_run_at_once_and_give_the_bits_of_a_lone_call():
     assert same_bits(got["b"], want_b), "thread b's relax differs from a lone call"
 
 
+def test_each_call_has_its_own_thread_count(tmp_path, monkeypatch):
+    (tmp_path / "tiny.ini").write_text(CASE)
+    summaries = {}
+
+    def work(n):
+        summaries[n] = sandslide.run(tmp_path / "tiny.ini", tmp_path / f"t{n}.h5",
+                                     set={"grid.nx": 120, "grid.ny": 120}, threads=n)
+
+    threads = [threading.Thread(target=work, args=(n,)) for n in (1, 2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert [summaries[n]["threads"] for n in (1, 2)] == [1, 2], \
+        f"threads=1 and threads=2 side by side ran with {summaries[1]['threads']} and " \
+        f"{summaries[2]['threads']}"
+    # None: OMP_NUM_THREADS, read at the call, not a count left by a call before
+    monkeypatch.setenv("OMP_NUM_THREADS", "3")
+    s = sandslide.run(tmp_path / "tiny.ini", tmp_path / "t3.h5")
+    assert s["threads"] == 3, f"threads=None with OMP_NUM_THREADS=3 ran with {s['threads']}"
+
+
 def test_errors_in_two_threads_keep_their_own_message():
     said, barrier = {}, threading.Barrier(2)
 
