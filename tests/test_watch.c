@@ -7,7 +7,7 @@
  * reads its progress (steps rising, fraction in 0..1) and stops it, and
  * the relax must then return SS_OK with "interrupted" as its end.  Two
  * threads set different bad options, interleaved: each reads back its own
- * message.  The seed of the surface is printed.
+ * message, and ss_error_adopt hands one to this thread.  The seed of the surface is printed.
  */
 #include "check.h"
 
@@ -125,6 +125,11 @@ static void each_thread_reads_its_own_message(void)
 	      read_back[0]);
 	CHECK(strstr(read_back[1], "'-3'"), "thread 1 reads '%s', not its own message",
 	      read_back[1]);
+	/* a worker's message handed to this thread (render's frames do so) */
+	CHECK(!strstr(ss_error_last_message(), "'95'"), "this thread reads another's message");
+	CHECK(ss_error_adopt(SS_ERR_INPUT, read_back[0]) == SS_ERR_INPUT &&
+	      !strcmp(ss_error_last_message(), read_back[0]),
+	      "adopted '%s', reads '%s'", read_back[0], ss_error_last_message());
 }
 
 int main(void)

@@ -48,6 +48,13 @@ const char *ss_error_last_message(void)
 	return last_message;
 }
 
+int ss_error_adopt(int status, const char *message)
+{
+	if (message != last_message)
+		snprintf(last_message, sizeof last_message, "%s", message);
+	return status;
+}
+
 int ss_error_input(const char *fmt, ...)
 {
 	va_list ap;
