@@ -37,7 +37,8 @@ void ss_watch_stop(struct ss_watch *w);
 /* The last progress reported, from any thread: *time (s, simulated),
  * *end (s; INFINITY: until steady), *steps (substeps since t = 0),
  * *fraction (of the work done, 0..1; NaN when it cannot be told: a relax
- * before its first substep), *runs (a fit's forward runs so far, else 0).
+ * before its first substep; until steady an estimate, at most 0.99),
+ * *runs (a fit's forward runs so far, else 0).
  * Any pointer may be NULL.  Returns the number of reports so far (0: none
  * yet, the values are then 0 and NaN). */
 long long ss_watch_read(const struct ss_watch *w, double *time, double *end, long long *steps,

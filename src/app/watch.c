@@ -88,7 +88,7 @@ static void publish(struct ss_watch *w, double time, double end, long long steps
 /* The fraction done: of the time to the end when there is one; until
  * steady, how far max |dh/dt| has fallen from the first substep's towards
  * the steady tolerance on a log scale (the decay is roughly exponential),
- * never going back. */
+ * never going back; 1 only from the caller, when the call has returned. */
 void ss_watch_progress(void *context, const struct ss_progress *p)
 {
 	struct ss_watch *w = context;
@@ -99,9 +99,11 @@ void ss_watch_progress(void *context, const struct ss_progress *p)
 		if (isnan(w->rate_first))
 			w->rate_first = p->rate_max;
 		const double span = log(w->rate_first / p->steady_tol);
-		f = span > 0.0 ? log(w->rate_first / p->rate_max) / span : 1.0;
+		/* at most 0.99: below the tolerance the steady rule may still wait
+		 * for the last faces to come down to the repose angle */
+		f = fmin(span > 0.0 ? log(w->rate_first / p->rate_max) / span : 1.0, 0.99);
 	} else if (p->steady_tol > 0.0 && p->rate_max == 0.0) {
-		f = 1.0;
+		f = 0.99;
 	}
 	if (!isnan(f)) {
 		f = fmin(fmax(f, w->fraction_max), 1.0);
