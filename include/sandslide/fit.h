@@ -43,7 +43,8 @@ enum ss_fit_cost {
 	SS_FIT_COST_BOTH,       /* height / relief^2 + support_weight * support */
 };
 
-/* What a fit reports as it goes (ss_fit_options.progress). */
+/* What a fit reports as it goes (ss_fit_options.progress): after each
+ * forward run, and after each substep of one. */
 struct ss_fit_progress {
 	const char *closure;    /* being fitted */
 	const char *stage;      /* "grid", "search", "uncertainty", "profile", "front" */

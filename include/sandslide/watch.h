@@ -30,8 +30,9 @@ struct ss_watch;
 struct ss_watch *ss_watch_create(void);
 void ss_watch_destroy(struct ss_watch *w);
 
-/* Ask the watched call to stop after its current substep.  Safe from any
- * thread and from a signal handler (one store to the flag). */
+/* Ask the watched call to stop: it does after its next substep (the
+ * progress callback hands the request to the flag the call reads).  Safe
+ * from any thread and from a signal handler (a lock-free atomic store). */
 void ss_watch_stop(struct ss_watch *w);
 
 /* The last progress reported, from any thread: *time (s, simulated),
@@ -45,7 +46,8 @@ long long ss_watch_read(const struct ss_watch *w, double *time, double *end, lon
                         double *fraction, long long *runs);
 
 /* What the attach functions install, for C callers with their own
- * options: the stop flag, and the callbacks (context: the watch). */
+ * options: the stop flag, and the callbacks (context: the watch), which
+ * must both be installed: the callbacks set the flag on a request. */
 const volatile sig_atomic_t *ss_watch_stop_flag(const struct ss_watch *w);
 void ss_watch_progress(void *context, const struct ss_progress *p);
 void ss_watch_fit_progress(void *context, const struct ss_fit_progress *p);

@@ -11,11 +11,12 @@
  * report, never half of two.  The writer is the library's own thread and
  * never waits on a reader.
  *
- * The stop flag is the volatile sig_atomic_t the options point at (the
- * stepper reads it between substeps, as it reads the CLI's signal flag).
- * It only ever goes from 0 to 1, once: a word-sized aligned store that
- * the reader sees within a substep or two on every platform the library
- * builds for.
+ * The stop flag the options point at is a volatile sig_atomic_t, as the
+ * CLI's signal flag is, read by the stepper after each substep.  Another
+ * thread must not write it (a data race: ThreadSanitizer says so), so
+ * ss_watch_stop sets a C11 atomic request instead, and the progress
+ * callbacks, which run in the thread of the call after each substep,
+ * copy the request into the flag: the stepper sees it one substep later.
  */
 #include "sandslide/watch.h"
 
@@ -25,7 +26,9 @@
 #include "sandslide/error.h"
 
 struct ss_watch {
-	volatile sig_atomic_t stop;       /* 1: stop after this substep */
+	atomic_int stop_request;          /* 1: asked, from any thread */
+	volatile sig_atomic_t stop;       /* 1: stop after this substep; written
+	                                   * only in the thread of the call */
 	atomic_ullong seq;                /* odd while the writer stores */
 	_Atomic double time, end;         /* s */
 	_Atomic double fraction;          /* 0..1, NaN: unknown */
@@ -40,6 +43,7 @@ struct ss_watch *ss_watch_create(void)
 	struct ss_watch *w = ss_alloc(1, sizeof *w, "a watch");
 	if (!w)
 		return NULL;
+	atomic_init(&w->stop_request, 0);
 	w->stop = 0;
 	atomic_init(&w->seq, 0);
 	atomic_init(&w->time, 0.0);
@@ -60,7 +64,15 @@ void ss_watch_destroy(struct ss_watch *w)
 
 void ss_watch_stop(struct ss_watch *w)
 {
-	w->stop = 1;
+	/* lock-free, so also safe in a signal handler (C11 7.14.1.1) */
+	atomic_store_explicit(&w->stop_request, 1, memory_order_relaxed);
+}
+
+/* In the thread of the call: the request becomes the flag it reads. */
+static void hand_over_stop(struct ss_watch *w)
+{
+	if (!w->stop && atomic_load_explicit(&w->stop_request, memory_order_relaxed))
+		w->stop = 1;
 }
 
 const volatile sig_atomic_t *ss_watch_stop_flag(const struct ss_watch *w)
@@ -110,6 +122,7 @@ void ss_watch_progress(void *context, const struct ss_progress *p)
 		w->fraction_max = f;
 	}
 	publish(w, p->time, p->end, p->steps, f, 0);
+	hand_over_stop(w);
 }
 
 void ss_watch_fit_progress(void *context, const struct ss_fit_progress *p)
@@ -117,6 +130,7 @@ void ss_watch_fit_progress(void *context, const struct ss_fit_progress *p)
 	struct ss_watch *w = context;
 	const double f = p->closure_count > 0 ? (double)p->closure_index / p->closure_count : NAN;
 	publish(w, NAN, NAN, 0, f, p->runs);
+	hand_over_stop(w);
 }
 
 long long ss_watch_read(const struct ss_watch *w, double *time, double *end, long long *steps,
