@@ -170,6 +170,38 @@ def test_each_call_has_its_own_thread_count(tmp_path, monkeypatch):
     assert s["threads"] == 3, f"threads=None with OMP_NUM_THREADS=3 ran with {s['threads']}"
 
 
+def test_without_a_thread_safe_hdf5_runs_take_turns(tmp_path, monkeypatch):
+    """The lock that an HDF5 built without thread safety needs (Debian's
+    is thread-safe, so it is forced here): runs do not overlap, and a
+    refused run lets go of it."""
+    monkeypatch.setattr(_native, "HDF5_THREADSAFE", False)
+    (tmp_path / "tiny.ini").write_text(CASE)
+    spans, errors = {}, []
+
+    def work(n):
+        try:
+            t0 = time.monotonic()
+            sandslide.run(tmp_path / "tiny.ini", tmp_path / f"r{n}.h5", threads=1,
+                          set={"grid.nx": 150, "grid.ny": 150, "time.end": 20})
+            spans[n] = (t0, time.monotonic())
+        except BaseException as e:   # noqa: B902 (reported below)
+            errors.append(e)
+
+    with pytest.raises(sandslide.InputError):   # refused inside the lock
+        sandslide.run(tmp_path / "tiny.ini", tmp_path / "no" / "such" / "r.h5")
+    threads = [threading.Thread(target=work, args=(n,)) for n in (1, 2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(timeout=60)
+    assert not errors and len(spans) == 2, f"runs failed or hung: {errors!r}"
+    (a0, a1), (b0, b1) = spans[1], spans[2]
+    ends = sorted([(a0, a1), (b0, b1)])
+    # the second waited for the first: it ended at least its own run time later
+    assert ends[1][1] - ends[0][1] > 0.5 * (ends[0][1] - ends[0][0]), \
+        f"the runs overlapped under the HDF5 lock: {spans}"
+
+
 def test_errors_in_two_threads_keep_their_own_message():
     said, barrier = {}, threading.Barrier(2)
 
