@@ -316,6 +316,10 @@ static int render_frames(const struct ss_render_plan *p, struct ss_render_source
 	const int by_frames = n > 1 && ss_parallel_max_threads() > 1 &&
 	                      (long long)p->image_w * p->image_h <= FRAME_PARALLEL_MAX_PIXELS;
 	int err = SS_OK;
+	/* the first failure's message: reported in the thread that rendered
+	 * the frame, whose last message it is (error.h), and handed to this
+	 * one (shared by the region's threads, written under the critical) */
+	char first[SS_ERROR_MESSAGE_MAX] = "";
 
 	#pragma omp parallel for schedule(dynamic, 1) if(by_frames)
 	for (long long k = 0; k < n; k++) {
@@ -327,11 +331,13 @@ static int render_frames(const struct ss_render_plan *p, struct ss_render_source
 		const int e = render_one(p, s, k, sel[k], dir, html, !by_frames);
 		if (e) {
 			#pragma omp critical(ss_render_first_error)
-			if (!err)
+			if (!err) {
 				err = e;
+				snprintf(first, sizeof first, "%s", ss_error_last_message());
+			}
 		}
 	}
-	return err;
+	return err ? ss_error_adopt(err, first) : SS_OK;
 }
 
 /* The height scale: the options', else the whole file's lowest and

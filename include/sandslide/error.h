@@ -36,10 +36,15 @@ int ss_status_exit_code(int status);
 #define SS_ERROR_MESSAGE_MAX 8192
 /* Print "sandslide: <message>" to stderr (stdout flushed first). */
 void ss_error_print(const char *message);
-/* The last message this process reported ("" for none).  In a run of
- * several ranks only rank 0 prints as it reports; comm.h says how the
- * message of another rank reaches it. */
+/* The last message the calling thread reported ("" for none): calls in
+ * different threads each read their own.  In a run of several ranks only
+ * rank 0 prints as it reports; comm.h says how the message of another rank
+ * reaches it. */
 const char *ss_error_last_message(void);
+/* Make message the calling thread's last, without printing it, and return
+ * status: for a message reported (and printed) in another thread, an
+ * OpenMP worker, handed to the thread that returns the status. */
+int ss_error_adopt(int status, const char *message);
 /* on != 0: report without printing, for a program that shows
  * ss_error_last_message() its own way (the Python module raises it as an
  * exception).  Off by default. */

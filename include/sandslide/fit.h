@@ -43,7 +43,8 @@ enum ss_fit_cost {
 	SS_FIT_COST_BOTH,       /* height / relief^2 + support_weight * support */
 };
 
-/* What a fit reports as it goes (ss_fit_options.progress). */
+/* What a fit reports as it goes (ss_fit_options.progress): after each
+ * forward run, and after each substep of one. */
 struct ss_fit_progress {
 	const char *closure;    /* being fitted */
 	const char *stage;      /* "grid", "search", "uncertainty", "profile", "front" */
@@ -106,6 +107,12 @@ int ss_fit_run(const struct ss_fit_options *o, char **report, char **summary);
 struct ss_fit_options *ss_fit_options_create(void);
 void ss_fit_options_destroy(struct ss_fit_options *o);
 int ss_fit_options_set(struct ss_fit_options *o, const char *key, const char *value);
+
+/* Attach watch w (watch.h) to options o: its stop flag becomes their
+ * stop_signal and its callback their progress, replacing any set; w NULL
+ * detaches (no stop signal, no progress).  w must outlive the call. */
+struct ss_watch;
+void ss_fit_options_set_watch(struct ss_fit_options *o, struct ss_watch *w);
 
 /* ss_fit_run with the report copied into buf (size bytes): SS_ERR_INPUT
  * when it does not fit, saying how many bytes it needs. */

@@ -7,7 +7,10 @@
 
 /* Threads the next parallel region will use. */
 int ss_parallel_max_threads(void);
-/* Use n threads (n >= 1) from now on. */
+/* Use n threads (n >= 1) from now on, in the parallel regions the calling
+ * thread starts: OpenMP keeps the count per thread (its nthreads-var ICV
+ * is the calling task's), so calls in different threads each use their
+ * own; run, relax and fit set it at the start of every call. */
 void ss_parallel_set_threads(int n);
 /* Number of the calling thread in its parallel region (0 outside). */
 int ss_parallel_thread_id(void);

@@ -32,6 +32,7 @@
 #include "sandslide/progress.h"
 #include "sandslide/shape.h"
 #include "sandslide/stepper.h"
+#include "sandslide/watch.h"
 
 struct ss_relax_options {
 	const char *dem;                  /* input: path or FILE.h5[:/dataset] */
@@ -105,6 +106,11 @@ void ss_relax_options_destroy(struct ss_relax_options *o);
  * text ones work on any options. */
 int ss_relax_options_set(struct ss_relax_options *o, const char *key, const char *value);
 
+/* Attach watch w (watch.h) to options o: its stop flag becomes their
+ * stop_signal and its callback their progress, replacing any set; w NULL
+ * detaches (no stop signal, no progress).  w must outlive the call. */
+void ss_relax_options_set_watch(struct ss_relax_options *o, struct ss_watch *w);
+
 /* The words of --sides ("wall" or "open": periodic sides make no sense for
  * a DEM) and --nodata ("wall" or "open"); 0, or -1 if word is not one. */
 int ss_relax_sides_parse(const char *word, enum ss_side_kind *sides);
@@ -166,5 +172,12 @@ int ss_relax_report_json(const struct ss_relax_options *o, const struct ss_relax
 int ss_relax_heights(const struct ss_relax_options *o, int nx, int ny, double dx, double dy,
                      const double *heights, const double *bedrock, double *relaxed,
                      char *report_json, size_t report_size);
+
+/* ss_relax_run with the report as JSON (ss_relax_report_json) into
+ * report_json (report_size bytes): `sandslide relax DEM -o OUT` for
+ * foreign callers, the options (dem, output, force, ...) set by name.  The
+ * files are read, checked (a DEM in degrees is refused) and written as the
+ * command line reads, checks and writes them. */
+int ss_relax_file_json(const struct ss_relax_options *o, char *report_json, size_t report_size);
 
 #endif

@@ -17,6 +17,7 @@
 
 #include "sandslide/option.h"
 #include "sandslide/progress.h"
+#include "sandslide/watch.h"
 
 /* What a run reports after each snapshot is written and flushed. */
 struct ss_run_snapshot {
@@ -127,6 +128,11 @@ void ss_run_options_destroy(struct ss_run_options *o);
  * are copied.  SS_ERR_INPUT names the key and what it accepts, options
  * unchanged. */
 int ss_run_options_set(struct ss_run_options *o, const char *key, const char *value);
+
+/* Attach watch w (watch.h) to options o: its stop flag becomes their
+ * stop_signal and its callback their progress, replacing any set; w NULL
+ * detaches (no stop signal, no progress).  w must outlive the call. */
+void ss_run_options_set_watch(struct ss_run_options *o, struct ss_watch *w);
 
 /* The summary as JSON into buf (size bytes, NUL-terminated): "output",
  * "end" ("done", "steady", "not steady", "interrupted"), "snapshots",

@@ -6,10 +6,11 @@
  *
  * Each header says what its part does; the tiers they belong to are in
  * src/README.md.  The commands as functions (run.h, relax.h, render.h,
- * bench.h) are the usual entry points; the kernel (grid.h, stepper.h,
- * sweep.h) is for programs that drive the time loop themselves.  Every
- * function returns a status (error.h) and prints only error messages, which
- * ss_error_set_quiet() turns off in favour of ss_error_last_message().
+ * bench.h) are the usual entry points, which watch.h lets another thread
+ * stop and follow; the kernel (grid.h, stepper.h, sweep.h) is for programs
+ * that drive the time loop themselves.  Every function returns a status
+ * (error.h) and prints only error messages, which ss_error_set_quiet()
+ * turns off in favour of ss_error_last_message() (the calling thread's).
  */
 #ifndef SANDSLIDE_SANDSLIDE_H
 #define SANDSLIDE_SANDSLIDE_H
@@ -36,6 +37,7 @@
 #include "sandslide/shape.h"
 #include "sandslide/case.h"
 #include "sandslide/progress.h"
+#include "sandslide/watch.h"
 
 #include "sandslide/run.h"
 #include "sandslide/relax.h"

@@ -73,6 +73,13 @@ struct ss_snapshot_meta {
  * and no clean-up at exit, which crashes HDF5 1.10 after a failed close. */
 void ss_snapshot_library_init(void);
 
+/* 1 when the HDF5 library linked serializes its own calls (built
+ * thread-safe: H5is_library_threadsafe), so that calls writing or reading
+ * different files may run in different threads at once; else 0, and the
+ * caller must let one thread at a time into anything that touches HDF5
+ * (run, fit, an .h5 DEM or output). */
+int ss_snapshot_threadsafe(void);
+
 /* Create the output and write the static variables; cell_types are packed
  * in the grid's halo layout (grid.h).  The file is written as "path.partial" and renamed to
  * path when the first snapshot is complete (an existing file of that name is

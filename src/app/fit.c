@@ -259,6 +259,33 @@ static double residuals_at(const struct fit *f, long long k, const double *h, do
 	return sum;
 }
 
+/* The fit's progress as it stands, fitting closure cf, to o->progress. */
+static void report_progress(const struct fit *f, const struct closure_fit *cf)
+{
+	if (!f->o->progress)
+		return;
+	const struct ss_fit_progress p = {
+		ss_closure_name(cf->kind), f->stage, f->current, f->fit_count, f->runs, cf->cost,
+	};
+	f->o->progress(f->o->progress_context, &p);
+}
+
+/* What a forward run's substeps report. */
+struct run_context {
+	const struct fit *f;
+	const struct closure_fit *cf;
+};
+
+/* After each substep of a forward run, the progress again: a caller that
+ * watches from another thread (watch.h) hands its stop request over in the
+ * callback, so a fit stops within a substep, not a whole run. */
+static void substep_progress(void *context, const struct ss_stepper *st)
+{
+	(void)st;
+	const struct run_context *c = context;
+	report_progress(c->f, c->cf);
+}
+
 /*
  * One forward run of closure cf at u through every observation time: the
  * cost (F5) into *cost and, with r, the residuals.  With a finite cut the
@@ -279,7 +306,10 @@ static int forward(struct fit *f, struct closure_fit *cf, const double *u, doubl
 	*cost = 0.0;
 	if (err)
 		return err;
-	struct ss_advance_options adv = {.stop = f->o->stop_signal};
+	const struct run_context rc = {f, cf};
+	struct ss_advance_options adv = {.stop = f->o->stop_signal,
+	                                 .progress = f->o->progress ? substep_progress : NULL,
+	                                 .context = (void *)&rc};
 	long long at = 0;
 	double radius_prev = 0.0;
 	for (long long k = 0; k < f->obs.times; k++) {
@@ -316,12 +346,7 @@ static int forward(struct fit *f, struct closure_fit *cf, const double *u, doubl
 	f->run_seconds += ss_parallel_wall_seconds() - t0;
 	if (*how == RUN_STOPPED)
 		f->interrupted = 1;
-	if (f->o->progress) {
-		const struct ss_fit_progress p = {
-			ss_closure_name(cf->kind), f->stage, f->current, f->fit_count, f->runs, cf->cost,
-		};
-		f->o->progress(f->o->progress_context, &p);
-	}
+	report_progress(f, cf);
 	return err;
 }
 
@@ -890,7 +915,10 @@ static int trace(struct fit *f, struct closure_fit *cf)
 	if (err)
 		return err;
 	f->stage = "front";
-	struct ss_advance_options adv = {.stop = f->o->stop_signal};
+	const struct run_context rc = {f, cf};
+	struct ss_advance_options adv = {.stop = f->o->stop_signal,
+	                                 .progress = f->o->progress ? substep_progress : NULL,
+	                                 .context = (void *)&rc};
 	for (int k = 0; k < TRACE_TIMES; k++) {
 		const double t = f->trace_time[k];
 		if (t > st.time && ss_stepper_advance(&st, t, &adv) != SS_ADVANCE_REACHED)

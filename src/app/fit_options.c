@@ -12,6 +12,7 @@
 
 #include "base/strings.h"
 #include "sandslide/error.h"
+#include "sandslide/watch.h"
 
 static int parse_cost(const char *value, void *field)
 {
@@ -202,4 +203,11 @@ int ss_fit_run_json(const struct ss_fit_options *o, char *buf, size_t size)
 	memcpy(buf, report, n);
 	free(report);
 	return SS_OK;
+}
+
+void ss_fit_options_set_watch(struct ss_fit_options *o, struct ss_watch *w)
+{
+	o->stop_signal = w ? ss_watch_stop_flag(w) : NULL;
+	o->progress = w ? ss_watch_fit_progress : NULL;
+	o->progress_context = w;
 }

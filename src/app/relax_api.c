@@ -12,6 +12,14 @@
 
 #include "base/strings.h"
 #include "sandslide/error.h"
+#include "sandslide/watch.h"
+
+void ss_relax_options_set_watch(struct ss_relax_options *o, struct ss_watch *w)
+{
+	o->stop_signal = w ? ss_watch_stop_flag(w) : NULL;
+	o->progress = w ? ss_watch_progress : NULL;
+	o->progress_context = w;
+}
 
 int ss_relax_report_json(const struct ss_relax_options *o, const struct ss_relax_report *r,
                          char *buf, size_t size)
@@ -147,4 +155,11 @@ int ss_relax_heights(const struct ss_relax_options *o, int nx, int ny, double dx
 	ss_raster_release(&rock);
 	ss_raster_release(&in);
 	return err;
+}
+
+int ss_relax_file_json(const struct ss_relax_options *o, char *report_json, size_t report_size)
+{
+	struct ss_relax_report r;
+	const int err = ss_relax_run(o, &r);
+	return err ? err : ss_relax_report_json(o, &r, report_json, report_size);
 }

@@ -76,8 +76,14 @@ static int restart_case(const struct ss_run_options *o, const struct ss_restart_
 		return ss_error_fail("out of memory");
 	}
 	int m = 0;
-	for (char *line = strtok(copy, "\n"); line && m < n; line = strtok(NULL, "\n"))
-		v[m++] = line;
+	/* split at the newlines, empty lines skipped (not strtok: its state is
+	 * shared by every thread, and two runs may restart at once) */
+	for (char *line = copy, *next; line && m < n; line = next) {
+		if ((next = strchr(line, '\n')))
+			*next++ = '\0';
+		if (*line)
+			v[m++] = line;
+	}
 	err = ss_case_parse(c, o->case_path ? o->case_path : r->case_path, r->case_text, v, m);
 	free(v);
 	free(copy);

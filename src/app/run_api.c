@@ -11,6 +11,14 @@
 
 #include "base/strings.h"
 #include "sandslide/error.h"
+#include "sandslide/watch.h"
+
+void ss_run_options_set_watch(struct ss_run_options *o, struct ss_watch *w)
+{
+	o->stop_signal = w ? ss_watch_stop_flag(w) : NULL;
+	o->progress = w ? ss_watch_progress : NULL;
+	o->progress_context = w;
+}
 
 static const char *end_name(enum ss_run_end end)
 {

@@ -13,11 +13,15 @@
 #include <string.h>
 #include <sys/resource.h>
 
-/* The last message of this process: in a distributed run only rank 0
+/* The last message of the calling thread: calls on different data may run
+ * at the same time in different threads (the Python module), and each
+ * caller reads its own call's message.  In a distributed run only rank 0
  * prints, and ss_comm_agree has it printed there when another rank failed
- * first (comm.h). */
-static char last_message[SS_ERROR_MESSAGE_MAX];
-/* Set by a program that shows the messages itself (the Python module). */
+ * first (comm.h).  OpenMP's worker threads report nothing: errors are
+ * raised outside the parallel regions. */
+static _Thread_local char last_message[SS_ERROR_MESSAGE_MAX];
+/* Set by a program that shows the messages itself (the Python module):
+ * once, before any call, for the whole process. */
 static int quiet;
 
 void ss_error_set_quiet(int on)
@@ -42,6 +46,13 @@ void ss_error_print(const char *message)
 const char *ss_error_last_message(void)
 {
 	return last_message;
+}
+
+int ss_error_adopt(int status, const char *message)
+{
+	if (message != last_message)
+		snprintf(last_message, sizeof last_message, "%s", message);
+	return status;
 }
 
 int ss_error_input(const char *fmt, ...)
@@ -121,7 +132,7 @@ void ss_free(void *p)
 
 const char *ss_format_bytes(double bytes, char buf[32])
 {
-	static const char *unit[] = {"B", "KiB", "MiB", "GiB", "TiB", "PiB"};
+	static const char *const unit[] = {"B", "KiB", "MiB", "GiB", "TiB", "PiB"};
 	int u = 0;
 	while (bytes >= 1024.0 && u < 5) {
 		bytes /= 1024.0;

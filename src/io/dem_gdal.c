@@ -18,6 +18,7 @@
 #ifdef SS_HAVE_GDAL
 
 #include <math.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -29,10 +30,12 @@
 
 static void gdal_start(void)
 {
-	static int registered;
-	if (!registered) {
+	/* atomic: two threads may read rasters at once; both registering is
+	 * harmless (GDALAllRegister locks and skips known drivers) */
+	static atomic_int registered;
+	if (!atomic_load(&registered)) {
 		GDALAllRegister();
-		registered = 1;
+		atomic_store(&registered, 1);
 	}
 	CPLPushErrorHandler(CPLQuietErrorHandler);
 	CPLErrorReset();

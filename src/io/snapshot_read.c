@@ -49,6 +49,12 @@
 #define DEFLATE_MAX_RATIO 1032.0    /* zlib: 1032:1 at most */
 #define BLOCK_BYTES (8ll << 20)     /* rows per block read: about 8 MB */
 
+int ss_snapshot_threadsafe(void)
+{
+	hbool_t safe = 0;
+	return H5is_library_threadsafe(&safe) >= 0 && safe;
+}
+
 static void quiet_hdf5(void)
 {
 	H5Eset_auto2(H5E_DEFAULT, NULL, NULL);

@@ -231,7 +231,9 @@ def test_bad_option_raises_the_cli_message(tmp_path, option, value):
     with pytest.raises(sandslide.InputError) as e:
         sandslide.relax(h0, 1.0, **{option: value})
     assert isinstance(e.value, ValueError) and isinstance(e.value, sandslide.Error)
-    assert said == "sandslide: --" + str(e.value).replace(option, option.replace("_", "-"), 1), \
+    # the CLI's message, its flag named as Python's keyword: --max-time 'x' is max_time='x'
+    flag = "sandslide: --" + option.replace("_", "-") + " "
+    assert said.startswith(flag) and str(e.value) == option + "=" + said[len(flag):], \
         f"{option}={value!r}: Python says {str(e.value)!r}, the CLI {said!r}"
 
 
@@ -250,7 +252,7 @@ def test_bad_arrays_raise_input_errors(heights, words):
 
 def test_bad_cell_size_and_bedrock_raise_input_errors():
     h0 = pile_on_ramp(8, 8)
-    with pytest.raises(sandslide.InputError, match=r"dx '-1': expected m > 0"):
+    with pytest.raises(sandslide.InputError, match=r"dx='-1': expected m > 0"):
         sandslide.relax(h0, -1.0)
     with pytest.raises(sandslide.InputError, match="shape"):
         sandslide.relax(h0, 1.0, bedrock=np.zeros((8, 7)))
@@ -281,16 +283,24 @@ def test_the_defaults_are_the_librarys():
         "relax's table lost its defaults"
     assert table["angle"]["case_key"] == "model.repose_angle", table["angle"]
     params = inspect.signature(sandslide.relax).parameters
+    doc = " ".join(sandslide.relax.__doc__.split())
     for name, p in params.items():
         if name in ("heights", "dx"):
             continue
+        if name == "progress":   # the module's own, not an option of the library
+            assert p.default is False, f"relax(progress={p.default!r}): expected off"
+            continue
         assert p.default is None, f"relax({name}={p.default!r}): a default of its own"
-        if name not in ("dy", "bedrock"):
+        assert f"{name} : " in doc, f"the docstring has no numpydoc entry for {name}"
+        if name not in ("dy", "bedrock", "threads"):
             assert name in table and table[name]["by_name"], \
                 f"relax's keyword {name} is not an option of the library"
-            default = table[name]["default"] or "none"
-            assert f"{name} (default {default})" in sandslide.relax.__doc__, \
-                f"the docstring does not give {name}'s default {default}"
+            default = table[name]["default"]
+            if default is not None:
+                entry = doc[doc.index(f"{name} : "):]
+                entry = entry[:entry.index(" : ", len(name) + 3)]
+                assert f"(library default: {default})" in entry, \
+                    f"the docstring does not give {name}'s default {default}: {entry!r}"
     settable = {n for n, o in table.items() if o["by_name"] and o["kind"] not in ("text",)}
     # what only a file has: its output, the PNG range, the cell size (dx
     # is relax()'s own argument), the series' snapshots
@@ -426,10 +436,15 @@ def test_open_gives_a_dataset(tmp_path, case):
     sandslide.run(case, out, threads=1)
     with sandslide.open(out) as ds:
         assert ds["height"].dims == ("time", "y", "x"), ds["height"].dims
-        # /time in "seconds": elapsed time, timedelta64
-        secs = ds["time"].values / np.timedelta64(1, "s")
-        assert list(secs) == [0.0, 0.5, 1.0], ds["time"].values
+        # /time in "seconds": float seconds by default, so plots read seconds
+        t = ds["time"].values
+        assert t.dtype == np.float64 and list(t) == [0.0, 0.5, 1.0], \
+            f"time is {t!r} ({t.dtype}): expected float seconds 0, 0.5, 1"
         assert ds.sizes["x"] == 20 and ds.sizes["y"] == 16, dict(ds.sizes)
+    with sandslide.open(out, timedelta=True) as ds:
+        secs = ds["time"].values / np.timedelta64(1, "s")
+        assert ds["time"].dtype.kind == "m" and list(secs) == [0.0, 0.5, 1.0], \
+            f"timedelta=True gives {ds['time'].values!r}: expected timedelta64 of 0, 0.5, 1 s"
 
 
 def test_version():
