@@ -30,9 +30,11 @@ functions.
 bmipy is not in Debian: SandslideBmi subclasses bmipy.Bmi when bmipy is
 importable, and has the same methods as a plain class otherwise.
 """
+import contextlib
 import ctypes
 import math
 import os
+import threading
 
 import numpy as np
 
@@ -160,6 +162,7 @@ class SandslideBmi(_Base):
         if not _register(ctypes.addressof(self._c)):
             raise RunError("BMI: ss_bmi_register refused the struct")
         self._self = ctypes.addressof(self._c)
+        self._lock = threading.Lock()
         self._vars = None     # name -> (grid, numpy dtype, item count, is input)
         self._grids = None    # grid id -> (type, rank, size)
 
@@ -174,7 +177,12 @@ class SandslideBmi(_Base):
     def _call(self, func, *args, error=InputError, what=None):
         """The C function func(self, *args); error(message) on BMI_FAILURE,
         with the library's message where it gave one."""
-        with _native.lock:
+        # the library's last message is per thread; one model's calls go
+        # one at a time (its state is not shared between threads), and
+        # initialize may read an HDF5 file (an initial surface from an
+        # output), under the module's HDF5 lock when HDF5 is not thread-safe
+        hdf5 = func == "initialize" and not _native.HDF5_THREADSAFE
+        with self._lock, (_native.hdf5_lock if hdf5 else contextlib.nullcontext()):
             before = _native.last_message()
             status = getattr(self._c, func)(self._self, *args)
             after = _native.last_message()
