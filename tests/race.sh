@@ -11,7 +11,8 @@
 #               walls, open cells and sides, periodic sides, two sources
 #               switching, bedrock limits, tiles 1x3 .. 64x64, 1 and 2
 #               threads; test_physics: the stepper end to end; test_render
-#               (frames split by rows), test_dem, test_closure
+#               (frames split by rows), test_dem, test_closure, test_watch
+#               (a watch read and stopped from another thread)
 #   CLI         a small case with a wall, an open pit, an open side, a source
 #               and a bedrock, through both kernels, --tile 8x4; relax of a
 #               cliff DEM; render of the series (frames between threads) and
@@ -49,7 +50,7 @@ check() {
 	fi
 }
 
-for t in test_sweep test_physics test_render test_dem test_closure; do
+for t in test_sweep test_physics test_render test_dem test_closure test_watch; do
 	check "$t" "$build/tests/$t"
 done
 
