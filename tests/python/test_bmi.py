@@ -17,18 +17,13 @@ import gc
 import inspect
 import math
 import os
-import sys
 
 import numpy as np
 import pytest
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
-try:
-    import sandslide
-except ImportError:   # not on PYTHONPATH: this checkout's
-    sys.path.insert(0, os.path.join(ROOT, "python"))
-    import sandslide
+import sandslide  # conftest.py: this checkout's when not installed
 from sandslide.bmi import SandslideBmi, UnsupportedError
 
 ELEV = "land_surface__elevation"

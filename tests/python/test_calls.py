@@ -23,11 +23,7 @@ import pytest
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
-try:
-    import sandslide
-except ImportError:   # not on PYTHONPATH: this checkout's
-    sys.path.insert(0, os.path.join(ROOT, "python"))
-    import sandslide
+import sandslide  # conftest.py: this checkout's when not installed
 from sandslide import _native
 
 SANDSLIDE = os.environ.get("SANDSLIDE", os.path.join(ROOT, "build", "sandslide"))

@@ -25,11 +25,7 @@ import pytest
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
-try:
-    import sandslide
-except ImportError:   # not on PYTHONPATH: this checkout's
-    sys.path.insert(0, os.path.join(ROOT, "python"))
-    import sandslide
+import sandslide  # conftest.py: this checkout's when not installed
 SANDSLIDE = os.environ.get("SANDSLIDE", os.path.join(ROOT, "build", "sandslide"))
 TAN35 = math.tan(math.radians(35.0))
 SLOPE_TOL = 1e-6          # relax's default --slope-tol
