@@ -709,7 +709,9 @@ def open(path: PathLike, *, timedelta: bool = False, **kwargs: Any) -> xarray.Da
         read nanoseconds).
     **kwargs
         Passed to xarray.open_dataset (a decode_timedelta given here wins
-        over timedelta).
+        over timedelta).  The snapshots are those the file's time counts:
+        a run killed in the middle of a snapshot leaves height one longer,
+        and that unfinished one is left out.
 
     Returns
     -------
@@ -749,5 +751,23 @@ def open(path: PathLike, *, timedelta: bool = False, **kwargs: Any) -> xarray.Da
     if engine is None:
         raise ImportError("sandslide.open needs netCDF4 or h5netcdf for xarray: install "
                           "Debian package python3-netcdf4 (or python3-h5netcdf)")
-    kwargs.setdefault("decode_timedelta", bool(timedelta))
-    return xarray.open_dataset(os.fspath(path), engine=engine, **kwargs)
+    decode = kwargs.pop("decode_timedelta", bool(timedelta))
+    ds = xarray.open_dataset(os.fspath(path), engine=engine, decode_timedelta=False, **kwargs)
+    # A run killed between a snapshot's two flushes leaves height and the
+    # diagnostics one longer than time, which netCDF reads as one more time
+    # that was never written (the default fill value, 9.97e36): the
+    # complete snapshots are the leading ones with a time written
+    # (doc/output.md#written-as-the-run-goes).
+    if "time" in ds.dims and "time" in ds.variables and ds["time"].dtype.kind == "f":
+        t = ds["time"].values
+        written = np.isfinite(t) & (np.abs(t) < 1e36)
+        complete = len(t) if written.all() else int(np.argmin(written))
+        if complete < len(t):
+            ds = ds.isel(time=slice(0, complete))
+        if decode and ds["time"].attrs.get("units") == "seconds":
+            # as xarray decodes units "seconds", after the trim (the fill
+            # value overflows timedelta64)
+            attrs = {k: v for k, v in ds["time"].attrs.items() if k != "units"}
+            ds = ds.assign_coords(time=("time", (ds["time"].values * 1e9).astype(
+                "timedelta64[ns]"), attrs))
+    return ds
