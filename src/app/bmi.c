@@ -54,6 +54,8 @@ struct bmi_state {
 	double step;         /* s: the case's output_every */
 	double *rate;        /* m/s, ny * nx [y][x]: the deposition rate set
 	                      * (the stepper's rate field), 0 until set */
+	double *rate_next;   /* the same room: a set is built here, and the two
+	                      * swap when the stepper takes it */
 	int cells;           /* nx * ny (fits an int: checked) */
 };
 
@@ -296,8 +298,11 @@ static int bmi_initialize(struct Bmi *self, const char *config_file)
 	int err = setup(s, config_file);
 	if (!err) {
 		s->cells = s->st.grid.nx * s->st.grid.ny;
-		if (!(s->rate = ss_alloc((size_t)s->cells, sizeof(double),
-		                         "the BMI's deposition rate"))) {
+		s->rate = ss_alloc((size_t)s->cells, sizeof(double), "the BMI's deposition rate");
+		s->rate_next = ss_alloc((size_t)s->cells, sizeof(double), "the BMI's deposition rate");
+		if (!s->rate || !s->rate_next) {
+			ss_free(s->rate);
+			ss_free(s->rate_next);
 			ss_stepper_release(&s->st);
 			err = SS_ERR_FAIL;
 		}
@@ -355,6 +360,7 @@ static int bmi_finalize(struct Bmi *self)
 		return BMI_FAILURE;
 	ss_stepper_release(&s->st);
 	ss_free(s->rate);
+	ss_free(s->rate_next);
 	ss_free(s);
 	self->data = NULL;
 	return BMI_SUCCESS;
@@ -640,17 +646,15 @@ static int set_heights(struct bmi_state *s, const int *inds, int count, const do
  * negative over a bedrock).  Refused: the field is as it was. */
 static int set_rate(struct bmi_state *s, const int *inds, int count, const double *src)
 {
-	double *saved = ss_alloc((size_t)s->cells, sizeof(double), "the deposition rate");
-	if (!saved)
-		return BMI_FAILURE;
-	memcpy(saved, s->rate, (size_t)s->cells * sizeof(double));
+	memcpy(s->rate_next, s->rate, (size_t)s->cells * sizeof(double));
 	for (int k = 0; k < count; k++)
-		s->rate[inds ? inds[k] : k] = src[k];
-	const int err = ss_stepper_set_rate_field(&s->st, s->rate);
-	if (err)
-		memcpy(s->rate, saved, (size_t)s->cells * sizeof(double));
-	ss_free(saved);
-	return err ? BMI_FAILURE : BMI_SUCCESS;
+		s->rate_next[inds ? inds[k] : k] = src[k];
+	if (ss_stepper_set_rate_field(&s->st, s->rate_next))
+		return BMI_FAILURE;
+	double *taken = s->rate_next;
+	s->rate_next = s->rate;
+	s->rate = taken;
+	return BMI_SUCCESS;
 }
 
 /* The input variable called name: elevation or rate, else NULL. */
