@@ -152,8 +152,9 @@ _register = _prototype("ss_bmi_register", _P, [_P])
 class SandslideBmi(_Base):
     """sandslide behind the Basic Model Interface 2.0 (bmipy's Bmi).
 
-    SandslideBmi() makes an uninitialized model; initialize(case_file)
-    sets up a case as `sandslide run` does; finalize() releases it (also
+    SandslideBmi() makes an uninitialized model; initialize(config) sets
+    up a case file, or a [bmi] config naming a case or a DEM
+    (doc/bmi.md#the-config); finalize() releases it (also
     on leaving a `with` block, or when the object is collected).  Every
     other call before initialize raises sandslide.Error."""
 
@@ -248,9 +249,11 @@ class SandslideBmi(_Base):
     # ---- initialize, run, finalize ----------------------------------------
 
     def initialize(self, config_file):
-        """Set up the case file config_file (doc/case-file.md) as `sandslide
-        run` does.  InputError for a case the library refuses, or when the
-        model is already initialized (finalize first)."""
+        """Set up config_file: a case file (doc/case-file.md), set up as
+        `sandslide run` does, or a BMI config whose [bmi] section names a
+        case or a DEM with relax's options (doc/bmi.md#the-config).
+        InputError for a config the library refuses, or when the model is
+        already initialized (finalize first)."""
         if self._vars is not None:
             raise InputError("BMI initialize: already initialized (finalize first)")
         path = os.fsencode(config_file)
