@@ -451,7 +451,8 @@ test-slurm: all
 
 # The tiers of src/README.md, checked by the #includes of each file: the
 # kernel knows nothing of files, printing or the command line, I/O nothing
-# of the stencil, and <hdf5.h> is in two files (tests/check_layering.sh).
+# of the stencil, and only the io/h5 files (src/io/h5_*) include <hdf5.h>
+# (tests/check_layering.sh).
 check-layering:
 	@sh tests/check_layering.sh
 

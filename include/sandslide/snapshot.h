@@ -1,7 +1,7 @@
 /*
  * snapshot.h - the HDF5 output of a run (doc/output.md), its XDMF
- * sidecar, and the one reader of such files.  src/io/snapshot_write.c
- * (the writer) and src/io/snapshot_read.c (every read: `info`, restarts,
+ * sidecar, and the one reader of such files.  src/io/h5_write.c
+ * (the writer) and src/io/h5_read.c (every read: `info`, restarts,
  * the renderer, .h5 DEMs) are the only code that includes <hdf5.h>; no
  * HDF5 type appears here.
  *

@@ -1,12 +1,12 @@
 /*
- * snapshot_write.c - HDF5 + XDMF output (see snapshot.h for the layout);
- * the reads are in snapshot_read.c.
+ * h5_write.c - HDF5 + XDMF output (see snapshot.h for the layout);
+ * the reads are in h5_read.c.
  *
  * File types are explicit little-endian IEEE (H5T_IEEE_F64LE, H5T_STD_I8LE),
  * memory types native.  Heights are copied a band of chunk rows at a time,
  * with NaN (the CF _FillValue) at walls and at cells without data, so
  * that netCDF readers, GDAL and ParaView show them as missing rather than
- * as floor at 0 m; the reader (snapshot_read.c) gives them 0 m again.
+ * as floor at 0 m; the reader (h5_read.c) gives them 0 m again.
  * Cells without data (meta.nodata, relax's DEM) are /cell_type 3
  * (SS_SNAPSHOT_CELL_NODATA), whatever the stepper made of them; only then
  * does flag_values have a fourth value, so a run's file is as before.  HDF5's own error stack

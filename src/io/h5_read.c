@@ -1,5 +1,5 @@
 /*
- * snapshot_read.c - every read of an HDF5 file (snapshot.h): the one
+ * h5_read.c - every read of an HDF5 file (snapshot.h): the one
  * definition of a sandslide file, and what `sandslide info` (the
  * summary), `run --restart`, the renderer, .h5 DEMs and
  * ss_snapshot_open_append's check read through it.
@@ -795,7 +795,7 @@ static void check_rows(const struct ss_snapshot_file *f, int j0, int rows)
 		SS_BUG("rows %d .. %d of a grid of %d rows", j0, j0 + rows - 1, f->ny);
 }
 
-/* Walls are stored as NaN (the _FillValue, snapshot_write.c) and held at
+/* Walls are stored as NaN (the _FillValue, h5_write.c) and held at
  * 0 m by the stepper: give them 0 m again, so that a restart, a frame or a
  * DEM read from the file sees what the run had; so are cells without data
  * (read as walls), and a DEM read from the file has them as nodata, whose
