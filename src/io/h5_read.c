@@ -2,51 +2,26 @@
  * h5_read.c - every read of an HDF5 file (snapshot.h): the one
  * definition of a sandslide file, and what `sandslide info` (the
  * summary), `run --restart`, the renderer, .h5 DEMs and
- * ss_snapshot_open_append's check read through it.
- *
- * Damaged files.  HDF5 believes the sizes a file states: a changed byte in
- * a dataspace can make a 64 KB file claim 10^12 snapshots, and a changed
- * chunk size can make HDF5 itself allocate gigabytes before its read
- * fails.  So before anything of a stated size is allocated, here or by
- * HDF5, the size is checked against the file:
- *   - a dataset's values fit in the file: at most its size in bytes when
- *     stored plainly, 1032 times that with deflate (zlib's largest ratio);
- *     filters other than deflate, shuffle and fletcher32 are refused, as
- *     their ratio is unbounded (scale-offset) or unknown;
- *   - one chunk fits likewise, as HDF5 allocates a whole chunk to read any
- *     of it;
- *   - every chunk a read touches is stored, inside the file, and not
- *     smaller than its values can be packed into: a sandslide writer
- *     stores every value it declares, and an unstored chunk would read back
- *     as fill values;
- *   - a contiguous dataset's bytes lie inside the file; a fixed-length
- *     string is shorter than the file.
- * A file that fails one of these, or whose read fails (a fletcher32
- * checksum, say), is damaged: SS_ERR_INPUT with one message saying so.
- * Datasets with external or virtual storage are refused: they would read
- * other files.  Numbers must be IEEE floats or standard integers, so that
- * HDF5 converts them with its well-trodden code.
- *
- * HDF5's own error printing is off (per thread: OpenMP threads that read
- * turn it off too); each failure prints one sandslide message.
+ * ss_snapshot_open_append's check read through it.  Every read goes
+ * through h5_checked.c, which checks each size a file states against the
+ * file before anything of that size is allocated (a damaged file is
+ * SS_ERR_INPUT with one message saying so) and turns HDF5's own error
+ * printing off: each failure prints one sandslide message.
  */
 #include "sandslide/snapshot.h"
 
-#include <errno.h>
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 #include <hdf5.h>
 
 #include "sandslide/error.h"
 #include "sandslide/grid.h"
+#include "io/h5_checked.h"
 #include "io/snapshot_layout.h"
 
-#define DEFLATE_MAX_RATIO 1032.0    /* zlib: 1032:1 at most */
 #define BLOCK_BYTES (8ll << 20)     /* rows per block read: about 8 MB */
 
 int ss_snapshot_threadsafe(void)
@@ -55,525 +30,16 @@ int ss_snapshot_threadsafe(void)
 	return H5is_library_threadsafe(&safe) >= 0 && safe;
 }
 
-static void quiet_hdf5(void)
-{
-	H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
-}
-
-/*
- * LeakSanitizer, in sanitized builds (make SANITIZE=1, the fuzz harnesses):
- * HDF5 1.10.8 loses memory of its own on some error paths of damaged files
- * (H5Dopen2 that fails in H5D__layout_oh_read leaks the chunk cache's
- * slots, 4176 bytes, from its free lists).  Debian's libhdf5 has no frame
- * pointers, so a leak's stack ends at its first frame in the library: the
- * suppression names the library.  The only memory HDF5 allocates for us,
- * variable-length strings, is freed with H5free_memory in attr_read_vlen.
- * Not listed at exit (a damaged file still gets its one line of stderr).
- * Weak, so that a program may set its own.
- */
-const char *__lsan_default_suppressions(void) __attribute__((weak));
-const char *__lsan_default_suppressions(void)
-{
-	return "leak:libhdf5_serial.so\nleak:libhdf5.so\n";
-}
-
-const char *__lsan_default_options(void) __attribute__((weak));
-const char *__lsan_default_options(void)
-{
-	return "print_suppressions=0";
-}
-
-/* ---- an open HDF5 file and its messages ------------------------------ */
-
-/* A file open for reading: the checks need its size. */
-struct h5in {
-	hid_t file;
-	const char *name;           /* for messages */
-	double bytes;               /* size of the file or image */
-};
-
-/* "'name' is damaged: ..." */
-static int damaged(const struct h5in *in, const char *fmt, ...)
-	__attribute__((format(printf, 2, 3)));
-static int damaged(const struct h5in *in, const char *fmt, ...)
-{
-	char what[512];
-	va_list ap;
-	va_start(ap, fmt);
-	vsnprintf(what, sizeof what, fmt, ap);
-	va_end(ap);
-	return ss_error_input("'%s' is damaged: %s", in->name, what);
-}
-
-/* What the HDF5 error stack says about the last failure. */
-struct h5why {
-	char text[200];             /* the innermost description */
-	int locked;                 /* another program holds the file lock */
-};
-
-static herr_t why_walk(unsigned n, const H5E_error2_t *e, void *data)
-{
-	struct h5why *w = data;
-	if (n == 0 && e->desc)
-		snprintf(w->text, sizeof w->text, "%s", e->desc);
-	if (e->min_num == H5E_CANTLOCKFILE)
-		w->locked = 1;
-	return 0;
-}
-
-static void why_failed(struct h5why *w)
-{
-	memset(w, 0, sizeof *w);
-	H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, why_walk, w);
-	if (!w->text[0])
-		snprintf(w->text, sizeof w->text, "no reason given");
-}
-
-/* A read of what that failed: damage (a checksum, a chunk past the end). */
-static int read_failed(const struct h5in *in, const char *what)
-{
-	struct h5why w;
-	why_failed(&w);
-	return damaged(in, "cannot read %s (HDF5: %s)", what, w.text);
-}
-
-/* "8 x 16 x 20" */
-static const char *format_dims(int rank, const hsize_t *dims, char *out, size_t size)
-{
-	size_t at = 0;
-	out[0] = '\0';
-	for (int k = 0; k < rank && at < size; k++)
-		at += (size_t)snprintf(out + at, size - at, "%s%llu", k ? " x " : "",
-		                       (unsigned long long)dims[k]);
-	return out;
-}
-
-/* ---- opening --------------------------------------------------------- */
-
-/* HDF5's signature at 0, 512, 1024, 2048, ... (where the library looks). */
-static int has_signature(const unsigned char *data, size_t size)
-{
-	static const unsigned char sig[8] = {0x89, 'H', 'D', 'F', '\r', '\n', 0x1a, '\n'};
-	for (size_t at = 0; at + 8 <= size; at = at ? 2 * at : 512)
-		if (!memcmp(data + at, sig, 8))
-			return 1;
-	return 0;
-}
-
-/* File access of an image in memory: the core driver, no file behind it. */
-static hid_t image_access(const void *data, size_t size)
-{
-	hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
-	if (fapl >= 0 && (H5Pset_fapl_core(fapl, 64 << 10, 0) < 0 ||
-	                  H5Pset_file_image(fapl, (void *)data, size) < 0)) {
-		H5Pclose(fapl);
-		fapl = -1;
-	}
-	return fapl;
-}
-
-/* Open name (a path, or an image when data is not NULL) read-only. */
-static int h5in_open(struct h5in *in, const char *name, const void *data, size_t size)
-{
-	quiet_hdf5();
-	in->file = -1;
-	in->name = name;
-	hid_t fapl = H5P_DEFAULT;
-	if (!data) {
-		struct stat sb;
-		FILE *probe = fopen(name, "rb");   /* says why: missing, no permission */
-		if (!probe || stat(name, &sb) != 0) {
-			const int e = errno;
-			if (probe)
-				fclose(probe);
-			return ss_error_input("cannot open '%s': %s", name, strerror(e));
-		}
-		fclose(probe);
-		in->bytes = (double)sb.st_size;
-		if (S_ISDIR(sb.st_mode) || H5Fis_hdf5(name) <= 0)
-			return ss_error_input("'%s' is not an HDF5 file", name);
-	} else {
-		in->bytes = (double)size;
-		if (!has_signature(data, size))
-			return ss_error_input("'%s' is not an HDF5 file", name);
-		if ((fapl = image_access(data, size)) < 0)
-			return ss_error_fail("'%s': cannot set up HDF5 to read an image", name);
-	}
-	in->file = H5Fopen(name, H5F_ACC_RDONLY, fapl);
-	if (fapl != H5P_DEFAULT)
-		H5Pclose(fapl);
-	if (in->file >= 0)
-		return SS_OK;
-	struct h5why w;
-	why_failed(&w);
-	if (w.locked)
-		return ss_error_input("cannot open '%s': another program is writing it (HDF5 "
-		                      "file lock)", name);
-	return damaged(in, "HDF5 cannot open it (%s)", w.text);
-}
-
-static void h5in_close(struct h5in *in)
-{
-	if (in->file >= 0)
-		H5Fclose(in->file);
-	in->file = -1;
-}
-
-/* ---- attributes ------------------------------------------------------ */
-
-/* An open attribute with its file type and dataspace. */
-struct attr {
-	hid_t a, type, space;
-};
-
-static void attr_close(struct attr *at)
-{
-	if (at->space >= 0)
-		H5Sclose(at->space);
-	if (at->type >= 0)
-		H5Tclose(at->type);
-	if (at->a >= 0)
-		H5Aclose(at->a);
-}
-
-/* Attribute name of obj of one value or, for numbers, n values: 0, or -1
- * (at closed) if there is none such. */
-static int attr_open(hid_t obj, const char *name, hssize_t n, struct attr *at)
-{
-	at->a = H5Aexists(obj, name) > 0 ? H5Aopen(obj, name, H5P_DEFAULT) : -1;
-	at->type = at->a >= 0 ? H5Aget_type(at->a) : -1;
-	at->space = at->a >= 0 ? H5Aget_space(at->a) : -1;
-	if (at->type >= 0 && at->space >= 0 && H5Sget_simple_extent_npoints(at->space) == n)
-		return 0;
-	attr_close(at);
-	return -1;
-}
-
-/* A variable-length string value of attribute a (of file type ft) as a
- * new string. */
-static int attr_read_vlen(hid_t a, hid_t ft, char **out)
-{
-	hid_t mt = H5Tcopy(H5T_C_S1);
-	char *v = NULL;
-	int err = SS_OK;
-	/* in the file's character set: HDF5 converts none into another */
-	if (mt >= 0 && H5Tset_size(mt, H5T_VARIABLE) >= 0 &&
-	    H5Tset_cset(mt, H5Tget_cset(ft)) >= 0 && H5Aread(a, mt, &v) >= 0 && v) {
-		if (!(*out = strdup(v)))
-			err = ss_error_fail("out of memory");
-	}
-	if (v)
-		H5free_memory(v);
-	if (mt >= 0)
-		H5Tclose(mt);
-	return err;
-}
-
-/*
- * A string attribute (one value, fixed or variable length) as a new
- * string in *out (free()); *out NULL if absent, not one string or
- * unreadable.  SS_ERR_INPUT if its stated length cannot be in the file.
- */
-static int attr_text(const struct h5in *in, hid_t obj, const char *name, char **out)
-{
-	*out = NULL;
-	struct attr at;
-	if (attr_open(obj, name, 1, &at))
-		return SS_OK;
-	int err = SS_OK;
-	const size_t n = H5Tget_size(at.type);
-	if (H5Tget_class(at.type) == H5T_STRING) {
-		if (H5Tis_variable_str(at.type) > 0)
-			err = attr_read_vlen(at.a, at.type, out);
-		else if ((double)n > in->bytes)
-			err = damaged(in, "attribute '%s' claims %zu characters, more than the file "
-			              "holds", name, n);
-		else if (!(*out = calloc(1, n + 1)))
-			err = ss_error_fail("out of memory");
-		else if (H5Aread(at.a, at.type, *out) < 0) {
-			free(*out);
-			*out = NULL;
-		}
-	}
-	attr_close(&at);
-	return err;
-}
-
-/* attr_text into a buffer ("" if absent). */
-static int attr_string(const struct h5in *in, hid_t obj, const char *name, char *out,
-                       size_t size)
-{
-	char *text;
-	const int err = attr_text(in, obj, name, &text);
-	snprintf(out, size, "%s", text ? text : "");
-	free(text);
-	return err;
-}
-
-/* IEEE floats and standard integers of either byte order. */
-static int is_number_type(hid_t t)
-{
-	const hid_t known[] = {
-		H5T_IEEE_F64LE, H5T_IEEE_F64BE, H5T_IEEE_F32LE, H5T_IEEE_F32BE,
-		H5T_STD_U8LE, H5T_STD_U8BE, H5T_STD_I8LE, H5T_STD_I8BE,
-		H5T_STD_U16LE, H5T_STD_U16BE, H5T_STD_I16LE, H5T_STD_I16BE,
-		H5T_STD_U32LE, H5T_STD_U32BE, H5T_STD_I32LE, H5T_STD_I32BE,
-		H5T_STD_U64LE, H5T_STD_U64BE, H5T_STD_I64LE, H5T_STD_I64BE,
-	};
-	for (size_t k = 0; k < sizeof known / sizeof known[0]; k++)
-		if (H5Tequal(t, known[k]) > 0)
-			return 1;
-	return 0;
-}
-
-/* n numbers of attribute name into v; -1 (v untouched) if absent or not
- * n numbers. */
-static int attr_doubles(hid_t obj, const char *name, int n, double *v)
-{
-	struct attr at;
-	double got[SS_SNAPSHOT_RESTART_VALUES];
-	if (n > SS_SNAPSHOT_RESTART_VALUES || attr_open(obj, name, n, &at))
-		return -1;
-	const int ok = is_number_type(at.type) && H5Aread(at.a, H5T_NATIVE_DOUBLE, got) >= 0;
-	if (ok)
-		memcpy(v, got, (size_t)n * sizeof *v);
-	attr_close(&at);
-	return ok ? 0 : -1;
-}
-
-static double attr_double(hid_t obj, const char *name)
-{
-	double v = NAN;
-	attr_doubles(obj, name, 1, &v);
-	return v;
-}
-
-/* ---- datasets -------------------------------------------------------- */
-
-/* An open dataset of numbers, rank 1 to 3, and how it is stored. */
-struct var {
-	hid_t d;
-	const char *name;           /* for messages, without a leading '/' */
-	int rank;
-	hsize_t dims[3], maxdims[3];
-	double type_bytes;          /* per value in the file */
-	double ratio;               /* largest ratio of values to stored bytes */
-	int chunked;
-	hsize_t chunk[3];
-	double chunk_bytes;
-};
-
-enum { VAR_MISSING = 1, VAR_NOT_NUMBERS = 2 };
-
-static void var_close(struct var *v)
-{
-	if (v->d >= 0)
-		H5Dclose(v->d);
-	v->d = -1;
-}
-
-/* The filters of dcpl and their largest packing ratio; 0 if a filter is
- * not one of deflate, shuffle, fletcher32. */
-static double filters_ratio(hid_t dcpl)
-{
-	const int n = H5Pget_nfilters(dcpl);
-	double ratio = n < 0 ? 0.0 : 1.0;
-	for (int k = 0; k < n; k++) {
-		unsigned flags, cd[8];
-		size_t ncd = 8;
-		const H5Z_filter_t id = H5Pget_filter2(dcpl, (unsigned)k, &flags, &ncd, cd, 0, NULL,
-		                                       NULL);
-		if (id == H5Z_FILTER_DEFLATE)
-			ratio *= DEFLATE_MAX_RATIO;
-		else if (id != H5Z_FILTER_SHUFFLE && id != H5Z_FILTER_FLETCHER32)
-			return 0.0;
-	}
-	return ratio;
-}
-
-/* How v is stored (dcpl): the ratio, chunk sizes; SS_ERR_INPUT when the
- * storage is one this reader refuses or cannot be true. */
-static int var_layout(const struct h5in *in, struct var *v, hid_t dcpl)
-{
-	const H5D_layout_t layout = H5Pget_layout(dcpl);
-	if (layout == H5D_VIRTUAL || H5Pget_external_count(dcpl) != 0)
-		return ss_error_input("'%s': /%s keeps its values in other files (external or "
-		                      "virtual storage): not read", in->name, v->name);
-	if (!(v->ratio = filters_ratio(dcpl)))
-		return ss_error_input("'%s': /%s is stored with an HDF5 filter other than deflate, "
-		                      "shuffle and fletcher32: not read", in->name, v->name);
-	v->chunked = layout == H5D_CHUNKED;
-	v->chunk_bytes = v->type_bytes;
-	if (!v->chunked)
-		return SS_OK;
-	if (H5Pget_chunk(dcpl, v->rank, v->chunk) != v->rank)
-		return damaged(in, "/%s has chunks of another rank than its own", v->name);
-	for (int k = 0; k < v->rank; k++) {
-		/* HDF5 creates no chunk larger than a dimension that cannot grow
-		 * (and 1.10 reads past its buffers when a chunk is) */
-		if (v->chunk[k] < 1 || (v->maxdims[k] != H5S_UNLIMITED && v->chunk[k] > v->maxdims[k]))
-			return damaged(in, "/%s has chunks of %llu along a dimension of at most %llu",
-			               v->name, (unsigned long long)v->chunk[k],
-			               (unsigned long long)v->maxdims[k]);
-		v->chunk_bytes *= (double)v->chunk[k];
-	}
-	if (v->chunk_bytes > in->bytes * v->ratio) {
-		char b[32];
-		return damaged(in, "/%s claims chunks of %.0f bytes, more than its %s can hold",
-		               v->name, v->chunk_bytes, ss_format_bytes(in->bytes, b));
-	}
-	return SS_OK;
-}
-
-/* Stored bytes that must hold the values of v, checked against the file. */
-static int var_check_size(const struct h5in *in, const struct var *v)
-{
-	double values = v->type_bytes;
-	for (int k = 0; k < v->rank; k++)
-		values *= (double)v->dims[k];
-	char b[32], d[96];
-	if (values > in->bytes * v->ratio)
-		return damaged(in, "/%s claims %s values of %.0f bytes, more than its %s can hold",
-		               v->name, format_dims(v->rank, v->dims, d, sizeof d), v->type_bytes,
-		               ss_format_bytes(in->bytes, b));
-	if (v->chunked || values == 0.0)
-		return SS_OK;     /* chunks are checked where they are read */
-	const haddr_t at = H5Dget_offset(v->d);
-	const double stored = (double)H5Dget_storage_size(v->d);
-	if (stored < values || (at != HADDR_UNDEF && (double)at + stored > in->bytes))
-		return damaged(in, "/%s claims %s values of %.0f bytes but stores %.0f bytes%s",
-		               v->name, format_dims(v->rank, v->dims, d, sizeof d), v->type_bytes,
-		               stored, stored < values ? "" : " past the end of the file");
-	return SS_OK;
-}
-
-/*
- * Open dataset name as a var: SS_OK; VAR_MISSING (no such dataset) or
- * VAR_NOT_NUMBERS (not numbers of rank 1 to 3), with nothing printed, for
- * the caller to say what it needed; SS_ERR_INPUT if what it claims cannot
- * be in the file.
- */
-static int var_open(const struct h5in *in, const char *name, struct var *v)
-{
-	memset(v, 0, sizeof *v);
-	v->d = -1;
-	v->name = name[0] == '/' ? name + 1 : name;
-	/* a hard link only: a soft or external one could lead to another file */
-	H5L_info_t link;
-	H5O_info_t obj;
-	if (H5Lexists(in->file, name, H5P_DEFAULT) <= 0 ||
-	    H5Lget_info(in->file, name, &link, H5P_DEFAULT) < 0 || link.type != H5L_TYPE_HARD)
-		return VAR_MISSING;
-	char what[300];
-	snprintf(what, sizeof what, "/%s", v->name);
-	if (H5Oget_info_by_name2(in->file, name, &obj, H5O_INFO_BASIC, H5P_DEFAULT) < 0)
-		return read_failed(in, what);
-	if (obj.type != H5O_TYPE_DATASET)
-		return VAR_MISSING;
-	if ((v->d = H5Dopen2(in->file, name, H5P_DEFAULT)) < 0)
-		return read_failed(in, what);
-	hid_t t = H5Dget_type(v->d), sp = H5Dget_space(v->d);
-	v->rank = sp >= 0 ? H5Sget_simple_extent_ndims(sp) : -1;
-	const int numbers = t >= 0 && is_number_type(t) && v->rank >= 1 && v->rank <= 3 &&
-	                    H5Sget_simple_extent_dims(sp, v->dims, v->maxdims) == v->rank;
-	v->type_bytes = numbers ? (double)H5Tget_size(t) : 0.0;
-	if (sp >= 0)
-		H5Sclose(sp);
-	if (t >= 0)
-		H5Tclose(t);
-	if (!numbers) {
-		var_close(v);
-		return VAR_NOT_NUMBERS;
-	}
-	hid_t dcpl = H5Dget_create_plist(v->d);
-	int err = dcpl < 0 ? damaged(in, "cannot read how /%s is stored", v->name)
-	                   : var_layout(in, v, dcpl);
-	if (dcpl >= 0)
-		H5Pclose(dcpl);
-	if (!err)
-		err = var_check_size(in, v);
-	if (err)
-		var_close(v);
-	return err;
-}
-
-/* The chunk of v at offset is stored, inside the file, and large enough. */
-static int check_chunk(const struct h5in *in, const struct var *v, const hsize_t *offset)
-{
-	unsigned mask;
-	haddr_t at;
-	hsize_t size;
-	char d[96], o[96];
-	if (H5Dget_chunk_info_by_coord(v->d, offset, &mask, &at, &size) < 0) {
-		char what[300];
-		snprintf(what, sizeof what, "the chunk index of /%s", v->name);
-		return read_failed(in, what);
-	}
-	if (at == HADDR_UNDEF)
-		return damaged(in, "/%s declares %s values but stores no chunk at %s", v->name,
-		               format_dims(v->rank, v->dims, d, sizeof d),
-		               format_dims(v->rank, offset, o, sizeof o));
-	if ((double)at + (double)size > in->bytes || (double)size * v->ratio < v->chunk_bytes)
-		return damaged(in, "/%s has a chunk of %llu bytes at byte %llu, of a file of "
-		               "%.0f bytes, for %.0f bytes of values", v->name,
-		               (unsigned long long)size, (unsigned long long)at, in->bytes,
-		               v->chunk_bytes);
-	return SS_OK;
-}
-
-/* Every chunk of the block start .. start + count - 1 passes check_chunk. */
-static int check_chunks(const struct h5in *in, const struct var *v, const hsize_t *start,
-                        const hsize_t *count)
-{
-	if (!v->chunked)
-		return SS_OK;
-	hsize_t first[3], last[3], at[3];
-	for (int k = 0; k < v->rank; k++) {
-		first[k] = at[k] = start[k] / v->chunk[k] * v->chunk[k];
-		last[k] = (start[k] + count[k] - 1) / v->chunk[k] * v->chunk[k];
-	}
-	for (;;) {
-		const int err = check_chunk(in, v, at);
-		if (err)
-			return err;
-		int k = v->rank - 1;
-		while (k >= 0 && (at[k] += v->chunk[k]) > last[k]) {
-			at[k] = first[k];
-			k--;
-		}
-		if (k < 0)
-			return SS_OK;
-	}
-}
-
-/* The block start .. start + count - 1 of v (rank values each) into out,
- * as mem_type; what names it in a message. */
-static int var_read(const struct h5in *in, const struct var *v, const hsize_t *start,
-                    const hsize_t *count, hid_t mem_type, void *out, const char *what)
-{
-	int err = check_chunks(in, v, start, count);
-	if (err)
-		return err;
-	hid_t fs = H5Dget_space(v->d);
-	hid_t ms = H5Screate_simple(v->rank, count, NULL);
-	if (fs < 0 || ms < 0 ||
-	    H5Sselect_hyperslab(fs, H5S_SELECT_SET, start, NULL, count, NULL) < 0 ||
-	    H5Dread(v->d, mem_type, ms, fs, H5P_DEFAULT, out) < 0)
-		err = read_failed(in, what);
-	if (ms >= 0)
-		H5Sclose(ms);
-	if (fs >= 0)
-		H5Sclose(fs);
-	return err;
-}
+/* ---- a series of a sandslide file -------------------------------------- */
 
 /* The first n values of the 1-D series name into out; SS_ERR_INPUT naming
  * the series if it is missing or does not have n or n + 1 (the last one
  * unfinished: doc/output.md#written-as-the-run-goes) values. */
-static int read_series(const struct h5in *in, const char *name, long long n, double *out)
+static int read_series(const struct ss_h5_file *in, const char *name, long long n,
+                       double *out)
 {
-	struct var v;
-	int err = var_open(in, name, &v);
+	struct ss_h5_var v;
+	int err = ss_h5_var_open(in, name, &v);
 	if (err > 0 || (!err && (v.rank != 1 || v.dims[0] < (hsize_t)n ||
 	                         v.dims[0] > (hsize_t)n + 1)))
 		err = ss_error_input("'%s' is not a sandslide output file: no /%s (time) of %lld "
@@ -582,20 +48,20 @@ static int read_series(const struct h5in *in, const char *name, long long n, dou
 	char what[80];
 	snprintf(what, sizeof what, "/%s", name);
 	if (!err && n > 0)
-		err = var_read(in, &v, &start, &count, H5T_NATIVE_DOUBLE, out, what);
-	var_close(&v);
+		err = ss_h5_var_read(in, &v, &start, &count, H5T_NATIVE_DOUBLE, out, what);
+	ss_h5_var_close(&v);
 	return err;
 }
 
 /* ---- a sandslide file ------------------------------------------------ */
 
 struct ss_snapshot_file_h5 {
-	struct h5in in;
-	struct var height;          /* (time, y, x) */
-	struct var cell_type;       /* (y, x) */
+	struct ss_h5_file in;
+	struct ss_h5_var height;    /* (time, y, x) */
+	struct ss_h5_var cell_type; /* (y, x) */
 };
 
-static int not_sandslide(const struct h5in *in, const char *why)
+static int not_sandslide(const struct ss_h5_file *in, const char *why)
 {
 	return ss_error_input("'%s' is not a sandslide output file: %s", in->name, why);
 }
@@ -605,7 +71,7 @@ static int not_sandslide(const struct h5in *in, const char *why)
 static int check_grid(struct ss_snapshot_file *f)
 {
 	struct ss_snapshot_file_h5 *h = f->h5;
-	int err = var_open(&h->in, "height", &h->height);
+	int err = ss_h5_var_open(&h->in, "height", &h->height);
 	if (err > 0 || (!err && h->height.rank != 3))
 		return not_sandslide(&h->in, "no /height (time, y, x) of numbers (doc/output.md)");
 	if (err)
@@ -617,7 +83,7 @@ static int check_grid(struct ss_snapshot_file *f)
 		                      (unsigned long long)hd[1]);
 	f->ny = (int)hd[1];
 	f->nx = (int)hd[2];
-	err = var_open(&h->in, "cell_type", &h->cell_type);
+	err = ss_h5_var_open(&h->in, "cell_type", &h->cell_type);
 	const hsize_t *cd = h->cell_type.dims;
 	if (err > 0 || (!err && (h->cell_type.rank != 2 || cd[0] != hd[1] || cd[1] != hd[2])))
 		return not_sandslide(&h->in, "/cell_type (y, x) does not match /height");
@@ -630,9 +96,9 @@ static int check_grid(struct ss_snapshot_file *f)
 static int read_times(struct ss_snapshot_file *f)
 {
 	const struct ss_snapshot_file_h5 *h = f->h5;
-	const struct h5in *in = &h->in;
-	struct var v;
-	int err = var_open(in, "time", &v);
+	const struct ss_h5_file *in = &h->in;
+	struct ss_h5_var v;
+	int err = ss_h5_var_open(in, "time", &v);
 	const hsize_t stored = h->height.dims[0];
 	if (err > 0 || (!err && (v.rank != 1 || v.dims[0] > stored || v.dims[0] + 1 < stored))) {
 		char why[96];
@@ -642,12 +108,12 @@ static int read_times(struct ss_snapshot_file *f)
 	}
 	if (!err)
 		f->count = (long long)v.dims[0];
-	var_close(&v);
+	ss_h5_var_close(&v);
 	/* snapshots are written in order: the last one stored, all are */
 	const hsize_t last[3] = {(hsize_t)f->count - 1, 0, 0},
 	              one[3] = {1, h->height.dims[1], h->height.dims[2]};
 	if (!err && f->count > 0)
-		err = check_chunks(in, &h->height, last, one);
+		err = ss_h5_var_check_chunks(in, &h->height, last, one);
 	if (!err && !(f->time = malloc((size_t)(f->count ? f->count : 1) * sizeof *f->time)))
 		err = ss_error_fail("out of memory");
 	return err ? err : read_series(in, "time", f->count, f->time);
@@ -655,18 +121,18 @@ static int read_times(struct ss_snapshot_file *f)
 
 /* The first value of the optional 1-D variable name into *v (NAN if it is
  * absent or empty). */
-static int first_value(const struct h5in *in, const char *name, double *v)
+static int first_value(const struct ss_h5_file *in, const char *name, double *v)
 {
-	struct var x;
+	struct ss_h5_var x;
 	*v = NAN;
-	int err = var_open(in, name, &x);
+	int err = ss_h5_var_open(in, name, &x);
 	if (err > 0)
 		return SS_OK;
 	if (!err && x.rank == 1 && x.dims[0] >= 1) {
 		const hsize_t start = 0, one = 1;
-		err = var_read(in, &x, &start, &one, H5T_NATIVE_DOUBLE, v, name);
+		err = ss_h5_var_read(in, &x, &start, &one, H5T_NATIVE_DOUBLE, v, name);
 	}
-	var_close(&x);
+	ss_h5_var_close(&x);
 	return err;
 }
 
@@ -675,9 +141,9 @@ static int first_value(const struct h5in *in, const char *name, double *v)
  * file damaged. */
 static int read_wall_sides(struct ss_snapshot_file *f)
 {
-	const struct h5in *in = &f->h5->in;
+	const struct ss_h5_file *in = &f->h5->in;
 	char text[256], *save = NULL;
-	int err = attr_string(in, in->file, SS_SNAPSHOT_BOUNDARY, text, sizeof text);
+	int err = ss_h5_attr_read_string(in, in->file, SS_SNAPSHOT_BOUNDARY, text, sizeof text);
 	for (char *w = strtok_r(text, " ", &save); w && !err; w = strtok_r(NULL, " ", &save)) {
 		char *eq = strchr(w, '=');
 		enum ss_side_kind kind;
@@ -687,9 +153,9 @@ static int read_wall_sides(struct ss_snapshot_file *f)
 			    !strncmp(w, ss_side_name(k), (size_t)(eq - w)))
 				side = k;
 		if (side < 0 || ss_side_kind_parse(eq + 1, &kind))
-			err = damaged(in, "root attribute %s has '%s': expected SIDE=KIND, SIDE west, "
-			              "east, south or north and KIND wall, open or periodic",
-			              SS_SNAPSHOT_BOUNDARY, w);
+			err = ss_h5_damaged(in, "root attribute %s has '%s': expected SIDE=KIND, "
+			                    "SIDE west, east, south or north and KIND wall, open or "
+			                    "periodic", SS_SNAPSHOT_BOUNDARY, w);
 		else if (kind == SS_SIDE_WALL)
 			f->wall_sides |= 1u << side;
 	}
@@ -699,9 +165,9 @@ static int read_wall_sides(struct ss_snapshot_file *f)
 /* The definition of snapshot.h, the sizes and geometry into f. */
 static int check_definition(struct ss_snapshot_file *f)
 {
-	const struct h5in *in = &f->h5->in;
+	const struct ss_h5_file *in = &f->h5->in;
 	char source[256];
-	int err = attr_string(in, in->file, "source", source, sizeof source);
+	int err = ss_h5_attr_read_string(in, in->file, "source", source, sizeof source);
 	if (err)
 		return err;
 	if (strncmp(source, SS_SNAPSHOT_SOURCE, strlen(SS_SNAPSHOT_SOURCE)))
@@ -709,8 +175,8 @@ static int check_definition(struct ss_snapshot_file *f)
 		                         "(doc/output.md#the-one-reader)");
 	if ((err = check_grid(f)) || (err = read_times(f)))
 		return err;
-	f->dx = attr_double(in->file, "dx");
-	f->dy = attr_double(in->file, "dy");
+	f->dx = ss_h5_attr_read_double(in->file, "dx");
+	f->dy = ss_h5_attr_read_double(in->file, "dy");
 	if (!(f->dx > 0.0) || !(f->dy > 0.0) || !isfinite(f->dx) || !isfinite(f->dy))
 		return not_sandslide(in, "no positive dx, dy attributes");
 	double x0, y0;
@@ -727,7 +193,7 @@ static int check_definition(struct ss_snapshot_file *f)
 	if (H5Lexists(in->file, "crs", H5P_DEFAULT) > 0) {
 		hid_t crs = H5Oopen(in->file, "crs", H5P_DEFAULT);
 		if (crs >= 0) {
-			err = attr_text(in, crs, "crs_wkt", &f->crs_wkt);
+			err = ss_h5_attr_read_text(in, crs, "crs_wkt", &f->crs_wkt);
 			H5Oclose(crs);
 		}
 	}
@@ -737,9 +203,9 @@ static int check_definition(struct ss_snapshot_file *f)
 void ss_snapshot_file_close(struct ss_snapshot_file *f)
 {
 	if (f->h5) {
-		var_close(&f->h5->height);
-		var_close(&f->h5->cell_type);
-		h5in_close(&f->h5->in);
+		ss_h5_var_close(&f->h5->height);
+		ss_h5_var_close(&f->h5->cell_type);
+		ss_h5_file_close(&f->h5->in);
 		free(f->h5);
 	}
 	free(f->time);
@@ -760,7 +226,7 @@ static int file_open(struct ss_snapshot_file *f, const char *name, const void *d
 		return ss_error_fail("out of memory");
 	}
 	f->h5->height.d = f->h5->cell_type.d = f->h5->in.file = -1;
-	int err = h5in_open(&f->h5->in, f->name, data, size);
+	int err = ss_h5_file_open(&f->h5->in, f->name, data, size);
 	if (!err)
 		err = check_definition(f);
 	if (err)
@@ -834,9 +300,9 @@ int ss_snapshot_file_read_rows(struct ss_snapshot_file *f, long long t, int j0, 
 	int err;
 	#pragma omp critical(ss_snapshot_hdf5)
 	{
-		quiet_hdf5();
-		err = var_read(&f->h5->in, &f->h5->height, start, count, H5T_NATIVE_DOUBLE, out,
-		               what);
+		ss_h5_quiet();
+		err = ss_h5_var_read(&f->h5->in, &f->h5->height, start, count, H5T_NATIVE_DOUBLE,
+		                     out, what);
 	}
 	return err ? err : walls_to_zero(f, j0, rows, out);
 }
@@ -851,16 +317,17 @@ int ss_snapshot_file_read_cell_flags(struct ss_snapshot_file *f, int j0, int row
 	int err;
 	#pragma omp critical(ss_snapshot_hdf5)
 	{
-		quiet_hdf5();
-		err = var_read(&f->h5->in, &f->h5->cell_type, start, count, H5T_NATIVE_UINT8, out,
-		               what);
+		ss_h5_quiet();
+		err = ss_h5_var_read(&f->h5->in, &f->h5->cell_type, start, count, H5T_NATIVE_UINT8,
+		                     out, what);
 	}
 	const size_t n = (size_t)rows * (size_t)f->nx;
 	for (size_t k = 0; k < n && !err; k++)
 		if (out[k] > SS_SNAPSHOT_CELL_NODATA)
-			err = damaged(&f->h5->in, "/cell_type holds %d at column %zu, row %zu (from the "
-			              "south): expected 0 (flow), 1 (wall), 2 (open) or 3 (no data)",
-			              out[k], k % (size_t)f->nx + 1, j0 + k / (size_t)f->nx + 1);
+			err = ss_h5_damaged(&f->h5->in, "/cell_type holds %d at column %zu, row "
+			                    "%zu (from the south): expected 0 (flow), 1 (wall), 2 "
+			                    "(open) or 3 (no data)", out[k], k % (size_t)f->nx + 1,
+			                    j0 + k / (size_t)f->nx + 1);
 	return err;
 }
 
@@ -925,14 +392,14 @@ static int read_diagnostics(struct ss_snapshot_file *f, struct ss_snapshot_summa
 		return ss_error_fail("out of memory");
 	int err = SS_OK;
 	for (int k = 0; k < SS_SNAPSHOT_DIAG_COUNT && !err; k++) {
-		struct var v;
-		const int opened = var_open(&f->h5->in, ss_snapshot_diag_name(k), &v);
-		var_close(&v);
+		struct ss_h5_var v;
+		const int opened = ss_h5_var_open(&f->h5->in, ss_snapshot_diag_name(k), &v);
+		ss_h5_var_close(&v);
 		if (opened < 0) {   /* damaged: said so already (read_series would again) */
 			err = opened;
 			break;
 		}
-		if (k == SS_SNAPSHOT_DIAG_EVALUATIONS && opened == VAR_MISSING) {
+		if (k == SS_SNAPSHOT_DIAG_EVALUATIONS && opened == SS_H5_VAR_MISSING) {
 			/* written before RKL2: one evaluation per step */
 			for (long long m = 0; m < n; m++)
 				sum->diag[m].evaluations = sum->diag[m].steps;
@@ -949,7 +416,7 @@ static int read_diagnostics(struct ss_snapshot_file *f, struct ss_snapshot_summa
 int ss_snapshot_file_summary(struct ss_snapshot_file *f, struct ss_snapshot_summary *sum)
 {
 	memset(sum, 0, sizeof *sum);
-	const struct h5in *in = &f->h5->in;
+	const struct ss_h5_file *in = &f->h5->in;
 	sum->nx = f->nx;
 	sum->ny = f->ny;
 	sum->count = f->count;
@@ -958,15 +425,17 @@ int ss_snapshot_file_summary(struct ss_snapshot_file *f, struct ss_snapshot_summ
 	sum->origin_x = f->origin_x;
 	sum->origin_y = f->origin_y;
 	int err;
-	if ((err = attr_string(in, in->file, "source", sum->source, sizeof sum->source)) ||
-	    (err = attr_string(in, in->file, "closure", sum->closure, sizeof sum->closure)) ||
-	    (err = attr_string(in, in->file, "integrator", sum->integrator,
-	                       sizeof sum->integrator)) ||
-	    (err = attr_string(in, in->file, "title", sum->title, sizeof sum->title)))
+	if ((err = ss_h5_attr_read_string(in, in->file, "source", sum->source,
+	                                  sizeof sum->source)) ||
+	    (err = ss_h5_attr_read_string(in, in->file, "closure", sum->closure,
+	                                  sizeof sum->closure)) ||
+	    (err = ss_h5_attr_read_string(in, in->file, "integrator", sum->integrator,
+	                                  sizeof sum->integrator)) ||
+	    (err = ss_h5_attr_read_string(in, in->file, "title", sum->title, sizeof sum->title)))
 		return err;
-	sum->repose_angle_deg = attr_double(in->file, "repose_angle_deg");
-	sum->nu = attr_double(in->file, "nu");
-	sum->gamma = attr_double(in->file, "gamma");
+	sum->repose_angle_deg = ss_h5_attr_read_double(in->file, "repose_angle_deg");
+	sum->nu = ss_h5_attr_read_double(in->file, "nu");
+	sum->gamma = ss_h5_attr_read_double(in->file, "gamma");
 
 	const size_t n = (size_t)(f->count ? f->count : 1);
 	sum->time = malloc(n * sizeof *sum->time);
@@ -1027,11 +496,11 @@ void ss_restart_info_release(struct ss_restart_info *r)
 /* The case a restart continues: its text, path and --set values. */
 static int read_case(struct ss_snapshot_file *f, struct ss_restart_info *r)
 {
-	const struct h5in *in = &f->h5->in;
+	const struct ss_h5_file *in = &f->h5->in;
 	int err;
-	if ((err = attr_text(in, in->file, "case", &r->case_text)) ||
-	    (err = attr_text(in, in->file, "title", &r->case_path)) ||
-	    (err = attr_text(in, in->file, "case_overrides", &r->case_overrides)))
+	if ((err = ss_h5_attr_read_text(in, in->file, "case", &r->case_text)) ||
+	    (err = ss_h5_attr_read_text(in, in->file, "title", &r->case_path)) ||
+	    (err = ss_h5_attr_read_text(in, in->file, "case_overrides", &r->case_overrides)))
 		return err;
 	if (!r->case_text || !r->case_path || !r->case_overrides || !*r->case_text)
 		return ss_error_input("cannot restart from '%s': it does not hold the case it was "
@@ -1042,14 +511,14 @@ static int read_case(struct ss_snapshot_file *f, struct ss_restart_info *r)
 /* The restart state of the last snapshot, checked. */
 static int read_state(struct ss_snapshot_file *f, struct ss_restart_info *r)
 {
-	const struct h5in *in = &f->h5->in;
+	const struct ss_h5_file *in = &f->h5->in;
 	double v[SS_SNAPSHOT_RESTART_VALUES] = {NAN, NAN, NAN, NAN, NAN, NAN, NAN};
 	/* the last snapshot's by its parity; one restart_state in older files */
 	const char *name = ss_snapshot_restart_attribute(f->count - 1);
 	if (H5Aexists(in->file, name) <= 0)
 		name = "restart_state";
-	if (attr_doubles(in->file, name, SS_SNAPSHOT_RESTART_VALUES, v) &&
-	    !attr_doubles(in->file, name, SS_SNAPSHOT_RESTART_VALUES_OLD, v)) {
+	if (ss_h5_attr_read_doubles(in->file, name, SS_SNAPSHOT_RESTART_VALUES, v) &&
+	    !ss_h5_attr_read_doubles(in->file, name, SS_SNAPSHOT_RESTART_VALUES_OLD, v)) {
 		/* before RKL2: Euler's evaluations are its steps */
 		v[5] = v[0];
 		v[6] = INFINITY;
@@ -1160,8 +629,8 @@ int ss_snapshot_read_restart_case(const char *path, struct ss_restart_info *r)
 
 /* Snapshot index (negative: from the end) of a (time, y, x) v, or the
  * (y, x) v, as a new array. */
-static int read_field_var(const struct h5in *in, const struct var *v, long long index,
-                          int *nx, int *ny, double **values)
+static int read_field_var(const struct ss_h5_file *in, const struct ss_h5_var *v,
+                          long long index, int *nx, int *ny, double **values)
 {
 	hsize_t dims[3] = {1, 0, 0};
 	memcpy(v->rank == 3 ? dims : dims + 1, v->dims, (size_t)v->rank * sizeof *dims);
@@ -1182,8 +651,8 @@ static int read_field_var(const struct h5in *in, const struct var *v, long long 
 	char what[300];
 	snprintf(what, sizeof what, "/%s", v->name);
 	const int skip = 3 - v->rank;   /* (y, x): no time */
-	const int err = var_read(in, v, start + skip, count + skip, H5T_NATIVE_DOUBLE, *values,
-	                         what);
+	const int err = ss_h5_var_read(in, v, start + skip, count + skip, H5T_NATIVE_DOUBLE,
+	                               *values, what);
 	if (err) {
 		ss_free(*values);
 		*values = NULL;
@@ -1215,20 +684,20 @@ int ss_snapshot_read_field(const char *path, const char *dataset, long long inde
 	*values = NULL;
 	if (!dataset || !*dataset)
 		return read_snapshot_field(path, index, nx, ny, values);
-	struct h5in in;
-	int err = h5in_open(&in, path, NULL, 0);
-	struct var v = {.d = -1};
+	struct ss_h5_file in;
+	int err = ss_h5_file_open(&in, path, NULL, 0);
+	struct ss_h5_var v = {.d = -1};
 	if (!err)
-		err = var_open(&in, dataset, &v);
-	if (err == VAR_MISSING)
+		err = ss_h5_var_open(&in, dataset, &v);
+	if (err == SS_H5_VAR_MISSING)
 		err = ss_error_input("'%s' has no dataset '%s'", path, dataset);
-	else if (err == VAR_NOT_NUMBERS)
+	else if (err == SS_H5_VAR_NOT_NUMBERS)
 		err = ss_error_input("'%s:%s' is not a (y, x) or non-empty (time, y, x) variable "
 		                     "of numbers", path, dataset);
 	if (!err)
 		err = read_field_var(&in, &v, index, nx, ny, values);
-	var_close(&v);
-	h5in_close(&in);
+	ss_h5_var_close(&v);
+	ss_h5_file_close(&in);
 	return err;
 }
 
@@ -1243,7 +712,7 @@ void ss_height_series_release(struct ss_height_series *s)
 }
 
 /* "'obs.h5' is not a height series: ..., the layout it needs" */
-static int not_series(const struct h5in *in, const char *why)
+static int not_series(const struct ss_h5_file *in, const char *why)
 {
 	return ss_error_input("'%s' is not a height series: %s (expected /time (time) in s and "
 	                      "/height (time, y, x) in m, doc/output.md)", in->name, why);
@@ -1255,16 +724,16 @@ static int not_series(const struct h5in *in, const char *why)
  * finite, increasing and evenly spaced, as a grid's are: a /y from north
  * to south would flip every snapshot without a word.
  */
-static int read_centres(const struct h5in *in, const char *name, int n, double *d,
+static int read_centres(const struct ss_h5_file *in, const char *name, int n, double *d,
                         double *origin)
 {
-	struct var v;
+	struct ss_h5_var v;
 	*d = *origin = NAN;
-	int err = var_open(in, name, &v);
-	if (err == VAR_MISSING)
+	int err = ss_h5_var_open(in, name, &v);
+	if (err == SS_H5_VAR_MISSING)
 		return SS_OK;
 	if (err > 0 || (!err && (v.rank != 1 || v.dims[0] != (hsize_t)n))) {
-		var_close(&v);
+		ss_h5_var_close(&v);
 		return ss_error_input("'%s': /%s is not %d numbers, one per %s of /height", in->name,
 		                      name, n, name[0] == 'x' ? "column" : "row");
 	}
@@ -1273,8 +742,8 @@ static int read_centres(const struct h5in *in, const char *name, int n, double *
 		err = SS_ERR_FAIL;
 	const hsize_t start = 0, count = (hsize_t)n;
 	if (!err)
-		err = var_read(in, &v, &start, &count, H5T_NATIVE_DOUBLE, c, name);
-	var_close(&v);
+		err = ss_h5_var_read(in, &v, &start, &count, H5T_NATIVE_DOUBLE, c, name);
+	ss_h5_var_close(&v);
 	if (!err && n >= 2) {
 		const double step = c[1] - c[0];
 		if (!(step > 0.0) || !isfinite(step))
@@ -1303,7 +772,7 @@ static int read_centres(const struct h5in *in, const char *name, int n, double *
 
 /* The cell size along name (/x or /y) and the corner: from the centres,
  * else (one cell, or none given) the root attribute of a sandslide file. */
-static int series_geometry(const struct h5in *in, const char *name, int n, double *d,
+static int series_geometry(const struct ss_h5_file *in, const char *name, int n, double *d,
                            double *origin)
 {
 	double first;
@@ -1311,7 +780,7 @@ static int series_geometry(const struct h5in *in, const char *name, int n, doubl
 	if (err)
 		return err;
 	if (isnan(*d)) {
-		const double a = attr_double(in->file, name[0] == 'x' ? "dx" : "dy");
+		const double a = ss_h5_attr_read_double(in->file, name[0] == 'x' ? "dx" : "dy");
 		*d = a > 0.0 && isfinite(a) ? a : NAN;
 	}
 	*origin = first - 0.5 * *d;
@@ -1322,15 +791,15 @@ static int series_geometry(const struct h5in *in, const char *name, int n, doubl
 
 /* /cell_type, when the file has one: its walls and cells without data
  * as NaN in every snapshot. */
-static int series_walls(const struct h5in *in, struct ss_height_series *s)
+static int series_walls(const struct ss_h5_file *in, struct ss_height_series *s)
 {
-	struct var v;
-	int err = var_open(in, "cell_type", &v);
-	if (err == VAR_MISSING)
+	struct ss_h5_var v;
+	int err = ss_h5_var_open(in, "cell_type", &v);
+	if (err == SS_H5_VAR_MISSING)
 		return SS_OK;
 	if (err > 0 || (!err && (v.rank != 2 || v.dims[0] != (hsize_t)s->ny ||
 	                         v.dims[1] != (hsize_t)s->nx))) {
-		var_close(&v);
+		ss_h5_var_close(&v);
 		return ss_error_input("'%s': /cell_type is not %d x %d numbers (y, x) as /height's "
 		                      "snapshots", in->name, s->nx, s->ny);
 	}
@@ -1340,8 +809,8 @@ static int series_walls(const struct h5in *in, struct ss_height_series *s)
 		err = SS_ERR_FAIL;
 	const hsize_t start[2] = {0, 0}, count[2] = {(hsize_t)s->ny, (hsize_t)s->nx};
 	if (!err)
-		err = var_read(in, &v, start, count, H5T_NATIVE_UINT8, types, "/cell_type");
-	var_close(&v);
+		err = ss_h5_var_read(in, &v, start, count, H5T_NATIVE_UINT8, types, "/cell_type");
+	ss_h5_var_close(&v);
 	for (size_t k = 0; k < cells && !err; k++) {
 		if (types[k] > SS_SNAPSHOT_CELL_NODATA)
 			err = ss_error_input("'%s': /cell_type holds %d at column %zu, row %zu (from "
@@ -1358,21 +827,22 @@ static int series_walls(const struct h5in *in, struct ss_height_series *s)
 }
 
 /* /time and /height: their sizes, then (memory allowing) their values. */
-static int series_values(const struct h5in *in, struct ss_height_series *s)
+static int series_values(const struct ss_h5_file *in, struct ss_height_series *s)
 {
-	struct var h, t;
-	int err = var_open(in, "height", &h);
+	struct ss_h5_var h, t;
+	int err = ss_h5_var_open(in, "height", &h);
 	if (err > 0 || (!err && h.rank != 3)) {
-		var_close(&h);
-		return not_series(in, err == VAR_MISSING ? "no /height"
-		                                         : "/height is not (time, y, x) numbers");
+		ss_h5_var_close(&h);
+		return not_series(in, err == SS_H5_VAR_MISSING
+		                      ? "no /height" : "/height is not (time, y, x) numbers");
 	}
 	if (err)
 		return err;
-	if ((err = var_open(in, "time", &t)) > 0 || (!err && t.rank != 1)) {
-		var_close(&h);
-		var_close(&t);
-		return not_series(in, err == VAR_MISSING ? "no /time" : "/time is not (time) numbers");
+	if ((err = ss_h5_var_open(in, "time", &t)) > 0 || (!err && t.rank != 1)) {
+		ss_h5_var_close(&h);
+		ss_h5_var_close(&t);
+		return not_series(in, err == SS_H5_VAR_MISSING
+		                      ? "no /time" : "/time is not (time) numbers");
 	}
 	const hsize_t *hd = h.dims;
 	char d[96];
@@ -1388,7 +858,7 @@ static int series_values(const struct h5in *in, struct ss_height_series *s)
 	else if (!err && (hd[1] < 1 || hd[2] < 1 || hd[1] > SS_SNAPSHOT_MAX_SIDE ||
 	                  hd[2] > SS_SNAPSHOT_MAX_SIDE))
 		err = ss_error_input("'%s': /height is %s (time, y, x): expected 1 to %d cells a "
-		                     "side", in->name, format_dims(3, hd, d, sizeof d),
+		                     "side", in->name, ss_h5_format_dims(3, hd, d, sizeof d),
 		                     SS_SNAPSHOT_MAX_SIDE);
 	s->count = (long long)(err ? hd[0] : t.dims[0]);
 	s->ny = (int)hd[1];
@@ -1414,16 +884,16 @@ static int series_values(const struct h5in *in, struct ss_height_series *s)
 	}
 	const hsize_t t0 = 0, tn = (hsize_t)s->count;
 	if (!err && s->count > 0)
-		err = var_read(in, &t, &t0, &tn, H5T_NATIVE_DOUBLE, s->time, "/time");
+		err = ss_h5_var_read(in, &t, &t0, &tn, H5T_NATIVE_DOUBLE, s->time, "/time");
 	for (long long k = 0; k < s->count && !err; k++) {
 		const hsize_t start[3] = {(hsize_t)k, 0, 0}, count[3] = {1, hd[1], hd[2]};
 		char what[64];
 		snprintf(what, sizeof what, "snapshot %lld of /height", k);
-		err = var_read(in, &h, start, count, H5T_NATIVE_DOUBLE,
-		               s->height + (size_t)k * cells, what);
+		err = ss_h5_var_read(in, &h, start, count, H5T_NATIVE_DOUBLE,
+		                     s->height + (size_t)k * cells, what);
 	}
-	var_close(&t);
-	var_close(&h);
+	ss_h5_var_close(&t);
+	ss_h5_var_close(&h);
 	return err;
 }
 
@@ -1431,8 +901,8 @@ int ss_snapshot_read_height_series(const char *path, struct ss_height_series *s)
 {
 	memset(s, 0, sizeof *s);
 	s->dx = s->dy = s->origin_x = s->origin_y = NAN;
-	struct h5in in;
-	int err = h5in_open(&in, path, NULL, 0);
+	struct ss_h5_file in;
+	int err = ss_h5_file_open(&in, path, NULL, 0);
 	if (!err)
 		err = series_values(&in, s);
 	if (!err)
@@ -1441,7 +911,7 @@ int ss_snapshot_read_height_series(const char *path, struct ss_height_series *s)
 		err = series_geometry(&in, "y", s->ny, &s->dy, &s->origin_y);
 	if (!err)
 		err = series_walls(&in, s);
-	h5in_close(&in);
+	ss_h5_file_close(&in);
 	if (err)
 		ss_height_series_release(s);
 	return err;
