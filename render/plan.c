@@ -1,5 +1,5 @@
 /*
- * frame.c - one frame: the options, the picture's size, the plan shared by
+ * plan.c - one frame: the options, the picture's size, the plan shared by
  * the frames of a series (resampling weights, pixel types, height scale),
  * and the three steps of render.h put together.
  */

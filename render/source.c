@@ -1,5 +1,5 @@
 /*
- * series.c - a sandslide output file (doc/output.md) as the renderer
+ * source.c - a sandslide output file (doc/output.md) as the renderer
  * reads it: the file through the one reader of src/io/h5_read.c
  * (snapshot.h), which checks it and serialises HDF5 between the threads
  * that render frames, and its cell types (one byte per cell, the file's
