@@ -210,7 +210,7 @@ void ss_render_source_close(struct ss_render_source *s);
 int ss_render_source_range(struct ss_render_source *s, long long first, long long last,
                            double *zmin, double *zmax);
 
-/* ---- plan.c: one frame from a source --------------------------------- */
+/* ---- plan.c: what the frames of a series share ----------------------- */
 
 /* Fill in a missing zmin or zmax (NAN) from the data's range [lo, hi]
  * (empty: 0..1, flat: widened by 0.5 m each way); SS_ERR_INPUT naming
@@ -275,6 +275,8 @@ int ss_render_plan_gradients(const struct ss_render_plan *p, const double *h,
 int ss_render_plan_draw(const struct ss_render_plan *p, const double *pixel_h,
                         ptrdiff_t stride, const float *gx, const float *gy, double time,
                         struct ss_render_image *img, int parallel);
+
+/* ---- frame.c: one frame of a source, drawn with a plan ---------------- */
 
 /* Render snapshot t of s into img (initialised here; release it, also
  * after a failure), with its time, snapshot, source and map corner; when
