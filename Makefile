@@ -205,13 +205,16 @@ ifeq ($(MPI),1)
   MPIFLAG := -DSS_HAVE_MPI
 endif
 # Sources made by the build (the viewer's script as a C array): GEN, on
-# the include path of every build of the library.
+# the include path of every build of the library.  The top folder is on it
+# too, for the renderer's headers that other tiers include as
+# "render/plot.h" (private to the library: include/sandslide/ is the
+# installed interface).
 GEN      := $(BUILD)/gen
 # -fPIC: the same objects make the static and the shared library (on
 # x86-64 the kernel's loops make no calls through the PLT or GOT, so the
 # sweep runs as fast: doc/performance.md#how-the-figures-were-measured).
 ALL_CFLAGS  := $(BASE) -fPIC $(WARN) $(OMPFLAG) $(SANFLAG) $(MPIFLAG) $(PATHDEF) -Iinclude -Isrc \
-               -I$(GEN) \
+               -I. -I$(GEN) \
                -DSS_VERSION='"$(VERSION)"' \
                $(DEP_CFLAGS) -MMD -MP $(CFLAGS)
 ALL_LDFLAGS := $(OMPFLAG) $(SANFLAG) $(LDFLAGS)
@@ -344,7 +347,7 @@ FUZZ_CC      ?= clang
 FUZZ_BUILD   := $(BUILD)/fuzz
 FUZZ_SAN     := -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
 FUZZ_CFLAGS  := -std=c11 -D_XOPEN_SOURCE=700 -O1 -g $(WARN) -Wno-unknown-pragmas -Iinclude -Isrc \
-                -I$(GEN) -Itests/fuzz -DSS_VERSION='"$(VERSION)"' $(DEP_CFLAGS) $(FUZZ_SAN) -MMD -MP $(CFLAGS)
+                -I. -I$(GEN) -Itests/fuzz -DSS_VERSION='"$(VERSION)"' $(DEP_CFLAGS) $(FUZZ_SAN) -MMD -MP $(CFLAGS)
 FUZZ_LIB_SRC := $(LIB_SRC) $(RENDER_SRC)
 FUZZ_BIN     := $(FUZZ_NAMES:%=$(FUZZ_BUILD)/fuzz_%)
 FUZZ_REPLAY  := $(FUZZ_NAMES:%=$(FUZZ_BUILD)/replay/fuzz_%)
