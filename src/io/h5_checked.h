@@ -32,7 +32,8 @@ struct ss_h5_file {
 
 /* Open name (a path, or an image of size bytes in memory when data is not
  * NULL) read-only, quietly: SS_ERR_INPUT when it is missing, not HDF5,
- * damaged or locked by a writer. */
+ * damaged or locked by a writer; SS_ERR_FAIL when HDF5 cannot be set up to
+ * read an image.  The file's size is kept for the checks. */
 int ss_h5_file_open(struct ss_h5_file *in, const char *name, const void *data, size_t size);
 void ss_h5_file_close(struct ss_h5_file *in);
 
