@@ -204,10 +204,17 @@ endif
 ifeq ($(MPI),1)
   MPIFLAG := -DSS_HAVE_MPI
 endif
+# Sources made by the build (the viewer's script as a C array): GEN, on
+# the include path of every build of the library.  The top folder is on it
+# too, for the renderer's headers that other tiers include as
+# "render/plot.h" (private to the library: include/sandslide/ is the
+# installed interface).
+GEN      := $(BUILD)/gen
 # -fPIC: the same objects make the static and the shared library (on
 # x86-64 the kernel's loops make no calls through the PLT or GOT, so the
 # sweep runs as fast: doc/performance.md#how-the-figures-were-measured).
 ALL_CFLAGS  := $(BASE) -fPIC $(WARN) $(OMPFLAG) $(SANFLAG) $(MPIFLAG) $(PATHDEF) -Iinclude -Isrc \
+               -I. -I$(GEN) \
                -DSS_VERSION='"$(VERSION)"' \
                $(DEP_CFLAGS) -MMD -MP $(CFLAGS)
 ALL_LDFLAGS := $(OMPFLAG) $(SANFLAG) $(LDFLAGS)
@@ -268,6 +275,28 @@ $(BUILD)/obj/render/%.o: render/%.c $(BUILD)/.flags
 	@$(if $(Q),echo '  CC      $<')
 	$(Q)$(CC) $(ALL_CFLAGS) -c $< -o $@
 
+# The HTML viewer's script, render/viewer.js, as a C array of its bytes
+# (ss_render_viewer_js) that render/html.c includes: the page holds the
+# file's bytes exactly, less its header comment (the // lines up to the
+# first empty line, and that line: what the file says of itself).  awk,
+# od and sed only (POSIX; xxd may be missing, no Python at build time).
+# Every build that compiles html.c (the library's, the fuzz builds') has
+# the header as a prerequisite: its first compile has no .d file yet.
+VIEWER_JS := $(GEN)/render/viewer_js.h
+$(VIEWER_JS): render/viewer.js
+	@mkdir -p $(@D)
+	@$(if $(Q),echo '  GEN     $@')
+	$(Q)awk 'NR == 1 && /^\/\// { head = 1 } head && /^\/\// { next } \
+	  head && /^$$/ { head = 0; next } { head = 0; print }' $< > $@.js
+	$(Q)od -An -v -tx1 $@.js > $@.od
+	$(Q){ echo '/* render/viewer.js as bytes, less its header comment: made by the'; \
+	  echo ' * Makefile (awk, od, sed); edit render/viewer.js instead */'; \
+	  echo 'static const unsigned char ss_render_viewer_js[] = {'; \
+	  sed -e 's/ *\([0-9a-fA-F][0-9a-fA-F]\)/0x\1,/g' $@.od; \
+	  echo '};'; } > $@.tmp
+	$(Q)rm -f $@.js $@.od && mv $@.tmp $@
+$(BUILD)/obj/render/html.o: $(VIEWER_JS)
+
 $(BUILD)/libsandslide.a: $(LIB_OBJ)
 	@$(if $(Q),echo '  AR      $@')
 	$(Q)rm -f $@ && ar rcs $@ $^
@@ -318,7 +347,7 @@ FUZZ_CC      ?= clang
 FUZZ_BUILD   := $(BUILD)/fuzz
 FUZZ_SAN     := -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
 FUZZ_CFLAGS  := -std=c11 -D_XOPEN_SOURCE=700 -O1 -g $(WARN) -Wno-unknown-pragmas -Iinclude -Isrc \
-                -Itests/fuzz -DSS_VERSION='"$(VERSION)"' $(DEP_CFLAGS) $(FUZZ_SAN) -MMD -MP $(CFLAGS)
+                -I. -I$(GEN) -Itests/fuzz -DSS_VERSION='"$(VERSION)"' $(DEP_CFLAGS) $(FUZZ_SAN) -MMD -MP $(CFLAGS)
 FUZZ_LIB_SRC := $(LIB_SRC) $(RENDER_SRC)
 FUZZ_BIN     := $(FUZZ_NAMES:%=$(FUZZ_BUILD)/fuzz_%)
 FUZZ_REPLAY  := $(FUZZ_NAMES:%=$(FUZZ_BUILD)/replay/fuzz_%)
@@ -342,6 +371,7 @@ $(FUZZ_BUILD)/replay/%.o: %.c $(BUILD)/.flags
 	@mkdir -p $(@D)
 	@$(if $(Q),echo '  CC      $<')
 	$(Q)$(CC) $(FUZZ_CFLAGS) -c $< -o $@
+$(FUZZ_BUILD)/lf/render/html.o $(FUZZ_BUILD)/replay/render/html.o: $(VIEWER_JS)
 $(FUZZ_BUILD)/lf/libsandslide.a: $(FUZZ_LIB_SRC:%.c=$(FUZZ_BUILD)/lf/%.o)
 	$(Q)rm -f $@ && ar rcs $@ $^
 $(FUZZ_BUILD)/replay/libsandslide.a: $(FUZZ_LIB_SRC:%.c=$(FUZZ_BUILD)/replay/%.o)
@@ -451,7 +481,8 @@ test-slurm: all
 
 # The tiers of src/README.md, checked by the #includes of each file: the
 # kernel knows nothing of files, printing or the command line, I/O nothing
-# of the stencil, and <hdf5.h> is in two files (tests/check_layering.sh).
+# of the stencil, and only the io/h5 files (src/io/h5_*) include <hdf5.h>
+# (tests/check_layering.sh).
 check-layering:
 	@sh tests/check_layering.sh
 

@@ -44,7 +44,6 @@
 #include "sandslide/fit.h"
 #include "sandslide/bench.h"
 #include "sandslide/render.h"
-#include "sandslide/plot.h"
 #include "sandslide/bmi.h"
 
 #endif
