@@ -37,6 +37,7 @@
 #include "sandslide/shape.h"
 #include "sandslide/case.h"
 #include "sandslide/progress.h"
+#include "sandslide/job.h"
 #include "sandslide/watch.h"
 
 #include "sandslide/run.h"
