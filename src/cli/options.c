@@ -151,23 +151,27 @@ static void roff_put(const char *s, size_t n, FILE *f)
 	}
 }
 
-/* text's '\n'-separated lines as lines of roff text, which roff fills into
- * one paragraph: the help's indentation dropped, no empty line (a blank
- * line in roff is vertical space), \& before a line that roff would take
- * for a request. */
-static void roff_lines(const char *text, FILE *f)
+/* text's '\n'-separated lines (the help's, laid out for a terminal) as
+ * one line of roff text, without the line's end: the indentation dropped,
+ * the lines joined by a blank, so that roff fills them and takes no line's
+ * last word for the end of a sentence ("e.g."); \& first when roff would
+ * take the line for a request.  Returns how many lines it wrote. */
+static int roff_line(const char *text, FILE *f)
 {
+	int words = 0;
 	for (const char *p = text; *p;) {
 		p += strspn(p, " \t");
 		const size_t n = strcspn(p, "\n");
 		if (n) {
-			if (*p == '.' || *p == '\'')
+			if (words++)
+				fputc(' ', f);
+			else if (*p == '.' || *p == '\'')
 				fputs("\\&", f);
 			roff_put(p, n, f);
-			fputc('\n', f);
 		}
 		p += n + (p[n] == '\n');
 	}
+	return words;
 }
 
 /* ".TP" with the names in bold and the value in italics, then the text
@@ -189,18 +193,21 @@ static void roff_option(const struct ss_option *o, FILE *f)
 		fputs("\\fR", f);
 	}
 	fputc('\n', f);
-	roff_lines(o->help ? o->help : "", f);
+	const int text = roff_line(o->help ? o->help : "", f);
 	if (o->default_value) {
-		fputs("(default ", f);
+		fputs(text ? " (default " : "(default ", f);
 		roff_put(o->default_value, strlen(o->default_value), f);
-		fputs(")\n", f);
+		fputc(')', f);
 	}
+	if (text || o->default_value)
+		fputc('\n', f);
 }
 
 static void roff_heading(const char *text, FILE *f)
 {
 	fputs(".\\\" heading\n.PP\n", f);
-	roff_lines(text, f);
+	if (roff_line(text, f))
+		fputc('\n', f);
 }
 
 void cli_help_roff(const struct cli_command *c, FILE *f)
