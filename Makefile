@@ -1,6 +1,7 @@
 # sandslide - plain GNU Makefile.
 #
-#   make            build build/sandslide, build/libsandslide.a and .so
+#   make            build build/sandslide, build/libsandslide.a and .so, and
+#                   the man page build/sandslide.1 (man -l build/sandslide.1)
 #   make lib        only the shared library build/libsandslide.so.0 (what
 #                   the Python module loads; pip's build runs it, setup.py)
 #   make deps       install the Debian packages building and running need
@@ -245,7 +246,7 @@ HEADERS  := $(wildcard include/sandslide/*.h)
         install uninstall
 SONAME   := libsandslide.so.$(SOVERSION)
 SHLIB    := libsandslide.so.$(VERSION)
-all: $(BUILD)/sandslide $(BUILD)/libsandslide.a $(BUILD)/libsandslide.so
+all: $(BUILD)/sandslide $(BUILD)/libsandslide.a $(BUILD)/libsandslide.so $(BUILD)/sandslide.1
 lib: $(BUILD)/libsandslide.so
 
 # A flags stamp: objects rebuild when the flags change (git's GIT-CFLAGS).
@@ -384,6 +385,15 @@ $(FUZZ_BUILD)/replay/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/replay.c $(FUZZ_BUIL
 	$(Q)$(CC) $(filter-out -MMD -MP,$(FUZZ_CFLAGS)) $(filter %.c %.a,$^) $(LIBS) -o $@
 # replay/render/x.d and replay/src/io/x.d: the tiers are one level deeper
 -include $(wildcard $(FUZZ_BUILD)/*/*/*.d $(FUZZ_BUILD)/*/*/*/*.d)
+
+# The man page: doc/sandslide.1.in, written by hand, with each command's
+# options filled in by the program itself from the option tables it parses
+# (`sandslide help --roff CMD`, the --help's walk written as roff), so that
+# the page and --help cannot disagree; doc/manpage.awk puts them, and the
+# template's notes on them, where the template's blocks say.  POSIX awk.
+$(BUILD)/sandslide.1: doc/sandslide.1.in doc/manpage.awk $(BUILD)/sandslide
+	@$(if $(Q),echo '  MAN     $@')
+	$(Q)awk -v program=$(BUILD)/sandslide -f doc/manpage.awk doc/sandslide.1.in > $@
 
 # The test hooks (tests/hooks/NAME_step.c): the command line linked again
 # with the stepper's advance wrapped, as $(BUILD)/tests/sandslide-NAME, so
@@ -552,7 +562,7 @@ install: all
 	  -e 's|@VERSION@|$(VERSION)|' \
 	  -e 's|@REQUIRES@|$(PC_REQUIRES)|' -e 's|@OPENMP@|$(filter -fopenmp,$(OMPFLAG))|' \
 	  sandslide.pc.in > $(DESTDIR)$(PKGCONFIGDIR)/sandslide.pc
-	$(INSTALL) -m 644 doc/sandslide.1 $(DESTDIR)$(MANDIR)/man1/sandslide.1
+	$(INSTALL) -m 644 $(BUILD)/sandslide.1 $(DESTDIR)$(MANDIR)/man1/sandslide.1
 	$(INSTALL) -m 644 $(wildcard cases/*.ini cases/*.py) $(DESTDIR)$(DATADIR)/sandslide/cases/
 	$(INSTALL) -m 644 $(wildcard cases/dem/*) $(DESTDIR)$(DATADIR)/sandslide/cases/dem/
 	$(if $(PY_SRC),$(INSTALL) -m 644 $(PY_SRC) $(DESTDIR)$(PYTHONDIR)/sandslide/)
