@@ -3,9 +3,9 @@ file"): the commit before it, f9026b5, is built from this checkout's
 history in a git worktree (under the build folder, kept between runs), and
 tools/same_bits.py --quick compares what both builds write: the door, the
 cone and the DEM case, relax of cases/dem/terrain.asc with its report, a
-fit twin's report and the README's Python relax.  The full comparison
+fit twin's report and the Python relax of README.md.  The full comparison
 (every case on every kernel, integrator and thread count, the MPI builds)
-is tools/same_bits.py without --quick, as the issue's note shows.
+is tools/same_bits.py without --quick.
 
 Skipped where the checkout has no history holding f9026b5 (a tarball) or
 no git, and for a sanitized build (a plain build of the old tree is what
