@@ -145,6 +145,30 @@ def test_transient_cone_gives_closure_nu_and_angle(tmp_path):
     assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 5000, "fit.png is not a figure"
 
 
+def test_noise_free_twin_interval_holds_the_truth(tmp_path):
+    """A noise-free twin made by `run` at the case's rkl2_tol 0.1, fitted
+    at 0.01: the residual left at the best point is the forward model's
+    error, not noise, and it moves the best nu off 0.13 by more than the
+    noise's interval allows.  The 95 % interval counts that error (F7a)
+    and holds the truth; the report gives both parts of the std."""
+    truth = twin(tmp_path, "exact", "model.nu=0.13")
+    obs = degrade(truth, tmp_path / "exact_scan.h5", [1, 2, 4])
+    report = fit(tmp_path, tmp_path / "exact.ini", obs, "--param", "nu=0.01:1:log",
+                 "--profile-points", "3")
+    assert report["rkl2_tol"] == 0.01
+    c = closure_of(report, "coulomb")
+    u = c["uncertainty"]["nu"]
+    assert u["low"] < 0.13 < u["high"], \
+        f"nu {c['params']['nu']}: the 95 % interval {u['low']} .. {u['high']} misses 0.13"
+    assert u["std"] ** 2 == pytest.approx(u["std_noise"] ** 2 + u["std_model"] ** 2,
+                                          rel=1e-4), u
+    assert u["std_noise"] > 0 and u["std_model"] > 0, u
+    m = c["model_error"]
+    assert m["reference"] == "rkl2_tol 0.1 (the case's)", m
+    assert 0 < m["cost"] and m["noise_cost"] >= c["cost"], m
+    assert c["identifiable"] == {"nu": True}, c
+
+
 def test_end_states_do_not_identify_nu(tmp_path):
     """States at rest (t = 150 and 200 s; the cone is still after 20 s)
     see the angle but not nu: the time scale L^2 / nu has gone."""
