@@ -33,6 +33,10 @@
 
 enum { PROFILE_MAX = 33, CLOSURES = 4, FRONT_SAMPLES = 4, TRACE_TIMES = 40 };
 
+/* A best value within this of a bound, in u, is on it (F9a): ten times
+ * the search's stopping step (1e-4). */
+static const double BOUND_TOL = 1e-3;
+
 /* How a forward run ended. */
 enum { RUN_DONE, RUN_CUT, RUN_STOPPED };
 
@@ -121,6 +125,18 @@ struct fit {
 static double value_of(const struct ss_fit_param *p, double u)
 {
 	return p->log ? p->lo * pow(p->hi / p->lo, u) : p->lo + u * (p->hi - p->lo);
+}
+
+/* Whether u is on a bound of the range searched (F9a): -1 the lower, +1
+ * the upper, 0 neither. */
+static int bound_side(double u)
+{
+	return u <= BOUND_TOL ? -1 : u >= 1.0 - BOUND_TOL ? 1 : 0;
+}
+
+static const char *bound_name(int side)
+{
+	return side < 0 ? "lower" : "upper";
 }
 
 /* The row of the model's table that parameter p frees (its case key is
@@ -768,7 +784,17 @@ static int profiles(struct fit *f, struct closure_fit *cf)
 		for (int i = 0; i < n; i++)
 			rise = fmax(rise, cf->profile_cost[k][i] - cf->cost);
 		const double width = 2.0 * 1.96 * cf->std_u[k];
-		if (!(rise > 3.84 * s2)) {
+		const int side = bound_side(cf->u[k]);
+		if (side) {
+			/* the least cost may lie beyond the range: neither the rise
+			 * nor the interval says where the minimum is (F9a) */
+			cf->identifiable[k] = 0;
+			snprintf(cf->why[k], sizeof cf->why[k],
+			         "the best value %s is on the %s bound of the range searched "
+			         "(%s .. %s): the cost may fall further beyond it; widen the range "
+			         "(--param %s=LO:HI) and fit again", SS_REAL(value_of(p, cf->u[k])),
+			         bound_name(side), SS_REAL(p->lo), SS_REAL(p->hi), p->name);
+		} else if (!(rise > 3.84 * s2)) {
 			cf->identifiable[k] = 0;
 			snprintf(cf->why[k], sizeof cf->why[k],
 			         "the cost changes by less than the noise over the whole range of %s: "
@@ -1220,7 +1246,14 @@ static void json_closure(struct ss_strbuf *b, const struct fit *f, const struct 
 	} else {
 		ss_strbuf_printf(b, "null");
 	}
-	ss_strbuf_printf(b, ",\n     \"identifiable\": {");
+	ss_strbuf_printf(b, ",\n     \"at_bound\": {");
+	for (int k = 0, first = 1; k < cf->p; k++)
+		if (bound_side(cf->u[k])) {
+			ss_strbuf_printf(b, "%s\"%s\": \"%s\"", first ? "" : ", ",
+			                 params[cf->param[k]].name, bound_side(cf->u[k]) < 0 ? "lo" : "hi");
+			first = 0;
+		}
+	ss_strbuf_printf(b, "},\n     \"identifiable\": {");
 	for (int k = 0; cf->assessed && k < cf->p; k++)
 		ss_strbuf_printf(b, "%s\"%s\": %s", k ? ", " : "", params[cf->param[k]].name,
 		                 cf->identifiable[k] ? "true" : "false");
@@ -1305,7 +1338,7 @@ static void format_report(struct ss_strbuf *b, const struct fit *f, int best)
 		if (isfinite(f->fits[c].cost) && f->fits[c].aic - top->aic < 2.0)
 			ss_strbuf_printf(b, "%s\"%s\"", ties++ ? ", " : "", ss_closure_name(f->fits[c].kind));
 	ss_strbuf_printf(b, "],\n  \"verdict\": ");
-	char verdict[600];
+	char verdict[2048];   /* 4 closures x 4 parameters of notes at most */
 	struct ss_strbuf v = {verdict, sizeof verdict, 0};
 	if (!top)
 		ss_strbuf_printf(&v, "no forward run finished");
@@ -1322,6 +1355,9 @@ static void format_report(struct ss_strbuf *b, const struct fit *f, int best)
 			if (!cf->identifiable[k])
 				ss_strbuf_printf(&v, "; %s: %s not identifiable", ss_closure_name(cf->kind),
 				                 p->name);
+			if (!cf->identifiable[k] && bound_side(cf->u[k]))
+				ss_strbuf_printf(&v, ", on the %s bound of its range: widen it",
+				                 bound_name(bound_side(cf->u[k])));
 			/* Herschel-Bulkley with gamma = 1 is Bingham exactly (closure.h) */
 			if (cf->kind == SS_CLOSURE_HERSCHEL_BULKLEY && !strcmp(p->name, "gamma") &&
 			    fabs(value_of(p, cf->u[k]) - 1.0) <
@@ -1358,6 +1394,9 @@ static void format_summary(struct ss_strbuf *b, const struct fit *f, int best)
 				ss_strbuf_printf(b, " (%.4g .. %.4g)",
 				                 value_of(p, fmax(cf->u[k] - 1.96 * cf->std_u[k], 0.0)),
 				                 value_of(p, fmin(cf->u[k] + 1.96 * cf->std_u[k], 1.0)));
+			if (cf->assessed && bound_side(cf->u[k]))
+				ss_strbuf_printf(b, " on the %s bound: widen the range,",
+				                 bound_name(bound_side(cf->u[k])));
 			if (cf->assessed && !cf->identifiable[k])
 				ss_strbuf_printf(b, " not identifiable");
 		}

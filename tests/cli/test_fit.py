@@ -169,6 +169,32 @@ def test_noise_free_twin_interval_holds_the_truth(tmp_path):
     assert c["identifiable"] == {"nu": True}, c
 
 
+@pytest.mark.parametrize("bounds, side, word", [("0.01:0.05", "hi", "upper"),
+                                                 ("0.5:2", "lo", "lower")])
+def test_best_on_a_bound_is_flagged_not_identified(tmp_path, bounds, side, word):
+    """nu = 0.13 searched in a range that does not hold it: the best value
+    is the bound nearest the truth, where the cost still falls outwards.
+    The report flags it on that bound, never identifiable, and says to
+    widen the range: in the JSON, the verdict and the summary line."""
+    truth = twin(tmp_path, "edge", "model.nu=0.13")
+    degrade(truth, tmp_path / "edge_scan.h5", [1, 2, 4])
+    r = run_ok(["fit", "edge.ini", "edge_scan.h5", "--param", f"nu={bounds}:log",
+                "--profile-points", "3", "-o", "f.json"], cwd=tmp_path)
+    report = json.loads((tmp_path / "f.json").read_text())
+    c = closure_of(report, "coulomb")
+    lo, hi = (float(v) for v in bounds.split(":"))
+    assert c["params"]["nu"] == pytest.approx(hi if side == "hi" else lo, rel=1e-3), c["params"]
+    assert c["identifiable"] == {"nu": False}, \
+        f"nu = {c['params']['nu']} on the {word} bound is called identifiable: {c}"
+    assert c["at_bound"] == {"nu": side}, c
+    assert f"{word} bound" in c["why"]["nu"] and "widen the range" in c["why"]["nu"], c["why"]
+    assert f"nu not identifiable, on the {word} bound of its range: widen it" in \
+        report["verdict"], report["verdict"]
+    line = r.stdout.splitlines()[0]
+    assert f"on the {word} bound: widen the range" in line and "not identifiable" in line, \
+        r.stdout
+
+
 def test_end_states_do_not_identify_nu(tmp_path):
     """States at rest (t = 150 and 200 s; the cone is still after 20 s)
     see the angle but not nu: the time scale L^2 / nu has gone."""
