@@ -215,7 +215,7 @@ static double fit_rkl2_tol(const struct fit *f)
  * case's own tolerance when the fit tightened it (the case as `run`
  * solves it: the fit's tighter tolerance only smooths the cost for the
  * search), else one ten times tighter; with forward Euler half the CFL
- * number.
+ * number (covariance() doubles that difference: Euler is first order).
  */
 static double reference_rkl2_tol(const struct fit *f)
 {
@@ -717,14 +717,18 @@ static int covariance(struct fit *f, struct closure_fit *cf)
 				s += ja[i] * jb[i];
 			jtj[a][b] = s;
 		}
-	/* d = r_fit - r_ref at the best point, J_m = sum d_i^2, J_r^T d (F7a) */
+	/* d = r_fit - r_ref at the best point (twice that for Euler),
+	 * J_m = sum d_i^2, J_r^T d (F7a) */
 	if (residuals(f, cf, cf->u, STEP_FIT, f->residuals) ||
 	    residuals(f, cf, cf->u, STEP_REFERENCE, f->model_delta))
 		return -1;
+	/* forward Euler is first order in its step: h(dt) - h(dt/2) is half
+	 * the error of h(dt) (Richardson); RKL2's tolerance sets no such rate */
+	const double richardson = f->integrator == SS_INTEGRATOR_RKL2 ? 1.0 : 2.0;
 	double jtd[SS_FIT_MAX_PARAMS] = {0.0};
 	cf->model_cost = 0.0;
 	for (long long i = 0; i < m; i++) {
-		const double d = f->residuals[i] - f->model_delta[i];
+		const double d = richardson * (f->residuals[i] - f->model_delta[i]);
 		cf->model_cost += d * d;
 		for (int a = 0; a < p; a++)
 			jtd[a] += f->jacobian[(size_t)a * m + i] * d;

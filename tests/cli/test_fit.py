@@ -169,6 +169,24 @@ def test_noise_free_twin_interval_holds_the_truth(tmp_path):
     assert c["identifiable"] == {"nu": True}, c
 
 
+@pytest.mark.parametrize("setting, reference", [("rkl2_tol = 0.01", "rkl2_tol 0.001"),
+                                                ("integrator = euler", "euler, cfl 0.45")])
+def test_model_error_reference_when_the_fit_does_not_tighten(tmp_path, setting, reference):
+    """A case already at the fit's tolerance, or on forward Euler: the
+    model's error is measured against a tenth of the tolerance, or half
+    the CFL number (F7a); a noise-free twin of the same case is fitted
+    within its interval, and the model's part of it is not zero."""
+    case = cone_case(tmp_path / "ref.ini")
+    case.write_text(edit(case.read_text(), "[time]\n", f"[time]\n{setting}\n"))
+    run_ok(["run", str(case), "-o", str(tmp_path / "ref.h5"), "-q", "--set", "model.nu=0.13"])
+    obs = degrade(tmp_path / "ref.h5", tmp_path / "ref_scan.h5", [1, 2, 4])
+    report = fit(tmp_path, case, obs, "--param", "nu=0.01:1:log", "--profile-points", "3")
+    c = closure_of(report, "coulomb")
+    assert c["model_error"]["reference"] == reference, c["model_error"]
+    u = c["uncertainty"]["nu"]
+    assert u["low"] < 0.13 < u["high"] and u["std_model"] > 0, u
+
+
 @pytest.mark.parametrize("bounds, side, word", [("0.01:0.05", "hi", "upper"),
                                                  ("0.5:2", "lo", "lower")])
 def test_best_on_a_bound_is_flagged_not_identified(tmp_path, bounds, side, word):
