@@ -1,8 +1,9 @@
 /*
  * fit.c - `sandslide fit` (fit.h): forward runs through the library, the
  * cost functionals, the search (a coarse grid, then NLopt's BOBYQA), the
- * uncertainty and the identifiability verdicts, the comparison of the
- * closures.  doc/fit.md gives the equations this file computes (F0-F10).
+ * uncertainty (the noise and the forward model's own error) and the
+ * identifiability verdicts, the comparison of the closures.  doc/fit.md
+ * gives the equations this file computes (F0-F10).
  *
  * Every parameter is searched in a unit coordinate u in [0, 1]:
  * value = lo + u (hi - lo), or lo (hi / lo)^u on a log scale, so that one
