@@ -103,7 +103,7 @@ struct fit {
 	double *sim;                    /* [cells] a forward run's heights */
 	double *thickness, *chi_sim;    /* [cells] its thickness and support */
 	double *residuals;              /* [M] */
-	double *model_delta;            /* [M] residuals of the reference run (F7a) */
+	double *model_delta;            /* [M] the reference run's residuals (F7a) */
 	double *jacobian;               /* [M][p] */
 	double trace_time[TRACE_TIMES];
 	enum ss_integrator integrator;  /* the case's, resolved */
@@ -674,8 +674,9 @@ static int residuals(struct fit *f, struct closure_fit *cf, const double *u,
  * The Gauss-Newton covariance of the best point (F7) with the forward
  * model's own error (F7a): J_r by central differences of the residuals in
  * u (one-sided at a bound), the noise s^2 = max(J, J_floor) / (M - p) from
- * the residuals, and d = r_fit(u*) - r_ref(u*), the change of the
- * residuals when the reference's time stepping replaces the fit's.
+ * the residuals, and d = c (r_fit(u*) - r_ref(u*)), the change of the
+ * residuals when the reference's time stepping replaces the fit's (c = 1
+ * for RKL2, 2 for Euler).
  *
  * Linearised about the truth u_t, the residuals are r(u) = e + d +
  * J_r (u - u_t), e the noise (independent, variance s^2 each) and d the
@@ -1080,7 +1081,7 @@ static int prepare(struct fit *f)
 	if (!(f->residuals = ss_alloc((size_t)f->residual_count, sizeof *f->residuals,
 	                              "residuals")) ||
 	    !(f->model_delta = ss_alloc((size_t)f->residual_count, sizeof *f->model_delta,
-	                                "residuals")) ||
+	                                "the reference run's residuals")) ||
 	    !(f->jacobian = ss_alloc((size_t)f->residual_count * (size_t)most,
 	                             sizeof *f->jacobian, "the Jacobian")))
 		return SS_ERR_FAIL;
