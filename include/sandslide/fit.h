@@ -11,8 +11,10 @@
  * For each closure asked for it searches the bounds (a coarse grid, then
  * NLopt's BOBYQA from the best points), runs forward through the library
  * (no files written), then estimates the uncertainty (a Gauss-Newton
- * covariance with the noise from the residuals, and the cost along each
- * parameter) and says which parameters the data identify.  The closures
+ * covariance with the noise from the residuals and the forward model's
+ * own error from a run with another time stepping, and the cost along
+ * each parameter) and says which parameters the data identify (never one
+ * whose best value is on a bound of its range).  The closures
  * are compared by cost and by Akaike's information criterion.  The report
  * is JSON.  The library prints nothing: progress goes to a callback.
  */

@@ -1,8 +1,9 @@
 /*
  * fit.c - `sandslide fit` (fit.h): forward runs through the library, the
  * cost functionals, the search (a coarse grid, then NLopt's BOBYQA), the
- * uncertainty and the identifiability verdicts, the comparison of the
- * closures.  doc/fit.md gives the equations this file computes (F0-F10).
+ * uncertainty (the noise and the forward model's own error) and the
+ * identifiability verdicts, the comparison of the closures.  doc/fit.md
+ * gives the equations this file computes (F0-F10).
  *
  * Every parameter is searched in a unit coordinate u in [0, 1]:
  * value = lo + u (hi - lo), or lo (hi / lo)^u on a log scale, so that one
@@ -33,8 +34,17 @@
 
 enum { PROFILE_MAX = 33, CLOSURES = 4, FRONT_SAMPLES = 4, TRACE_TIMES = 40 };
 
+/* A best value within this of a bound, in u, is on it (F9a): ten times
+ * the search's stopping step (1e-4). */
+static const double BOUND_TOL = 1e-3;
+
 /* How a forward run ended. */
 enum { RUN_DONE, RUN_CUT, RUN_STOPPED };
+
+/* The time stepping of a forward run: the fit's (the case's, with the
+ * RKL2 tolerance at most --rkl2-tol), or the reference that the forward
+ * model's own error is measured against (F7a). */
+enum stepping { STEP_FIT, STEP_REFERENCE };
 
 /* One closure's fit. */
 struct closure_fit {
@@ -53,6 +63,10 @@ struct closure_fit {
 	double std_u[SS_FIT_MAX_PARAMS]; /* Gauss-Newton standard deviation in u
 	                                  * (INFINITY: J^T J singular) */
 	double noise;                   /* cost of pure noise used, s^2 (F7) */
+	double std_noise_u[SS_FIT_MAX_PARAMS]; /* the noise's part of std_u */
+	double shift_u[SS_FIT_MAX_PARAMS]; /* du: how far the forward model's own
+	                                    * error moves the best point (F7a) */
+	double model_cost;              /* J_m: the cost of that error (F7a) */
 	int profile_n;
 	double profile_u[SS_FIT_MAX_PARAMS][PROFILE_MAX];
 	double profile_cost[SS_FIT_MAX_PARAMS][PROFILE_MAX];
@@ -89,6 +103,7 @@ struct fit {
 	double *sim;                    /* [cells] a forward run's heights */
 	double *thickness, *chi_sim;    /* [cells] its thickness and support */
 	double *residuals;              /* [M] */
+	double *model_delta;            /* [M] the reference run's residuals (F7a) */
 	double *jacobian;               /* [M][p] */
 	double trace_time[TRACE_TIMES];
 	enum ss_integrator integrator;  /* the case's, resolved */
@@ -111,6 +126,18 @@ struct fit {
 static double value_of(const struct ss_fit_param *p, double u)
 {
 	return p->log ? p->lo * pow(p->hi / p->lo, u) : p->lo + u * (p->hi - p->lo);
+}
+
+/* Whether u is on a bound of the range searched (F9a): -1 the lower, +1
+ * the upper, 0 neither. */
+static int bound_side(double u)
+{
+	return u <= BOUND_TOL ? -1 : u >= 1.0 - BOUND_TOL ? 1 : 0;
+}
+
+static const char *bound_name(int side)
+{
+	return side < 0 ? "lower" : "upper";
 }
 
 /* The row of the model's table that parameter p frees (its case key is
@@ -177,11 +204,43 @@ static void copy_heights(const struct ss_stepper *st, double *out)
 	}
 }
 
+/* The forward runs' RKL2 tolerance: the case's, at most --rkl2-tol. */
+static double fit_rkl2_tol(const struct fit *f)
+{
+	return fmin(f->base.model.rkl2_tol, f->o->rkl2_tol);
+}
+
+/*
+ * The time stepping that the forward model's own error is measured
+ * against (F7a): another solution of the same case.  With RKL2 the
+ * case's own tolerance when the fit tightened it (the case as `run`
+ * solves it: the fit's tighter tolerance only smooths the cost for the
+ * search), else one ten times tighter; with forward Euler half the CFL
+ * number (covariance() doubles that difference: Euler is first order).
+ */
+static double reference_rkl2_tol(const struct fit *f)
+{
+	return f->base.model.rkl2_tol > f->o->rkl2_tol ? f->base.model.rkl2_tol
+	                                               : 0.1 * f->base.model.rkl2_tol;
+}
+
+/* The reference's time stepping in words, for the report:
+ * "rkl2_tol 0.1 (the case's)", "rkl2_tol 0.001", "euler, cfl 0.45". */
+static void reference_text(const struct fit *f, char *buf, size_t size)
+{
+	if (f->integrator == SS_INTEGRATOR_RKL2)
+		snprintf(buf, size, "rkl2_tol %s%s", SS_REAL(reference_rkl2_tol(f)),
+		         f->base.model.rkl2_tol > f->o->rkl2_tol ? " (the case's)" : "");
+	else
+		snprintf(buf, size, "%s, cfl %s", ss_integrator_name(f->integrator),
+		         SS_REAL(0.5 * f->base.model.cfl));
+}
+
 /* The stepper of closure cf at u, prepared at t = 0: its case with each
  * parameter's value, nu derived again when the case derives it, and the
- * forward runs' RKL2 tolerance. */
+ * forward runs' RKL2 tolerance, or the reference's time stepping. */
 static int make_stepper(const struct fit *f, const struct closure_fit *cf, const double *u,
-                        struct ss_stepper *st)
+                        enum stepping stepping, struct ss_stepper *st)
 {
 	struct ss_case c = cf->c;   /* a copy of the values: the set-up only reads */
 	for (int k = 0; k < cf->p; k++) {
@@ -199,8 +258,10 @@ static int make_stepper(const struct fit *f, const struct closure_fit *cf, const
 			                      "at %s: expected a finite value > 0", c.path, c.model.nu, at);
 		}
 	}
-	if (f->integrator == SS_INTEGRATOR_RKL2 && c.model.rkl2_tol > f->o->rkl2_tol)
-		c.model.rkl2_tol = f->o->rkl2_tol;
+	if (f->integrator == SS_INTEGRATOR_RKL2)
+		c.model.rkl2_tol = stepping == STEP_REFERENCE ? reference_rkl2_tol(f) : fit_rkl2_tol(f);
+	else if (stepping == STEP_REFERENCE)
+		c.model.cfl *= 0.5;
 	return ss_setup_stepper(&c, f->o->job.tile[0], f->o->job.tile[1], SS_KERNEL_FAST, st);
 }
 
@@ -338,14 +399,14 @@ struct run_end {
  * the front's trace are both such runs.
  */
 static int run_through(struct fit *f, const struct closure_fit *cf, const double *u,
-                       const double *t, long long n,
+                       enum stepping stepping, const double *t, long long n,
                        int (*at_time)(struct fit *f, long long k, void *context), void *context,
                        int *how, struct run_end *e)
 {
 	struct ss_stepper st;
 	*how = RUN_DONE;
 	e->end = SS_ADVANCE_REACHED;
-	int err = make_stepper(f, cf, u, &st);
+	int err = make_stepper(f, cf, u, stepping, &st);
 	if (err)
 		return err;
 	const struct run_context rc = {f, cf};
@@ -393,13 +454,15 @@ static int add_residuals(struct fit *f, long long k, void *context)
  * lower bound): safe where only "is it better than the best?" is asked,
  * since every time adds a non-negative term.  RUN_STOPPED: the stop signal.
  */
-static int forward(struct fit *f, struct closure_fit *cf, const double *u, double cut,
-                   double *r, double *cost, int *how)
+static int forward_stepped(struct fit *f, struct closure_fit *cf, const double *u,
+                           enum stepping stepping, double cut, double *r, double *cost,
+                           int *how)
 {
 	const double t0 = ss_parallel_wall_seconds();
 	struct cost_sum sum = {.cut = cut, .r = r};
 	struct run_end e;
-	int err = run_through(f, cf, u, f->obs.time, f->obs.times, add_residuals, &sum, how, &e);
+	int err = run_through(f, cf, u, stepping, f->obs.time, f->obs.times, add_residuals, &sum,
+	                      how, &e);
 	*cost = sum.cost;
 	if (err)
 		return err;   /* no run: the set-up failed */
@@ -420,6 +483,13 @@ static int forward(struct fit *f, struct closure_fit *cf, const double *u, doubl
 		f->interrupted = 1;
 	report_progress(f, cf);
 	return err;
+}
+
+/* forward_stepped with the fit's time stepping. */
+static int forward(struct fit *f, struct closure_fit *cf, const double *u, double cut,
+                   double *r, double *cost, int *how)
+{
+	return forward_stepped(f, cf, u, STEP_FIT, cut, r, cost, how);
 }
 
 /* A forward run that keeps the best point: the cost, or INFINITY once the
@@ -587,21 +657,39 @@ static int invert(int p, double a[SS_FIT_MAX_PARAMS][SS_FIT_MAX_PARAMS],
 	return 0;
 }
 
-/* The residuals at u into r (a full run); -1 when stopped or failed. */
-static int residuals(struct fit *f, struct closure_fit *cf, const double *u, double *r)
+/* The residuals at u into r (a full run with the time stepping given);
+ * -1 when stopped or failed. */
+static int residuals(struct fit *f, struct closure_fit *cf, const double *u,
+                     enum stepping stepping, double *r)
 {
 	double cost;
 	int how;
-	const int err = forward(f, cf, u, INFINITY, r, &cost, &how);
+	const int err = forward_stepped(f, cf, u, stepping, INFINITY, r, &cost, &how);
 	if (err)
 		f->failed = err;
 	return err || how != RUN_DONE ? -1 : 0;
 }
 
 /*
- * The Gauss-Newton covariance of the best point (F7): J by central
- * differences of the residuals in u (one-sided at a bound), the noise s^2
- * from the residuals (at least cost_floor), C = s^2 / (M - p) (J^T J)^-1.
+ * The Gauss-Newton covariance of the best point (F7) with the forward
+ * model's own error (F7a): J_r by central differences of the residuals in
+ * u (one-sided at a bound), the noise s^2 = max(J, J_floor) / (M - p) from
+ * the residuals, and d = c (r_fit(u*) - r_ref(u*)), the change of the
+ * residuals when the reference's time stepping replaces the fit's (c = 1
+ * for RKL2, 2 for Euler).
+ *
+ * Linearised about the truth u_t, the residuals are r(u) = e + d +
+ * J_r (u - u_t), e the noise (independent, variance s^2 each) and d the
+ * model's error (the same in every run); least squares gives
+ * u* - u_t = -(J_r^T J_r)^-1 J_r^T (e + d), so with Sigma = s^2 I + d d^T
+ * the residuals' covariance,
+ *
+ *   C_u = (J_r^T J_r)^-1 J_r^T Sigma J_r (J_r^T J_r)^-1
+ *       = s^2 (J_r^T J_r)^-1 + du du^T,   du = (J_r^T J_r)^-1 J_r^T d
+ *
+ * Added to s^2 as if it were noise, the model's cost J_m = |d|^2 would be
+ * spread over the M residuals and averaged away, by up to sqrt(M): it
+ * does not average, every residual carries it the same way in every run.
  */
 static int covariance(struct fit *f, struct closure_fit *cf)
 {
@@ -616,7 +704,8 @@ static int covariance(struct fit *f, struct closure_fit *cf)
 		up[k] = fmin(cf->u[k] + h, 1.0);
 		down[k] = fmax(cf->u[k] - h, 0.0);
 		double *col = f->jacobian + (size_t)k * m;
-		if (residuals(f, cf, up, col) || residuals(f, cf, down, f->residuals))
+		if (residuals(f, cf, up, STEP_FIT, col) ||
+		    residuals(f, cf, down, STEP_FIT, f->residuals))
 			return -1;
 		for (long long i = 0; i < m; i++)
 			col[i] = (col[i] - f->residuals[i]) / (up[k] - down[k]);
@@ -630,14 +719,37 @@ static int covariance(struct fit *f, struct closure_fit *cf)
 				s += ja[i] * jb[i];
 			jtj[a][b] = s;
 		}
+	/* d = r_fit - r_ref at the best point (twice that for Euler),
+	 * J_m = sum d_i^2, J_r^T d (F7a) */
+	if (residuals(f, cf, cf->u, STEP_FIT, f->residuals) ||
+	    residuals(f, cf, cf->u, STEP_REFERENCE, f->model_delta))
+		return -1;
+	/* forward Euler is first order in its step: h(dt) - h(dt/2) is half
+	 * the error of h(dt) (Richardson); RKL2's tolerance sets no such rate */
+	const double richardson = f->integrator == SS_INTEGRATOR_RKL2 ? 1.0 : 2.0;
+	double jtd[SS_FIT_MAX_PARAMS] = {0.0};
+	cf->model_cost = 0.0;
+	for (long long i = 0; i < m; i++) {
+		const double d = richardson * (f->residuals[i] - f->model_delta[i]);
+		cf->model_cost += d * d;
+		for (int a = 0; a < p; a++)
+			jtd[a] += f->jacobian[(size_t)a * m + i] * d;
+	}
 	cf->noise = fmax(cf->cost, f->cost_floor);
 	const double s2 = cf->noise / (double)(m > p ? m - p : 1);
 	if (invert(p, jtj, inv)) {
 		for (int k = 0; k < p; k++)
-			cf->std_u[k] = INFINITY;
-	} else {
-		for (int k = 0; k < p; k++)
-			cf->std_u[k] = inv[k][k] > 0.0 ? sqrt(s2 * inv[k][k]) : INFINITY;
+			cf->std_u[k] = cf->std_noise_u[k] = cf->shift_u[k] = INFINITY;
+		return 0;
+	}
+	/* C_u = s^2 (J_r^T J_r)^-1 + du du^T,  du = (J_r^T J_r)^-1 J_r^T d  (F7) */
+	for (int k = 0; k < p; k++) {
+		double du = 0.0;
+		for (int b = 0; b < p; b++)
+			du += inv[k][b] * jtd[b];
+		cf->shift_u[k] = du;
+		cf->std_noise_u[k] = inv[k][k] > 0.0 ? sqrt(s2 * inv[k][k]) : INFINITY;
+		cf->std_u[k] = sqrt(cf->std_noise_u[k] * cf->std_noise_u[k] + du * du);
 	}
 	return 0;
 }
@@ -678,7 +790,17 @@ static int profiles(struct fit *f, struct closure_fit *cf)
 		for (int i = 0; i < n; i++)
 			rise = fmax(rise, cf->profile_cost[k][i] - cf->cost);
 		const double width = 2.0 * 1.96 * cf->std_u[k];
-		if (!(rise > 3.84 * s2)) {
+		const int side = bound_side(cf->u[k]);
+		if (side) {
+			/* the least cost may lie beyond the range: neither the rise
+			 * nor the interval says where the minimum is (F9a) */
+			cf->identifiable[k] = 0;
+			snprintf(cf->why[k], sizeof cf->why[k],
+			         "the best value %s is on the %s bound of the range searched "
+			         "(%s .. %s): the cost may fall further beyond it; widen the range "
+			         "(--param %s=LO:HI) and fit again", SS_REAL(value_of(p, cf->u[k])),
+			         bound_name(side), SS_REAL(p->lo), SS_REAL(p->hi), p->name);
+		} else if (!(rise > 3.84 * s2)) {
 			cf->identifiable[k] = 0;
 			snprintf(cf->why[k], sizeof cf->why[k],
 			         "the cost changes by less than the noise over the whole range of %s: "
@@ -958,6 +1080,8 @@ static int prepare(struct fit *f)
 		most = f->fits[c].p > most ? f->fits[c].p : most;
 	if (!(f->residuals = ss_alloc((size_t)f->residual_count, sizeof *f->residuals,
 	                              "residuals")) ||
+	    !(f->model_delta = ss_alloc((size_t)f->residual_count, sizeof *f->model_delta,
+	                                "the reference run's residuals")) ||
 	    !(f->jacobian = ss_alloc((size_t)f->residual_count * (size_t)most,
 	                             sizeof *f->jacobian, "the Jacobian")))
 		return SS_ERR_FAIL;
@@ -985,6 +1109,7 @@ static void release(struct fit *f)
 	ss_free(f->area_obs);
 	ss_free(f->radius_obs);
 	ss_free(f->residuals);
+	ss_free(f->model_delta);
 	ss_free(f->jacobian);
 }
 
@@ -1007,7 +1132,8 @@ static int trace(struct fit *f, struct closure_fit *cf)
 	int how;
 	struct run_end e;
 	f->stage = "front";
-	return run_through(f, cf, cf->u, f->trace_time, TRACE_TIMES, add_radius, cf, &how, &e);
+	return run_through(f, cf, cf->u, STEP_FIT, f->trace_time, TRACE_TIMES, add_radius, cf,
+	                   &how, &e);
 }
 
 /* ---- the figure ----------------------------------------------------------- */
@@ -1104,8 +1230,35 @@ static void json_closure(struct ss_strbuf *b, const struct fit *f, const struct 
 		ss_strbuf_json_number(b, isfinite(cf->std_u[k]) ? value_of(p, lo_u) : p->lo, 10);
 		ss_strbuf_printf(b, ", \"high\": ");
 		ss_strbuf_json_number(b, isfinite(cf->std_u[k]) ? value_of(p, hi_u) : p->hi, 10);
-		ss_strbuf_printf(b, ", \"method\": \"gauss-newton, 95 %%\"}");
+		ss_strbuf_printf(b, ", \"method\": \"gauss-newton, 95 %%\", \"std_noise\": ");
+		ss_strbuf_json_number(b, isfinite(cf->std_noise_u[k]) ? cf->std_noise_u[k] * slope
+		                                                      : NAN, 6);
+		ss_strbuf_printf(b, ", \"std_model\": ");
+		ss_strbuf_json_number(b, isfinite(cf->shift_u[k]) ? fabs(cf->shift_u[k]) * slope
+		                                                  : NAN, 6);
+		ss_strbuf_printf(b, "}");
 	}
+	ss_strbuf_printf(b, "},\n     \"model_error\": ");
+	if (cf->assessed) {
+		char reference[96];
+		reference_text(f, reference, sizeof reference);
+		ss_strbuf_printf(b, "{\"cost\": ");
+		ss_strbuf_json_number(b, cf->model_cost, 6);
+		ss_strbuf_printf(b, ", \"noise_cost\": ");
+		ss_strbuf_json_number(b, cf->noise, 6);
+		ss_strbuf_printf(b, ", \"reference\": ");
+		ss_strbuf_json_string(b, reference);
+		ss_strbuf_printf(b, "}");
+	} else {
+		ss_strbuf_printf(b, "null");
+	}
+	ss_strbuf_printf(b, ",\n     \"at_bound\": {");
+	for (int k = 0, first = 1; k < cf->p; k++)
+		if (bound_side(cf->u[k])) {
+			ss_strbuf_printf(b, "%s\"%s\": \"%s\"", first ? "" : ", ",
+			                 params[cf->param[k]].name, bound_side(cf->u[k]) < 0 ? "lo" : "hi");
+			first = 0;
+		}
 	ss_strbuf_printf(b, "},\n     \"identifiable\": {");
 	for (int k = 0; cf->assessed && k < cf->p; k++)
 		ss_strbuf_printf(b, "%s\"%s\": %s", k ? ", " : "", params[cf->param[k]].name,
@@ -1191,7 +1344,7 @@ static void format_report(struct ss_strbuf *b, const struct fit *f, int best)
 		if (isfinite(f->fits[c].cost) && f->fits[c].aic - top->aic < 2.0)
 			ss_strbuf_printf(b, "%s\"%s\"", ties++ ? ", " : "", ss_closure_name(f->fits[c].kind));
 	ss_strbuf_printf(b, "],\n  \"verdict\": ");
-	char verdict[600];
+	char verdict[2048];   /* 4 closures x 4 parameters of notes at most */
 	struct ss_strbuf v = {verdict, sizeof verdict, 0};
 	if (!top)
 		ss_strbuf_printf(&v, "no forward run finished");
@@ -1208,6 +1361,9 @@ static void format_report(struct ss_strbuf *b, const struct fit *f, int best)
 			if (!cf->identifiable[k])
 				ss_strbuf_printf(&v, "; %s: %s not identifiable", ss_closure_name(cf->kind),
 				                 p->name);
+			if (!cf->identifiable[k] && bound_side(cf->u[k]))
+				ss_strbuf_printf(&v, ", on the %s bound of its range: widen it",
+				                 bound_name(bound_side(cf->u[k])));
 			/* Herschel-Bulkley with gamma = 1 is Bingham exactly (closure.h) */
 			if (cf->kind == SS_CLOSURE_HERSCHEL_BULKLEY && !strcmp(p->name, "gamma") &&
 			    fabs(value_of(p, cf->u[k]) - 1.0) <
@@ -1220,7 +1376,7 @@ static void format_report(struct ss_strbuf *b, const struct fit *f, int best)
 	ss_strbuf_printf(b, ",\n  \"integrator\": \"%s\", \"rkl2_tol\": ",
 	                 ss_integrator_name(f->integrator));
 	ss_strbuf_json_number(b, f->integrator == SS_INTEGRATOR_RKL2
-	                         ? fmin(f->base.model.rkl2_tol, o->rkl2_tol) : NAN, 10);
+	                         ? fit_rkl2_tol(f) : NAN, 10);
 	ss_strbuf_printf(b, ", \"forward_runs\": %lld, \"seconds\": ", f->runs);
 	ss_strbuf_json_number(b, f->seconds, 4);
 	ss_strbuf_printf(b, ", \"seconds_per_run\": ");
@@ -1244,6 +1400,9 @@ static void format_summary(struct ss_strbuf *b, const struct fit *f, int best)
 				ss_strbuf_printf(b, " (%.4g .. %.4g)",
 				                 value_of(p, fmax(cf->u[k] - 1.96 * cf->std_u[k], 0.0)),
 				                 value_of(p, fmin(cf->u[k] + 1.96 * cf->std_u[k], 1.0)));
+			if (cf->assessed && bound_side(cf->u[k]))
+				ss_strbuf_printf(b, " on the %s bound: widen the range,",
+				                 bound_name(bound_side(cf->u[k])));
 			if (cf->assessed && !cf->identifiable[k])
 				ss_strbuf_printf(b, " not identifiable");
 		}

@@ -145,6 +145,74 @@ def test_transient_cone_gives_closure_nu_and_angle(tmp_path):
     assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 5000, "fit.png is not a figure"
 
 
+def test_noise_free_twin_interval_holds_the_truth(tmp_path):
+    """A noise-free twin made by `run` at the case's rkl2_tol 0.1, fitted
+    at 0.01: the residual left at the best point is the forward model's
+    error, not noise, and it moves the best nu off 0.13 by more than the
+    noise's interval allows.  The 95 % interval counts that error (F7a)
+    and holds the truth; the report gives both parts of the std."""
+    truth = twin(tmp_path, "exact", "model.nu=0.13")
+    obs = degrade(truth, tmp_path / "exact_scan.h5", [1, 2, 4])
+    report = fit(tmp_path, tmp_path / "exact.ini", obs, "--param", "nu=0.01:1:log",
+                 "--profile-points", "3")
+    assert report["rkl2_tol"] == 0.01
+    c = closure_of(report, "coulomb")
+    u = c["uncertainty"]["nu"]
+    assert u["low"] < 0.13 < u["high"], \
+        f"nu {c['params']['nu']}: the 95 % interval {u['low']} .. {u['high']} misses 0.13"
+    assert u["std"] ** 2 == pytest.approx(u["std_noise"] ** 2 + u["std_model"] ** 2,
+                                          rel=1e-4), u
+    assert u["std_noise"] > 0 and u["std_model"] > 0, u
+    m = c["model_error"]
+    assert m["reference"] == "rkl2_tol 0.1 (the case's)", m
+    assert 0 < m["cost"] and m["noise_cost"] >= c["cost"], m
+    assert c["identifiable"] == {"nu": True}, c
+
+
+@pytest.mark.parametrize("setting, reference", [("rkl2_tol = 0.01", "rkl2_tol 0.001"),
+                                                ("integrator = euler", "euler, cfl 0.45")])
+def test_model_error_reference_when_the_fit_does_not_tighten(tmp_path, setting, reference):
+    """A case already at the fit's tolerance, or on forward Euler: the
+    model's error is measured against a tenth of the tolerance, or half
+    the CFL number (F7a); a noise-free twin of the same case is fitted
+    within its interval, and the model's part of it is not zero."""
+    case = cone_case(tmp_path / "ref.ini")
+    case.write_text(edit(case.read_text(), "[time]\n", f"[time]\n{setting}\n"))
+    run_ok(["run", str(case), "-o", str(tmp_path / "ref.h5"), "-q", "--set", "model.nu=0.13"])
+    obs = degrade(tmp_path / "ref.h5", tmp_path / "ref_scan.h5", [1, 2, 4])
+    report = fit(tmp_path, case, obs, "--param", "nu=0.01:1:log", "--profile-points", "3")
+    c = closure_of(report, "coulomb")
+    assert c["model_error"]["reference"] == reference, c["model_error"]
+    u = c["uncertainty"]["nu"]
+    assert u["low"] < 0.13 < u["high"] and u["std_model"] > 0, u
+
+
+@pytest.mark.parametrize("bounds, side, word", [("0.01:0.05", "hi", "upper"),
+                                                 ("0.5:2", "lo", "lower")])
+def test_best_on_a_bound_is_flagged_not_identified(tmp_path, bounds, side, word):
+    """nu = 0.13 searched in a range that does not hold it: the best value
+    is the bound nearest the truth, where the cost still falls outwards.
+    The report flags it on that bound, never identifiable, and says to
+    widen the range: in the JSON, the verdict and the summary line."""
+    truth = twin(tmp_path, "edge", "model.nu=0.13")
+    degrade(truth, tmp_path / "edge_scan.h5", [1, 2, 4])
+    r = run_ok(["fit", "edge.ini", "edge_scan.h5", "--param", f"nu={bounds}:log",
+                "--profile-points", "3", "-o", "f.json"], cwd=tmp_path)
+    report = json.loads((tmp_path / "f.json").read_text())
+    c = closure_of(report, "coulomb")
+    lo, hi = (float(v) for v in bounds.split(":"))
+    assert c["params"]["nu"] == pytest.approx(hi if side == "hi" else lo, rel=1e-3), c["params"]
+    assert c["identifiable"] == {"nu": False}, \
+        f"nu = {c['params']['nu']} on the {word} bound is called identifiable: {c}"
+    assert c["at_bound"] == {"nu": side}, c
+    assert f"{word} bound" in c["why"]["nu"] and "widen the range" in c["why"]["nu"], c["why"]
+    assert f"nu not identifiable, on the {word} bound of its range: widen it" in \
+        report["verdict"], report["verdict"]
+    line = r.stdout.splitlines()[0]
+    assert f"on the {word} bound: widen the range" in line and "not identifiable" in line, \
+        r.stdout
+
+
 def test_end_states_do_not_identify_nu(tmp_path):
     """States at rest (t = 150 and 200 s; the cone is still after 20 s)
     see the angle but not nu: the time scale L^2 / nu has gone."""
