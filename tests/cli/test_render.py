@@ -227,7 +227,8 @@ def test_wall_sides_drawn(series, tmp_path):
 
 def test_label_strip_covers_nothing(series, tmp_path):
     """--label puts the time in a white strip above the picture, which is
-    otherwise the same pixels."""
+    otherwise the same pixels; the text is black, antialiased (a real font:
+    grey at its edges, no other colour)."""
     d, times = series
     run_ok(["render", d / "out.h5", "-o", tmp_path / "a", "--frames", "2", "-q"])
     run_ok(["render", d / "out.h5", "-o", tmp_path / "b", "--frames", "2", "--label", "-q"])
@@ -236,10 +237,12 @@ def test_label_strip_covers_nothing(series, tmp_path):
     strip = b.shape[0] - a.shape[0]
     assert b.shape[1] == a.shape[1] and strip > 7, (a.shape, b.shape)
     assert np.array_equal(b[strip:], a), "the picture below the strip is untouched"
-    label = b[:strip]
+    label = b[:strip].astype(int)
+    grey = (label[:, :, 0] == label[:, :, 1]) & (label[:, :, 1] == label[:, :, 2])
     black = np.all(label == 0, axis=2)
     white = np.all(label == 255, axis=2)
-    assert np.all(black | white) and black.sum() > 50, "black text on white"
+    assert np.all(grey) and black.sum() > 50, "black text on white"
+    assert (~black & ~white).sum() > 20, "edges in grey: antialiased"
 
 
 def test_force(series, tmp_path):
