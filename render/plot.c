@@ -11,10 +11,11 @@
  *     +-------------------------------------+
  *   y |  grid, vertical lines, series,      |  the legend in the first
  *   t |  legend                             |  corner where it covers no
- *   i |                                     |  data, else beside the frame
+ *   i |                                     |  data
  *   t +-------------------------------------+
  *   l   ticks, tick labels
  *   e   x title (centred)
+ *       [legend, its entries in rows, when no corner is free]
  *
  * The axes span the data with 5 % to spare.  Tick steps are 1, 2 or 5
  * times a power of ten (whole decades on a log axis, or every 2nd, 3rd, 5th
@@ -622,8 +623,6 @@ struct legend {
 	                             * entry a row */
 	int w, h;                   /* the box, px */
 	int x, y;                   /* its top-left corner */
-	int below;                  /* 1: under the plot area, which was
-	                             * shortened for it */
 };
 
 /* Sizes of a panel's parts, px: text from the fonts' em, lines and markers
@@ -959,7 +958,6 @@ static void draw_panel(struct ss_render_image *img, const struct panel *pn,
 		                               &bx, &by);
 		if (m.area.y1 - m.area.y0 >= img->height / 3) {
 			l = m, ax = bx, ay = by, g = under;
-			g.below = 1;
 			g.x = max_int((l.area.x0 + l.area.x1) / 2 - g.w / 2, l.pad);
 			if (g.x + g.w > img->width - l.pad)
 				g.x = max_int(img->width - l.pad - g.w, 0);

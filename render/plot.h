@@ -16,7 +16,8 @@
  * neighbours keep an em between them; a panel with nothing to draw shows
  * empty axes and its title.  The legend goes into the first corner of the
  * plot area (upper right, upper left, lower right, lower left) where it
- * covers no drawn data, else beside the plot area, which narrows for it.
+ * covers no drawn data, else under the plot area (its entries in rows),
+ * which is shortened for it.
  * Text is the renderer's font (DejaVu Sans through FreeType, antialiased:
  * render/text.c) at about 1/24 of the panel's shorter side, titles a fifth
  * larger; text wider than its panel is cut at the panel's edge.

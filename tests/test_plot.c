@@ -620,6 +620,72 @@ static void test_legend_covers_no_data(void)
 	check_legend_clear(cross_figure, "cross", 1);
 }
 
+/* Is there ink (a pixel darker than mid-grey) in column x, rows [y0, y1)? */
+static int ink_in_column(const struct pic *p, int x, int y0, int y1)
+{
+	for (int y = y0; y < y1; y++)
+		if (pic_at(p, x, y)[0] < 128)
+			return 1;
+	return 0;
+}
+
+static int ink_in_row(const struct pic *p, int y, int x0, int x1)
+{
+	for (int x = x0; x < x1; x++)
+		if (pic_at(p, x, y)[0] < 128)
+			return 1;
+	return 0;
+}
+
+/*
+ * Tick labels do not run into each other, in a proportional font on a
+ * small panel with long labels: between the marks of neighbouring x ticks
+ * (black pixels just under the frame) a column of the labels' rows is
+ * blank, and between neighbouring y ticks a row of the labels' columns.
+ */
+static void test_tick_labels_apart(void)
+{
+	struct ss_plot *p;
+	CHECK(ss_plot_create(&p, 1, 1, 240, 180) == SS_OK, "create");
+	CHECK(ss_plot_panel(p, 0, "ticks", "x", "y", 0) == SS_OK, "panel");
+	const double x[2] = {123450.0, 123990.0}, y[2] = {1.2e-4, 9.7e-4};
+	CHECK(ss_plot_add(p, 0, x, y, 2, SS_PLOT_LINE, 0, NULL) == SS_OK, "add");
+	const char *path = check_file("ticks.png");
+	CHECK(ss_plot_write_png(p, path) == SS_OK, "write");
+	struct pic pic;
+	CHECK(pic_read(path, &pic) == 0, "read");
+	if (pic.px) {
+		const struct box f = frame_box(&pic);
+		/* x: tick marks in the row under the frame, labels below them */
+		int ticks[64], n = 0, apart = 1;
+		for (int c = f.x0; c <= f.x1 && n < 64; c++)
+			if (pic_at(&pic, c, f.y1 + 1)[0] == 0)
+				ticks[n++] = c;
+		const int y0 = f.y1 + 3, y1 = f.y1 + 3 + 22;
+		for (int i = 0; i + 1 < n; i++) {
+			int blank = 0;
+			for (int c = ticks[i] + 1; c < ticks[i + 1] && !blank; c++)
+				blank = !ink_in_column(&pic, c, y0, y1);
+			apart &= blank;
+		}
+		CHECK(n >= 2 && apart, "%d x ticks, their labels apart: %d", n, apart);
+		/* y: tick marks in the column left of the frame, labels left of them */
+		n = 0, apart = 1;
+		for (int r = f.y0; r <= f.y1 && n < 64; r++)
+			if (pic_at(&pic, f.x0 - 2, r)[0] == 0)
+				ticks[n++] = r;
+		for (int i = 0; i + 1 < n; i++) {
+			int blank = 0;
+			for (int r = ticks[i] + 1; r < ticks[i + 1] && !blank; r++)
+				blank = !ink_in_row(&pic, r, f.x0 - 40 < 0 ? 0 : f.x0 - 40, f.x0 - 4);
+			apart &= blank;
+		}
+		CHECK(n >= 2 && apart, "%d y ticks, their labels apart: %d", n, apart);
+	}
+	free(pic.px);
+	ss_plot_destroy(p);
+}
+
 /* The demo of sandslide fit --plot: fronts over time and a cost along nu. */
 static struct ss_plot *demo_figure(void)
 {
@@ -778,6 +844,7 @@ int main(void)
 	RUN(test_legend_corner);
 	RUN(test_legend_covers_no_data);
 	RUN(test_descenders);
+	RUN(test_tick_labels_apart);
 	RUN(test_empty_panel);
 	RUN(test_deterministic);
 	RUN(test_bad_input);
