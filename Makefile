@@ -28,6 +28,9 @@
 #                   `make MPI=1 test-slurm` runs doc/cluster.md's Slurm job
 #                   on a one-node Slurm started here, as root)
 #   make check-layering  the tiers of src/README.md, by their #includes
+#   make FONT=FILE  build with another default font for the text of pictures
+#                   (DejaVu Sans of fonts-dejavu-core otherwise; SANDSLIDE_FONT
+#                   chooses one at run time)
 #   make V=1        show the full commands
 #
 # User CFLAGS/LDFLAGS are appended last, never overwritten.

@@ -170,12 +170,16 @@ const char *ss_render_font_file(void);
  * unless the font file can be opened: checked before work that would end
  * in drawing text (fit --plot). */
 int ss_render_font_check(void);
+/* The largest font, px: the plots' titles are a fifth larger than the
+ * text of their panels, whose size ss_render_font_px caps at half this. */
+#define SS_RENDER_FONT_PX_MAX 1024
 /* The font size (its em, px) of text on a picture of w x h px: about 1/24
- * of the shorter side, at least 12 px. */
+ * of the shorter side, at least 12 px and at most SS_RENDER_FONT_PX_MAX / 2. */
 int ss_render_font_px(int w, int h);
-/* A font of px px (its em) into *out; SS_ERR_FAIL with a message naming
- * the file when it cannot be read (ss_render_font_check's), or out of
- * memory.  ss_render_font_destroy(NULL) is a no-op. */
+/* A font whose em is px (1 .. SS_RENDER_FONT_PX_MAX) px, into *out;
+ * SS_ERR_FAIL with a message naming the file when it cannot be read
+ * (ss_render_font_check's), or out of memory.  ss_render_font_destroy(NULL)
+ * is a no-op. */
 int ss_render_font_create(struct ss_render_font **out, int px);
 void ss_render_font_destroy(struct ss_render_font *f);
 /* Its sizes, px: the em; above and below the baseline of a line of text

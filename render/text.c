@@ -54,7 +54,7 @@ struct ss_render_font {
 	int ascent, descent;        /* px above and below the baseline of a line */
 	int digit_h;                /* px of a digit above the baseline */
 	struct glyph glyph[SLOTS];
-	signed char kern[SLOTS][SLOTS];   /* px added between a pair (left, right) */
+	int16_t kern[SLOTS][SLOTS]; /* px added between a pair (left, right) */
 	uint8_t *coverage;          /* every glyph's bitmap, w * h bytes each, 0..255 */
 };
 
@@ -68,7 +68,7 @@ int ss_render_font_px(int w, int h)
 {
 	const int m = w < h ? w : h;
 	const int px = (m + 12) / 24;   /* a line of text about 1/20 of the picture */
-	return px < 12 ? 12 : px > 512 ? 512 : px;
+	return px < 12 ? 12 : px > SS_RENDER_FONT_PX_MAX / 2 ? SS_RENDER_FONT_PX_MAX / 2 : px;
 }
 
 /* The slot of character c (a byte of ASCII): MISSING for any other. */
@@ -181,14 +181,14 @@ static void kerning(struct ss_render_font *f, FT_Face face)
 			if (FT_Get_Kerning(face, index[a], index[b], FT_KERNING_DEFAULT, &d))
 				continue;
 			const long px = (d.x + (d.x < 0 ? -32 : 32)) / 64;
-			f->kern[a][b] = (signed char)(px < -64 ? -64 : px > 64 ? 64 : px);
+			f->kern[a][b] = (int16_t)(px < -4096 ? -4096 : px > 4096 ? 4096 : px);
 		}
 }
 
 int ss_render_font_create(struct ss_render_font **out, int px)
 {
 	*out = NULL;
-	if (px < 1 || px > 512)
+	if (px < 1 || px > SS_RENDER_FONT_PX_MAX)
 		SS_BUG("a font of %d px", px);
 	const char *path = ss_render_font_file();
 	int err = ss_render_font_check();
