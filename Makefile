@@ -28,6 +28,9 @@
 #                   `make MPI=1 test-slurm` runs doc/cluster.md's Slurm job
 #                   on a one-node Slurm started here, as root)
 #   make check-layering  the tiers of src/README.md, by their #includes
+#   make FONT=FILE  build with another default font for the text of pictures
+#                   (DejaVu Sans of fonts-dejavu-core otherwise; SANDSLIDE_FONT
+#                   chooses one at run time)
 #   make V=1        show the full commands
 #
 # User CFLAGS/LDFLAGS are appended last, never overwritten.
@@ -71,18 +74,27 @@ DEB_zlib   := zlib1g-dev
 DEB_inih   := libinih-dev
 # NLopt: the bounded derivative-free search of `sandslide fit` (BOBYQA)
 DEB_nlopt  := libnlopt-dev
+# FreeType: the text of pictures (render/text.c: the time label, the colour
+# bar, fit --plot's figures), in the font FONT below
+DEB_freetype2 := libfreetype-dev
 ifeq ($(MPI),1)
   PC_HDF5  := hdf5-openmpi
 else
   PC_HDF5  := hdf5-serial
 endif
-PC_MODULES := $(PC_HDF5) libpng zlib inih nlopt
+PC_MODULES := $(PC_HDF5) libpng zlib inih nlopt freetype2
 DEB_BUILD  := pkg-config $(foreach m,$(PC_MODULES),$(DEB_$(m)))
 ifeq ($(MPI),1)
   DEB_BUILD += openmpi-bin libopenmpi-dev
 endif
-# Run time: ffmpeg for render --video, numpy for the Python module.
-DEB_RUN    := ffmpeg python3-numpy
+# Run time: ffmpeg for render --video, numpy for the Python module, and the
+# font of the pictures' text: DejaVu Sans, at the path Debian's
+# fonts-dejavu-core installs it (FONT=FILE builds with another default; at
+# run time SANDSLIDE_FONT=FILE chooses one; without the file, drawing text
+# fails with one line naming both).
+DEB_RUN    := ffmpeg python3-numpy fonts-dejavu-core
+FONT       ?= /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf
+FONT_FLAG  := -DSS_FONT_FILE='"$(FONT)"'
 # The test suite's tools: the CLI tests (pytest, h5py), and the programs
 # that check the outputs open as they are (ncdump, gdalinfo and GDAL's
 # Python bindings, xarray with netCDF4, CDO, ParaView's pvbatch).  Debian's
@@ -127,6 +139,7 @@ else
   endif
   $(foreach m,$(PC_MODULES),$(if $(shell $(PKG_CONFIG) --exists $(m) && echo y),,\
     $(error library '$(m)' not found by pkg-config: install Debian package '$(DEB_$(m))' (or run 'make deps'))))
+  $(if $(wildcard $(FONT)),,$(warning font '$(FONT)' not found: pictures with text (--label, --colorbar, fit --plot) will fail until Debian package 'fonts-dejavu-core' is installed (or run 'make deps'), or SANDSLIDE_FONT names a font))
   DEP_CFLAGS := $(shell $(PKG_CONFIG) --cflags $(PC_MODULES))
   # The HDF5 high-level library (H5DS dimension scales) has no .pc file of
   # its own on Debian; it sits beside libhdf5.
@@ -216,7 +229,7 @@ GEN      := $(BUILD)/gen
 # sweep runs as fast: doc/performance.md#how-the-figures-were-measured).
 ALL_CFLAGS  := $(BASE) -fPIC $(WARN) $(OMPFLAG) $(SANFLAG) $(MPIFLAG) $(PATHDEF) -Iinclude -Isrc \
                -I. -I$(GEN) \
-               -DSS_VERSION='"$(VERSION)"' \
+               -DSS_VERSION='"$(VERSION)"' $(FONT_FLAG) \
                $(DEP_CFLAGS) -MMD -MP $(CFLAGS)
 ALL_LDFLAGS := $(OMPFLAG) $(SANFLAG) $(LDFLAGS)
 LIBS        := $(DEP_LIBS) -lm
@@ -348,7 +361,8 @@ FUZZ_CC      ?= clang
 FUZZ_BUILD   := $(BUILD)/fuzz
 FUZZ_SAN     := -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
 FUZZ_CFLAGS  := -std=c11 -D_XOPEN_SOURCE=700 -O1 -g $(WARN) -Wno-unknown-pragmas -Iinclude -Isrc \
-                -I. -I$(GEN) -Itests/fuzz -DSS_VERSION='"$(VERSION)"' $(DEP_CFLAGS) $(FUZZ_SAN) -MMD -MP $(CFLAGS)
+                -I. -I$(GEN) -Itests/fuzz -DSS_VERSION='"$(VERSION)"' $(FONT_FLAG) $(DEP_CFLAGS) \
+                $(FUZZ_SAN) -MMD -MP $(CFLAGS)
 FUZZ_LIB_SRC := $(LIB_SRC) $(RENDER_SRC)
 FUZZ_BIN     := $(FUZZ_NAMES:%=$(FUZZ_BUILD)/fuzz_%)
 FUZZ_REPLAY  := $(FUZZ_NAMES:%=$(FUZZ_BUILD)/replay/fuzz_%)

@@ -387,7 +387,7 @@ int ss_render_series(const struct ss_render_series_options *o,
 	int err = ss_render_options_check(&o->look);
 	if (err)
 		return err;
-	if ((o->video || o->html) && (o->fps < 1 || o->fps > 240))
+	if ((o->video || o->html) && (o->fps < 0 || o->fps > 240))
 		return ss_error_input("--fps %d: expected 1 to 240 frames per second", o->fps);
 	if (!o->output_dir && !o->video && !o->html)
 		return ss_error_input("no folder for the frames: give one, or --html to put the "
@@ -436,15 +436,16 @@ int ss_render_series(const struct ss_render_series_options *o,
 		goto out_html;
 	report->render_seconds = ss_parallel_wall_seconds() - t0;
 	report_frames(o, &s, &plan, sel, n, report);
+	report->fps = o->fps ? o->fps : ss_render_fps_for(n);
 	if (html) {
 		size_t bytes;
-		if ((err = ss_render_html_write(html, o->html, o->fps, &bytes)))
+		if ((err = ss_render_html_write(html, o->html, report->fps, &bytes)))
 			goto out_html;
 		report->html_bytes = (long long)bytes;
 	}
 	report->seconds = ss_parallel_wall_seconds() - started;
 	if (o->video)
-		err = ss_render_video(dir, n, o->fps, o->video, &report->video);
+		err = ss_render_video(dir, n, report->fps, o->video, &report->video);
 
 out_html:
 	if (tmp_dir[0])

@@ -157,27 +157,68 @@ void ss_render_oblique_size(const struct ss_render_raster *r,
 int ss_render_oblique(const struct ss_render_raster *r, const struct ss_render_options *o,
                       double zmin, double zmax, struct ss_render_image *img, int parallel);
 
+/* ---- text.c: a real font (FreeType, DejaVu Sans) ------------------- */
+
+/* A font at one size: its glyphs rendered once, read-only afterwards, so
+ * that threads drawing at once may share it. */
+struct ss_render_font;
+
+/* The font file text is drawn with: $SANDSLIDE_FONT, else the build's
+ * default (the Makefile's FONT). */
+const char *ss_render_font_file(void);
+/* SS_ERR_FAIL, with one line naming the file and what to install or set,
+ * unless the font file can be opened: checked before work that would end
+ * in drawing text (fit --plot). */
+int ss_render_font_check(void);
+/* The largest font, px: the plots' titles are a fifth larger than the
+ * text of their panels, whose size ss_render_font_px caps at half this. */
+#define SS_RENDER_FONT_PX_MAX 1024
+/* The font size (its em, px) of text on a picture of w x h px: about 1/24
+ * of the shorter side, at least 12 px and at most SS_RENDER_FONT_PX_MAX / 2. */
+int ss_render_font_px(int w, int h);
+/* A font whose em is px (1 .. SS_RENDER_FONT_PX_MAX) px, into *out;
+ * SS_ERR_FAIL with a message naming the file when it cannot be read
+ * (ss_render_font_check's), or out of memory.  ss_render_font_destroy(NULL)
+ * is a no-op. */
+int ss_render_font_create(struct ss_render_font **out, int px);
+void ss_render_font_destroy(struct ss_render_font *f);
+/* Its sizes, px: the em; above and below the baseline of a line of text
+ * (so a line is ascent + descent high: a descender such as g's ends
+ * within it); a digit's height above the baseline (to centre numbers). */
+int ss_render_font_em(const struct ss_render_font *f);
+int ss_render_font_ascent(const struct ss_render_font *f);
+int ss_render_font_descent(const struct ss_render_font *f);
+int ss_render_font_line(const struct ss_render_font *f);
+int ss_render_font_digit_height(const struct ss_render_font *f);
+/* The advance of a line of text, px (kerned). */
+int ss_render_text_width(const struct ss_render_font *f, const char *text);
+/* Draw text antialiased in colour rgb into an 8-bit RGB picture, clipped
+ * to it, the top-left corner of its line box at (x, y): the baseline is
+ * at y + ascent.  _up: turned a quarter anticlockwise (reading upwards,
+ * as a y axis's title), its box ss_render_font_line wide and
+ * ss_render_text_width high with its top-left corner at (x, y). */
+void ss_render_draw_text(struct ss_render_image *img, const struct ss_render_font *f, int x,
+                         int y, const char *text, const uint8_t rgb[3]);
+void ss_render_draw_text_up(struct ss_render_image *img, const struct ss_render_font *f,
+                            int x, int y, const char *text, const uint8_t rgb[3]);
+
 /* ---- overlay.c: label and colour bar --------------------------------- */
 
-/* Integer magnification of the 5 x 7 font for a picture of w x h px. */
-int ss_render_font_scale(int w, int h);
-int ss_render_text_width(const char *text, int scale);
-/* Draw text with its top-left corner at (x, y) in colour rgb (8-bit RGB
- * pictures), clipped to the picture. */
-void ss_render_draw_text(struct ss_render_image *img, int x, int y, int scale,
-                         const char *text, const uint8_t rgb[3]);
-/* Rows of the strip above a pic_w x pic_h picture that holds the label. */
-int ss_render_label_height(int pic_w, int pic_h);
+/* Rows of the strip that holds the label, in font f. */
+int ss_render_label_height(const struct ss_render_font *f);
 /* "t = 12.5 s" in the strip: rows 0 .. ss_render_label_height - 1 of img,
- * white, the text black, so it covers nothing of the picture. */
-void ss_render_draw_label(struct ss_render_image *img, int pic_w, int pic_h, double time);
-/* Width of the colour-bar strip added right of a pic_w x pic_h picture. */
-int ss_render_colorbar_width(int pic_w, int pic_h, double zmin, double zmax);
+ * columns 0 .. pic_w - 1, white, the text black, so it covers nothing of
+ * the picture. */
+void ss_render_draw_label(struct ss_render_image *img, const struct ss_render_font *f,
+                          int pic_w, double time);
+/* Width of the colour-bar strip added right of the picture. */
+int ss_render_colorbar_width(const struct ss_render_font *f, double zmin, double zmax);
 /* Draw the colour bar in columns x0 .. img->width - 1 beside the picture's
  * rows y0 .. y0 + pic_h - 1: the bar with a frame, ticks at round heights
  * outside it, each end labelled. */
-void ss_render_draw_colorbar(struct ss_render_image *img, int x0, int y0, int pic_h,
-                             enum ss_render_cmap cmap, double zmin, double zmax);
+void ss_render_draw_colorbar(struct ss_render_image *img, const struct ss_render_font *f,
+                             int x0, int y0, int pic_h, enum ss_render_cmap cmap, double zmin,
+                             double zmax);
 
 /* ---- png.c: encoding and atomic writes ------------------------------ */
 
@@ -243,6 +284,8 @@ struct ss_render_plan {
 	int image_w, image_h;       /* the whole frame */
 	int pic_w, pic_h;           /* the picture, without label strip and colour bar */
 	double wall_m[4];           /* border[] in m, for the oblique view */
+	struct ss_render_font *font;   /* the label's and colour bar's text, owned;
+	                                * NULL without either */
 };
 
 /* Set up a plan for a grid of nx x ny cells (cell_type with stride, NULL:

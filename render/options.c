@@ -98,10 +98,12 @@ static const struct ss_option series[] = {
 	 .expected = "a path",
 	 .help = "assemble the frames with ffmpeg (H.264, yuv420p); with\n"
 	         "-o the frames are kept (also when ffmpeg is missing)"},
+	/* no default: 0 in the options, chosen from the number of frames */
 	{.name = "fps", .value_name = "N", .kind = SS_OPTION_INT, .offset = AT(fps),
-	 .default_value = "24", .lo = 1, .hi = 240, .expected = "1 to 240",
+	 .lo = 1, .hi = 240, .expected = "1 to 240",
 	 .help = "frames per second of the video, and the speed the\n"
-	         "viewer starts at"},
+	         "viewer starts at (default: a quarter of the frames,\n"
+	         "1 to 24, so a video lasts 4 s or more: 21 frames at 5)"},
 	{.name = "html", .value_name = "FILE.html", .kind = SS_OPTION_TEXT, .offset = AT(html),
 	 .expected = "a path",
 	 .help = "write a self-contained viewer (frames, slider, play,\n"

@@ -82,6 +82,8 @@ void ss_render_plan_release(struct ss_render_plan *p)
 	ss_render_resampler_release(&p->rs);
 	ss_free(p->pixel_type);
 	p->pixel_type = NULL;
+	ss_render_font_destroy(p->font);
+	p->font = NULL;
 }
 
 /* Thickness of a wall side: a cell, and at least 1 % of the longer side
@@ -195,11 +197,19 @@ int ss_render_plan_init(struct ss_render_plan *p, const struct ss_render_options
 		memcpy(r.wall_m, p->wall_m, sizeof r.wall_m);
 		ss_render_oblique_size(&r, &p->look, zmin, zmax, &p->pic_w, &p->pic_h);
 	}
-	p->label_h = look->label ? ss_render_label_height(p->pic_w, p->pic_h) : 0;
+	/* the text's font, sized with the picture: made once here (its glyphs
+	 * rendered), then only read by the frames, on any thread */
+	int err;
+	if ((look->label || look->colorbar) &&
+	    (err = ss_render_font_create(&p->font, ss_render_font_px(p->pic_w, p->pic_h)))) {
+		ss_render_plan_release(p);
+		return err;
+	}
+	p->label_h = look->label ? ss_render_label_height(p->font) : 0;
 	p->image_w = p->pic_w;
 	p->image_h = p->label_h + p->pic_h;
 	if (look->colorbar)
-		p->image_w += ss_render_colorbar_width(p->pic_w, p->pic_h, zmin, zmax);
+		p->image_w += ss_render_colorbar_width(p->font, zmin, zmax);
 	return SS_OK;
 }
 
@@ -340,10 +350,10 @@ int ss_render_plan_draw(const struct ss_render_plan *p, const double *pixel_h,
 		break;
 	}
 	if (o->colorbar)
-		ss_render_draw_colorbar(img, p->pic_w, p->label_h, p->pic_h, o->cmap, p->zmin,
-		                        p->zmax);
+		ss_render_draw_colorbar(img, p->font, p->pic_w, p->label_h, p->pic_h, o->cmap,
+		                        p->zmin, p->zmax);
 	if (o->label)
-		ss_render_draw_label(img, p->pic_w, p->pic_h, time);
+		ss_render_draw_label(img, p->font, p->pic_w, time);
 	return SS_OK;
 }
 

@@ -8,20 +8,22 @@
  * by png.c.  A panel, top to bottom:
  *
  *     title (centred)
- *     y label (at the left, above the axis: the font cannot be turned)
  *     +-------------------------------------+
- *     |  grid, vertical lines, series,      |   the legend in the corner
- *     |  legend                             |   where it covers least
- *     +-------------------------------------+
- *     ticks, tick labels
- *     x label (centred)
+ *   y |  grid, vertical lines, series,      |  the legend in the first
+ *   t |  legend                             |  corner where it covers no
+ *   i |                                     |  data
+ *   t +-------------------------------------+
+ *   l   ticks, tick labels
+ *   e   x title (centred)
+ *       [legend, its entries in rows, when no corner is free]
  *
  * The axes span the data with 5 % to spare.  Tick steps are 1, 2 or 5
  * times a power of ten (whole decades on a log axis, or every 2nd, 3rd, 5th
- * ... decade when they crowd), the finest whose labels keep a gap between
- * them and that gives at most about 8 ticks.  Everything is sized in
- * multiples of the font's magnification (ss_render_font_scale), so a
- * larger panel gets larger text and thicker lines.
+ * ... decade when they crowd), the finest whose labels keep an em between
+ * them (two lines of text on the y axis) and that gives at most about 8
+ * ticks.  Text is sized from the panel (ss_render_font_px) and everything
+ * round it from the font's em; lines and markers thicken from 360 px on
+ * the shorter side.
  */
 #include "render/plot.h"
 
@@ -416,17 +418,17 @@ static void log_label(int m, int d, char *out, size_t size)
 }
 
 /* Space a tick label needs along the axis, px: its width on the x axis
- * (plus a gap of three characters), three text heights on the y axis. */
-static int label_room(const struct axis *a, int k)
+ * plus an em between neighbours; two lines of text on the y axis. */
+static int label_room(const struct axis *a, const struct ss_render_font *f)
 {
 	int w = 0;
 	if (a->flip)
-		return 3 * 7 * k;
+		return 2 * ss_render_font_line(f);
 	for (int i = 0; i < a->n_ticks; i++) {
-		const int tw = ss_render_text_width(a->label[i], k);
+		const int tw = ss_render_text_width(f, a->label[i]);
 		w = tw > w ? tw : w;
 	}
-	return w + ss_render_text_width("000", k);
+	return w + ss_render_font_em(f);
 }
 
 static double tick_spacing_px(const struct axis *a, double step_t)
@@ -438,7 +440,7 @@ static double tick_spacing_px(const struct axis *a, double step_t)
  * leaves room between labels and gives no more than about 8 ticks; for a
  * log axis less than a decade or so wide too (values, then, placed by
  * their logarithm). */
-static void linear_ticks(struct axis *a, int k)
+static void linear_ticks(struct axis *a, const struct ss_render_font *f)
 {
 	const double vlo = a->log ? pow(10.0, a->lo) : a->lo;
 	const double vhi = a->log ? pow(10.0, a->hi) : a->hi;
@@ -470,7 +472,7 @@ static void linear_ticks(struct axis *a, int k)
 		if (a->log && b.n_ticks >= 2)
 			gap = tick_spacing_px(&b, log10(b.tick[b.n_ticks - 1]) -
 			                              log10(b.tick[b.n_ticks - 2]));
-		const int fits = gap >= label_room(&b, k) && gap >= (a->len - 1) / 8.0;
+		const int fits = gap >= label_room(&b, f) && gap >= (a->len - 1) / 8.0;
 		if (fits || j == 3 * 6 - 1) {
 			a->n_ticks = b.n_ticks;
 			memcpy(a->tick, b.tick, sizeof a->tick);
@@ -484,7 +486,7 @@ static void linear_ticks(struct axis *a, int k)
  * labels have room; with a single decade each, also 2 and 5 times them;
  * failing two ticks, linear_ticks.  Unlabelled minor ticks at 2 .. 9 times
  * each decade when decades are far enough apart. */
-static void log_ticks(struct axis *a, int k)
+static void log_ticks(struct axis *a, const struct ss_render_font *f)
 {
 	const int dlo = (int)ceil(a->lo - 1e-9), dhi = (int)floor(a->hi + 1e-9);
 	static const int strides[] = {1, 2, 3, 5, 10, 20, 50, 100, 200};
@@ -500,7 +502,7 @@ static void log_ticks(struct axis *a, int k)
 			log_label(1, d, b.label[b.n_ticks], LABEL_SIZE);
 			b.n_ticks++;
 		}
-		if (tick_spacing_px(&b, strides[j]) >= label_room(&b, k) &&
+		if (tick_spacing_px(&b, strides[j]) >= label_room(&b, f) &&
 		    tick_spacing_px(&b, strides[j]) >= (a->len - 1) / 10.0) {
 			*a = b;
 			stride = strides[j];
@@ -521,14 +523,14 @@ static void log_ticks(struct axis *a, int k)
 				b.n_ticks++;
 			}
 		/* the narrowest gap is between 1 and 2 times a decade */
-		if (tick_spacing_px(&b, log10(2.0)) >= label_room(&b, k))
+		if (tick_spacing_px(&b, log10(2.0)) >= label_room(&b, f))
 			*a = b;
 	}
 	if (a->n_ticks < 3) {
 		/* within a decade or so (2 .. 5): 1-2-5 steps of the values, if
 		 * they give more ticks */
 		struct axis b = *a;
-		linear_ticks(&b, k);
+		linear_ticks(&b, f);
 		if (b.n_ticks > a->n_ticks) {
 			*a = b;
 			return;
@@ -536,7 +538,7 @@ static void log_ticks(struct axis *a, int k)
 	}
 	if (a->n_ticks < 2)
 		return;
-	if (stride == 1 && tick_spacing_px(a, 1.0) >= 8 * 7 * k)
+	if (stride == 1 && tick_spacing_px(a, 1.0) >= 6 * ss_render_font_em(f))
 		for (int d = dlo - 1; d <= dhi && a->n_minor < MAX_TICKS - 8; d++)
 			for (int m = 2; m <= 9; m++) {
 				const double t = d + log10(m);
@@ -545,12 +547,12 @@ static void log_ticks(struct axis *a, int k)
 			}
 }
 
-static void make_ticks(struct axis *a, int k)
+static void make_ticks(struct axis *a, const struct ss_render_font *f)
 {
 	if (a->log)
-		log_ticks(a, k);
+		log_ticks(a, f);
 	else
-		linear_ticks(a, k);
+		linear_ticks(a, f);
 }
 
 /* ---- pixels ----------------------------------------------------------- */
@@ -609,34 +611,89 @@ static void disc(struct ss_render_image *img, const struct clip *c, int x, int y
 
 /* ---- a panel ---------------------------------------------------------- */
 
-/* Sizes of a panel's parts, px, in multiples of the font scale k. */
+/* The fonts of a figure: titles, and everything else. */
+struct fonts {
+	struct ss_render_font *text, *title;
+};
+
+/* A legend's box and where it went. */
+struct legend {
+	int entries;
+	int flow_w;                 /* entries flow in rows this wide, px; 0: one
+	                             * entry a row */
+	int w, h;                   /* the box, px */
+	int x, y;                   /* its top-left corner */
+};
+
+/* Sizes of a panel's parts, px: text from the fonts' em, lines and markers
+ * thicker on larger panels. */
 struct layout {
-	int k, text_h, pad, tick, line_w, marker_r;
+	const struct fonts *fonts;
+	int em, line, pad, tick, gap, line_w, marker_r;
+	int below;                  /* px kept at the bottom for a legend */
 	struct clip whole, area;    /* the panel, and inside its frame */
 };
 
-static struct layout panel_layout(int w, int h)
+static int max_int(int a, int b)
+{
+	return a > b ? a : b;
+}
+
+/*
+ * The panel's layout for axes ax, ay (their ranges set; their ticks made
+ * here), with `below` px kept free at the bottom (for a legend put under
+ * the plot).  Top to bottom: pad, title, half an em, the plot area, ticks,
+ * tick labels, the x axis's title, `below`, pad; left to right: pad, the
+ * y axis's title (turned), the y tick labels, ticks, the area, room for
+ * half the last x tick label, pad.
+ */
+static struct layout panel_layout(const struct panel *pn, const struct fonts *fonts, int w,
+                                  int h, int below, struct axis *ax, struct axis *ay)
 {
 	struct layout l;
-	l.k = ss_render_font_scale(w, h);
-	l.text_h = 7 * l.k;
-	l.pad = 4 * l.k;
-	l.tick = 3 * l.k;
-	l.line_w = l.k < 2 ? 1 : 2;
-	l.marker_r = 3 * l.k;
+	const struct ss_render_font *f = fonts->text;
+	const int k = max_int((w < h ? w : h) + 120, 240) / 240;   /* thickness unit */
+	l.fonts = fonts;
+	l.em = ss_render_font_em(f);
+	l.line = ss_render_font_line(f);
+	l.pad = l.em / 2;
+	l.tick = max_int(l.em / 3, 3);
+	l.gap = max_int(l.em / 4, 2);
+	l.line_w = k < 2 ? 1 : 2;
+	l.marker_r = 3 * k;
+	l.below = below;
 	l.whole = (struct clip){0, 0, w, h};
-	/* title, gap, y label, gap, frame */
-	l.area.y0 = l.pad + l.text_h + 3 * l.k + l.text_h + 5 * l.k + 1;
-	/* frame, tick, gap, tick labels, gap, x label, pad */
-	l.area.y1 = h - (1 + l.tick + 2 * l.k + l.text_h + 3 * l.k + l.text_h + l.pad);
-	/* the left edge waits for the y labels; at the right, room for half
-	 * the last x tick label */
-	l.area.x0 = 0;
-	l.area.x1 = w - (l.pad + 12 * l.k + 1);
+	l.area.y0 = l.pad + (pn->title ? ss_render_font_line(fonts->title) : 0) + l.em / 2;
+	l.area.y1 = h - (l.pad + below + (pn->x_label ? l.line + l.gap : 0) + l.line + l.gap +
+	                 l.tick + 1);
+	ay->pix0 = l.area.y0;
+	ay->len = l.area.y1 - l.area.y0;
+	make_ticks(ay, f);
+	int label_w = 0;
+	for (int i = 0; i < ay->n_ticks; i++)
+		label_w = max_int(label_w, ss_render_text_width(f, ay->label[i]));
+	l.area.x0 = l.pad + (pn->y_label ? l.line + l.em / 2 : 0) + label_w + l.gap + l.tick + 1;
+	l.area.x1 = w - (l.pad + l.em + 1);
+	/* the last x tick label, centred on its tick, must end inside the
+	 * panel: narrow the area until it does (its ticks change with it) */
+	for (int tries = 0; tries < 4; tries++) {
+		ax->pix0 = l.area.x0;
+		ax->len = l.area.x1 - l.area.x0;
+		make_ticks(ax, f);
+		if (ax->n_ticks == 0)
+			break;
+		const int last = ax->n_ticks - 1;
+		const int x = round_px(axis_pixel(ax, ax->tick[last]));
+		const int over = x + (ss_render_text_width(f, ax->label[last]) + 1) / 2 - (w - l.pad);
+		if (over <= 0 || l.area.x1 - over - l.area.x0 < l.em)
+			break;
+		l.area.x1 -= over;
+	}
 	return l;
 }
 
-/* Ink in the box [x0, x1) x [y0, y1): what is neither background nor grid. */
+/* Data in the box [x0, x1) x [y0, y1): pixels that are neither background
+ * nor grid (only the series and vertical lines are drawn when it looks). */
 static long ink_in(const struct ss_render_image *img, int x0, int y0, int x1, int y1)
 {
 	long n = 0;
@@ -654,56 +711,114 @@ static void draw_sample(struct ss_render_image *img, const struct layout *l,
 {
 	uint8_t rgb[3];
 	ss_plot_palette(s->colour, rgb);
-	if (s->style != SS_PLOT_MARKERS)
-		line(img, &l->whole, x0, y, x1, y, l->line_w, rgb);
 	if (s->style != SS_PLOT_LINE)
 		disc(img, &l->whole, (x0 + x1) / 2, y, l->marker_r, rgb);
+	if (s->style != SS_PLOT_MARKERS)
+		line(img, &l->whole, x0, y, x1, y, l->line_w, rgb);
 }
 
-/* The legend in the corner of the plot area where it covers the least
- * already drawn (first of upper right, upper left, lower right, lower left
- * on a tie). */
-static void draw_legend(struct ss_render_image *img, const struct layout *l,
-                        const struct panel *pn)
+/* The width of a legend entry: its sample, a third of an em, its text. */
+static int entry_w(const struct ss_render_font *f, const char *text)
 {
-	const int k = l->k, inner = 3 * k, sample_w = 18 * k, row_h = l->text_h + 3 * k;
-	int entries = 0, text_w = 0;
+	const int em = ss_render_font_em(f);
+	return 2 * em + em / 3 + ss_render_text_width(f, text);
+}
+
+/* Entries placed in rows at most `width` px wide (0: one a row), an em
+ * between neighbours: the next entry's x in its row (row: fl->row). */
+struct flow {
+	int width, em, x, row;
+};
+
+static int flow_place(struct flow *fl, int w)
+{
+	if (fl->x > 0 && (fl->width == 0 || fl->x + fl->em + w > fl->width)) {
+		fl->row++;
+		fl->x = 0;
+	}
+	const int at = fl->x ? fl->x + fl->em : 0;
+	fl->x = at + w;
+	return at;
+}
+
+/* Inside the legend's frame: a third of an em and the frame's pixel. */
+static int legend_inner(const struct ss_render_font *f)
+{
+	return ss_render_font_em(f) / 3 + 1;
+}
+
+/* The legend's size in the text font with its entries in rows at most
+ * flow_w px wide (0: one entry a row). */
+static struct legend legend_size(const struct panel *pn, const struct ss_render_font *f,
+                                 int flow_w)
+{
+	struct legend g = {.flow_w = flow_w};
+	struct flow fl = {flow_w, ss_render_font_em(f), 0, 0};
+	int widest = 0;
 	for (int s = 0; s < pn->n_series; s++)
 		if (pn->series[s].legend) {
-			const int tw = ss_render_text_width(pn->series[s].legend, k);
-			text_w = tw > text_w ? tw : text_w;
-			entries++;
+			flow_place(&fl, entry_w(f, pn->series[s].legend));
+			widest = max_int(widest, fl.x);
+			g.entries++;
 		}
-	if (!entries)
-		return;
-	const int box_w = inner + sample_w + 2 * k + text_w + inner;
-	const int box_h = 2 * inner + entries * row_h - 3 * k;
-	const int inset = 4 * k;
-	const int left = l->area.x0 + inset, right = l->area.x1 - inset - box_w;
-	const int top = l->area.y0 + inset, bottom = l->area.y1 - inset - box_h;
-	const int corner_x[4] = {right, left, right, left}, corner_y[4] = {top, top, bottom, bottom};
-	int best = 0;
-	long best_ink = -1;
+	g.w = 2 * legend_inner(f) + widest;
+	g.h = 2 * legend_inner(f) + (fl.row + 1) * ss_render_font_line(f);
+	return g;
+}
+
+/*
+ * Where the legend goes inside the plot area: the first corner of upper
+ * right, upper left, lower right, lower left whose box, with a quarter em
+ * round it, holds no pixel of data already drawn; 0 if none does.  With
+ * `any`, the corner with the fewest such pixels instead (the fallback of
+ * a panel too small for a legend under its plot), and 1.
+ */
+static int legend_inside(const struct ss_render_image *img, const struct layout *l,
+                         struct legend *g, int any)
+{
+	const int inset = max_int(l->em / 3, 3), margin = max_int(l->em / 4, 2);
+	const int left = l->area.x0 + inset, right = l->area.x1 - inset - g->w;
+	const int top = l->area.y0 + inset, bottom = l->area.y1 - inset - g->h;
+	const int cx[4] = {right, left, right, left}, cy[4] = {top, top, bottom, bottom};
+	int best = -1;
+	long best_ink = 0;
 	for (int c = 0; c < 4; c++) {
-		const long n = ink_in(img, corner_x[c], corner_y[c], corner_x[c] + box_w,
-		                      corner_y[c] + box_h);
-		if (best_ink < 0 || n < best_ink)
+		const long n = ink_in(img, cx[c] - margin, cy[c] - margin, cx[c] + g->w + margin,
+		                      cy[c] + g->h + margin);
+		if (best < 0 || n < best_ink)
 			best = c, best_ink = n;
+		if (n == 0 && !any)
+			break;
 	}
-	const int bx = corner_x[best], by = corner_y[best];
-	fill(img, &l->area, bx, by, bx + box_w, by + box_h, white);
-	fill(img, &l->area, bx, by, bx + box_w, by + 1, legend_edge);
-	fill(img, &l->area, bx, by + box_h - 1, bx + box_w, by + box_h, legend_edge);
-	fill(img, &l->area, bx, by, bx + 1, by + box_h, legend_edge);
-	fill(img, &l->area, bx + box_w - 1, by, bx + box_w, by + box_h, legend_edge);
-	int y = by + inner;
+	if (best_ink > 0 && !any)
+		return 0;
+	g->x = cx[best];
+	g->y = cy[best];
+	return 1;
+}
+
+static void draw_legend(struct ss_render_image *img, const struct layout *l,
+                        const struct panel *pn, const struct legend *g)
+{
+	const struct ss_render_font *f = l->fonts->text;
+	const int em = l->em, inner = legend_inner(f), sample_w = 2 * em;
+	const int bx = g->x, by = g->y;
+	fill(img, &l->whole, bx, by, bx + g->w, by + g->h, white);
+	fill(img, &l->whole, bx, by, bx + g->w, by + 1, legend_edge);
+	fill(img, &l->whole, bx, by + g->h - 1, bx + g->w, by + g->h, legend_edge);
+	fill(img, &l->whole, bx, by, bx + 1, by + g->h, legend_edge);
+	fill(img, &l->whole, bx + g->w - 1, by, bx + g->w, by + g->h, legend_edge);
+	/* a sample on the height of the middle of its line's digits */
+	const int middle = ss_render_font_ascent(f) - ss_render_font_digit_height(f) / 2;
+	struct flow fl = {g->flow_w, em, 0, 0};
 	for (int s = 0; s < pn->n_series; s++) {
 		const struct series *sr = &pn->series[s];
 		if (!sr->legend)
 			continue;
-		draw_sample(img, l, sr, bx + inner, bx + inner + sample_w, y + l->text_h / 2);
-		ss_render_draw_text(img, bx + inner + sample_w + 2 * k, y, k, sr->legend, ink);
-		y += row_h;
+		const int x = bx + inner + flow_place(&fl, entry_w(f, sr->legend));
+		const int y = by + inner + fl.row * l->line;
+		draw_sample(img, l, sr, x, x + sample_w, y + middle);
+		ss_render_draw_text(img, f, x + sample_w + em / 3, y, sr->legend, ink);
 	}
 }
 
@@ -713,6 +828,7 @@ static void draw_series(struct ss_render_image *img, const struct layout *l,
 {
 	uint8_t rgb[3];
 	ss_plot_palette(s->colour, rgb);
+	const int dot = max_int(l->line_w, 1);
 	if (s->style != SS_PLOT_MARKERS) {
 		int have_prev = 0, px = 0, py = 0;
 		for (long long i = 0; i < s->n; i++) {
@@ -729,7 +845,7 @@ static void draw_series(struct ss_render_image *img, const struct layout *l,
 			const int alone = (i == 0 || !drawable(pn->log_x, s->x[i - 1], s->y[i - 1])) &&
 			                  (i == s->n - 1 || !drawable(pn->log_x, s->x[i + 1], s->y[i + 1]));
 			if (alone)
-				disc(img, &l->area, x, y, l->k, rgb);
+				disc(img, &l->area, x, y, dot, rgb);
 		}
 	}
 	if (s->style != SS_PLOT_LINE)
@@ -740,89 +856,125 @@ static void draw_series(struct ss_render_image *img, const struct layout *l,
 }
 
 /* Text centred on x, kept inside the panel. */
-static void text_centred(struct ss_render_image *img, const struct layout *l, int x, int y,
-                         const char *text)
+static void text_centred(struct ss_render_image *img, const struct ss_render_font *f, int x,
+                         int y, const char *text)
 {
-	const int w = ss_render_text_width(text, l->k);
+	const int w = ss_render_text_width(f, text);
 	int x0 = x - w / 2;
 	x0 = x0 + w > img->width ? img->width - w : x0;
 	x0 = x0 < 0 ? 0 : x0;
-	ss_render_draw_text(img, x0, y, l->k, text, ink);
+	ss_render_draw_text(img, f, x0, y, text, ink);
 }
 
-/* Panel pn into img (its own picture, the panel's size). */
-static void draw_panel(struct ss_render_image *img, const struct panel *pn)
+/* The data of the panel (grid, vertical lines, series) inside the area of
+ * layout l, on white. */
+static void draw_data(struct ss_render_image *img, const struct layout *l,
+                      const struct panel *pn, const struct axis *ax, const struct axis *ay)
 {
-	struct layout l = panel_layout(img->width, img->height);
-	const int k = l.k;
-	struct axis ax = {.log = pn->log_x}, ay = {.flip = 1};
-	data_ranges(pn, &ax, &ay);
-	ay.pix0 = l.area.y0;
-	ay.len = l.area.y1 - l.area.y0;
-	make_ticks(&ay, k);
-	int label_w = 0;
-	for (int i = 0; i < ay.n_ticks; i++) {
-		const int tw = ss_render_text_width(ay.label[i], k);
-		label_w = tw > label_w ? tw : label_w;
-	}
-	l.area.x0 = l.pad + label_w + 2 * k + l.tick + 1;
-	ax.pix0 = l.area.x0;
-	ax.len = l.area.x1 - l.area.x0;
-	make_ticks(&ax, k);
-
 	for (int y = 0; y < img->height; y++)
 		memset(img->pixels + (size_t)y * img->row_bytes, 0xff, 3 * (size_t)img->width);
-
-	/* grid, vertical lines, series, legend: inside the frame */
-	for (int i = 0; i < ax.n_ticks; i++) {
-		const int x = round_px(axis_pixel(&ax, ax.tick[i]));
-		fill(img, &l.area, x, l.area.y0, x + 1, l.area.y1, grid_rgb);
+	for (int i = 0; i < ax->n_ticks; i++) {
+		const int x = round_px(axis_pixel(ax, ax->tick[i]));
+		fill(img, &l->area, x, l->area.y0, x + 1, l->area.y1, grid_rgb);
 	}
-	for (int i = 0; i < ay.n_ticks; i++) {
-		const int y = round_px(axis_pixel(&ay, ay.tick[i]));
-		fill(img, &l.area, l.area.x0, y, l.area.x1, y + 1, grid_rgb);
+	for (int i = 0; i < ay->n_ticks; i++) {
+		const int y = round_px(axis_pixel(ay, ay->tick[i]));
+		fill(img, &l->area, l->area.x0, y, l->area.x1, y + 1, grid_rgb);
 	}
 	for (int v = 0; v < pn->n_vlines; v++) {
 		if (pn->log_x && !(pn->vlines[v].x > 0.0))
 			continue;
 		uint8_t rgb[3];
 		ss_plot_palette(pn->vlines[v].colour, rgb);
-		const int x = round_px(axis_pixel(&ax, pn->vlines[v].x));
-		line(img, &l.area, x, l.area.y0, x, l.area.y1 - 1, l.line_w, rgb);
+		const int x = round_px(axis_pixel(ax, pn->vlines[v].x));
+		line(img, &l->area, x, l->area.y0, x, l->area.y1 - 1, l->line_w, rgb);
 	}
 	for (int s = 0; s < pn->n_series; s++)
-		draw_series(img, &l, pn, &ax, &ay, &pn->series[s]);
-	draw_legend(img, &l, pn);
+		draw_series(img, l, pn, ax, ay, &pn->series[s]);
+}
 
-	/* the frame, one px outside the area, ticks outside it */
-	const struct clip *all = &l.whole;
-	const int fx0 = l.area.x0 - 1, fx1 = l.area.x1, fy0 = l.area.y0 - 1, fy1 = l.area.y1;
+/* The frame one px outside the area, ticks and their labels outside it,
+ * the axes' titles and the panel's. */
+static void draw_axes(struct ss_render_image *img, const struct layout *l,
+                      const struct panel *pn, const struct axis *ax, const struct axis *ay)
+{
+	const struct ss_render_font *f = l->fonts->text;
+	const struct clip *all = &l->whole;
+	const int fx0 = l->area.x0 - 1, fx1 = l->area.x1, fy0 = l->area.y0 - 1, fy1 = l->area.y1;
 	fill(img, all, fx0, fy0, fx1 + 1, fy0 + 1, ink);
 	fill(img, all, fx0, fy1, fx1 + 1, fy1 + 1, ink);
 	fill(img, all, fx0, fy0, fx0 + 1, fy1 + 1, ink);
 	fill(img, all, fx1, fy0, fx1 + 1, fy1 + 1, ink);
-	for (int i = 0; i < ax.n_ticks; i++) {
-		const int x = round_px(axis_pixel(&ax, ax.tick[i]));
-		fill(img, all, x, fy1 + 1, x + 1, fy1 + 1 + l.tick, ink);
-		text_centred(img, &l, x, fy1 + 1 + l.tick + 2 * k, ax.label[i]);
+	for (int i = 0; i < ax->n_ticks; i++) {
+		const int x = round_px(axis_pixel(ax, ax->tick[i]));
+		fill(img, all, x, fy1 + 1, x + 1, fy1 + 1 + l->tick, ink);
+		text_centred(img, f, x, fy1 + 1 + l->tick + l->gap, ax->label[i]);
 	}
-	for (int i = 0; i < ax.n_minor; i++) {
-		const int x = round_px(axis_pixel(&ax, ax.minor[i]));
-		fill(img, all, x, fy1 + 1, x + 1, fy1 + 1 + (l.tick + 1) / 2, ink);
+	for (int i = 0; i < ax->n_minor; i++) {
+		const int x = round_px(axis_pixel(ax, ax->minor[i]));
+		fill(img, all, x, fy1 + 1, x + 1, fy1 + 1 + (l->tick + 1) / 2, ink);
 	}
-	for (int i = 0; i < ay.n_ticks; i++) {
-		const int y = round_px(axis_pixel(&ay, ay.tick[i]));
-		fill(img, all, fx0 - l.tick, y, fx0, y + 1, ink);
-		const int tw = ss_render_text_width(ay.label[i], k);
-		ss_render_draw_text(img, fx0 - l.tick - 2 * k - tw, y - l.text_h / 2, k, ay.label[i],
-		                    ink);
+	/* a y tick label's digits are centred on its tick */
+	const int centre = ss_render_font_ascent(f) - ss_render_font_digit_height(f) / 2;
+	for (int i = 0; i < ay->n_ticks; i++) {
+		const int y = round_px(axis_pixel(ay, ay->tick[i]));
+		fill(img, all, fx0 - l->tick, y, fx0, y + 1, ink);
+		const int tw = ss_render_text_width(f, ay->label[i]);
+		ss_render_draw_text(img, f, fx0 - l->tick - l->gap - tw, y - centre, ay->label[i], ink);
 	}
 	if (pn->title)
-		text_centred(img, &l, img->width / 2, l.pad, pn->title);
-	if (pn->y_label)
-		ss_render_draw_text(img, l.pad, l.pad + l.text_h + 3 * k, k, pn->y_label, ink);
+		text_centred(img, l->fonts->title, img->width / 2, l->pad, pn->title);
 	if (pn->x_label)
-		text_centred(img, &l, (fx0 + fx1) / 2, img->height - l.pad - l.text_h, pn->x_label);
+		text_centred(img, f, (fx0 + fx1) / 2, img->height - l->pad - l->below - l->line,
+		             pn->x_label);
+	if (pn->y_label) {
+		const int tw = ss_render_text_width(f, pn->y_label);
+		int y = (fy0 + fy1) / 2 - tw / 2;
+		y = y + tw > img->height ? img->height - tw : y;
+		ss_render_draw_text_up(img, f, l->pad, y < 0 ? 0 : y, pn->y_label, ink);
+	}
+}
+
+/* Panel pn into img (its own picture, the panel's size).  The data are
+ * drawn first; the legend goes into a corner of the area where it covers
+ * none of them, else under the area (its entries in rows), which is
+ * shortened for it and drawn again; in a panel too small for that, into
+ * the corner where it covers least. */
+static void draw_panel(struct ss_render_image *img, const struct panel *pn,
+                       const struct fonts *fonts)
+{
+	struct axis ax = {.log = pn->log_x}, ay = {.flip = 1};
+	data_ranges(pn, &ax, &ay);
+	struct layout l = panel_layout(pn, fonts, img->width, img->height, 0, &ax, &ay);
+	draw_data(img, &l, pn, &ax, &ay);
+	struct legend g = legend_size(pn, fonts->text, 0);
+	if (g.entries && !legend_inside(img, &l, &g, 0)) {
+		const struct legend under = legend_size(pn, fonts->text,
+		                                        img->width - 2 * l.pad -
+		                                        2 * legend_inner(fonts->text));
+		struct axis bx = {.log = pn->log_x}, by = {.flip = 1};
+		data_ranges(pn, &bx, &by);
+		struct layout m = panel_layout(pn, fonts, img->width, img->height, under.h + l.gap,
+		                               &bx, &by);
+		if (m.area.y1 - m.area.y0 >= img->height / 3) {
+			l = m, ax = bx, ay = by, g = under;
+			g.x = max_int((l.area.x0 + l.area.x1) / 2 - g.w / 2, l.pad);
+			if (g.x + g.w > img->width - l.pad)
+				g.x = max_int(img->width - l.pad - g.w, 0);
+			g.y = img->height - l.pad - g.h;
+			draw_data(img, &l, pn, &ax, &ay);
+		} else {
+			legend_inside(img, &l, &g, 1);
+		}
+	}
+	if (g.entries)
+		draw_legend(img, &l, pn, &g);
+	draw_axes(img, &l, pn, &ax, &ay);
+}
+
+int ss_plot_check_font(void)
+{
+	return ss_render_font_check();
 }
 
 int ss_plot_write_png(const struct ss_plot *p, const char *path)
@@ -830,14 +982,19 @@ int ss_plot_write_png(const struct ss_plot *p, const char *path)
 	if (!path || !*path)
 		return ss_error_input("plot: no file name: a path for the PNG is accepted");
 	struct ss_render_image fig, panel;
-	int err = ss_render_image_init(&fig, p->columns * p->panel_w, p->rows * p->panel_h, 3, 8);
-	if (err)
+	struct fonts fonts = {NULL, NULL};
+	/* text about 1/24 of the panel's shorter side, titles a fifth larger */
+	const int px = ss_render_font_px(p->panel_w, p->panel_h);
+	int err = ss_render_font_create(&fonts.text, px);
+	if (err || (err = ss_render_font_create(&fonts.title, (6 * px + 2) / 5)))
+		goto out_fonts;
+	if ((err = ss_render_image_init(&fig, p->columns * p->panel_w, p->rows * p->panel_h, 3, 8)))
 		goto out_release_fig;
 	if ((err = ss_render_image_init(&panel, p->panel_w, p->panel_h, 3, 8)))
 		goto out_release_panel;
 	for (int r = 0; r < p->rows; r++)
 		for (int c = 0; c < p->columns; c++) {
-			draw_panel(&panel, &p->panels[r * p->columns + c]);
+			draw_panel(&panel, &p->panels[r * p->columns + c], &fonts);
 			for (int y = 0; y < p->panel_h; y++)
 				memcpy(fig.pixels + (size_t)(r * p->panel_h + y) * fig.row_bytes +
 				               3 * (size_t)c * (size_t)p->panel_w,
@@ -848,5 +1005,8 @@ out_release_panel:
 	ss_render_image_release(&panel);
 out_release_fig:
 	ss_render_image_release(&fig);
+out_fonts:
+	ss_render_font_destroy(fonts.title);
+	ss_render_font_destroy(fonts.text);
 	return err;
 }

@@ -8,14 +8,23 @@
  *
  * A figure is a grid of `columns` x `rows` panels of the same size; panel
  * k is in row k / columns, column k % columns (panel 0 top left).  Each
- * panel has a title, axis labels, an optional log x axis, series of (x, y)
- * points, vertical lines and a legend.  The axes fit the data that can be
- * drawn (with 5 % to spare on each side) and carry ticks at 1-2-5 steps
- * (decades on a log axis) labelled with short numbers ("0.02", "150",
- * "1e-3"); a panel with nothing to draw shows empty axes and its title.
- * Text is the renderer's 5 x 7 bitmap font (upper case drawn as lower),
- * magnified with the panel (twice from 360 px on the shorter side); text
- * wider than its panel is cut at the panel's edge.
+ * panel has a title, axis titles (the y axis's turned to read upwards),
+ * an optional log x axis, series of (x, y) points, vertical lines and a
+ * legend.  The axes fit the data that can be drawn (with 5 % to spare on
+ * each side) and carry ticks at 1-2-5 steps (decades on a log axis)
+ * labelled with short numbers ("0.02", "150", "1e-3") spaced so that
+ * neighbours keep an em between them; a panel with nothing to draw shows
+ * empty axes and its title.  The legend goes into the first corner of the
+ * plot area (upper right, upper left, lower right, lower left) where it
+ * covers no drawn data, else under the plot area (its entries in rows),
+ * which is shortened for it.
+ * Text is the renderer's font (DejaVu Sans through FreeType, antialiased:
+ * render/text.c) at about 1/24 of the panel's shorter side, titles a fifth
+ * larger; text wider than its panel is cut at the panel's edge.
+ *
+ * Drawing needs the font file (SANDSLIDE_FONT, else the build's default):
+ * ss_plot_check_font says early, before work whose end is a figure,
+ * whether it is there.
  *
  * Everything given is copied: the caller's arrays and strings may be freed
  * once a call returns.  A call that fails leaves the figure as it was.
@@ -95,11 +104,16 @@ int ss_plot_add(struct ss_plot *p, int panel, const double *x, const double *y, 
  * memory. */
 int ss_plot_vline(struct ss_plot *p, int panel, double x, int colour);
 
+/* SS_OK if the font that figures are drawn with can be opened, else
+ * SS_ERR_FAIL with one line naming the file and what to install or set. */
+int ss_plot_check_font(void);
+
 /* Draw the figure, (columns * panel_width_px) x (rows * panel_height_px)
  * px of 8-bit RGB on white, and write it to path as a PNG: to
  * "path.partial", renamed to path once complete, so a file by that name is
  * always whole.  The figure is not changed.  SS_ERR_FAIL (naming the file
- * and the system's reason) if it cannot be written, or out of memory. */
+ * and the system's reason) if it cannot be written, the font cannot be
+ * read (ss_plot_check_font), or out of memory. */
 int ss_plot_write_png(const struct ss_plot *p, const char *path);
 
 #endif

@@ -73,6 +73,16 @@ static int has_mp4_container(const char *video)
 	return !dot || !strcmp(dot, ".mp4") || !strcmp(dot, ".mov") || !strcmp(dot, ".m4v");
 }
 
+/* A video of a few frames at 24 per second is over before it is seen (21
+ * frames: 0.9 s): fewer frames play slower, a quarter of them per second,
+ * down to one, so that the video lasts 4 s or more; from 96 frames on,
+ * film speed. */
+int ss_render_fps_for(long long frames)
+{
+	const long long fps = frames / 4;
+	return fps < 1 ? 1 : fps > 24 ? 24 : (int)fps;
+}
+
 int ss_render_ffmpeg_found(void)
 {
 	char ffmpeg[4096];

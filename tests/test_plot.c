@@ -393,6 +393,299 @@ static void test_empty_panel(void)
 	ss_plot_destroy(p);
 }
 
+/* The last row of the first band of rows, from the top, that holds dark
+ * pixels (< 128) in columns [x0, x1): a panel's title; -1 if none. */
+static int first_band_bottom(const struct pic *p, int x0, int x1)
+{
+	int in_band = 0;
+	for (int y = 0; y < p->h; y++) {
+		int dark = 0;
+		for (int x = x0; x < x1 && !dark; x++)
+			dark = pic_at(p, x, y)[0] < 128;
+		if (dark)
+			in_band = 1;
+		else if (in_band)
+			return y - 1;
+	}
+	return -1;
+}
+
+/* The bottom of the title's ink of an empty 400 x 300 panel titled t. */
+static int title_bottom(const char *t, const char *name)
+{
+	struct ss_plot *p;
+	int bottom = -1;
+	CHECK(ss_plot_create(&p, 1, 1, 400, 300) == SS_OK, "create");
+	CHECK(ss_plot_panel(p, 0, t, NULL, NULL, 0) == SS_OK, "panel");
+	const char *path = check_file(name);
+	CHECK(ss_plot_write_png(p, path) == SS_OK, "write");
+	struct pic pic;
+	CHECK(pic_read(path, &pic) == 0, "read");
+	if (pic.px)
+		bottom = first_band_bottom(&pic, pic.w / 4, 3 * pic.w / 4);
+	free(pic.px);
+	ss_plot_destroy(p);
+	return bottom;
+}
+
+/* Descenders reach below the baseline (issue 36: the bitmap font drew
+ * "bin9ham" and "cost alon9 nu", its g within the line): a title with a g
+ * ends lower than the same letters without one, and so does one with p
+ * and y. */
+static void test_descenders(void)
+{
+	const int g = title_bottom("bingham", "g.png"), no_g = title_bottom("binham", "no_g.png");
+	CHECK(g >= 0 && no_g >= 0 && g >= no_g + 2,
+	      "\"bingham\" ends at row %d, \"binham\" at row %d: the g descends", g, no_g);
+	const int py = title_bottom("cost along nu (py)", "py.png");
+	const int plain = title_bottom("cost alon nu", "plain.png");
+	CHECK(py >= plain + 2, "\"cost along nu (py)\" ends at row %d, \"cost alon nu\" at %d", py,
+	      plain);
+}
+
+/* A legend's frame: the bounding box of the runs of 30 px or more along
+ * a row of one colour other than white, black, the grid's and the
+ * palette's (its top and bottom edges).  Text (antialiased grey) draws no
+ * such runs, though its pixels may have the frame's colour.  Returns 0 if
+ * there is none. */
+static int legend_box(const struct pic *p, struct box *b)
+{
+	const uint8_t grid[3] = {0xe4, 0xe4, 0xe4};
+	uint8_t edge[3];
+	int found = 0;
+	for (int y = 0; y < p->h && !found; y++)
+		for (int x = 0, run = 0; x < p->w && !found; x++) {
+			const uint8_t *q = pic_at(p, x, y);
+			int plain = (q[0] == 255 && q[1] == 255 && q[2] == 255) ||
+			            (q[0] == 0 && q[1] == 0 && q[2] == 0) || !memcmp(q, grid, 3);
+			for (int c = 0; c < SS_PLOT_COLOURS; c++)
+				plain |= is_colour(p, x, y, c);
+			run = !plain && x > 0 && !memcmp(q, pic_at(p, x - 1, y), 3) ? run + 1 : 0;
+			if (run >= 30) {
+				memcpy(edge, q, 3);
+				found = 1;
+			}
+		}
+	if (!found)
+		return 0;
+	*b = (struct box){p->w, p->h, -1, -1, 0};
+	for (int y = 0; y < p->h; y++)
+		for (int x = 0, run = 0; x <= p->w; x++) {
+			if (x < p->w && !memcmp(pic_at(p, x, y), edge, 3)) {
+				run++;
+				continue;
+			}
+			if (run >= 30) {
+				b->x0 = x - run < b->x0 ? x - run : b->x0;
+				b->x1 = x - 1 > b->x1 ? x - 1 : b->x1;
+				b->y0 = y < b->y0 ? y : b->y0;
+				b->y1 = y > b->y1 ? y : b->y1;
+				b->n++;
+			}
+			run = 0;
+		}
+	return 1;
+}
+
+/* The plot area's frame: the box of the longest black row run (its top and
+ * bottom lines; text is antialiased and draws no long black runs). */
+static struct box frame_box(const struct pic *p)
+{
+	struct box b = {p->w, p->h, -1, -1, 0};
+	int longest = 0;
+	for (int y = 0; y < p->h; y++)
+		for (int x = 0, run = 0; x < p->w; x++) {
+			const uint8_t *q = pic_at(p, x, y);
+			run = q[0] == 0 && q[1] == 0 && q[2] == 0 ? run + 1 : 0;
+			if (run > longest)
+				longest = run, b.x1 = x, b.x0 = x - run + 1;
+		}
+	for (int y = 0; y < p->h; y++) {
+		const uint8_t *q = pic_at(p, (b.x0 + b.x1) / 2, y);
+		if (q[0] == 0 && q[1] == 0 && q[2] == 0 && longest > 0) {
+			int run = 0;
+			while (b.x0 + run <= b.x1 && !pic_at(p, b.x0 + run, y)[0])
+				run++;
+			if (run == longest) {
+				b.y0 = b.y0 > y ? y : b.y0;
+				b.y1 = y;
+			}
+		}
+	}
+	return b;
+}
+
+/* fit --plot's first panel as fit draws it (src/app/fit.c: 480 x 360 px,
+ * its titles, the observed fronts as markers and each of the four
+ * closures' best run as a line, colours 0 and 1 + closure), with the
+ * fronts of tests/cli/test_fit.py's transient cone (the observed below the
+ * runs: the legend of f9026b5 sat on the last two); with legend entries or
+ * without. */
+static struct ss_plot *fronts_figure(int legends)
+{
+	struct ss_plot *p;
+	if (ss_plot_create(&p, 1, 1, 480, 360) != SS_OK)
+		return NULL;
+	ss_plot_panel(p, 0, "front: equivalent radius", "time (s)", "radius (m)", 0);
+	static const char *names[4] = {"coulomb", "bingham", "herschel-bulkley", "casson"};
+	static const double to[6] = {1, 2, 3, 5, 8, 12};
+	static const double ro[6] = {0.749, 0.768, 0.787, 0.795, 0.805, 0.821};
+	static const double reach[4] = {0.118, 0.125, 0.126, 0.130};
+	ss_plot_add(p, 0, to, ro, 6, SS_PLOT_MARKERS, 0, legends ? "observed" : NULL);
+	double t[49], r[49];
+	for (int c = 0; c < 4; c++) {
+		for (int i = 0; i <= 48; i++) {
+			t[i] = 0.25 * i;
+			r[i] = 0.784 + reach[c] * (1 - exp(-t[i] / 2.2));
+		}
+		ss_plot_add(p, 0, t, r, 49, SS_PLOT_LINE, 1 + c, legends ? names[c] : NULL);
+	}
+	return p;
+}
+
+/* Lines through every corner of the plot area (fit's panel size): no
+ * corner is free for the legend. */
+static struct ss_plot *cross_figure(int legends)
+{
+	struct ss_plot *p;
+	if (ss_plot_create(&p, 1, 1, 480, 360) != SS_OK)
+		return NULL;
+	ss_plot_panel(p, 0, "cost along nu", "nu", "cost", 0);
+	double x[41], y[3][41];
+	for (int i = 0; i <= 40; i++) {
+		x[i] = 0.05 * i;
+		y[0][i] = x[i];          /* corner to corner, both ways */
+		y[1][i] = 2.0 - x[i];
+		y[2][i] = i < 20 ? 0.0 : 2.0;
+	}
+	static const char *names[3] = {"coulomb", "bingham", "herschel-bulkley"};
+	for (int s = 0; s < 3; s++)
+		ss_plot_add(p, 0, x, y[s], 41, SS_PLOT_LINE, s, legends ? names[s] : NULL);
+	return p;
+}
+
+/*
+ * The legend covers no data (issue 36: fit's legend sat on the curves):
+ * the figure drawn with legend entries and again without, the legend's
+ * box (its frame) holds no pixel of a series of the figure without it,
+ * when the plot area is the same in both; when it is not, the legend went
+ * outside the area and stays out of it.
+ */
+static void check_legend_clear(struct ss_plot *(*figure)(int), const char *name,
+                               int want_outside)
+{
+	struct box box[2] = {{0}}, frame[2];
+	struct pic pic[2] = {{0}};
+	for (int with = 0; with < 2; with++) {
+		struct ss_plot *p = figure(with);
+		CHECK(p != NULL, "%s: figure made", name);
+		char file[64];
+		snprintf(file, sizeof file, "%s_%d.png", name, with);
+		const char *path = check_file(file);
+		CHECK(p && ss_plot_write_png(p, path) == SS_OK, "write");
+		CHECK(pic_read(path, &pic[with]) == 0, "read");
+		ss_plot_destroy(p);
+		if (!pic[with].px)
+			goto out;
+		frame[with] = frame_box(&pic[with]);
+	}
+	CHECK(legend_box(&pic[1], &box[1]), "%s: the legend is drawn", name);
+	CHECK(!legend_box(&pic[0], &box[0]), "%s: no legend without entries", name);
+	const struct box *b = &box[1], *f = &frame[1];
+	const int same_area = !memcmp(&frame[0], &frame[1], sizeof frame[0]);
+	if (same_area) {
+		long covered = 0;
+		for (int c = 0; c < SS_PLOT_COLOURS; c++)
+			covered += find_in(&pic[0], c, b->x0, b->x1 + 1, b->y0, b->y1 + 1).n;
+		CHECK(covered == 0, "%s: the legend (x %d..%d, y %d..%d) covers %ld px of the "
+		      "series", name, b->x0, b->x1, b->y0, b->y1, covered);
+	} else {
+		CHECK(b->x0 > f->x1 || b->x1 < f->x0 || b->y0 > f->y1 || b->y1 < f->y0,
+		      "%s: the legend (x %d..%d, y %d..%d) is outside the plot area (x %d..%d, "
+		      "y %d..%d)", name, b->x0, b->x1, b->y0, b->y1, f->x0, f->x1, f->y0, f->y1);
+	}
+	CHECK(want_outside == !same_area, "%s: the legend is %s the plot area", name,
+	      same_area ? "inside" : "outside");
+	CHECK(b->x1 < pic[1].w && b->y1 < pic[1].h, "%s: the legend is in the panel", name);
+out:
+	free(pic[0].px);
+	free(pic[1].px);
+}
+
+/* No corner is free in either: the legend goes under the plot area.  A
+ * free corner is test_legend_corner's. */
+static void test_legend_covers_no_data(void)
+{
+	check_legend_clear(fronts_figure, "fronts", 1);
+	check_legend_clear(cross_figure, "cross", 1);
+}
+
+/* Is there ink (a pixel darker than mid-grey) in column x, rows [y0, y1)? */
+static int ink_in_column(const struct pic *p, int x, int y0, int y1)
+{
+	for (int y = y0; y < y1; y++)
+		if (pic_at(p, x, y)[0] < 128)
+			return 1;
+	return 0;
+}
+
+static int ink_in_row(const struct pic *p, int y, int x0, int x1)
+{
+	for (int x = x0; x < x1; x++)
+		if (pic_at(p, x, y)[0] < 128)
+			return 1;
+	return 0;
+}
+
+/*
+ * Tick labels do not run into each other, in a proportional font on a
+ * small panel with long labels: between the marks of neighbouring x ticks
+ * (black pixels just under the frame) a column of the labels' rows is
+ * blank, and between neighbouring y ticks a row of the labels' columns.
+ */
+static void test_tick_labels_apart(void)
+{
+	struct ss_plot *p;
+	CHECK(ss_plot_create(&p, 1, 1, 240, 180) == SS_OK, "create");
+	CHECK(ss_plot_panel(p, 0, "ticks", "x", "y", 0) == SS_OK, "panel");
+	const double x[2] = {123450.0, 123990.0}, y[2] = {1.2e-4, 9.7e-4};
+	CHECK(ss_plot_add(p, 0, x, y, 2, SS_PLOT_LINE, 0, NULL) == SS_OK, "add");
+	const char *path = check_file("ticks.png");
+	CHECK(ss_plot_write_png(p, path) == SS_OK, "write");
+	struct pic pic;
+	CHECK(pic_read(path, &pic) == 0, "read");
+	if (pic.px) {
+		const struct box f = frame_box(&pic);
+		/* x: tick marks in the row under the frame, labels below them */
+		int ticks[64], n = 0, apart = 1;
+		for (int c = f.x0; c <= f.x1 && n < 64; c++)
+			if (pic_at(&pic, c, f.y1 + 1)[0] == 0)
+				ticks[n++] = c;
+		const int y0 = f.y1 + 3, y1 = f.y1 + 3 + 22;
+		for (int i = 0; i + 1 < n; i++) {
+			int blank = 0;
+			for (int c = ticks[i] + 1; c < ticks[i + 1] && !blank; c++)
+				blank = !ink_in_column(&pic, c, y0, y1);
+			apart &= blank;
+		}
+		CHECK(n >= 2 && apart, "%d x ticks, their labels apart: %d", n, apart);
+		/* y: tick marks in the column left of the frame, labels left of them */
+		n = 0, apart = 1;
+		for (int r = f.y0; r <= f.y1 && n < 64; r++)
+			if (pic_at(&pic, f.x0 - 2, r)[0] == 0)
+				ticks[n++] = r;
+		for (int i = 0; i + 1 < n; i++) {
+			int blank = 0;
+			for (int r = ticks[i] + 1; r < ticks[i + 1] && !blank; r++)
+				blank = !ink_in_row(&pic, r, f.x0 - 40 < 0 ? 0 : f.x0 - 40, f.x0 - 4);
+			apart &= blank;
+		}
+		CHECK(n >= 2 && apart, "%d y ticks, their labels apart: %d", n, apart);
+	}
+	free(pic.px);
+	ss_plot_destroy(p);
+}
+
 /* The demo of sandslide fit --plot: fronts over time and a cost along nu. */
 static struct ss_plot *demo_figure(void)
 {
@@ -549,6 +842,9 @@ int main(void)
 	RUN(test_nan_breaks_line);
 	RUN(test_log_x);
 	RUN(test_legend_corner);
+	RUN(test_legend_covers_no_data);
+	RUN(test_descenders);
+	RUN(test_tick_labels_apart);
 	RUN(test_empty_panel);
 	RUN(test_deterministic);
 	RUN(test_bad_input);

@@ -22,6 +22,8 @@
 #include "sandslide/parallel.h"
 #include "sandslide/render.h"
 
+#include "render/internal.h"   /* the font (text.c), which frames and plots share */
+
 static char tmpdir[256];
 
 /* ---- helpers ---------------------------------------------------------- */
@@ -529,17 +531,21 @@ static void test_label_and_colorbar(void)
 		map_same &= !memcmp(rgb_at(&plain, 0, y), rgb_at(&labelled, 0, y + strip),
 		                    3 * (size_t)plain.width);
 	CHECK(map_same, "the label covers no pixel of the map");
-	int black = 0, white = 0, other = 0;
+	/* black text on white in a real font: antialiased, so grey at the
+	 * edges of the strokes (and no other colour) */
+	int black = 0, white = 0, grey = 0, other = 0;
 	for (int y = 0; y < strip; y++)
 		for (int x = 0; x < labelled.width; x++) {
 			const uint8_t *p = rgb_at(&labelled, x, y);
 			black += is_rgb(p, 0, 0, 0);
 			white += is_rgb(p, 255, 255, 255);
-			other += !is_rgb(p, 0, 0, 0) && !is_rgb(p, 255, 255, 255);
+			grey += p[0] == p[1] && p[1] == p[2] && p[0] != 0 && p[0] != 255;
+			other += p[0] != p[1] || p[1] != p[2];
 		}
 	CHECK(black > 100 && white > black && other == 0,
 	      "the strip is black text on white: %d black, %d white, %d other", black, white,
 	      other);
+	CHECK(grey > black / 2, "the text is antialiased: %d grey pixels, %d black", grey, black);
 	ss_render_image_release(&labelled);
 
 	o.label = 0;
@@ -944,6 +950,119 @@ static void test_bad_options(void)
 	field_release(&t);
 }
 
+/* Ink of a picture drawn on white: the rows and columns of pixels darker
+ * than mid-grey. */
+struct ink {
+	int x0, y0, x1, y1;   /* inclusive; x0 > x1 when none */
+};
+
+static struct ink ink_of(const struct ss_render_image *img)
+{
+	struct ink k = {img->width, img->height, -1, -1};
+	for (int y = 0; y < img->height; y++)
+		for (int x = 0; x < img->width; x++)
+			if (rgb_at(img, x, y)[0] < 128) {
+				k.x0 = x < k.x0 ? x : k.x0;
+				k.x1 = x > k.x1 ? x : k.x1;
+				k.y0 = y < k.y0 ? y : k.y0;
+				k.y1 = y > k.y1 ? y : k.y1;
+			}
+	return k;
+}
+
+/* text in a picture of its own: w x h px of white, drawn at (0, 0) */
+static struct ink ink_of_text(const struct ss_render_font *f, const char *text, int up)
+{
+	struct ss_render_image img;
+	static const uint8_t black[3] = {0, 0, 0};
+	struct ink k = {1, 1, 0, 0};
+	const int line = ss_render_font_line(f), w = ss_render_text_width(f, text);
+	if (ss_render_image_init(&img, up ? line : w, up ? w : line, 3, 8))
+		return k;
+	memset(img.pixels, 0xff, img.row_bytes * (size_t)img.height);
+	if (up)
+		ss_render_draw_text_up(&img, f, 0, 0, text, black);
+	else
+		ss_render_draw_text(&img, f, 0, 0, text, black);
+	k = ink_of(&img);
+	ss_render_image_release(&img);
+	return k;
+}
+
+/*
+ * The font has descenders (the 5 x 7 bitmap font before issue 36 drew
+ * "g" within the line's height: "bin9ham"): a g reaches below the
+ * baseline, by a sixth of the em or more, and ends inside its line box, as
+ * do p and y; an o stays on the baseline.  Turned to read upwards, the
+ * same g's descender points right, away from the tops.
+ */
+static void test_font_descenders(void)
+{
+	struct ss_render_font *f = NULL;
+	CHECK(ss_render_font_create(&f, 20) == SS_OK, "the font at 20 px (%s)",
+	      ss_render_font_file());
+	if (!f)
+		return;
+	const int base = ss_render_font_ascent(f), line = ss_render_font_line(f);
+	const struct ink g = ink_of_text(f, "g", 0), o = ink_of_text(f, "o", 0);
+	/* the baseline runs between rows base - 1 and base */
+	CHECK(g.y1 - base + 1 >= 20 / 6 && g.y1 < line,
+	      "g's ink reaches %d rows below the baseline (above row %d), inside its line of "
+	      "%d px", g.y1 - base + 1, base, line);
+	CHECK(o.y1 <= base && o.y1 >= base - 1, "o sits on the baseline (row %d): it ends at %d",
+	      base, o.y1);
+	CHECK(g.y0 >= o.y0 - 1 && g.y0 <= o.y0 + 1, "g and o start at the x-height: rows %d, %d",
+	      g.y0, o.y0);
+	const struct ink py = ink_of_text(f, "py", 0), bingham = ink_of_text(f, "bingham", 0);
+	CHECK(py.y1 - base + 1 >= 20 / 6, "p and y descend too: to row %d", py.y1);
+	CHECK(bingham.y1 == g.y1 && bingham.y0 < g.y0,
+	      "\"bingham\": the g's descender and the b's ascender: rows %d..%d", bingham.y0,
+	      bingham.y1);
+	const struct ink up = ink_of_text(f, "g", 1);
+	CHECK(up.x1 == g.y1 && up.x0 == g.y0, "turned up: the g's rows become columns %d..%d "
+	      "(%d..%d)", up.x0, up.x1, g.y0, g.y1);
+	/* kerning and advances: a wider text is wider */
+	CHECK(ss_render_text_width(f, "bingham") > ss_render_text_width(f, "binham"),
+	      "text widths add up");
+	ss_render_font_destroy(f);
+	ss_render_font_destroy(NULL);
+}
+
+/* Without the font file, a picture with text is refused with one line
+ * naming the file, where its name came from and the package to install;
+ * one without text needs no font. */
+static void test_font_missing(void)
+{
+	const char *was = getenv("SANDSLIDE_FONT");
+	char saved[4096] = "";
+	if (was)
+		snprintf(saved, sizeof saved, "%s", was);
+	setenv("SANDSLIDE_FONT", "/nonexistent/DejaVuSans.ttf", 1);
+	struct field t;
+	field_init(&t, 8, 8);
+	struct ss_render_options o;
+	ss_render_options_default(&o);
+	struct ss_render_image img = {0};
+	ss_error_set_quiet(1);
+	o.label = 1;
+	const int status = ss_render_field(&t.f, &o, &img);
+	const char *m = ss_error_last_message();
+	CHECK(status == SS_ERR_FAIL && strstr(m, "'/nonexistent/DejaVuSans.ttf'") &&
+	          strstr(m, "SANDSLIDE_FONT") && strstr(m, "fonts-dejavu-core") && !strchr(m, '\n'),
+	      "a label without the font: status %d, \"%s\"", status, m);
+	if (status == SS_OK)
+		ss_render_image_release(&img);
+	ss_error_set_quiet(0);
+	o.label = 0;
+	CHECK(ss_render_field(&t.f, &o, &img) == SS_OK, "no text, no font needed");
+	ss_render_image_release(&img);
+	if (was)
+		setenv("SANDSLIDE_FONT", saved, 1);
+	else
+		unsetenv("SANDSLIDE_FONT");
+	field_release(&t);
+}
+
 /* A failed write leaves neither the picture nor its temporary file. */
 static void test_write_failure_leaves_nothing(void)
 {
@@ -1107,6 +1226,8 @@ int main(void)
 	RUN(test_nodata_cells_are_absent);
 	RUN(test_bad_options);
 	RUN(test_write_failure_leaves_nothing);
+	RUN(test_font_descenders);
+	RUN(test_font_missing);
 	char cmd[600];
 	snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
 	if (system(cmd) != 0)

@@ -175,7 +175,10 @@ struct ss_render_series_options {
 	double time;                /* s: the snapshot nearest this; NAN: unused */
 	const char *video;          /* FILE.mp4 to assemble with ffmpeg, or NULL */
 	int fps;                    /* frames per second of the video, and the
-	                             * speed the viewer starts at (24) */
+	                             * speed the viewer starts at; 0: chosen from
+	                             * the number of frames n, n / 4 (whole) within
+	                             * 1 .. 24, so that a video lasts 4 s or more
+	                             * (ss_render_fps_for) */
 	const char *html;           /* FILE.html: a self-contained viewer of the
 	                             * frames (PNG frames embedded as base64, a
 	                             * slider, play/pause, the colour bar, and
@@ -214,7 +217,14 @@ struct ss_render_series_report {
 	                             * earlier render; "" if there is none */
 	enum ss_render_video_made video;
 	long long html_bytes;       /* size of the viewer written, 0 if none */
+	int fps;                    /* of the video and the viewer: the options',
+	                             * or chosen from the frames */
 };
+
+/* The frame rate of a video of n frames when none is given: n / 4 frames
+ * per second (whole), at least 1 and at most 24, so that it lasts at
+ * least 4 s (n >= 4), and a long series plays at film speed. */
+int ss_render_fps_for(long long frames);
 
 /*
  * Render the chosen snapshots of o->input to output_dir/frame_00000.png,

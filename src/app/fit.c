@@ -1016,8 +1016,10 @@ static int prepare(struct fit *f)
 	if (o->job.output && ((err = ss_output_check_folder(o->job.output, 0)) ||
 	                      (err = ss_output_check_absent(o->job.output, o->job.force, NULL))))
 		return err;
+	/* the figure's font too: its absence would end the fit at its end */
 	if (o->plot && ((err = ss_output_check_folder(o->plot, 0)) ||
-	                (err = ss_output_check_absent(o->plot, o->job.force, NULL))))
+	                (err = ss_output_check_absent(o->plot, o->job.force, NULL)) ||
+	                (err = ss_plot_check_font())))
 		return err;
 	if ((err = ss_observations_read(&f->obs, o->observations)) || (err = check_grid(f)))
 		return err;

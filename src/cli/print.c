@@ -294,7 +294,7 @@ void cli_print_render_series(const struct ss_render_series_options *o,
 		        "frames are kept in '%s' (Debian: apt-get install ffmpeg)\n", r->frames,
 		        o->output_dir);
 	} else if (r->video == SS_RENDER_VIDEO_MADE && !quiet) {
-		printf("wrote %s: %lld frames at %d frames/s\n", o->video, r->frames, o->fps);
+		printf("wrote %s: %lld frames at %d frames/s\n", o->video, r->frames, r->fps);
 	}
 	if (r->html_bytes && !quiet) {
 		const double b = (double)r->html_bytes;

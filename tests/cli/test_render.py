@@ -227,7 +227,8 @@ def test_wall_sides_drawn(series, tmp_path):
 
 def test_label_strip_covers_nothing(series, tmp_path):
     """--label puts the time in a white strip above the picture, which is
-    otherwise the same pixels."""
+    otherwise the same pixels; the text is black, antialiased (a real font:
+    grey at its edges, no other colour)."""
     d, times = series
     run_ok(["render", d / "out.h5", "-o", tmp_path / "a", "--frames", "2", "-q"])
     run_ok(["render", d / "out.h5", "-o", tmp_path / "b", "--frames", "2", "--label", "-q"])
@@ -236,10 +237,12 @@ def test_label_strip_covers_nothing(series, tmp_path):
     strip = b.shape[0] - a.shape[0]
     assert b.shape[1] == a.shape[1] and strip > 7, (a.shape, b.shape)
     assert np.array_equal(b[strip:], a), "the picture below the strip is untouched"
-    label = b[:strip]
+    label = b[:strip].astype(int)
+    grey = (label[:, :, 0] == label[:, :, 1]) & (label[:, :, 1] == label[:, :, 2])
     black = np.all(label == 0, axis=2)
     white = np.all(label == 255, axis=2)
-    assert np.all(black | white) and black.sum() > 50, "black text on white"
+    assert np.all(grey) and black.sum() > 50, "black text on white"
+    assert (~black & ~white).sum() > 20, "edges in grey: antialiased"
 
 
 def test_force(series, tmp_path):
@@ -406,7 +409,8 @@ def test_video_alone_keeps_no_frames(series, tmp_path):
         f"the working folder got {os.listdir(tmp_path / 'work')} (a frames/ folder?)"
     assert os.listdir(tmp_path / "films") == ["v.mp4"], \
         f"beside the video: {os.listdir(tmp_path / 'films')} (frames left behind?)"
-    assert r.stdout == "wrote %s: 5 frames at 24 frames/s\n" % (tmp_path / "films" / "v.mp4"), \
+    # five frames, none given a rate: one a second (a quarter of 5, at least 1)
+    assert r.stdout == "wrote %s: 5 frames at 1 frames/s\n" % (tmp_path / "films" / "v.mp4"), \
         r.stdout
     probe = subprocess.run(["ffprobe", "-v", "error", "-count_frames", "-select_streams", "v:0",
                             "-show_entries", "stream=nb_read_frames", "-of", "csv=p=0",
@@ -448,6 +452,38 @@ def test_video_frame_count(series, tmp_path):
     fields = dict(line.split("=", 1) for line in probe.stdout.split())
     assert fields == {"codec_name": "h264", "pix_fmt": "yuv420p", "nb_read_frames": "5"}, \
         probe.stdout + probe.stderr
+
+
+def probe_video(path):
+    """Frames, frame rate and duration (s) of a video, by ffprobe."""
+    probe = subprocess.run(
+        ["ffprobe", "-v", "error", "-count_frames", "-select_streams", "v:0",
+         "-show_entries", "stream=nb_read_frames,r_frame_rate:format=duration", "-of",
+         "default=noprint_wrappers=1", str(path)], capture_output=True, text=True, timeout=60)
+    fields = dict(line.split("=", 1) for line in probe.stdout.split())
+    num, den = fields["r_frame_rate"].split("/")
+    return int(fields["nb_read_frames"]), int(num) / int(den), float(fields["duration"])
+
+
+@pytest.mark.skipif(not (shutil.which("ffmpeg") and shutil.which("ffprobe")),
+                    reason="ffmpeg or ffprobe not on PATH (Debian package ffmpeg)")
+def test_video_of_few_frames_lasts_seconds(tmp_path):
+    """Without --fps the frame rate comes from the number of frames: a
+    quarter of them per second, 1 to 24, so that 21 frames play for 4.2 s
+    at 5 frames/s, not 0.9 s at 24 (issue 36); the viewer starts at the
+    same speed; --fps still wins."""
+    (tmp_path / "case.ini").write_text(edit(BASE, "output_every = 0.5", "output_every = 0.05"))
+    run_ok(["run", "case.ini", "-o", "out.h5", "-q"], cwd=tmp_path)
+    r = run_ok(["render", "out.h5", "--video", "v.mp4", "--html", "v.html", "--max-size", "64"],
+               cwd=tmp_path)
+    assert "wrote v.mp4: 21 frames at 5 frames/s" in r.stdout, r.stdout
+    frames, rate, seconds = probe_video(tmp_path / "v.mp4")
+    assert (frames, rate) == (21, 5) and seconds >= 4.0, (frames, rate, seconds)
+    assert "fps: 5," in (tmp_path / "v.html").read_text(), "the viewer's starting speed"
+    run_ok(["render", "out.h5", "--video", "w.mp4", "--fps", "24", "--max-size", "64", "-q"],
+           cwd=tmp_path)
+    frames, rate, seconds = probe_video(tmp_path / "w.mp4")
+    assert (frames, rate) == (21, 24) and seconds < 1.0, (frames, rate, seconds)
 
 
 # ---- run --frames ---------------------------------------------------------
