@@ -38,6 +38,8 @@
 #include "sandslide/diagnostics.h"
 #include "sandslide/error.h"
 #include "sandslide/grid.h"
+#include "sandslide/model_options.h"
+#include "sandslide/option.h"
 #include "sandslide/parallel.h"
 #include "sandslide/rkl2.h"
 #include "sandslide/stepper.h"
@@ -87,6 +89,11 @@ static int setup_full(struct ss_stepper *st, int nx, int ny, double dx, double d
 		return err;
 	st->integrator = integrator;
 	st->kernel = kernel;
+	/* RKL2's settings at the model options' defaults */
+	struct ss_model_options m;
+	ss_model_options_init(&m);
+	st->rkl2_max_stages = m.rkl2_max_stages;
+	st->rkl2_tol = m.rkl2_tol;
 	return 0;
 }
 
@@ -1287,29 +1294,29 @@ static void test_refusals(void)
 		CHECK(ss_stepper_prepare(&st) == 0, "prepare with euler and a bedrock refused");
 	}
 	ss_stepper_release(&st);
-	CHECK(ss_integrator_resolve(SS_INTEGRATOR_AUTO, 1, 0) == SS_INTEGRATOR_EULER &&
-	      ss_integrator_resolve(SS_INTEGRATOR_AUTO, 0, 0) == SS_INTEGRATOR_RKL2 &&
-	      ss_integrator_resolve(SS_INTEGRATOR_AUTO, 0, 1) == SS_INTEGRATOR_RKL2 &&
-	      ss_integrator_resolve(SS_INTEGRATOR_AUTO, 1, 1) == SS_INTEGRATOR_EULER &&
-	      ss_integrator_resolve(SS_INTEGRATOR_RKL2, 1, 0) == SS_INTEGRATOR_RKL2 &&
-	      ss_integrator_resolve(SS_INTEGRATOR_RKL2, 0, 1) == SS_INTEGRATOR_RKL2,
-	      "auto does not resolve to euler with a bedrock, and rkl2 else (relax too)");
+	CHECK(ss_integrator_resolve(SS_INTEGRATOR_AUTO, 1) == SS_INTEGRATOR_EULER &&
+	      ss_integrator_resolve(SS_INTEGRATOR_AUTO, 0) == SS_INTEGRATOR_RKL2 &&
+	      ss_integrator_resolve(SS_INTEGRATOR_RKL2, 1) == SS_INTEGRATOR_RKL2 &&
+	      ss_integrator_resolve(SS_INTEGRATOR_EULER, 0) == SS_INTEGRATOR_EULER,
+	      "auto does not resolve to euler with a bedrock, and rkl2 else");
 
-	/* too few stages, no change allowed */
+	/* too few stages, no change allowed: refused by the model options'
+	 * table, the one place their ranges are checked (a stepper takes its
+	 * settings as given) */
 	const struct {
-		int stages;
-		double change;
-	} bad[] = {{1, 0.3}, {0, 0.3}, {-5, 0.3}, {256, 0.0}, {256, -1.0}, {256, NAN}};
+		const char *key, *value;
+	} bad[] = {{"rkl2-max-stages", "1"}, {"rkl2-max-stages", "0"}, {"rkl2-max-stages", "-5"},
+	           {"rkl2-tol", "0"}, {"rkl2-tol", "-1"}, {"rkl2-tol", "nan"}};
 	for (size_t k = 0; k < sizeof bad / sizeof *bad; k++) {
-		if (setup(&st, 8, 6, 0.1, SS_CLOSURE_COULOMB, 1.0, 0.01, sides(W, W, W, W, 0.0), 0,
-		          0, SS_INTEGRATOR_RKL2, SS_KERNEL_FAST))
-			continue;
-		st.rkl2_max_stages = bad[k].stages;
-		st.rkl2_tol = bad[k].change;
-		const int err = ss_stepper_prepare(&st);
-		CHECK(err == SS_ERR_INPUT, "prepare with rkl2_max_stages %d, rkl2_tol %g "
-		      "gave %d, not SS_ERR_INPUT", bad[k].stages, bad[k].change, err);
-		ss_stepper_release(&st);
+		struct ss_model_options m;
+		ss_model_options_init(&m);
+		const int stages = m.rkl2_max_stages;
+		const double tol = m.rkl2_tol;
+		size_t at;
+		const struct ss_option *o = ss_option_find(&ss_model_option_table, bad[k].key, &at);
+		const int err = o ? ss_option_parse(o, bad[k].value, (char *)&m + at + o->offset) : 0;
+		CHECK(o && err == -1 && m.rkl2_max_stages == stages && m.rkl2_tol == tol,
+		      "the model options took %s %s", bad[k].key, bad[k].value);
 	}
 	/* the smallest accepted */
 	if (setup(&st, 8, 6, 0.1, SS_CLOSURE_COULOMB, 1.0, 0.01, sides(W, W, W, W, 0.0), 0, 0,

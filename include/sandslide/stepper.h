@@ -112,17 +112,9 @@ int ss_integrator_parse(const char *name, enum ss_integrator *out);
 /* The integrator a stepper uses: the one asked for, and for auto (the one
  * place this rule is written): euler with a bedrock (RKL2's stages have
  * negative weights, so the per-face limit cannot keep sand above the
- * rock), else rkl2: pouring and flowing take 9 to 16 times fewer
- * evaluations, and relaxing a DEM, now that RKL2 polishes its approach
- * to rest in bursts of Euler steps, is faster on the real DEMs measured
- * (doc/model.md#which-integrator-is-the-default; slower on large
- * terrains of many small cliffs, where --integrator euler is the choice).
- * relaxing no longer changes the rule; it is kept for the callers. */
-enum ss_integrator ss_integrator_resolve(enum ss_integrator asked, int has_bedrock,
-                                         int relaxing);
-
-#define SS_RKL2_MAX_STAGES_DEFAULT 2048
-#define SS_RKL2_TOL_DEFAULT 0.1
+ * rock), else rkl2, for run and relax alike
+ * (doc/model.md#which-integrator-is-the-default says why). */
+enum ss_integrator ss_integrator_resolve(enum ss_integrator asked, int has_bedrock);
 
 enum ss_kernel {
 	SS_KERNEL_FAST,         /* in place, active tiles (sweep_fast.c) */
@@ -136,9 +128,13 @@ struct ss_stepper {
 	struct ss_face_rule face_rule;
 	enum ss_kernel kernel;        /* set before ss_stepper_prepare */
 	enum ss_integrator integrator; /* set before ss_stepper_prepare */
-	int rkl2_max_stages;          /* s <= it (>= 2) */
-	double rkl2_tol;              /* error estimate per super-step, in units
-	                               * of tan(a_cr) min(dx, dy) */
+	int rkl2_max_stages;          /* RKL2: s <= it, >= 2; set before
+	                               * ss_stepper_prepare */
+	double rkl2_tol;              /* RKL2: error estimate per super-step, in
+	                               * units of tan(a_cr) min(dx, dy), > 0
+	                               * (both: the model options' table,
+	                               * model_options.h, has the defaults and
+	                               * checks the ranges) */
 	struct ss_sweep_fast fast;
 	struct ss_cfl_bound cfl_bound;
 	struct ss_boundary boundary;
@@ -294,8 +290,10 @@ int ss_stepper_set_bedrock(struct ss_stepper *st, const double *bedrock);
 
 /* Call once heights and interior cell types are set: fills the halo types,
  * holds open cells at the open level, lists the outflow faces, sets up the
- * kernel chosen in st->kernel.  Returns SS_ERR_INPUT naming the first
- * non-finite height or the first cell whose bedrock is above the surface. */
+ * kernel chosen in st->kernel and the integrator in st->integrator (for
+ * rkl2 with the settings above: SS_BUG without them).  Returns
+ * SS_ERR_INPUT naming the first non-finite height, the first cell whose
+ * bedrock is above the surface, or rkl2 with a bedrock. */
 int ss_stepper_prepare(struct ss_stepper *st);
 
 /* How ss_stepper_advance ended.  Steady: see the top of this file. */

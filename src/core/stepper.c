@@ -37,12 +37,10 @@ int ss_integrator_parse(const char *name, enum ss_integrator *out)
 	return -1;
 }
 
-enum ss_integrator ss_integrator_resolve(enum ss_integrator asked, int has_bedrock,
-                                         int relaxing)
+enum ss_integrator ss_integrator_resolve(enum ss_integrator asked, int has_bedrock)
 {
 	if (asked != SS_INTEGRATOR_AUTO)
 		return asked;
-	(void)relaxing;
 	return has_bedrock ? SS_INTEGRATOR_EULER : SS_INTEGRATOR_RKL2;
 }
 
@@ -105,8 +103,6 @@ int ss_stepper_init(struct ss_stepper *st, const struct ss_grid *g,
 	st->closure = *c;
 	st->boundary = *b;
 	st->cfl = cfl;
-	st->rkl2_max_stages = SS_RKL2_MAX_STAGES_DEFAULT;
-	st->rkl2_tol = SS_RKL2_TOL_DEFAULT;
 	st->rkl2_tau = INFINITY;
 	ss_cfl_bound_init(&st->cfl_bound, c);
 	ss_face_rule_init(&st->face_rule, c);
@@ -559,10 +555,10 @@ static int rkl2_prepare(struct ss_stepper *st)
 	if (st->bedrock)
 		return ss_error_input("the rkl2 integrator cannot be used with a bedrock: its "
 		                      "stages cannot keep the sand above the rock; use euler");
-	if (st->rkl2_max_stages < 2)
-		return ss_error_input("rkl2_max_stages %d is below 2", st->rkl2_max_stages);
-	if (!(st->rkl2_tol > 0.0))
-		return ss_error_input("rkl2_tol %g must be above 0", st->rkl2_tol);
+	if (st->rkl2_max_stages < 2 || !(st->rkl2_tol > 0.0))
+		SS_BUG("rkl2_max_stages %d, rkl2_tol %g: set them before ss_stepper_prepare, "
+		       "in the model options' range (model_options.h)", st->rkl2_max_stages,
+		       st->rkl2_tol);
 	const size_t n = ss_grid_storage_cells(&st->grid);
 	st->rkl2_y0 = ss_alloc(n, sizeof(double), "RKL2 Y_0");
 	st->rkl2_d1 = ss_alloc(n, sizeof(double), "RKL2 D_{j-1}");
