@@ -820,8 +820,8 @@ static struct det_result determinism_run(int threads, int tile_nx, int tile_ny)
 		advance_to(&st, 60.0);
 		res.h = malloc((size_t)nx * ny * sizeof *res.h);
 		interior(&st, res.h);
-		res.inflow = st.inflow;
-		res.outflow = st.outflow;
+		res.inflow = ss_stepper_inflow(&st);
+		res.outflow = ss_stepper_outflow(&st);
 		res.steps = st.steps;
 	}
 	ss_stepper_release(&st);

@@ -33,6 +33,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "core/sweeper.h"
 #include "sandslide/boundary.h"
 #include "sandslide/closure.h"
 #include "sandslide/diagnostics.h"
@@ -422,7 +423,8 @@ static int order_setup(struct ss_stepper *st, enum ss_integrator in, double cfl)
 	}
 	if (prepare(st))
 		return -1;
-	st->rkl2_tau = INFINITY;   /* nor the start-up limit */
+	if (st->rkl2)
+		st->rkl2->tau_limit = INFINITY;   /* nor the start-up limit */
 	return 0;
 }
 
@@ -432,7 +434,7 @@ static double dt_all_of(const struct ss_stepper *st)
 	const struct ss_grid *g = &st->grid;
 	const double inv_d2 = 1.0 / (g->dx * g->dx) + 1.0 / (g->dy * g->dy);
 	return st->cfl / (2.0 * st->closure.nu *
-	                  ss_cfl_bound_lookup(&st->cfl_bound, HUGE_VAL) * inv_d2);
+	                  ss_cfl_bound_lookup(&st->sweeper->cfl_bound, HUGE_VAL) * inv_d2);
 }
 
 /* RKL2 from 0 to T with targets T k/n, k = 1..n, and the given cfl (which
@@ -453,12 +455,12 @@ static int order_run(double T, int n, double cfl, double *h, long long *first)
 		const long long before = st.steps;
 		advance_to(&st, T * k / n);
 		if (k == 2)
-			stages = st.last_stages;
-		ok = st.steps == before + 1 && st.last_stages == stages;
+			stages = st.rkl2->last_stages;
+		ok = st.steps == before + 1 && st.rkl2->last_stages == stages;
 	}
 	CHECK(ok, "test set-up: the calls to T k/%d (cfl %g) did not take one super-step of "
 	      "%d stages each: %lld super-steps, last %d stages", n, cfl, stages, st.steps,
-	      st.last_stages);
+	      st.rkl2->last_stages);
 	interior(&st, h);
 	ss_stepper_release(&st);
 	return ok ? stages : -1;
@@ -604,8 +606,8 @@ static struct det_result door_run(int threads, int tile_nx, int tile_ny, enum ss
 		advance_to(&st, 0.4 * t_end);
 		advance_to(&st, t_end);
 		res.h = interior_copy(&st);
-		res.inflow = st.inflow;
-		res.outflow = st.outflow;
+		res.inflow = ss_stepper_inflow(&st);
+		res.outflow = ss_stepper_outflow(&st);
 		res.steps = st.steps;
 		res.evaluations = st.evaluations;
 	}
@@ -867,7 +869,8 @@ static void conservation_case(enum ss_closure_kind kind, enum ss_kernel kernel,
 	for (size_t k = 0; k < sizeof times / sizeof *times; k++) {
 		while (st.time < times[k]) {
 			advance_one(&st, times[k]);
-			stages_max = st.last_stages > stages_max ? st.last_stages : stages_max;
+			stages_max = st.rkl2->last_stages > stages_max ? st.rkl2->last_stages
+			                                               : stages_max;
 		}
 		struct ss_diagnostics d = diag(&st);
 		const double err = fabs((d.volume - v0) - (d.inflow - d.outflow));
@@ -1355,22 +1358,24 @@ static void restart_case(enum ss_kernel kernel, double t1, long long cut, double
 	struct ss_restart_state saved;
 	ss_stepper_restart_state(&a, &saved);
 	double *h1 = interior_copy(&a);
-	const double tau1 = a.rkl2_tau;
+	const double tau1 = a.rkl2->tau_limit;
 	advance_to(&a, t2);
 
 	if (door_room(&b, 0, 0, SS_INTEGRATOR_RKL2, kernel) == 0) {
 		ss_stepper_restore(&b, t1, h1, &saved);
-		CHECK(memcmp(&b.rkl2_tau, &tau1, sizeof tau1) == 0, "restore did not carry the "
-		      "next super-step limit: %.17g, saved %.17g", b.rkl2_tau, tau1);
+		CHECK(memcmp(&b.rkl2->tau_limit, &tau1, sizeof tau1) == 0, "restore did not carry "
+		      "the next super-step limit: %.17g, saved %.17g", b.rkl2->tau_limit, tau1);
 		advance_to(&b, t2);
 		double *ha = interior_copy(&a), *hb = interior_copy(&b);
 		CHECK(same_bits(ha, hb, cells), "%s kernel, restart at t = %.17g s: heights at "
 		      "t = %g s differ from the uninterrupted run's (max %.3g m)", kernel_name(kernel),
 		      t1, t2, max_abs_diff(ha, hb, cells));
-		CHECK(memcmp(&a.inflow, &b.inflow, sizeof a.inflow) == 0 &&
-		      memcmp(&a.outflow, &b.outflow, sizeof a.outflow) == 0,
+		const double in_a = ss_stepper_inflow(&a), out_a = ss_stepper_outflow(&a);
+		const double in_b = ss_stepper_inflow(&b), out_b = ss_stepper_outflow(&b);
+		CHECK(memcmp(&in_a, &in_b, sizeof in_a) == 0 &&
+		      memcmp(&out_a, &out_b, sizeof out_a) == 0,
 		      "%s kernel, restart at t = %.17g s: inflow/outflow %.17g/%.17g, uninterrupted "
-		      "%.17g/%.17g", kernel_name(kernel), t1, b.inflow, b.outflow, a.inflow, a.outflow);
+		      "%.17g/%.17g", kernel_name(kernel), t1, in_b, out_b, in_a, out_a);
 		CHECK(a.steps == b.steps && a.evaluations == b.evaluations,
 		      "%s kernel, restart at t = %.17g s: %lld super-steps, %lld evaluations; "
 		      "uninterrupted %lld, %lld", kernel_name(kernel), t1, b.steps, b.evaluations,

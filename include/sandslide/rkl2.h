@@ -1,8 +1,9 @@
 /*
  * rkl2.h - the coefficients of second-order Runge-Kutta-Legendre
- * super-time-stepping (RKL2; [Meyer2014]: Meyer, Balsara & Aslam, J. Comput. Phys. 257,
- * 2014, section 3; the recurrence PLUTO, Idefix, Athena++ and SUNDIALS
- * LSRKStep use).
+ * super-time-stepping (RKL2; [Meyer2014]: Meyer, Balsara & Aslam,
+ * J. Comput. Phys. 257, 2014, section 3; the recurrence PLUTO, Idefix,
+ * Athena++ and SUNDIALS LSRKStep use), and a stepper's super-steps with
+ * them (the second half).
  *
  * An s-stage super-step of length tau for dY/dt = M(Y), in delta form:
  *
@@ -32,6 +33,8 @@
 #ifndef SANDSLIDE_RKL2_H
 #define SANDSLIDE_RKL2_H
 
+#include <math.h>
+
 struct ss_rkl2_stage {
 	double mu;          /* weight of Y_{j-1} - Y_0 (0 for j = 1) */
 	double nu;          /* weight of Y_{j-2} - Y_0 (0 for j = 1) */
@@ -49,5 +52,50 @@ double ss_rkl2_stable_ratio(int s);
 /* The fewest stages s >= 2 whose super-step may be `ratio` largest stable
  * forward-Euler steps long: the smallest s with (s^2 + s - 2)/4 >= ratio. */
 int ss_rkl2_stages_for(double ratio);
+
+/*
+ * A stepper's RKL2 (stepper.h's rules, doc/model.md#rkl2-super-steps): the
+ * arrays a super-step carries, the super-step and the accuracy rule that
+ * sizes the next.  The arrays, as after a super-step in which nothing
+ * moved until the first: Y_0 = the heights, D = 0 and M(Y_0) = 0
+ * everywhere (the fast sweep relies on it for the tiles it skips).
+ */
+struct ss_stepper;
+
+struct ss_rkl2 {
+	double *y0;             /* Y_0, m, with halo (ss_grid_index) */
+	double *d1, *d2;        /* D_{j-1}, D_{j-2} = Y - Y_0, m (sweep.h) */
+	double *m0;             /* M(Y_0), m/s */
+	double dt_all;          /* forward Euler's step for every slope the
+	                         * closure has: the unit of super-steps, s */
+	double tau_stages;      /* the longest super-step the stage cap
+	                         * (rkl2_max_stages) allows, s */
+	double tol;             /* the error tolerance, m */
+	double tau_limit;       /* the accuracy rule's longest next super-step,
+	                         * s (INFINITY: no limit); restart state */
+	int last_stages;        /* s of the last super-step */
+};
+
+/* For st's grid, heights and settings (ss_stepper_prepare): SS_ERR_INPUT
+ * with a bedrock, SS_ERR_FAIL when an allocation fails; SS_BUG when
+ * rkl2_max_stages or rkl2_tol is out of the model options' range (the
+ * caller sets them: stepper.h). */
+int ss_rkl2_create(struct ss_rkl2 **out, const struct ss_stepper *st);
+void ss_rkl2_destroy(struct ss_rkl2 *r);
+
+/* The longest super-step the rules allow now, s. */
+static inline double ss_rkl2_longest(const struct ss_rkl2 *r)
+{
+	return fmin(r->tau_stages, r->tau_limit);
+}
+
+/*
+ * One super-step of st of tau seconds (at most ss_rkl2_longest), in as few
+ * stages as its length needs (at most rkl2_max_stages), from the state the
+ * stepper measured; then the accuracy rule sets the next limit.  Counts
+ * the evaluations and books the inflow and outflow (ledger.h).  Returns
+ * max |Y_s - Y_0| (as max |D_s|), m, INFINITY on NaN.
+ */
+double ss_rkl2_superstep(struct ss_stepper *st, double tau);
 
 #endif
