@@ -29,6 +29,7 @@
 
 #include "check.h"
 #include "scale.h"
+#include "core/sweep.h"
 #include "sandslide/boundary.h"
 #include "sandslide/closure.h"
 #include "sandslide/diagnostics.h"
@@ -36,7 +37,6 @@
 #include "sandslide/grid.h"
 #include "sandslide/parallel.h"
 #include "sandslide/stepper.h"
-#include "sandslide/sweep.h"
 
 #define DEG (M_PI / 180.0)
 #define REPOSE 35.0

@@ -33,6 +33,8 @@
 #include <string.h>
 
 #include "check.h"
+#include "core/rkl2.h"
+#include "core/sweep.h"
 #include "core/sweeper.h"
 #include "sandslide/boundary.h"
 #include "sandslide/closure.h"
@@ -42,9 +44,7 @@
 #include "sandslide/model_options.h"
 #include "sandslide/option.h"
 #include "sandslide/parallel.h"
-#include "sandslide/rkl2.h"
 #include "sandslide/stepper.h"
-#include "sandslide/sweep.h"
 
 #define DEG (M_PI / 180.0)
 #define REPOSE 35.0

@@ -48,17 +48,17 @@
 
 #include "check.h"
 #include "scale.h"
+#include "core/face.h"
 #include "core/ledger.h"
+#include "core/sweep.h"
 #include "core/sweeper.h"
 #include "sandslide/boundary.h"
 #include "sandslide/closure.h"
 #include "sandslide/cpu.h"
 #include "sandslide/diagnostics.h"
-#include "sandslide/face.h"
 #include "sandslide/grid.h"
 #include "sandslide/parallel.h"
 #include "sandslide/stepper.h"
-#include "sandslide/sweep.h"
 
 #define REPOSE 35.0
 

@@ -6,8 +6,8 @@
  * a source switching on or off) -> the sweep -> account inflow and outflow.
  * The fast sweep (default) measures S as a by-product of the previous sweep
  * and updates in place over the active tiles; the reference sweep computes
- * every flux into two arrays, then updates (sweep.h).  Both give the same
- * bits.  The step is forward Euler with
+ * every flux into two arrays, then updates (src/core/sweep.h).  Both give
+ * the same bits.  The step is forward Euler with
  *
  *   dt = cfl / (2 nu Lambda(S) (1/dx^2 + 1/dy^2))    doc/model.md eq. (11)
  *
@@ -19,7 +19,7 @@
  *
  * RKL2 (integrator = SS_INTEGRATOR_RKL2) advances the same stencil by
  * super-steps of s stages instead (doc/model.md#rkl2-super-steps; the
- * state between super-steps and their rules: rkl2.h).  Its rules:
+ * state between super-steps and their rules: src/core/rkl2.h).  Its rules:
  *
  *   stability  tau <= dt_all (s^2 + s - 2) / 4 with dt_all forward Euler's
  *              step above for Lambda(infinity), the bound of every slope
@@ -271,7 +271,7 @@ void ss_stepper_diagnostics(struct ss_stepper *st, struct ss_diagnostics *d);
 /*
  * The steepest face of the sand, s = |grad h| over every rank (fills the
  * halo): the faces that can carry flux whose stencil lies in sand at least
- * 1e-6 min(dx, dy) thick (ss_sweep_max_sand_slope); without a bedrock every
+ * 1e-6 min(dx, dy) thick (src/core/sweep.h); without a bedrock every
  * such face.  Bare rock may stay steeper than the repose angle for ever,
  * and a cell at the top of a rock cliff drains geometrically (a quarter of
  * its sand per face and step, doc/model.md#bedrock), so it never quite

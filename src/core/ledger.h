@@ -41,9 +41,9 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "core/sweep.h"
 #include "sandslide/diagnostics.h"
 #include "sandslide/grid.h"
-#include "sandslide/sweep.h"
 
 /* The outflow batch's bytes a rank unless batch_bytes says otherwise. */
 #define SS_LEDGER_BATCH_BYTES ((size_t)4 << 20)

@@ -3,18 +3,18 @@
  * super-steps with them: the stages, the error estimate, the accuracy rule
  * (rkl2.h, stepper.h).
  */
-#include "sandslide/rkl2.h"
+#include "core/rkl2.h"
 
 #include <math.h>
 #include <string.h>
 
 #include "core/ledger.h"
 #include "core/sources.h"
+#include "core/sweep.h"
 #include "core/sweeper.h"
 #include "sandslide/comm.h"
 #include "sandslide/error.h"
 #include "sandslide/stepper.h"
-#include "sandslide/sweep.h"
 
 /* b_j of the recurrence: 1/3 for j <= 2, else (j^2 + j - 2) / (2 j (j + 1)) */
 static double b_of(int j)

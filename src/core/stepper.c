@@ -11,13 +11,13 @@
 #include <string.h>
 
 #include "core/ledger.h"
+#include "core/rkl2.h"
 #include "core/sources.h"
+#include "core/sweep.h"
 #include "core/sweeper.h"
 #include "sandslide/comm.h"
 #include "sandslide/cpu.h"
 #include "sandslide/error.h"
-#include "sandslide/rkl2.h"
-#include "sandslide/sweep.h"
 
 static const char *const integrator_names[] = {
 	[SS_INTEGRATOR_EULER] = "euler", [SS_INTEGRATOR_RKL2] = "rkl2",

@@ -15,7 +15,7 @@
  * the path in use once per call, in the generic copy only.  A copy calls
  * its own path's face flux.
  */
-#include "sandslide/sweep.h"
+#include "core/sweep.h"
 
 #include <math.h>
 #include <string.h>

@@ -21,10 +21,10 @@
 
 #include <stdint.h>
 
+#include "core/face.h"
+#include "core/sweep.h"
 #include "sandslide/closure.h"
-#include "sandslide/face.h"
 #include "sandslide/stepper.h"
-#include "sandslide/sweep.h"
 
 struct ss_sweeper {
 	struct ss_tiling tiling;        /* this rank's tiles */

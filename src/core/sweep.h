@@ -18,13 +18,13 @@
  * maxima, which do not depend on order.  Pure compute: no I/O, no
  * allocation.  The caller fills the halo first (boundary.h).
  */
-#ifndef SANDSLIDE_SWEEP_H
-#define SANDSLIDE_SWEEP_H
+#ifndef SANDSLIDE_CORE_SWEEP_H
+#define SANDSLIDE_CORE_SWEEP_H
 
 #include <stdint.h>
 
 #include "sandslide/closure.h"
-#include "sandslide/face.h"
+#include "core/face.h"
 #include "sandslide/grid.h"
 
 /*

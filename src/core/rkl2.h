@@ -30,8 +30,8 @@
  * and a slope relaxing towards the repose angle is not pushed through it
  * at linear order.  The method is second order in tau for any s >= 2.
  */
-#ifndef SANDSLIDE_RKL2_H
-#define SANDSLIDE_RKL2_H
+#ifndef SANDSLIDE_CORE_RKL2_H
+#define SANDSLIDE_CORE_RKL2_H
 
 #include <math.h>
 
