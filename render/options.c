@@ -111,9 +111,11 @@ static const struct ss_option series[] = {
 	 .help = "replace existing frames, video or viewer"},
 };
 
+static const struct ss_option_part parts[] = {{&ss_render_look_option_table, AT(look)}};
+
 const struct ss_option_table ss_render_option_table = {
 	.command = "render", .options = series, .count = sizeof series / sizeof *series,
-	.more = &ss_render_look_option_table, .more_offset = AT(look),
+	.parts = parts, .part_count = 1,
 };
 
 void ss_render_series_options_init(struct ss_render_series_options *o)

@@ -1,7 +1,7 @@
 /*
- * test_api.c - the entry points for foreign callers (relax_api.c,
- * run_api.c): options set by name are checked as the command line checks
- * them and own their text; the JSON formatters say when a buffer is too
+ * test_api.c - the entry points for foreign callers (options objects,
+ * option.h; relax_report.c, run_report.c): options set by name are
+ * checked as the command line checks them and own their text; the JSON formatters say when a buffer is too
  * small and escape what JSON cannot hold; ss_relax_heights gives the bits
  * of ss_relax_run on the same DEM file; a case runs through
  * ss_run_case_json.  Under `make SANITIZE=1 test` it also shows that the
@@ -35,77 +35,76 @@ static void pile(double *h)
 
 static void relax_options_are_checked_as_the_cli_checks_them(void)
 {
-	struct ss_relax_options *o = ss_relax_options_create();
+	struct ss_relax_options *o = ss_option_object_create(&ss_relax_option_table);
 	CHECK(o != NULL, "create");
 	if (!o)
 		return;
 	CHECK(o->model.angle_deg == 35.0 && o->model.nu == 1.0 && o->model.steady_tol == 1e-9 &&
 	      isnan(o->model.max_time) && o->sand_shape.kind == SS_SHAPE_NONE, "the table's defaults");
-	CHECK(ss_relax_options_set(o, "angle", "30") == SS_OK && o->model.angle_deg == 30.0, "angle");
-	CHECK(ss_relax_options_set(o, "angle", "95") == SS_ERR_INPUT, "angle 95 refused");
+	CHECK(ss_option_object_set(o, "angle", "30") == SS_OK && o->model.angle_deg == 30.0, "angle");
+	CHECK(ss_option_object_set(o, "angle", "95") == SS_ERR_INPUT, "angle 95 refused");
 	CHECK(!strcmp(ss_error_last_message(), "angle '95': expected degrees in (0, 90)"), "%s",
 	      ss_error_last_message());
 	CHECK(o->model.angle_deg == 30.0, "a refused value leaves the option as it was");
-	CHECK(ss_relax_options_set(o, "angle", "30x") == SS_ERR_INPUT, "trailing junk refused");
-	CHECK(ss_relax_options_set(o, "max_time", "5") == SS_OK && o->model.max_time == 5.0, "max_time");
-	CHECK(ss_relax_options_set(o, "max-time", "6") == SS_OK && o->model.max_time == 6.0, "max-time");
-	CHECK(ss_relax_options_set(o, "closure", "casson") == SS_OK &&
+	CHECK(ss_option_object_set(o, "angle", "30x") == SS_ERR_INPUT, "trailing junk refused");
+	CHECK(ss_option_object_set(o, "max_time", "5") == SS_OK && o->model.max_time == 5.0, "max_time");
+	CHECK(ss_option_object_set(o, "max-time", "6") == SS_OK && o->model.max_time == 6.0, "max-time");
+	CHECK(ss_option_object_set(o, "closure", "casson") == SS_OK &&
 	      o->model.closure == SS_CLOSURE_CASSON, "closure");
-	CHECK(ss_relax_options_set(o, "closure", "bogus") == SS_ERR_INPUT, "bogus closure");
+	CHECK(ss_option_object_set(o, "closure", "bogus") == SS_ERR_INPUT, "bogus closure");
 	CHECK(!strcmp(ss_error_last_message(), "closure 'bogus': expected " SS_CLOSURE_NAMES),
 	      "%s", ss_error_last_message());
-	CHECK(ss_relax_options_set(o, "sides", "open") == SS_OK && o->sides == SS_SIDE_OPEN,
+	CHECK(ss_option_object_set(o, "sides", "open") == SS_OK && o->sides == SS_SIDE_OPEN,
 	      "sides");
-	CHECK(ss_relax_options_set(o, "sides", "periodic") == SS_ERR_INPUT, "periodic refused");
-	CHECK(ss_relax_options_set(o, "nodata", "wall") == SS_OK &&
+	CHECK(ss_option_object_set(o, "sides", "periodic") == SS_ERR_INPUT, "periodic refused");
+	CHECK(ss_option_object_set(o, "nodata", "wall") == SS_OK &&
 	      o->nodata_type == SS_CELL_WALL, "nodata");
-	CHECK(ss_relax_options_set(o, "integrator", "rkl2") == SS_OK &&
+	CHECK(ss_option_object_set(o, "integrator", "rkl2") == SS_OK &&
 	      o->model.integrator == SS_INTEGRATOR_RKL2, "integrator");
-	CHECK(ss_relax_options_set(o, "threads", "3") == SS_OK && o->threads == 3, "threads");
-	CHECK(ss_relax_options_set(o, "threads", "2.5") == SS_ERR_INPUT, "threads 2.5 refused");
-	CHECK(ss_relax_options_set(o, "dx", "0.25") == SS_OK && o->read.cellsize == 0.25, "dx");
-	CHECK(ss_relax_options_set(o, "force", "1") == SS_OK && o->force == 1, "force");
-	CHECK(ss_relax_options_set(o, "force", "yes") == SS_ERR_INPUT, "force yes refused");
-	CHECK(ss_relax_options_set(o, "tol", "") == SS_ERR_INPUT, "an empty value refused");
-	CHECK(ss_relax_options_set(o, "bogus", "1") == SS_ERR_INPUT, "unknown key");
+	CHECK(ss_option_object_set(o, "threads", "3") == SS_OK && o->job.threads == 3, "threads");
+	CHECK(ss_option_object_set(o, "threads", "2.5") == SS_ERR_INPUT, "threads 2.5 refused");
+	CHECK(ss_option_object_set(o, "dx", "0.25") == SS_OK && o->read.cellsize == 0.25, "dx");
+	CHECK(ss_option_object_set(o, "force", "1") == SS_OK && o->job.force == 1, "force");
+	CHECK(ss_option_object_set(o, "force", "yes") == SS_ERR_INPUT, "force yes refused");
+	CHECK(ss_option_object_set(o, "tol", "") == SS_ERR_INPUT, "an empty value refused");
+	CHECK(ss_option_object_set(o, "bogus", "1") == SS_ERR_INPUT, "unknown key");
 	CHECK(!strncmp(ss_error_last_message(), "unknown relax option 'bogus': expected one of ",
 	               46) && strstr(ss_error_last_message(), ", angle, ") &&
 	      strstr(ss_error_last_message(), ", add-sand, "), "%s", ss_error_last_message());
-	CHECK(ss_relax_options_set(o, "add-sand", "disk=5,6,2") == SS_OK &&
+	CHECK(ss_option_object_set(o, "add-sand", "disk=5,6,2") == SS_OK &&
 	      o->sand_shape.kind == SS_SHAPE_DISK && o->sand_shape.v[2] == 2.0, "add-sand");
-	CHECK(ss_relax_options_set(o, "add-sand", "disk=5,6,0") == SS_ERR_INPUT &&
+	CHECK(ss_option_object_set(o, "add-sand", "disk=5,6,0") == SS_ERR_INPUT &&
 	      o->sand_shape.v[2] == 2.0, "add-sand with R = 0 refused, the shape kept");
 
 	char path[32] = "first.asc";
-	CHECK(ss_relax_options_set(o, "output", path) == SS_OK, "output");
+	CHECK(ss_option_object_set(o, "output", path) == SS_OK, "output");
 	strcpy(path, "changed");
-	CHECK(o->output && !strcmp(o->output, "first.asc"), "the text is copied: %s", o->output);
-	CHECK(ss_relax_options_set(o, "output", "second.asc") == SS_OK &&
-	      !strcmp(o->output, "second.asc"), "set again (the first copy freed)");
-	ss_relax_options_destroy(o);
-	ss_relax_options_destroy(NULL);
+	CHECK(o->job.output && !strcmp(o->job.output, "first.asc"), "the text is copied: %s", o->job.output);
+	CHECK(ss_option_object_set(o, "output", "second.asc") == SS_OK &&
+	      !strcmp(o->job.output, "second.asc"), "set again (the first copy freed)");
+	ss_option_object_destroy(o);
+	ss_option_object_destroy(NULL);
 }
 
 static void report_json_fits_or_says_so(void)
 {
-	struct ss_relax_options o;
-	ss_relax_options_init(&o);
-	o.dem = "a \"quoted\" \\ path\n";
 	struct ss_relax_report r;
 	memset(&r, 0, sizeof r);
+	ss_model_options_init(&r.model);
+	r.input = "a \"quoted\" \\ path\n";
 	r.nx = 3;
 	r.steady = 1;
 	r.integrator = "euler";
 	r.max_slope_after_deg = NAN;
 	snprintf(r.output, sizeof r.output, "out.asc");
 	char buf[2048], tiny[40];
-	CHECK(ss_relax_report_json(&o, &r, buf, sizeof buf) == SS_OK, "formatted");
+	CHECK(ss_relax_report_json(&r, buf, sizeof buf) == SS_OK, "formatted");
 	CHECK(strstr(buf, "\"input\": \"a \\\"quoted\\\" \\\\ path\\u000a\",") != NULL,
 	      "quotes, backslash and newline escaped: %s", buf);
 	CHECK(strstr(buf, "\"max_slope_after_deg\": null\n}\n") != NULL, "NaN is null: %s", buf);
 	CHECK(strstr(buf, "\"steady\": true, \"end\": ") && strstr(buf, "\"tol\": 1e-09,"),
 	      "the shortest text: %s", buf);
-	CHECK(ss_relax_report_json(&o, &r, tiny, sizeof tiny) == SS_ERR_INPUT, "too small");
+	CHECK(ss_relax_report_json(&r, tiny, sizeof tiny) == SS_ERR_INPUT, "too small");
 	CHECK(strstr(ss_error_last_message(), "the buffer has 40") != NULL, "%s",
 	      ss_error_last_message());
 	CHECK(strlen(tiny) == sizeof tiny - 1, "a cut report is still a string");
@@ -151,9 +150,9 @@ static void relax_heights_gives_the_bits_of_a_relaxed_file(void)
 	struct ss_relax_options o;
 	ss_relax_options_init(&o);
 	o.dem = dem;
-	o.output = out;
+	o.job.output = out;
 	o.report = report;
-	o.threads = 1;
+	o.job.threads = 1;
 	struct ss_relax_report r;
 	struct ss_raster want;
 	int err = ss_relax_run(&o, &r);
@@ -164,9 +163,9 @@ static void relax_heights_gives_the_bits_of_a_relaxed_file(void)
 	if (err)
 		return;
 
-	struct ss_relax_options *p = ss_relax_options_create();
+	struct ss_relax_options *p = ss_option_object_create(&ss_relax_option_table);
 	char json[4096];
-	CHECK(p && ss_relax_options_set(p, "threads", "1") == SS_OK, "threads");
+	CHECK(p && ss_option_object_set(p, "threads", "1") == SS_OK, "threads");
 	CHECK(ss_relax_heights(p, NX, NY, 0.5, 0.5, h, NULL, got, json, sizeof json) == SS_OK,
 	      "%s", ss_error_last_message());
 	int differ = 0;
@@ -206,7 +205,7 @@ static void relax_heights_gives_the_bits_of_a_relaxed_file(void)
 	      "no columns refused");
 	CHECK(ss_relax_heights(p, NX, NY, 0.5, -1.0, h, NULL, got, NULL, 0) == SS_ERR_INPUT,
 	      "dy < 0 refused");
-	ss_relax_options_destroy(p);
+	ss_option_object_destroy(p);
 	ss_raster_release(&want);
 	remove(dem);
 	remove(out);
@@ -219,8 +218,8 @@ static void bedrock_in_memory_holds_the_sand(void)
 	pile(h);
 	for (int m = 0; m < NX * NY; m++)
 		rock[m] = isnan(h[m]) ? NAN : h[m] - 0.5;   /* NaN only under no data */
-	struct ss_relax_options *p = ss_relax_options_create();
-	CHECK(p && ss_relax_options_set(p, "threads", "1") == SS_OK, "threads");
+	struct ss_relax_options *p = ss_option_object_create(&ss_relax_option_table);
+	CHECK(p && ss_option_object_set(p, "threads", "1") == SS_OK, "threads");
 	CHECK(ss_relax_heights(p, NX, NY, 0.5, 0.5, h, rock, got, NULL, 0) == SS_OK, "%s",
 	      ss_error_last_message());
 	double below = 0.0;
@@ -231,12 +230,12 @@ static void bedrock_in_memory_holds_the_sand(void)
 	rock[2] = NAN;
 	CHECK(ss_relax_heights(p, NX, NY, 0.5, 0.5, h, rock, got, NULL, 0) == SS_ERR_INPUT,
 	      "NaN bedrock under sand refused");
-	ss_relax_options_destroy(p);
+	ss_option_object_destroy(p);
 }
 
 static void run_options_and_a_case(void)
 {
-	struct ss_run_options *o = ss_run_options_create();
+	struct ss_run_options *o = ss_option_object_create(&ss_run_option_table);
 	CHECK(o != NULL, "create");
 	if (!o)
 		return;
@@ -244,33 +243,33 @@ static void run_options_and_a_case(void)
 	           "closure = coulomb\nrepose_angle = 35\nnu = 0.1\n\n[time]\nend = 1\n"
 	           "output_every = 0.5\n\n[boundary]\nwest = wall\neast = open\nsouth = wall\n"
 	           "north = wall\n\n[initial]\ntype = flat\nheight = 0.2\n");
-	CHECK(ss_run_options_set(o, "case", check_file("tiny.ini")) == SS_OK, "case");
-	CHECK(ss_run_options_set(o, "output", check_file("tiny.h5")) == SS_OK, "output");
+	CHECK(ss_option_object_set(o, "case", check_file("tiny.ini")) == SS_OK, "case");
+	CHECK(ss_option_object_set(o, "output", check_file("tiny.h5")) == SS_OK, "output");
 	for (int k = 0; k < 20; k++)    /* more than the first allocation */
-		CHECK(ss_run_options_set(o, "set", k % 2 ? "time.end=0.5" : "time.end=2") == SS_OK,
+		CHECK(ss_option_object_set(o, "set", k % 2 ? "time.end=0.5" : "time.end=2") == SS_OK,
 		      "set %d", k);
-	CHECK(o->override_count == 20 && !strcmp(o->overrides[19], "time.end=0.5"), "overrides");
-	CHECK(ss_run_options_set(o, "tile", "8x4") == SS_OK && o->tile[0] == 8 &&
-	      o->tile[1] == 4, "tile");
-	CHECK(ss_run_options_set(o, "set", "time.end") == SS_ERR_INPUT, "a set without '='");
-	CHECK(ss_run_options_set(o, "unset", "time.end=1") == SS_ERR_INPUT, "an unset with '='");
-	CHECK(o->override_count == 20, "refused overrides are not kept");
-	CHECK(ss_run_options_set(o, "tile", "8by4") == SS_ERR_INPUT, "bad tile");
+	CHECK(o->overrides.count == 20 && !strcmp(o->overrides.items[19], "time.end=0.5"), "overrides");
+	CHECK(ss_option_object_set(o, "tile", "8x4") == SS_OK && o->job.tile[0] == 8 &&
+	      o->job.tile[1] == 4, "tile");
+	CHECK(ss_option_object_set(o, "set", "time.end") == SS_ERR_INPUT, "a set without '='");
+	CHECK(ss_option_object_set(o, "unset", "time.end=1") == SS_ERR_INPUT, "an unset with '='");
+	CHECK(o->overrides.count == 20, "refused overrides are not kept");
+	CHECK(ss_option_object_set(o, "tile", "8by4") == SS_ERR_INPUT, "bad tile");
 	CHECK(!strcmp(ss_error_last_message(), "tile '8by4': expected NXxNY, e.g. 256x64"), "%s",
 	      ss_error_last_message());
-	CHECK(ss_run_options_set(o, "deflate", "10") == SS_ERR_INPUT, "deflate 10");
-	CHECK(ss_run_options_set(o, "threads", "1") == SS_OK && o->threads == 1, "threads");
-	CHECK(ss_run_options_set(o, "reference_kernel", "1") == SS_OK && o->reference_kernel,
+	CHECK(ss_option_object_set(o, "deflate", "10") == SS_ERR_INPUT, "deflate 10");
+	CHECK(ss_option_object_set(o, "threads", "1") == SS_OK && o->job.threads == 1, "threads");
+	CHECK(ss_option_object_set(o, "reference_kernel", "1") == SS_OK && o->reference_kernel,
 	      "reference-kernel");
 	char json[8192];
 	CHECK(ss_run_case_json(o, json, sizeof json) == SS_OK, "%s", ss_error_last_message());
 	CHECK(!strcmp(field(json, "end"), "\"done\"") && !strcmp(field(json, "time"), "0.5") &&
 	      !strcmp(field(json, "snapshots"), "2"), "%s", json);
 	CHECK(ss_run_case_json(o, json, sizeof json) == SS_ERR_INPUT, "an existing output");
-	CHECK(ss_run_options_set(o, "force", "1") == SS_OK &&
+	CHECK(ss_option_object_set(o, "force", "1") == SS_OK &&
 	      ss_run_case_json(o, json, sizeof json) == SS_OK, "--force");
-	ss_run_options_destroy(o);
-	ss_run_options_destroy(NULL);
+	ss_option_object_destroy(o);
+	ss_option_object_destroy(NULL);
 	remove(check_file("tiny.h5"));
 	remove(check_file("tiny.xmf"));
 	remove(check_file("tiny.h5.aux.xml"));   /* GDAL's sidecar */

@@ -225,16 +225,16 @@ static void grid(void)
  * run` wrote at k * output_every, bit for bit. */
 static void value_is_what_run_writes(void)
 {
-	struct ss_run_options *o = ss_run_options_create();
+	struct ss_run_options *o = ss_option_object_create(&ss_run_option_table);
 	CHECK(o != NULL, "run options");
 	if (!o)
 		return;
 	char json[8192];
-	CHECK(ss_run_options_set(o, "case", check_file("cone.ini")) == SS_OK &&
-	      ss_run_options_set(o, "output", check_file("cone.h5")) == SS_OK &&
-	      ss_run_options_set(o, "force", "1") == SS_OK, "options");
+	CHECK(ss_option_object_set(o, "case", check_file("cone.ini")) == SS_OK &&
+	      ss_option_object_set(o, "output", check_file("cone.h5")) == SS_OK &&
+	      ss_option_object_set(o, "force", "1") == SS_OK, "options");
 	CHECK(ss_run_case_json(o, json, sizeof json) == SS_OK, "%s", ss_error_last_message());
-	ss_run_options_destroy(o);
+	ss_option_object_destroy(o);
 	struct ss_height_series hs;
 	CHECK(ss_snapshot_read_height_series(check_file("cone.h5"), &hs) == SS_OK, "%s",
 	      ss_error_last_message());
@@ -396,19 +396,19 @@ static void set_then_run_with(const char *integrator)
 		for (int i = 0; i < NX; i++)
 			fprintf(f, "%.17g%s", h[j * NX + i], i == NX - 1 ? "\n" : " ");
 	fclose(f);
-	struct ss_run_options *o = ss_run_options_create();
+	struct ss_run_options *o = ss_option_object_create(&ss_run_option_table);
 	CHECK(o != NULL, "run options");
 	if (!o)
 		return;
 	char json[8192];
-	CHECK(ss_run_options_set(o, "case", check_file("square.ini")) == SS_OK &&
-	      ss_run_options_set(o, "output", check_file("bumps.h5")) == SS_OK &&
-	      ss_run_options_set(o, "set", "initial.type=file") == SS_OK &&
-	      ss_run_options_set(o, "set", "initial.file=bumps.asc") == SS_OK &&
-	      ss_run_options_set(o, "set", "time.end=0.5") == SS_OK &&
-	      ss_run_options_set(o, "set", "time.output_every=0.5") == SS_OK, "options");
+	CHECK(ss_option_object_set(o, "case", check_file("square.ini")) == SS_OK &&
+	      ss_option_object_set(o, "output", check_file("bumps.h5")) == SS_OK &&
+	      ss_option_object_set(o, "set", "initial.type=file") == SS_OK &&
+	      ss_option_object_set(o, "set", "initial.file=bumps.asc") == SS_OK &&
+	      ss_option_object_set(o, "set", "time.end=0.5") == SS_OK &&
+	      ss_option_object_set(o, "set", "time.output_every=0.5") == SS_OK, "options");
 	CHECK(ss_run_case_json(o, json, sizeof json) == SS_OK, "%s", ss_error_last_message());
-	ss_run_options_destroy(o);
+	ss_option_object_destroy(o);
 	struct ss_height_series hs;
 	CHECK(ss_snapshot_read_height_series(check_file("bumps.h5"), &hs) == SS_OK, "%s",
 	      ss_error_last_message());
@@ -646,13 +646,13 @@ static void config_names_a_case_or_a_dem(void)
 	CHECK(m->update_until(m, 1.0) == BMI_SUCCESS, "update_until");
 	CHECK(m->get_value(m, ELEV, got) == BMI_SUCCESS, "get_value");
 	ss_bmi_destroy(m);
-	struct ss_relax_options *o = ss_relax_options_create();
-	CHECK(o && !ss_relax_options_set(o, "angle", "33") && !ss_relax_options_set(o, "nu", "0.1") &&
-	      !ss_relax_options_set(o, "sides", "open") &&
-	      !ss_relax_options_set(o, "max-time", "1"), "relax options");
+	struct ss_relax_options *o = ss_option_object_create(&ss_relax_option_table);
+	CHECK(o && !ss_option_object_set(o, "angle", "33") && !ss_option_object_set(o, "nu", "0.1") &&
+	      !ss_option_object_set(o, "sides", "open") &&
+	      !ss_option_object_set(o, "max-time", "1"), "relax options");
 	CHECK(o && ss_relax_heights(o, DX, DY, 0.5, 0.5, dem, NULL, want, NULL, 0) == SS_OK, "%s",
 	      ss_error_last_message());
-	ss_relax_options_destroy(o);
+	ss_option_object_destroy(o);
 	CHECK(same_bits(got, want, DX * DY), "the DEM's update_until(1) is not relax's "
 	      "--max-time 1");
 	CHECK(!same_bits(got, dem, DX * DY), "the pile slid");

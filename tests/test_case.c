@@ -71,8 +71,8 @@ static void nu_and_the_sliding_layer_replace_each_other(void)
 	struct ss_case c;
 	const char *nu[] = {"model.nu=0.25"};
 	CHECK(parse(&c, bingham_layer, nu, 1) == SS_OK, "%s", ss_error_last_message());
-	CHECK(c.model.nu == 0.25 && isnan(c.delta) && isnan(c.viscosity), "nu %g, delta %g",
-	      c.model.nu, c.delta);
+	CHECK(c.model.nu == 0.25 && isnan(c.model.layer.delta) && isnan(c.model.layer.viscosity), "nu %g, delta %g",
+	      c.model.nu, c.model.layer.delta);
 	CHECK(c.note_count == 3 && noted(&c, "delta", "--set model.nu=0.25") &&
 	      noted(&c, "density", "gives nu") && noted(&c, "viscosity", "gives nu"),
 	      "%d notes: %s", c.note_count, c.notes[0]);
@@ -104,9 +104,10 @@ static void a_closure_drops_the_other_law(void)
 	struct ss_case c;
 	const char *hb[] = {"model.closure=herschel-bulkley", "model.consistency=0.2"};
 	CHECK(parse(&c, bingham_layer, hb, 2) == SS_OK, "%s", ss_error_last_message());
-	CHECK(isnan(c.viscosity) && c.consistency == 0.2 && c.model.gamma == 1.0,
-	      "viscosity %g, consistency %g, gamma %g (its one default)", c.viscosity,
-	      c.consistency, c.model.gamma);
+	const struct ss_sliding_layer *l = &c.model.layer;
+	CHECK(isnan(l->viscosity) && l->consistency == 0.2 && c.model.gamma == 1.0,
+	      "viscosity %g, consistency %g, gamma %g (its one default)", l->viscosity,
+	      l->consistency, c.model.gamma);
 	CHECK(noted(&c, "viscosity", "--set model.closure=herschel-bulkley"), "%s", c.notes[0]);
 	ss_case_release(&c);
 

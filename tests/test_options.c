@@ -16,6 +16,8 @@
 #include "sandslide/bench.h"
 #include "sandslide/case.h"
 #include "sandslide/error.h"
+#include "sandslide/fit.h"
+#include "sandslide/job.h"
 #include "sandslide/model_options.h"
 #include "sandslide/option.h"
 #include "sandslide/relax.h"
@@ -23,9 +25,9 @@
 #include "sandslide/run.h"
 
 static const struct ss_option_table *const tables[] = {
-	&ss_relax_option_table, &ss_run_option_table, &ss_render_option_table,
-	&ss_render_look_option_table, &ss_bench_option_table, &ss_model_option_table,
-	&ss_case_option_table,
+	&ss_relax_option_table, &ss_run_option_table, &ss_fit_option_table,
+	&ss_render_option_table, &ss_render_look_option_table, &ss_bench_option_table,
+	&ss_model_option_table, &ss_job_option_table, &ss_case_option_table,
 };
 enum { TABLES = sizeof tables / sizeof *tables };
 
@@ -41,26 +43,27 @@ static void every_table_is_consistent(void)
 {
 	for (int t = 0; t < TABLES; t++) {
 		const struct ss_option_table *table = tables[t];
-		for (const struct ss_option_table *u = table; u; u = u->more) {
-			for (int k = 0; k < u->count; k++) {
-				const struct ss_option *o = &u->options[k];
-				if (!o->name && !o->case_key)
-					continue;   /* a heading */
-				const char *id = o->name ? o->name : o->case_key;
-				CHECK(o->expected || o->kind == SS_OPTION_FLAG ||
-				      o->kind == SS_OPTION_OPTIONAL_INT,
-				      "%s: '%s' says nothing of what it accepts", table->command, id);
-				CHECK(o->kind != SS_OPTION_WORD || o->parse,
-				      "%s: the word option '%s' has no parser", table->command, id);
-				size_t offset;
-				if (o->name)
-					CHECK(ss_option_find(table, o->name, &offset) == o,
-					      "%s: two options are named '%s'", table->command, o->name);
-				if (o->case_key)
-					CHECK(ss_option_find_key(table, o->case_key, &offset) == o,
-					      "%s: two options are the case key '%s'", table->command,
-					      o->case_key);
-			}
+		const struct ss_option *option[SS_OPTION_MAX];
+		size_t at[SS_OPTION_MAX];
+		const int n = ss_option_flatten(table, option, at);
+		for (int k = 0; k < n; k++) {
+			const struct ss_option *o = option[k];
+			if (!o->name && !o->case_key)
+				continue;   /* a heading */
+			const char *id = o->name ? o->name : o->case_key;
+			CHECK(o->expected || o->kind == SS_OPTION_FLAG ||
+			      o->kind == SS_OPTION_OPTIONAL_INT,
+			      "%s: '%s' says nothing of what it accepts", table->command, id);
+			CHECK(o->kind != SS_OPTION_WORD || o->parse,
+			      "%s: the word option '%s' has no parser", table->command, id);
+			size_t offset;
+			if (o->name)
+				CHECK(ss_option_find(table, o->name, &offset) == o && offset == at[k],
+				      "%s: two options are named '%s'", table->command, o->name);
+			if (o->case_key)
+				CHECK(ss_option_find_key(table, o->case_key, &offset) == o &&
+				      offset == at[k], "%s: two options are the case key '%s'",
+				      table->command, o->case_key);
 		}
 	}
 }
@@ -75,16 +78,18 @@ static void defaults_parse_and_tables_describe_themselves(void)
 		CHECK(ss_option_table_json(table, json, sizeof json) == SS_OK, "%s: %s",
 		      table->command, ss_error_last_message());
 		CHECK(json[0] == '[' && strstr(json, "\"default\""), "%s: %.80s", table->command, json);
-		for (const struct ss_option_table *u = table; u; u = u->more)
-			for (int k = 0; k < u->count; k++) {
-				const struct ss_option *o = &u->options[k];
-				if (o->name && !(o->flags & SS_OPTION_CLI_ONLY)) {
-					char quoted[80];
-					snprintf(quoted, sizeof quoted, "\"name\": \"%s\"", o->name);
-					CHECK(strstr(json, quoted), "%s: '%s' missing from its JSON",
-					      table->command, o->name);
-				}
+		const struct ss_option *option[SS_OPTION_MAX];
+		size_t at[SS_OPTION_MAX];
+		const int n = ss_option_flatten(table, option, at);
+		for (int k = 0; k < n; k++) {
+			const struct ss_option *o = option[k];
+			if (o->name && !(o->flags & SS_OPTION_CLI_ONLY)) {
+				char quoted[80];
+				snprintf(quoted, sizeof quoted, "\"name\": \"%s\"", o->name);
+				CHECK(strstr(json, quoted), "%s: '%s' missing from its JSON",
+				      table->command, o->name);
 			}
+		}
 		CHECK(ss_option_table_json(table, json, 16) == SS_ERR_INPUT &&
 		      strstr(ss_error_last_message(), "bytes"), "%s: a short buffer: %s",
 		      table->command, ss_error_last_message());
@@ -126,8 +131,8 @@ static void model_options_are_case_keys_with_the_same_rules(void)
 	const struct ss_option_table *m = &ss_model_option_table;
 	for (int k = 0; k < m->count; k++) {
 		const struct ss_option *o = &m->options[k];
-		if (!o->case_key)
-			continue;
+		if (!o->case_key || !o->name)
+			continue;   /* a heading, or a case's key only (the sliding layer) */
 		/* a value relax takes, as a case key (an override of the
 		 * minimal case: it gives repose_angle and nu itself; max_time
 		 * belongs to end = steady) */
@@ -135,14 +140,14 @@ static void model_options_are_case_keys_with_the_same_rules(void)
 		char set[128];
 		const char *sets[2] = {"time.end=steady", set};
 		snprintf(set, sizeof set, "%s=%s", o->case_key, good);
-		struct ss_relax_options *ro = ss_relax_options_create();
-		CHECK(ss_relax_options_set(ro, o->name, good) == SS_OK, "relax --%s %s: %s", o->name,
+		struct ss_relax_options *ro = ss_option_object_create(&ss_relax_option_table);
+		CHECK(ss_option_object_set(ro, o->name, good) == SS_OK, "relax --%s %s: %s", o->name,
 		      good, ss_error_last_message());
 		CHECK(parse_case(&c, sets, 2) == SS_OK, "--set %s: %s", set, ss_error_last_message());
 		ss_case_release(&c);
 
 		/* a word neither takes, refused with the same words */
-		CHECK(ss_relax_options_set(ro, o->name, "x1") == SS_ERR_INPUT, "relax --%s x1",
+		CHECK(ss_option_object_set(ro, o->name, "x1") == SS_ERR_INPUT, "relax --%s x1",
 		      o->name);
 		char relax_message[512];
 		snprintf(relax_message, sizeof relax_message, "%s", ss_error_last_message());
@@ -154,23 +159,23 @@ static void model_options_are_case_keys_with_the_same_rules(void)
 		      "%s: relax says '%s', the case '%s'", o->case_key, relax_message,
 		      ss_error_last_message());
 		ss_case_release(&c);
-		ss_relax_options_destroy(ro);
+		ss_option_object_destroy(ro);
 	}
 }
 
 /* (0, 90) and (0, 1]: the ends as the ranges say. */
 static void open_and_closed_ends(void)
 {
-	struct ss_relax_options *o = ss_relax_options_create();
-	CHECK(ss_relax_options_set(o, "angle", "0") == SS_ERR_INPUT, "angle 0 refused");
-	CHECK(ss_relax_options_set(o, "angle", "90") == SS_ERR_INPUT, "angle 90 refused");
-	CHECK(ss_relax_options_set(o, "angle", "1e-6") == SS_OK, "angle 1e-6 taken");
-	CHECK(ss_relax_options_set(o, "cfl", "1") == SS_OK, "cfl 1 taken");
-	CHECK(ss_relax_options_set(o, "cfl", "0") == SS_ERR_INPUT, "cfl 0 refused");
-	CHECK(ss_relax_options_set(o, "nu", "inf") == SS_ERR_INPUT, "nu inf refused");
-	CHECK(ss_relax_options_set(o, "open-level", "-5") == SS_OK && o->open_level == -5.0,
+	struct ss_relax_options *o = ss_option_object_create(&ss_relax_option_table);
+	CHECK(ss_option_object_set(o, "angle", "0") == SS_ERR_INPUT, "angle 0 refused");
+	CHECK(ss_option_object_set(o, "angle", "90") == SS_ERR_INPUT, "angle 90 refused");
+	CHECK(ss_option_object_set(o, "angle", "1e-6") == SS_OK, "angle 1e-6 taken");
+	CHECK(ss_option_object_set(o, "cfl", "1") == SS_OK, "cfl 1 taken");
+	CHECK(ss_option_object_set(o, "cfl", "0") == SS_ERR_INPUT, "cfl 0 refused");
+	CHECK(ss_option_object_set(o, "nu", "inf") == SS_ERR_INPUT, "nu inf refused");
+	CHECK(ss_option_object_set(o, "open-level", "-5") == SS_OK && o->open_level == -5.0,
 	      "a negative open level taken");
-	ss_relax_options_destroy(o);
+	ss_option_object_destroy(o);
 }
 
 int main(void)

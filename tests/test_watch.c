@@ -44,7 +44,7 @@ static void a_relax_is_watched_and_stopped_from_another_thread(void)
 	unsigned seed = (unsigned)(getenv("SEED") ? atoi(getenv("SEED")) : 27);
 	printf("seed = %u\n", seed);
 	srand(seed);
-	struct job j = {.o = ss_relax_options_create(), .h = malloc(sizeof(double) * NX * NY)};
+	struct job j = {.o = ss_option_object_create(&ss_relax_option_table), .h = malloc(sizeof(double) * NX * NY)};
 	struct ss_watch *w = ss_watch_create();
 	CHECK(j.o && j.h && w, "create");
 	if (!j.o || !j.h || !w)
@@ -55,8 +55,8 @@ static void a_relax_is_watched_and_stopped_from_another_thread(void)
 	long long s, r;
 	CHECK(ss_watch_read(w, &t, &e, &s, &f, &r) == 0 && isnan(f),
 	      "a new watch has no report and an unknown fraction (%g)", f);
-	CHECK(ss_relax_options_set(j.o, "threads", "1") == SS_OK, "%s", ss_error_last_message());
-	ss_relax_options_set_watch(j.o, w);
+	CHECK(ss_option_object_set(j.o, "threads", "1") == SS_OK, "%s", ss_error_last_message());
+	ss_job_set_watch(&j.o->job, w);
 
 	pthread_t th;
 	CHECK(pthread_create(&th, NULL, relax_job, &j) == 0, "thread");
@@ -91,7 +91,7 @@ static void a_relax_is_watched_and_stopped_from_another_thread(void)
 out:
 	ss_watch_destroy(w);
 	ss_watch_destroy(NULL);
-	ss_relax_options_destroy(j.o);
+	ss_option_object_destroy(j.o);
 	free(j.h);
 }
 
@@ -102,15 +102,15 @@ static char read_back[2][256];   /* each thread's message, checked in main */
 static void *fail_in_turn(void *arg)
 {
 	const int me = *(int *)arg;
-	struct ss_relax_options *o = ss_relax_options_create();
+	struct ss_relax_options *o = ss_option_object_create(&ss_relax_option_table);
 	while (atomic_load(&turn) != me)
 		sched_yield();
-	ss_relax_options_set(o, "angle", me == 0 ? "95" : "-3");
+	ss_option_object_set(o, "angle", me == 0 ? "95" : "-3");
 	atomic_store(&turn, me + 1);
 	while (atomic_load(&turn) != 2)
 		sched_yield();
 	snprintf(read_back[me], sizeof read_back[me], "%s", ss_error_last_message());
-	ss_relax_options_destroy(o);
+	ss_option_object_destroy(o);
 	return NULL;
 }
 

@@ -68,15 +68,11 @@ struct ss_case {
 	double origin_x, origin_y; /* lower-left corner, m */
 
 	/* [model] closure, repose_angle, nu (given or derived), gamma (1
-	 * but for herschel-bulkley), and [time] cfl, steady_tol,
-	 * steady_slope_tol, max_time, integrator, rkl2_max_stages, rkl2_tol */
+	 * but for herschel-bulkley), the sliding layer nu may be derived from
+	 * (model.layer: delta, density, gravity, viscosity, consistency), and
+	 * [time] cfl, steady_tol, steady_slope_tol, max_time, integrator,
+	 * rkl2_max_stages, rkl2_tol */
 	struct ss_model_options model;
-	/* [model]: the sliding layer nu may be derived from */
-	double delta;           /* sliding layer thickness, m */
-	double density;         /* kg/m^3 */
-	double gravity;         /* m/s^2 */
-	double viscosity;       /* Pa s (bingham, casson) */
-	double consistency;     /* Pa s^gamma (herschel-bulkley) */
 
 	/* [time] */
 	double end;             /* s; INFINITY when steady */

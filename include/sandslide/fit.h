@@ -22,6 +22,7 @@
 #include <signal.h>
 #include <stddef.h>
 
+#include "sandslide/job.h"
 #include "sandslide/option.h"
 
 /* A parameter freed by --param NAME=LO:HI[:log]: a [model] key of the case
@@ -43,8 +44,8 @@ enum ss_fit_cost {
 	SS_FIT_COST_BOTH,       /* height / relief^2 + support_weight * support */
 };
 
-/* What a fit reports as it goes (ss_fit_options.progress): after each
- * forward run, and after each substep of one. */
+/* What a fit reports as it goes, the fit part of the job's progress
+ * (progress.h): after each forward run, and after each substep of one. */
 struct ss_fit_progress {
 	const char *closure;    /* being fitted */
 	const char *stage;      /* "grid", "search", "uncertainty", "profile", "front" */
@@ -56,7 +57,15 @@ struct ss_fit_progress {
 struct ss_fit_options {
 	const char *case_path;
 	const char *observations;    /* OBS: .h5 heights, or a CSV */
-	const char *output;          /* FIT.json; NULL: the report is only returned */
+	struct ss_job job;           /* output: FIT.json (NULL: the report is
+	                              * only returned); force: replace FIT.json
+	                              * and FIT.png; threads and tiles of each
+	                              * forward run; the stop signal (when it
+	                              * becomes non-zero the fit stops and
+	                              * reports the best so far) and the
+	                              * progress, after each forward run and
+	                              * each substep of one, with its fit part
+	                              * set (progress.h, job.h) */
 	const char *plot;            /* FIT.png, or NULL */
 	const char *closures;        /* "all", or a comma-separated list; NULL:
 	                              * the case's closure */
@@ -71,14 +80,8 @@ struct ss_fit_options {
 	double rkl2_tol;             /* the forward runs' RKL2 tolerance, when the
 	                              * case's is larger: the search needs a
 	                              * cost smooth in the parameters */
-	int threads;                 /* <= 0: OMP_NUM_THREADS, else all */
-	int force;                   /* replace FIT.json and FIT.png */
-	struct ss_fit_param params[SS_FIT_MAX_PARAMS];
-	int param_count;
-	const volatile sig_atomic_t *stop_signal; /* when it becomes non-zero the
-	                              * fit stops and reports the best so far */
-	void (*progress)(void *context, const struct ss_fit_progress *p);
-	void *progress_context;
+	struct ss_option_list params; /* --param's words, NAME=LO:HI[:log]
+	                              * (ss_fit_param_parse), in order */
 };
 
 /* fit's options: name, kind, default, range, help (option.h). */
@@ -98,21 +101,6 @@ int ss_fit_param_parse(const char *text, struct ss_fit_param *p);
  * SS_ERR_FAIL for a failure while fitting.  An interrupted fit is SS_OK
  * with "interrupted": true in the report. */
 int ss_fit_run(const struct ss_fit_options *o, char **report, char **summary);
-
-/* For foreign callers (Python's ctypes): options on the heap set by name
- * ("case", "observations", "output", "plot", "closures", "cost",
- * "threshold", "support-weight", "grid-points", "max-runs",
- * "profile-points", "threads", "force", and "param" NAME=LO:HI[:log], one
- * more each time), checked as the command line checks them. */
-struct ss_fit_options *ss_fit_options_create(void);
-void ss_fit_options_destroy(struct ss_fit_options *o);
-int ss_fit_options_set(struct ss_fit_options *o, const char *key, const char *value);
-
-/* Attach watch w (watch.h) to options o: its stop flag becomes their
- * stop_signal and its callback their progress, replacing any set; w NULL
- * detaches (no stop signal, no progress).  w must outlive the call. */
-struct ss_watch;
-void ss_fit_options_set_watch(struct ss_fit_options *o, struct ss_watch *w);
 
 /* ss_fit_run with the report copied into buf (size bytes): SS_ERR_INPUT
  * when it does not fit, saying how many bytes it needs. */

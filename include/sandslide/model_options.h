@@ -17,6 +17,16 @@
 #include "sandslide/option.h"
 #include "sandslide/stepper.h"
 
+/* What nu may be derived from, for the viscoplastic closures
+ * (doc/model.md#nu-from-the-sliding-layer): a case's [model] keys only. */
+struct ss_sliding_layer {
+	double delta;                     /* thickness, m */
+	double density;                   /* kg/m^3 */
+	double gravity;                   /* m/s^2 */
+	double viscosity;                 /* Pa s (bingham, casson) */
+	double consistency;               /* Pa s^gamma (herschel-bulkley) */
+};
+
 struct ss_model_options {
 	enum ss_closure_kind closure;     /* f_sl of doc/model.md */
 	double angle_deg;                 /* repose angle a_cr, degrees in (0, 90) */
@@ -34,15 +44,35 @@ struct ss_model_options {
 	int rkl2_max_stages;              /* RKL2: stages per super-step */
 	double rkl2_tol;                  /* RKL2: error estimate per super-step,
 	                                   * in tan(a_cr) min(dx, dy) */
+	struct ss_sliding_layer layer;    /* NaN where not given (a case's nu is
+	                                   * given or derived from it: case.h) */
+	int nu_from_layer;                /* nu was derived from the layer (a
+	                                   * case that gives the layer, not nu) */
 };
 
-/* The table: name (relax's --NAME), case key, kind, default, range, help. */
+/* The table: name (relax's --NAME), case key, kind, default, range, help.
+ * The rows flagged SS_OPTION_FITTABLE are the keys `sandslide fit` may
+ * free (fit.h), each for the closures of its applies_to. */
 extern const struct ss_option_table ss_model_option_table;
+
+/* Whether the row o of the model's table is a key of the sliding layer
+ * (the keys nu is derived from). */
+int ss_model_option_is_layer(const struct ss_option *o);
 
 /* Every option at its default (the table's). */
 void ss_model_options_init(struct ss_model_options *m);
 
 /* max_time as a time limit: INFINITY when there is none. */
 double ss_model_time_limit(const struct ss_model_options *m);
+
+/* The closure of the model's law, angle and nu (ss_closure_init). */
+int ss_model_closure(const struct ss_model_options *m, struct ss_closure *c);
+
+/* nu from the sliding layer and the repose angle for m's closure
+ * (bingham, herschel-bulkley, casson; doc/model.md#nu-from-the-sliding-
+ * layer, [Paper] eqs. 8 and 12): the layer's keys that closure takes must
+ * be set.  *nu may come out not finite or not positive: the caller says
+ * where it came from. */
+double ss_model_nu_from_layer(const struct ss_model_options *m);
 
 #endif

@@ -27,30 +27,30 @@
 #include "sandslide/boundary.h"
 #include "sandslide/closure.h"
 #include "sandslide/dem.h"
+#include "sandslide/job.h"
 #include "sandslide/model_options.h"
 #include "sandslide/option.h"
-#include "sandslide/progress.h"
 #include "sandslide/shape.h"
 #include "sandslide/stepper.h"
-#include "sandslide/watch.h"
 
 struct ss_relax_options {
 	const char *dem;                  /* input: path or FILE.h5[:/dataset] */
 	struct ss_dem_read_options read;  /* PNG range, cell size */
-	const char *output;               /* NULL: out/<stem>-relaxed.<ext> */
+	struct ss_job job;                /* output (NULL: out/<stem>-relaxed.<ext>),
+	                                   * force, threads, tile (<= 0: relax's
+	                                   * defaults, setup.h), history, the stop
+	                                   * signal (non-zero: stop after the
+	                                   * substep and write what there is) and
+	                                   * the progress after every substep
+	                                   * (job.h) */
 	struct ss_model_options model;    /* closure, angle, nu, tol, integrator,
 	                                   * ... (model_options.h); max_time NaN:
 	                                   * until steady */
-	int threads;                      /* <= 0: OMP_NUM_THREADS, else the
-	                                     * processors this process may run
-	                                     * on over the node's ranks */
 	enum ss_side_kind sides;          /* all four grid sides */
 	enum ss_cell_type nodata_type;    /* SS_CELL_WALL (default) or
 	                                     SS_CELL_OPEN */
 	double open_level;                /* m; NAN: the lowest height of the DEM */
 	const char *bedrock;              /* raster of the fixed base, or NULL */
-	int tile[2];                      /* cells per tile, nx and ny; <= 0:
-	                                   * relax's defaults (setup.h) */
 	struct ss_shape sand_shape;       /* pour sand on it (rect or disk, m;
 	                                   * SS_SHAPE_NONE: none): */
 	double sand_rate;                 /*   m/s */
@@ -59,12 +59,6 @@ struct ss_relax_options {
 	                                     over max_time, else only first and
 	                                     last */
 	const char *report;               /* JSON diagnostics file, or NULL */
-	const char *history;              /* the command line */
-	int force;                        /* replace an existing output */
-	const volatile sig_atomic_t *stop_signal; /* non-zero: stop after the
-	                                     substep and write what there is */
-	ss_progress_fn *progress;         /* after every substep (NULL: none) */
-	void *progress_context;
 	/* In memory, for a program that holds its rasters (the Python module).
 	 * Each, when set, replaces a file: input_raster is relaxed instead of
 	 * reading dem and bedrock_raster is the base instead of reading
@@ -72,44 +66,21 @@ struct ss_relax_options {
 	 * report, and must be set), and the relaxed heights go to the values
 	 * of output_raster, which must have the input's size, instead of a
 	 * file (0 where the input has no data, as rasters store it): nothing
-	 * is claimed or written, output and force are unused.  The caller owns
-	 * all three. */
+	 * is claimed or written, job.output and job.force are unused.  The
+	 * caller owns all three. */
 	const struct ss_raster *input_raster;
 	const struct ss_raster *bedrock_raster;
 	struct ss_raster *output_raster;
 };
 
 /* relax's options: name, kind, default, range, help of each (option.h),
- * continued by the model's at o->model.  The command line, the options set
- * by name and the Python module all read them from here. */
+ * continued by the model's at o->model and the job's at o->job.  The
+ * command line, the options set by name (ss_option_object_create) and the
+ * Python module all read them from here. */
 extern const struct ss_option_table ss_relax_option_table;
 
 /* Every option at its default (the table's). */
 void ss_relax_options_init(struct ss_relax_options *o);
-
-/* For callers that cannot lay the struct out (a foreign-function
- * interface such as Python's ctypes; its fields change between
- * versions): heap options set by name.  create returns options
- * ss_relax_options_init'ed, or NULL (message printed) when out of memory;
- * destroy(NULL) does nothing. */
-struct ss_relax_options *ss_relax_options_create(void);
-void ss_relax_options_destroy(struct ss_relax_options *o);
-
-/* Set option `key` of options from ss_relax_options_create to `value`,
- * parsed and checked as the command line does (ss_relax_option_table):
- * keys are relax's option names without the dashes ("angle", "closure",
- * "nu", "tol", "max-time", "add-sand"; '_' may stand for '-') and value is
- * the word the command line would take ("35", "coulomb", "disk=5,5,2",
- * "1" or "0" for a flag).  Text values (dem, output, report, bedrock) are
- * copied.  SS_ERR_INPUT names the key and what it accepts ("angle '95':
- * expected degrees in (0, 90)"), options unchanged.  Keys other than the
- * text ones work on any options. */
-int ss_relax_options_set(struct ss_relax_options *o, const char *key, const char *value);
-
-/* Attach watch w (watch.h) to options o: its stop flag becomes their
- * stop_signal and its callback their progress, replacing any set; w NULL
- * detaches (no stop signal, no progress).  w must outlive the call. */
-void ss_relax_options_set_watch(struct ss_relax_options *o, struct ss_watch *w);
 
 /* The words of --sides ("wall" or "open": periodic sides make no sense for
  * a DEM) and --nodata ("wall" or "open"); 0, or -1 if word is not one. */
@@ -117,6 +88,8 @@ int ss_relax_sides_parse(const char *word, enum ss_side_kind *sides);
 int ss_relax_nodata_parse(const char *word, enum ss_cell_type *type);
 
 struct ss_relax_report {
+	const char *input;                /* the options' dem (its name) */
+	struct ss_model_options model;    /* the model relaxed with */
 	int nx, ny;
 	double dx, dy;                    /* m */
 	long long cells_moved;            /* flow cells whose height changed */
@@ -152,11 +125,10 @@ struct ss_relax_report {
  * progress and the report. */
 int ss_relax_run(const struct ss_relax_options *o, struct ss_relax_report *report);
 
-/* The JSON of `sandslide relax --report` for a relaxation (o, r) into buf
- * (size bytes, NUL-terminated); SS_ERR_INPUT when it does not fit (the
- * message says how many bytes it needs). */
-int ss_relax_report_json(const struct ss_relax_options *o, const struct ss_relax_report *r,
-                         char *buf, size_t size);
+/* The JSON of `sandslide relax --report` for report r into buf (size
+ * bytes, NUL-terminated); SS_ERR_INPUT when it does not fit (the message
+ * says how many bytes it needs). */
+int ss_relax_report_json(const struct ss_relax_report *r, char *buf, size_t size);
 
 /* ss_relax_run on arrays, a flat entry point for foreign callers: nx x ny
  * heights (m), row-major, row j the j-th from the SOUTH, NaN where there is
@@ -166,7 +138,7 @@ int ss_relax_report_json(const struct ss_relax_options *o, const struct ss_relax
  * and the report's JSON (ss_relax_report_json) to report_json
  * (report_size bytes), or nowhere when report_json is NULL.  The options'
  * dem and bedrock name the arrays in messages ("(array)" when NULL); their
- * output, force, dx and in-memory fields are not used, and report is
+ * job.output, job.force, dx and in-memory fields are not used, and report is
  * written when set.  An infinite height is refused.  Returns as
  * ss_relax_run; relaxed is written only when SS_OK. */
 int ss_relax_heights(const struct ss_relax_options *o, int nx, int ny, double dx, double dy,

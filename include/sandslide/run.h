@@ -15,9 +15,8 @@
 #include <signal.h>
 #include <stddef.h>
 
+#include "sandslide/job.h"
 #include "sandslide/option.h"
-#include "sandslide/progress.h"
-#include "sandslide/watch.h"
 
 /* What a run reports after each snapshot is written and flushed. */
 struct ss_run_snapshot {
@@ -34,35 +33,29 @@ struct ss_run_snapshot {
 
 struct ss_run_options {
 	const char *case_path;
-	const char *output;          /* NULL: out/<case name>.h5 */
-	const char *const *overrides; /* in order: "SECTION.KEY=VALUE" sets a
+	struct ss_job job;           /* output (NULL: out/<case name>.h5),
+	                              * force, threads, tile, history, the stop
+	                              * signal (when it becomes non-zero the
+	                              * run finishes its substep, writes a
+	                              * snapshot and returns SS_OK) and the
+	                              * progress after every substep (job.h) */
+	struct ss_option_list overrides; /* in order: "SECTION.KEY=VALUE" sets a
 	                              * key, "SECTION.KEY" or "SECTION" unsets
 	                              * (case.h) */
-	int override_count;
-	int threads;                 /* <= 0: OMP_NUM_THREADS, else the
-	                                * processors this process may run on
-	                                * over the node's ranks (parallel.h) */
-	int tile[2];                 /* cells per tile, nx and ny; <= 0: defaults */
 	int reference_kernel;        /* use the reference sweep (sweep.h) */
 	int deflate;                 /* HDF5 deflate level 0..9 */
-	const char *history;         /* the command line, for the file */
-	int force;                   /* replace an existing output (else refused) */
 	const char *restart;         /* continue the run in this output from its
 	                              * last snapshot (case_path may be NULL) */
-	const volatile sig_atomic_t *stop_signal; /* when it becomes non-zero, the
-	                              * run finishes its substep, writes a
-	                              * snapshot and returns SS_OK */
-	ss_progress_fn *progress;    /* after every substep (NULL: none) */
-	void *progress_context;
 	/* Called after every snapshot (NULL: none), e.g. to render it; a
 	 * non-zero return (a status, message printed) stops the run. */
 	int (*on_snapshot)(void *context, const struct ss_run_snapshot *s);
 	void *snapshot_context;
 };
 
-/* run's options: name, kind, default, range, help of each (option.h).
- * The command line, the options set by name and the Python module all
- * read them from here. */
+/* run's options: name, kind, default, range, help of each (option.h),
+ * continued by the job's at o->job.  The command line, the options set by
+ * name (ss_option_object_create) and the Python module all read them from
+ * here. */
 extern const struct ss_option_table ss_run_option_table;
 
 /* Every option at its default (the table's). */
@@ -108,31 +101,6 @@ struct ss_run_summary {
 /* Returns SS_OK, SS_ERR_INPUT or SS_ERR_FAIL (message already printed);
  * *summary is filled when SS_OK. */
 int ss_run_case(const struct ss_run_options *o, struct ss_run_summary *summary);
-
-/* For callers that cannot lay the structs out (a foreign-function
- * interface such as Python's ctypes; their fields change between
- * versions): heap options set by name.  create returns the table's
- * defaults, or NULL (message printed) when out of memory; destroy(NULL)
- * does nothing. */
-struct ss_run_options *ss_run_options_create(void);
-void ss_run_options_destroy(struct ss_run_options *o);
-
-/* Set option `key` of options from ss_run_options_create to `value`,
- * checked as the command line does (ss_run_option_table): keys are run's
- * option names without the dashes ('_' may stand for '-'): "output",
- * "restart", "threads", "force" and "reference-kernel" ("1" or "0"),
- * "deflate", "tile" ("NXxNY"), "set" (one SECTION.KEY=VALUE override) and
- * "unset" (one SECTION.KEY or SECTION), each added after those before, as
- * --set and --unset are (the case parser checks them), and "case"
- * (CASE.ini) and "history" (the file's history attribute).  Text values
- * are copied.  SS_ERR_INPUT names the key and what it accepts, options
- * unchanged. */
-int ss_run_options_set(struct ss_run_options *o, const char *key, const char *value);
-
-/* Attach watch w (watch.h) to options o: its stop flag becomes their
- * stop_signal and its callback their progress, replacing any set; w NULL
- * detaches (no stop signal, no progress).  w must outlive the call. */
-void ss_run_options_set_watch(struct ss_run_options *o, struct ss_watch *w);
 
 /* The summary as JSON into buf (size bytes, NUL-terminated): "output",
  * "end" ("done", "steady", "not steady", "interrupted"), "snapshots",

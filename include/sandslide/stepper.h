@@ -183,6 +183,11 @@ void ss_stepper_release(struct ss_stepper *st);
 void ss_stepper_slab_rows(const struct ss_grid *g, int tile_nx, int tile_ny, int rank,
                           int *first_row, int *rows);
 
+/* The cells per tile of st's sweep: the sizes ss_stepper_init was given,
+ * or the defaults they resolved to (what ss_stepper_slab_rows needs to
+ * split another grid as st's was). */
+void ss_stepper_tile_size(const struct ss_stepper *st, int *tile_nx, int *tile_ny);
+
 /* Bytes the stepper allocates for grid g with the fast kernel and that
  * integrator (for the memory check). */
 double ss_stepper_memory_bytes(const struct ss_grid *g, enum ss_integrator integrator);

@@ -4,9 +4,8 @@
  * structs, such as Python's ctypes).
  *
  * A watch holds a stop flag and the last progress the library reported.
- * Attached to options (ss_relax_options_set_watch, ss_run_options_set_watch,
- * ss_fit_options_set_watch), it becomes their stop_signal and progress
- * callback: the thread running the call writes the progress after each
+ * Attached to a command's job (ss_job_set_watch, job.h), it becomes its
+ * stop_signal and progress callback: the thread running the call writes the progress after each
  * substep (each forward run of a fit), and any other thread may read it
  * with ss_watch_read or ask the call to stop with ss_watch_stop.  The call
  * then ends as a stop signal ends it: relax and run with the state of
@@ -20,7 +19,6 @@
 
 #include <signal.h>
 
-#include "sandslide/fit.h"
 #include "sandslide/progress.h"
 
 struct ss_watch;
@@ -45,11 +43,10 @@ void ss_watch_stop(struct ss_watch *w);
 long long ss_watch_read(const struct ss_watch *w, double *time, double *end, long long *steps,
                         double *fraction, long long *runs);
 
-/* What the attach functions install, for C callers with their own
- * options: the stop flag, and the callbacks (context: the watch), which
- * must both be installed: the callbacks set the flag on a request. */
+/* What ss_job_set_watch installs: the stop flag, and the callback
+ * (context: the watch), which must both be installed: the callback sets
+ * the flag on a request.  A progress with its fit part set is a fit's. */
 const volatile sig_atomic_t *ss_watch_stop_flag(const struct ss_watch *w);
 void ss_watch_progress(void *context, const struct ss_progress *p);
-void ss_watch_fit_progress(void *context, const struct ss_fit_progress *p);
 
 #endif

@@ -109,7 +109,9 @@ def options(command: str) -> List[Dict[str, Any]]:
     table = _native.option_table(command)
     buf = ctypes.create_string_buffer(_JSON_BYTES)
     _native.check(_native.lib.ss_option_table_json(table, buf, len(buf)))
-    return json.loads(buf.value.decode())
+    # the case's keys that are no option of the command (a case file's
+    # sliding layer, in the model's table) have no name
+    return [o for o in json.loads(buf.value.decode()) if o["name"] is not None]
 
 
 _KINDS = {"real": "float", "int": "int", "flag": "bool", "word": "str", "text": "str",
@@ -342,7 +344,7 @@ def relax(heights: np.typing.ArrayLike, dx: float, dy: Optional[float] = None,
             if value is not None:
                 o.set(key, _word(value))
         # h is this call's copy: the library may write the result over it
-        _native.call(o, _native.lib.ss_relax_options_set_watch, _native.lib.ss_relax_heights,
+        _native.call(o, _native.lib.ss_relax_heights,
                      (o.ptr, nx, ny, dx, dy, h.ctypes.data,
                       rock.ctypes.data if rock is not None else None, h.ctypes.data, report,
                       len(report)),
@@ -442,7 +444,7 @@ def run(case: PathLike, out: PathLike,
             o.set("threads", _word(threads))
         if force:
             o.set("force", "1")
-        _native.call(o, _native.lib.ss_run_options_set_watch, _native.lib.ss_run_case_json,
+        _native.call(o, _native.lib.ss_run_case_json,
                      (o.ptr, summary, len(summary)), progress="run" if progress else None,
                      keywords=keywords, hdf5=True)
     return json.loads(summary.value.decode())
@@ -559,8 +561,7 @@ def relax_raster(source: Union[str, os.PathLike, osgeo.gdal.Dataset], output: Pa
             for key, value in relax_keywords.items():
                 if value is not None:
                     o.set(key, _word(_tile_word(value) if key == "tile" else value))
-            _native.call(o, _native.lib.ss_relax_options_set_watch,
-                         _native.lib.ss_relax_file_json, (o.ptr, report, len(report)),
+            _native.call(o, _native.lib.ss_relax_file_json, (o.ptr, report, len(report)),
                          progress="relax" if progress else None, keywords=keywords,
                          hdf5=touches_h5)
         result = json.loads(report.value.decode())
@@ -682,7 +683,7 @@ def fit(case: PathLike, observations: PathLike,
             o.set("force", "1")
         for key, value in options.items():
             o.set(key, _word(value))
-        _native.call(o, _native.lib.ss_fit_options_set_watch, _native.lib.ss_fit_run_json,
+        _native.call(o, _native.lib.ss_fit_run_json,
                      (o.ptr, report, len(report)), progress="fit" if progress else None,
                      keywords=keywords, hdf5=True)
     return json.loads(report.value.decode())

@@ -98,27 +98,20 @@ _PROTOTYPES = {
     "ss_version": (_S, []),
     "ss_error_set_quiet": (None, [_I]),
     "ss_error_last_message": (_S, []),
-    "ss_relax_options_create": (_P, []),
-    "ss_relax_options_destroy": (None, [_P]),
-    "ss_relax_options_set": (_I, [_P, _S, _S]),
-    "ss_relax_heights": (_I, [_P, _I, _I, _D, _D, _P, _P, _P, _P, _Z]),
-    "ss_run_options_create": (_P, []),
-    "ss_run_options_destroy": (None, [_P]),
-    "ss_run_options_set": (_I, [_P, _S, _S]),
-    "ss_run_case_json": (_I, [_P, _P, _Z]),
+    "ss_option_object_create": (_P, [_P]),
+    "ss_option_object_destroy": (None, [_P]),
+    "ss_option_object_set": (_I, [_P, _S, _S]),
     "ss_option_table_json": (_I, [_P, _P, _Z]),
-    "ss_fit_options_create": (_P, []),
-    "ss_fit_options_destroy": (None, [_P]),
-    "ss_fit_options_set": (_I, [_P, _S, _S]),
+    "ss_job_of": (_P, [_P, _P]),
+    "ss_job_set_watch": (None, [_P, _P]),
+    "ss_relax_heights": (_I, [_P, _I, _I, _D, _D, _P, _P, _P, _P, _Z]),
+    "ss_run_case_json": (_I, [_P, _P, _Z]),
     "ss_fit_run_json": (_I, [_P, _P, _Z]),
     "ss_relax_file_json": (_I, [_P, _P, _Z]),
     "ss_watch_create": (_P, []),
     "ss_watch_destroy": (None, [_P]),
     "ss_watch_stop": (None, [_P]),
     "ss_watch_read": (ctypes.c_longlong, [_P, _P, _P, _P, _P, _P]),
-    "ss_relax_options_set_watch": (None, [_P, _P]),
-    "ss_run_options_set_watch": (None, [_P, _P]),
-    "ss_fit_options_set_watch": (None, [_P, _P]),
     "ss_snapshot_threadsafe": (_I, []),
 }
 for _name, (_res, _args) in _PROTOTYPES.items():
@@ -198,27 +191,32 @@ def translate_message(message, keywords):
 
 
 class Options:
-    """Heap options of the library (relax, run or fit), destroyed on exit."""
+    """Heap options of the library (relax, run or fit: an options object of
+    the command's table, option.h), destroyed on exit."""
 
     def __init__(self, kind, keywords=None):
         self.keywords = keywords   # the messages' keywords (translate_message)
-        self._create = getattr(lib, f"ss_{kind}_options_create")
-        self._destroy = getattr(lib, f"ss_{kind}_options_destroy")
-        self._set = getattr(lib, f"ss_{kind}_options_set")
+        self.table = option_table(kind)
         self.ptr = None
 
     def __enter__(self):
-        self.ptr = self._create()
+        self.ptr = lib.ss_option_object_create(self.table)
         if not self.ptr:
             check(SS_ERR_FAIL)
         return self
 
     def __exit__(self, *exc):
-        self._destroy(self.ptr)
+        lib.ss_option_object_destroy(self.ptr)
         self.ptr = None
 
     def set(self, key, word):
-        check(self._set(self.ptr, key.encode(), os.fsencode(word)), keywords=self.keywords)
+        check(lib.ss_option_object_set(self.ptr, key.encode(), os.fsencode(word)),
+              keywords=self.keywords)
+
+    def watch(self, watch):
+        """Attach watch (a Watch; None: detach) to the options' job (job.h)."""
+        lib.ss_job_set_watch(lib.ss_job_of(self.table, self.ptr),
+                             watch.ptr if watch is not None else None)
 
 
 class Watch:
@@ -306,10 +304,10 @@ class Progress:
             sys.stderr.flush()
 
 
-def call(options, attach, function, args, *, progress=None, keywords=None, hdf5=False):
+def call(options, function, args, *, progress=None, keywords=None, hdf5=False):
     """function(*args), a call of the library that returns a status, in a
-    worker thread with a watch attached to options (attach: the library's
-    ss_*_options_set_watch), while this thread waits in short intervals.
+    worker thread with a watch attached to the job of options (an Options),
+    while this thread waits in short intervals.
 
     ctypes lets go of the GIL during the call, so the waiting thread stays
     free: a KeyboardInterrupt (Ctrl-C) lands here, sets the watch's stop
@@ -322,7 +320,7 @@ def call(options, attach, function, args, *, progress=None, keywords=None, hdf5=
     Raises the exception of the status (check) with the message, read in
     the worker since it is per thread."""
     watch = Watch()
-    attach(options.ptr, watch.ptr)
+    options.watch(watch)
     done = {"status": SS_ERR_FAIL, "message": "sandslide: the call did not return"}
     # Held while the worker lives, released by it as its last act.  Not
     # Thread.join: a KeyboardInterrupt inside join() can leave the Thread
@@ -388,7 +386,7 @@ def call(options, attach, function, args, *, progress=None, keywords=None, hdf5=
                 wait()
         if bar is not None:
             bar.close()
-        attach(options.ptr, None)
+        options.watch(None)
         watch.close()
         if locked:
             hdf5_lock.release()

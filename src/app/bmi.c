@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "app/relax_inputs.h"
 #include "base/strings.h"
 #include "model/setup.h"
 #include "sandslide/case.h"
@@ -190,7 +191,7 @@ static int setup_dem(struct bmi_state *s, const struct config *cf)
 		                      step);
 	if (end && (ss_parse_real(end, 0.0, INFINITY, &s->end) || !(s->end > 0.0)))
 		return ss_error_input("%s: [bmi] end '%s': expected seconds > 0", cf->path, end);
-	struct ss_relax_options *o = ss_relax_options_create();
+	struct ss_relax_options *o = ss_option_object_create(&ss_relax_option_table);
 	if (!o)
 		return SS_ERR_FAIL;
 	char path[4096];
@@ -208,42 +209,24 @@ static int setup_dem(struct bmi_state *s, const struct config *cf)
 			                     "files; threads: OMP_NUM_THREADS)", cf->path, key);
 		else if (!strcmp(key, "dem") || !strcmp(key, "bedrock")) {
 			if (!(err = config_path(cf, value, path, sizeof path)))
-				err = ss_relax_options_set(o, key, path);
+				err = ss_option_object_set(o, key, path);
 		} else {
 			/* its message names the key and what it accepts */
-			err = ss_relax_options_set(o, key, value);
+			err = ss_option_object_set(o, key, value);
 		}
 	}
-	const int pour = o->sand_shape.kind != SS_SHAPE_NONE;
-	if (!err && (pour != !isnan(o->sand_rate) || pour != !isnan(o->sand_duration)))
-		err = ss_error_input("%s: [bmi] add_sand, sand_rate and sand_duration go together",
-		                     cf->path);
-	struct ss_raster dem = {0}, rock = {0};
+	struct ss_relax_inputs in = {0};
 	if (!err)
-		err = ss_dem_read(o->dem, NULL, &o->read, &dem);
-	if (!err && (double)dem.nx * dem.ny * sizeof(double) > INT_MAX)
+		err = ss_relax_inputs_read(o, &in);
+	if (!err && (double)in.dem.nx * in.dem.ny * sizeof(double) > INT_MAX)
 		err = ss_error_input("BMI initialize: %s: %d x %d cells is more than the BMI's int "
-		                     "sizes can count", o->dem, dem.nx, dem.ny);
-	if (!err && o->bedrock && !(err = ss_dem_read(o->bedrock, "bedrock", &o->read, &rock)) &&
-	    (rock.nx != dem.nx || rock.ny != dem.ny))
-		err = ss_error_input("%s: bedrock %s is %d x %d cells: expected the DEM's %d x %d",
-		                     cf->path, o->bedrock, rock.nx, rock.ny, dem.nx, dem.ny);
-	if (!err) {
-		const struct ss_raster_setup rs = {
-			.model = &o->model, .name = o->dem, .heights = &dem,
-			.dx = o->read.cellsize, .sides = o->sides, .nodata_type = o->nodata_type,
-			.open_level = o->open_level, .bedrock = o->bedrock ? &rock : NULL,
-			.tile_nx = o->tile[0], .tile_ny = o->tile[1],
-			.pour = pour ? &o->sand_shape : NULL, .pour_rate = o->sand_rate,
-			.pour_duration = o->sand_duration,
-		};
-		err = ss_setup_stepper_from_raster(&rs, &s->st);
-	}
+		                     "sizes can count", o->dem, in.dem.nx, in.dem.ny);
+	if (!err)
+		err = ss_relax_setup_stepper(o, &in, &s->st);
 	if (!err && !end)
 		s->end = isfinite(o->model.max_time) ? o->model.max_time : INFINITY;
-	ss_raster_release(&dem);
-	ss_raster_release(&rock);
-	ss_relax_options_destroy(o);
+	ss_relax_inputs_release(&in);
+	ss_option_object_destroy(o);
 	return err;
 }
 

@@ -119,7 +119,7 @@ static void report_progress(void *context, const struct ss_stepper *st)
 		.cells = (double)st->grid.global_nx * st->grid.global_ny,
 		.wall_seconds = ss_parallel_wall_seconds() - d->started,
 	};
-	d->progress(d->progress_context, &p);
+	d->job->progress(d->job->progress_context, &p);
 }
 
 /* Take the steps of the loop again on st, towards the same targets, until
@@ -247,9 +247,9 @@ int ss_drive_run(struct ss_drive *d, enum ss_drive_end *end)
 	const struct ss_advance_options adv = {
 		.steady_tol = d->steady_tol,
 		.steady_slope_tol = d->steady_slope_tol,
-		.progress = d->progress ? report_progress : NULL,
+		.progress = d->job && d->job->progress ? report_progress : NULL,
 		.context = d,
-		.stop = d->stop_signal,
+		.stop = d->job ? d->job->stop_signal : NULL,
 	};
 	d->time_start = st->time;
 	d->steps_start = st->steps;

@@ -34,7 +34,7 @@
 #include <signal.h>
 
 #include "io/output.h"
-#include "sandslide/progress.h"
+#include "sandslide/job.h"
 #include "sandslide/snapshot.h"
 #include "sandslide/stepper.h"
 
@@ -65,10 +65,9 @@ struct ss_drive {
 	double steady_tol;      /* m/s; <= 0: never steady */
 	double steady_slope_tol; /* stepper.h; <= 0: the default 1e-6 */
 	double started;         /* wall clock when the command started, s */
-	const volatile sig_atomic_t *stop_signal; /* NULL, or checked after
-	                           every substep (set by a signal handler) */
-	ss_progress_fn *progress;   /* after every substep (NULL: none) */
-	void *progress_context;
+	const struct ss_job *job;   /* its stop signal, checked after every
+	                           substep, and its progress after every
+	                           substep (NULL: neither) */
 	/* after every snapshot is written and flushed (NULL: none); a non-zero
 	 * return (a status, message printed) stops the loop */
 	int (*on_snapshot)(void *context, const char *path, long long index, double time);

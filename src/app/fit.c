@@ -39,6 +39,10 @@ enum { RUN_DONE, RUN_CUT, RUN_STOPPED };
 /* One closure's fit. */
 struct closure_fit {
 	enum ss_closure_kind kind;
+	struct ss_case c;               /* the case with this closure and the
+	                                 * parameters set by override (which keys
+	                                 * they drop: case.h); a forward run
+	                                 * copies it and sets their values */
 	int param[SS_FIT_MAX_PARAMS];   /* indices into the options' params */
 	int p;                          /* how many apply to this closure */
 	double u[SS_FIT_MAX_PARAMS];    /* the best point so far */
@@ -61,6 +65,8 @@ struct closure_fit {
 
 struct fit {
 	const struct ss_fit_options *o;
+	struct ss_fit_param params[SS_FIT_MAX_PARAMS];   /* --param's, parsed */
+	int param_count;
 	struct ss_case base;            /* the case as given */
 	struct ss_observations obs;
 	enum ss_fit_cost cost;
@@ -107,43 +113,56 @@ static double value_of(const struct ss_fit_param *p, double u)
 	return p->log ? p->lo * pow(p->hi / p->lo, u) : p->lo + u * (p->hi - p->lo);
 }
 
-/* Which [model] keys a closure takes (doc/case-file.md#model). */
-static int param_applies(const char *name, enum ss_closure_kind kind)
+/* The row of the model's table that parameter p frees (its case key is
+ * "model." p->name; ss_fit_param_parse checked that one is fittable). */
+static const struct ss_option *param_row(const struct ss_fit_param *p, size_t *offset)
 {
-	if (!strcmp(name, "nu") || !strcmp(name, "repose_angle"))
-		return 1;
-	if (!strcmp(name, "gamma") || !strcmp(name, "consistency"))
-		return kind == SS_CLOSURE_HERSCHEL_BULKLEY;
-	if (!strcmp(name, "viscosity"))
-		return kind == SS_CLOSURE_BINGHAM || kind == SS_CLOSURE_CASSON;
-	if (!strcmp(name, "delta"))
-		return kind != SS_CLOSURE_COULOMB;
-	return 0;
+	char key[48];
+	snprintf(key, sizeof key, "model.%s", p->name);
+	const struct ss_option *o = ss_option_find_key(&ss_case_option_table, key, offset);
+	if (!o)
+		SS_BUG("fit: no case key %s", key);
+	return o;
 }
 
-/* The overrides that set closure cf at u: "model.closure=NAME" and one per
- * parameter, each value written to read back to the same double. */
-static int overrides_of(const struct fit *f, const struct closure_fit *cf, const double *u,
-                        char text[][96], const char *ov[])
+/* Whether closure kind takes parameter p: the closures of its row. */
+static int param_applies(const struct ss_fit_param *p, enum ss_closure_kind kind)
 {
-	int n = 0;
-	if (f->integrator == SS_INTEGRATOR_RKL2 && f->base.model.rkl2_tol > f->o->rkl2_tol) {
-		char num[SS_REAL_TEXT_SIZE];
-		snprintf(text[n], 96, "time.rkl2_tol=%s", ss_real_text(f->o->rkl2_tol, num));
-		ov[n] = text[n];
-		n++;
+	size_t offset;
+	const struct ss_option *o = param_row(p, &offset);
+	return !o->applies_to || (o->applies_to >> kind & 1);
+}
+
+/* "nu=0.13, repose_angle=33" of cf at u into buf, for messages. */
+static void values_text(const struct fit *f, const struct closure_fit *cf, const double *u,
+                        char *buf, size_t size)
+{
+	struct ss_strbuf b = {buf, size, 0};
+	buf[0] = '\0';
+	for (int k = 0; k < cf->p; k++) {
+		const struct ss_fit_param *p = &f->params[cf->param[k]];
+		ss_strbuf_printf(&b, "%s%s=%s", k ? ", " : "", p->name, SS_REAL(value_of(p, u[k])));
 	}
+}
+
+/* The case of closure cf: the closure and each parameter set by override
+ * (any value of its range: which keys an override drops does not depend
+ * on it), parsed once; a forward run sets the values (make_stepper). */
+static int parse_closure_case(const struct fit *f, struct closure_fit *cf)
+{
+	char text[SS_FIT_MAX_PARAMS + 1][96];
+	const char *ov[SS_FIT_MAX_PARAMS + 1];
+	int n = 0;
 	snprintf(text[n], 96, "model.closure=%s", ss_closure_name(cf->kind));
 	ov[n] = text[n];
 	n++;
 	for (int k = 0; k < cf->p; k++) {
-		const struct ss_fit_param *p = &f->o->params[cf->param[k]];
-		char num[SS_REAL_TEXT_SIZE];
-		snprintf(text[n], 96, "model.%s=%s", p->name, ss_real_text(value_of(p, u[k]), num));
+		const struct ss_fit_param *p = &f->params[cf->param[k]];
+		snprintf(text[n], 96, "model.%s=%s", p->name, SS_REAL(value_of(p, 0.5)));
 		ov[n] = text[n];
 		n++;
 	}
-	return n;
+	return ss_case_parse(&cf->c, f->base.path, f->base.text, ov, n);
 }
 
 /* ---- the forward model ---------------------------------------------------- */
@@ -158,16 +177,31 @@ static void copy_heights(const struct ss_stepper *st, double *out)
 	}
 }
 
-/* The stepper of the case with the overrides ov[0..n-1], prepared at t = 0. */
-static int make_stepper(const struct fit *f, const char *const *ov, int n,
+/* The stepper of closure cf at u, prepared at t = 0: its case with each
+ * parameter's value, nu derived again when the case derives it, and the
+ * forward runs' RKL2 tolerance. */
+static int make_stepper(const struct fit *f, const struct closure_fit *cf, const double *u,
                         struct ss_stepper *st)
 {
-	struct ss_case c;
-	int err = ss_case_parse(&c, f->base.path, f->base.text, ov, n);
-	if (!err)
-		err = ss_setup_stepper(&c, 0, 0, SS_KERNEL_FAST, st);
-	ss_case_release(&c);
-	return err;
+	struct ss_case c = cf->c;   /* a copy of the values: the set-up only reads */
+	for (int k = 0; k < cf->p; k++) {
+		const struct ss_fit_param *p = &f->params[cf->param[k]];
+		size_t offset;
+		const struct ss_option *o = param_row(p, &offset);
+		*(double *)((char *)&c + offset + o->offset) = value_of(p, u[k]);
+	}
+	if (c.model.nu_from_layer) {
+		c.model.nu = ss_model_nu_from_layer(&c.model);
+		if (!(c.model.nu > 0.0) || !isfinite(c.model.nu)) {
+			char at[256];
+			values_text(f, cf, u, at, sizeof at);
+			return ss_error_input("%s: [model] the physical parameters give nu = %g m^2/s "
+			                      "at %s: expected a finite value > 0", c.path, c.model.nu, at);
+		}
+	}
+	if (f->integrator == SS_INTEGRATOR_RKL2 && c.model.rkl2_tol > f->o->rkl2_tol)
+		c.model.rkl2_tol = f->o->rkl2_tol;
+	return ss_setup_stepper(&c, f->o->job.tile[0], f->o->job.tile[1], SS_KERNEL_FAST, st);
 }
 
 /* The simulated support of heights h into f->chi_sim: per cell for a
@@ -259,15 +293,17 @@ static double residuals_at(const struct fit *f, long long k, const double *h, do
 	return sum;
 }
 
-/* The fit's progress as it stands, fitting closure cf, to o->progress. */
+/* The fit's progress as it stands, fitting closure cf, to the job's. */
 static void report_progress(const struct fit *f, const struct closure_fit *cf)
 {
-	if (!f->o->progress)
+	const struct ss_job *job = &f->o->job;
+	if (!job->progress)
 		return;
-	const struct ss_fit_progress p = {
+	const struct ss_fit_progress fit = {
 		ss_closure_name(cf->kind), f->stage, f->current, f->fit_count, f->runs, cf->cost,
 	};
-	f->o->progress(f->o->progress_context, &p);
+	const struct ss_progress p = {.fit = &fit};
+	job->progress(job->progress_context, &p);
 }
 
 /* What a forward run's substeps report. */
@@ -286,6 +322,70 @@ static void substep_progress(void *context, const struct ss_stepper *st)
 	report_progress(c->f, c->cf);
 }
 
+/* How a forward run that did not reach a time ended. */
+struct run_end {
+	enum ss_advance_end end;        /* SS_ADVANCE_REACHED: it reached them all */
+	double time;                    /* where it stopped, s */
+	long long k;                    /* the time it did not reach */
+};
+
+/*
+ * A forward run of closure cf at u through the times t[0..n-1]: at each the
+ * heights are copied to f->sim and at_time(f, k, context) called, which
+ * returns non-zero to stop the run there (*how RUN_CUT).  *how is RUN_DONE
+ * or RUN_STOPPED (the stop signal); *e says how the stepper ended when it
+ * did not reach a time (the caller says what that means).  The cost and
+ * the front's trace are both such runs.
+ */
+static int run_through(struct fit *f, const struct closure_fit *cf, const double *u,
+                       const double *t, long long n,
+                       int (*at_time)(struct fit *f, long long k, void *context), void *context,
+                       int *how, struct run_end *e)
+{
+	struct ss_stepper st;
+	*how = RUN_DONE;
+	e->end = SS_ADVANCE_REACHED;
+	int err = make_stepper(f, cf, u, &st);
+	if (err)
+		return err;
+	const struct run_context rc = {f, cf};
+	struct ss_advance_options adv = {.stop = f->o->job.stop_signal,
+	                                 .progress = f->o->job.progress ? substep_progress : NULL,
+	                                 .context = (void *)&rc};
+	for (long long k = 0; k < n; k++) {
+		e->end = t[k] > st.time ? ss_stepper_advance(&st, t[k], &adv) : SS_ADVANCE_REACHED;
+		e->time = st.time;
+		e->k = k;
+		if (e->end == SS_ADVANCE_INTERRUPTED)
+			*how = RUN_STOPPED;
+		if (e->end != SS_ADVANCE_REACHED)
+			break;
+		copy_heights(&st, f->sim);
+		if (at_time(f, k, context)) {
+			*how = RUN_CUT;
+			break;
+		}
+	}
+	ss_stepper_release(&st);
+	return SS_OK;
+}
+
+/* The cost of a forward run so far: the residuals of each observation
+ * time (residuals_at) added up, until it passes cut. */
+struct cost_sum {
+	double cut, cost;
+	double *r;                      /* the residuals, or NULL */
+	long long at;                   /* residuals written so far */
+	double radius_prev;             /* the front's radius at the time before */
+};
+
+static int add_residuals(struct fit *f, long long k, void *context)
+{
+	struct cost_sum *c = context;
+	c->cost += residuals_at(f, k, f->sim, c->r, &c->at, &c->radius_prev);
+	return c->cost > c->cut;
+}
+
 /*
  * One forward run of closure cf at u through every observation time: the
  * cost (F5) into *cost and, with r, the residuals.  With a finite cut the
@@ -296,50 +396,22 @@ static void substep_progress(void *context, const struct ss_stepper *st)
 static int forward(struct fit *f, struct closure_fit *cf, const double *u, double cut,
                    double *r, double *cost, int *how)
 {
-	char text[SS_FIT_MAX_PARAMS + 2][96];
-	const char *ov[SS_FIT_MAX_PARAMS + 2];
-	const int n = overrides_of(f, cf, u, text, ov);
-	struct ss_stepper st;
 	const double t0 = ss_parallel_wall_seconds();
-	int err = make_stepper(f, ov, n, &st);
-	*how = RUN_DONE;
-	*cost = 0.0;
+	struct cost_sum sum = {.cut = cut, .r = r};
+	struct run_end e;
+	int err = run_through(f, cf, u, f->obs.time, f->obs.times, add_residuals, &sum, how, &e);
+	*cost = sum.cost;
 	if (err)
-		return err;
-	const struct run_context rc = {f, cf};
-	struct ss_advance_options adv = {.stop = f->o->stop_signal,
-	                                 .progress = f->o->progress ? substep_progress : NULL,
-	                                 .context = (void *)&rc};
-	long long at = 0;
-	double radius_prev = 0.0;
-	for (long long k = 0; k < f->obs.times; k++) {
-		const double t = f->obs.time[k];
-		const enum ss_advance_end e = t > st.time ? ss_stepper_advance(&st, t, &adv)
-		                                          : SS_ADVANCE_REACHED;
-		if (e == SS_ADVANCE_INTERRUPTED) {
-			*how = RUN_STOPPED;
-			break;
-		}
-		if (e != SS_ADVANCE_REACHED) {
-			char list[512] = "";
-			struct ss_strbuf b = {list, sizeof list, 0};
-			for (int m = n - cf->p; m < n; m++)
-				ss_strbuf_printf(&b, "%s%s", m > n - cf->p ? ", " : "", ov[m] + 6);
-			err = ss_error_fail("the forward run of %s at %s stopped at t = %g s before "
-			                    "the observation at %g s: %s", ss_closure_name(cf->kind),
-			                    list, st.time, t,
-			                    e == SS_ADVANCE_NONFINITE ? "a height became non-finite"
-			                                              : "its time step vanished");
-			break;
-		}
-		copy_heights(&st, f->sim);
-		*cost += residuals_at(f, k, f->sim, r, &at, &radius_prev);
-		if (*cost > cut) {
-			*how = RUN_CUT;
-			break;
-		}
+		return err;   /* no run: the set-up failed */
+	if (e.end != SS_ADVANCE_REACHED && e.end != SS_ADVANCE_INTERRUPTED) {
+		char at[512];
+		values_text(f, cf, u, at, sizeof at);
+		err = ss_error_fail("the forward run of %s at %s stopped at t = %g s before the "
+		                    "observation at %g s: %s", ss_closure_name(cf->kind), at, e.time,
+		                    f->obs.time[e.k],
+		                    e.end == SS_ADVANCE_NONFINITE ? "a height became non-finite"
+		                                                  : "its time step vanished");
 	}
-	ss_stepper_release(&st);
 	f->runs++;
 	cf->runs++;
 	cf->cut_short += *how == RUN_CUT;
@@ -601,7 +673,7 @@ static int profiles(struct fit *f, struct closure_fit *cf)
 	const long long m = f->residual_count;
 	const double s2 = cf->noise / (double)(m > cf->p ? m - cf->p : 1);
 	for (int k = 0; k < cf->p; k++) {
-		const struct ss_fit_param *p = &f->o->params[cf->param[k]];
+		const struct ss_fit_param *p = &f->params[cf->param[k]];
 		double rise = 0.0;
 		for (int i = 0; i < n; i++)
 			rise = fmax(rise, cf->profile_cost[k][i] - cf->cost);
@@ -656,23 +728,31 @@ static int parse_closures(struct fit *f)
 	return SS_OK;
 }
 
-/* Each closure's parameters: those of --param it takes.  A closure that
- * takes none, nu and delta together, or a name given twice is refused. */
+/* --param's words parsed, then each closure's parameters: those it takes.
+ * A closure that takes none, nu and delta together, or a name given twice
+ * is refused. */
 static int assign_params(struct fit *f)
 {
 	const struct ss_fit_options *o = f->o;
-	if (o->param_count < 1)
+	if (o->params.count > SS_FIT_MAX_PARAMS)
+		return ss_error_input("at most %d --param", SS_FIT_MAX_PARAMS);
+	for (int k = 0; k < o->params.count; k++) {
+		int err = ss_fit_param_parse(o->params.items[k], &f->params[k]);
+		if (err)
+			return err;
+		f->param_count++;
+	}
+	if (f->param_count < 1)
 		return ss_error_input("fit needs at least one --param NAME=LO:HI[:log], e.g. "
 		                      "--param nu=0.01:1:log");
 	int nu = 0, derived = 0;
-	for (int k = 0; k < o->param_count; k++) {
+	for (int k = 0; k < f->param_count; k++) {
 		for (int m = 0; m < k; m++)
-			if (!strcmp(o->params[k].name, o->params[m].name))
-				return ss_error_input("--param %s is given twice", o->params[k].name);
-		nu |= !strcmp(o->params[k].name, "nu");
-		derived |= !strcmp(o->params[k].name, "delta") ||
-		           !strcmp(o->params[k].name, "viscosity") ||
-		           !strcmp(o->params[k].name, "consistency");
+			if (!strcmp(f->params[k].name, f->params[m].name))
+				return ss_error_input("--param %s is given twice", f->params[k].name);
+		size_t offset;
+		nu |= !strcmp(f->params[k].name, "nu");
+		derived |= ss_model_option_is_layer(param_row(&f->params[k], &offset));
 	}
 	if (nu && derived)
 		return ss_error_input("--param nu and the sliding layer's parameters (delta, "
@@ -681,13 +761,13 @@ static int assign_params(struct fit *f)
 	for (int c = 0; c < f->fit_count; c++) {
 		struct closure_fit *cf = &f->fits[c];
 		cf->cost = INFINITY;
-		for (int k = 0; k < o->param_count; k++)
-			if (param_applies(o->params[k].name, cf->kind))
+		for (int k = 0; k < f->param_count; k++)
+			if (param_applies(&f->params[k], cf->kind))
 				cf->param[cf->p++] = k;
 		if (cf->p == 0)
 			return ss_error_input("%s takes none of the parameters given (%s%s): it takes "
 			                      "nu and repose_angle%s", ss_closure_name(cf->kind),
-			                      o->params[0].name, o->param_count > 1 ? ", ..." : "",
+			                      f->params[0].name, f->param_count > 1 ? ", ..." : "",
 			                      cf->kind == SS_CLOSURE_COULOMB ? ""
 			                      : ", and the sliding layer's parameters");
 	}
@@ -721,7 +801,8 @@ static int check_grid(const struct fit *f)
 static int measure_initial(struct fit *f)
 {
 	struct ss_stepper st;
-	int err = make_stepper(f, NULL, 0, &st);
+	int err = ss_setup_stepper(&f->base, f->o->job.tile[0], f->o->job.tile[1], SS_KERNEL_FAST,
+	                           &st);
 	if (err)
 		return err;
 	const struct ss_grid *g = &st.grid;
@@ -810,11 +891,11 @@ static int prepare(struct fit *f)
 	if ((err = ss_case_load(&f->base, o->case_path, NULL, 0)) || (err = parse_closures(f)) ||
 	    (err = assign_params(f)))
 		return err;
-	if (o->output && ((err = ss_output_check_folder(o->output, 0)) ||
-	                  (err = ss_output_check_absent(o->output, o->force, NULL))))
+	if (o->job.output && ((err = ss_output_check_folder(o->job.output, 0)) ||
+	                      (err = ss_output_check_absent(o->job.output, o->job.force, NULL))))
 		return err;
 	if (o->plot && ((err = ss_output_check_folder(o->plot, 0)) ||
-	                (err = ss_output_check_absent(o->plot, o->force, NULL))))
+	                (err = ss_output_check_absent(o->plot, o->job.force, NULL))))
 		return err;
 	if ((err = ss_observations_read(&f->obs, o->observations)) || (err = check_grid(f)))
 		return err;
@@ -882,11 +963,16 @@ static int prepare(struct fit *f)
 		return SS_ERR_FAIL;
 	for (int k = 0; k < TRACE_TIMES; k++)
 		f->trace_time[k] = f->obs.time[f->obs.times - 1] * k / (TRACE_TIMES - 1);
+	for (int c = 0; c < f->fit_count; c++)
+		if ((err = parse_closure_case(f, &f->fits[c])))
+			return err;
 	return SS_OK;
 }
 
 static void release(struct fit *f)
 {
+	for (int c = 0; c < f->fit_count; c++)
+		ss_case_release(&f->fits[c].c);
 	ss_case_release(&f->base);
 	ss_observations_release(&f->obs);
 	ss_free(f->flow);
@@ -904,32 +990,24 @@ static void release(struct fit *f)
 
 /* ---- the front over time, for the plot ------------------------------------ */
 
-/* The equivalent radius of the best run of cf at the trace times. */
+/* The front's equivalent radius at trace time k of the run being traced. */
+static int add_radius(struct fit *f, long long k, void *context)
+{
+	struct closure_fit *cf = context;
+	simulated_support(f, f->sim);
+	cf->trace_radius[k] = sqrt(support_area(f) / M_PI);
+	cf->traced = (int)k + 1;
+	return 0;
+}
+
+/* The equivalent radius of the best run of cf at the trace times (as far
+ * as the run goes). */
 static int trace(struct fit *f, struct closure_fit *cf)
 {
-	char text[SS_FIT_MAX_PARAMS + 2][96];
-	const char *ov[SS_FIT_MAX_PARAMS + 2];
-	const int n = overrides_of(f, cf, cf->u, text, ov);
-	struct ss_stepper st;
-	int err = make_stepper(f, ov, n, &st);
-	if (err)
-		return err;
+	int how;
+	struct run_end e;
 	f->stage = "front";
-	const struct run_context rc = {f, cf};
-	struct ss_advance_options adv = {.stop = f->o->stop_signal,
-	                                 .progress = f->o->progress ? substep_progress : NULL,
-	                                 .context = (void *)&rc};
-	for (int k = 0; k < TRACE_TIMES; k++) {
-		const double t = f->trace_time[k];
-		if (t > st.time && ss_stepper_advance(&st, t, &adv) != SS_ADVANCE_REACHED)
-			break;
-		copy_heights(&st, f->sim);
-		simulated_support(f, f->sim);
-		cf->trace_radius[k] = sqrt(support_area(f) / M_PI);
-		cf->traced = k + 1;
-	}
-	ss_stepper_release(&st);
-	return SS_OK;
+	return run_through(f, cf, cf->u, f->trace_time, TRACE_TIMES, add_radius, cf, &how, &e);
 }
 
 /* ---- the figure ----------------------------------------------------------- */
@@ -942,8 +1020,7 @@ static int trace(struct fit *f, struct closure_fit *cf)
  */
 static int plot(const struct fit *f, int best, const char *path)
 {
-	const struct ss_fit_options *o = f->o;
-	const int panels = 1 + o->param_count;
+	const int panels = 1 + f->param_count;
 	const int columns = panels < 3 ? panels : 3, rows = (panels + columns - 1) / columns;
 	struct ss_plot *fig = NULL;
 	int err = ss_plot_create(&fig, columns, rows, 480, 360);
@@ -958,8 +1035,8 @@ static int plot(const struct fit *f, int best, const char *path)
 			err = ss_plot_add(fig, 0, f->trace_time, cf->trace_radius, cf->traced,
 			                  SS_PLOT_LINE, c + 1, ss_closure_name(cf->kind));
 	}
-	for (int k = 0; k < o->param_count && !err; k++) {
-		const struct ss_fit_param *p = &o->params[k];
+	for (int k = 0; k < f->param_count && !err; k++) {
+		const struct ss_fit_param *p = &f->params[k];
 		char title[96];
 		snprintf(title, sizeof title, "cost along %s", p->name);
 		err = ss_plot_panel(fig, 1 + k, title, p->name, "cost", p->log);
@@ -999,7 +1076,7 @@ static void json_value(struct ss_strbuf *b, const struct ss_fit_param *p, double
 static void json_closure(struct ss_strbuf *b, const struct fit *f, const struct closure_fit *cf,
                          double best_aic)
 {
-	const struct ss_fit_param *params = f->o->params;
+	const struct ss_fit_param *params = f->params;
 	ss_strbuf_printf(b, "    {\"closure\": \"%s\", \"params\": {", ss_closure_name(cf->kind));
 	for (int k = 0; k < cf->p; k++) {
 		ss_strbuf_printf(b, "%s\"%s\": ", k ? ", " : "", params[cf->param[k]].name);
@@ -1090,8 +1167,8 @@ static void format_report(struct ss_strbuf *b, const struct fit *f, int best)
 	if (top) {
 		ss_strbuf_printf(b, "{\"closure\": \"%s\", \"params\": {", ss_closure_name(top->kind));
 		for (int k = 0; k < top->p; k++) {
-			ss_strbuf_printf(b, "%s\"%s\": ", k ? ", " : "", o->params[top->param[k]].name);
-			json_value(b, &o->params[top->param[k]], top->u[k]);
+			ss_strbuf_printf(b, "%s\"%s\": ", k ? ", " : "", f->params[top->param[k]].name);
+			json_value(b, &f->params[top->param[k]], top->u[k]);
 		}
 		ss_strbuf_printf(b, "}, \"cost\": ");
 		ss_strbuf_json_number(b, top->cost, 10);
@@ -1127,7 +1204,7 @@ static void format_report(struct ss_strbuf *b, const struct fit *f, int best)
 	for (int c = 0; c < f->fit_count; c++) {
 		const struct closure_fit *cf = &f->fits[c];
 		for (int k = 0; cf->assessed && k < cf->p; k++) {
-			const struct ss_fit_param *p = &o->params[cf->param[k]];
+			const struct ss_fit_param *p = &f->params[cf->param[k]];
 			if (!cf->identifiable[k])
 				ss_strbuf_printf(&v, "; %s: %s not identifiable", ss_closure_name(cf->kind),
 				                 p->name);
@@ -1155,14 +1232,13 @@ static void format_report(struct ss_strbuf *b, const struct fit *f, int best)
 /* What the command line prints: a line per closure, the verdict. */
 static void format_summary(struct ss_strbuf *b, const struct fit *f, int best)
 {
-	const struct ss_fit_options *o = f->o;
 	for (int c = 0; c < f->fit_count; c++) {
 		const struct closure_fit *cf = &f->fits[c];
 		if (!isfinite(cf->cost))
 			continue;
 		ss_strbuf_printf(b, "%-16s", ss_closure_name(cf->kind));
 		for (int k = 0; k < cf->p; k++) {
-			const struct ss_fit_param *p = &o->params[cf->param[k]];
+			const struct ss_fit_param *p = &f->params[cf->param[k]];
 			ss_strbuf_printf(b, " %s = %.4g", p->name, value_of(p, cf->u[k]));
 			if (cf->assessed && isfinite(cf->std_u[k]))
 				ss_strbuf_printf(b, " (%.4g .. %.4g)",
@@ -1236,7 +1312,7 @@ int ss_fit_run(const struct ss_fit_options *o, char **report, char **summary)
 	memset(&f, 0, sizeof f);
 	f.o = o;
 	f.started = ss_parallel_wall_seconds();
-	ss_drive_set_threads(o->threads);
+	ss_drive_set_threads(o->job.threads);
 	int err = prepare(&f);
 	if (!err)
 		err = fit_all(&f);
@@ -1249,8 +1325,8 @@ int ss_fit_run(const struct ss_fit_options *o, char **report, char **summary)
 		err = text_of(format_report, &f, best, report);
 	if (!err && summary && best >= 0)
 		err = text_of(format_summary, &f, best, summary);
-	if (!err && o->output)
-		err = ss_output_write_text(o->output, *report);
+	if (!err && o->job.output)
+		err = ss_output_write_text(o->job.output, *report);
 	if (!err && o->plot && best >= 0)
 		err = plot(&f, best, o->plot);
 	if (err) {

@@ -1,7 +1,8 @@
 /*
  * fit_options.c - fit's options (fit.h): the one table the command line,
- * the options set by name and the Python module read; --param's words;
- * the options object for foreign callers.
+ * the options set by name and the Python module read, continued by the
+ * job's (job.h); --param's words; the report in a buffer for foreign
+ * callers.
  */
 #include "sandslide/fit.h"
 
@@ -11,8 +12,8 @@
 #include <string.h>
 
 #include "base/strings.h"
+#include "sandslide/model_options.h"
 #include "sandslide/error.h"
-#include "sandslide/watch.h"
 
 static int parse_cost(const char *value, void *field)
 {
@@ -44,12 +45,12 @@ static const struct ss_option options[] = {
 	 .flags = SS_OPTION_NAMED_ONLY, .expected = "a path",
 	 .help = "the observations (the command line's second argument)"},
 	{.name = "param", .alias = "-p", .value_name = "NAME=LO:HI[:log]", .kind = SS_OPTION_LIST,
-	 .parse = parse_param,
-	 .expected = "NAME=LO:HI or NAME=LO:HI:log, NAME one of nu, repose_angle, gamma, "
-	             "delta, viscosity, consistency, e.g. nu=0.01:1:log",
+	 .offset = AT(params), .parse = parse_param,
+	 .expected = "NAME=LO:HI or NAME=LO:HI:log, NAME a [model] key of the case, "
+	             "e.g. nu=0.01:1:log",
 	 .help = "free a [model] key of the case within LO..HI, searched\n"
 	         "on a log scale with :log; give one --param per key\n"
-	         "(nu, repose_angle, gamma, delta, viscosity, consistency)"},
+	         "(the keys: doc/fit.md#parameters)"},
 	{.name = "closures", .value_name = "LIST", .kind = SS_OPTION_TEXT, .offset = AT(closures),
 	 .expected = "all, or a comma-separated list of coulomb, bingham, herschel-bulkley, casson",
 	 .help = "fit each of these closures and compare them (default:\n"
@@ -86,22 +87,19 @@ static const struct ss_option options[] = {
 	         "larger (doc/fit.md#the-search: the cost must be\n"
 	         "smooth in the parameters)"},
 	{.name = "output", .alias = "-o", .value_name = "FIT.json", .kind = SS_OPTION_TEXT,
-	 .offset = AT(output), .expected = "a path",
+	 .offset = AT(job.output), .expected = "a path",
 	 .help = "write the report there (JSON, doc/fit.md#the-report)"},
 	{.name = "plot", .value_name = "FIT.png", .kind = SS_OPTION_TEXT, .offset = AT(plot),
 	 .expected = "a path",
 	 .help = "draw the observed and fitted fronts and the cost\n"
 	         "along each parameter"},
-	{.name = "force", .kind = SS_OPTION_FLAG, .offset = AT(force), .expected = "1 or 0",
-	 .help = "replace FIT.json and FIT.png if they exist"},
-	{.name = "threads", .value_name = "N", .kind = SS_OPTION_INT, .offset = AT(threads),
-	 .lo = 1, .hi = 4096, .expected = "an integer from 1 to 4096",
-	 .help = "OpenMP threads of each forward run (default:\n"
-	         "OMP_NUM_THREADS, else the processors)"},
 };
+
+static const struct ss_option_part parts[] = {{&ss_job_option_table, AT(job)}};
 
 const struct ss_option_table ss_fit_option_table = {
 	.command = "fit", .options = options, .count = sizeof options / sizeof *options,
+	.parts = parts, .part_count = 1, .size = sizeof(struct ss_fit_options),
 };
 
 void ss_fit_options_init(struct ss_fit_options *o)
@@ -110,21 +108,42 @@ void ss_fit_options_init(struct ss_fit_options *o)
 	ss_option_defaults(&ss_fit_option_table, o);
 }
 
+/* The names --param takes: the case keys of the model's rows flagged
+ * SS_OPTION_FITTABLE, without "model.", into buf ("nu, repose_angle, ..."). */
+static void fittable_names(char *buf, size_t size)
+{
+	struct ss_strbuf b = {buf, size, 0};
+	int n = 0;
+	buf[0] = '\0';
+	for (int k = 0; k < ss_model_option_table.count; k++) {
+		const struct ss_option *o = &ss_model_option_table.options[k];
+		if (o->flags & SS_OPTION_FITTABLE)
+			ss_strbuf_printf(&b, "%s%s", n++ ? ", " : "", strchr(o->case_key, '.') + 1);
+	}
+}
+
+/* Whether name (len bytes) is a key --param takes. */
+static int fittable(const char *name, size_t len)
+{
+	for (int k = 0; k < ss_model_option_table.count; k++) {
+		const struct ss_option *o = &ss_model_option_table.options[k];
+		const char *key = o->case_key ? strchr(o->case_key, '.') + 1 : NULL;
+		if ((o->flags & SS_OPTION_FITTABLE) && strlen(key) == len && !strncmp(name, key, len))
+			return 1;
+	}
+	return 0;
+}
+
 int ss_fit_param_parse(const char *text, struct ss_fit_param *p)
 {
-	static const char *const names[] = {"nu", "repose_angle", "gamma", "delta", "viscosity",
-	                                    "consistency"};
-	const char *expected = "NAME=LO:HI or NAME=LO:HI:log with NAME one of nu, repose_angle, "
-	                       "gamma, delta, viscosity, consistency and LO < HI, e.g. "
-	                       "nu=0.01:1:log";
+	char names[256], expected[512];
+	fittable_names(names, sizeof names);
+	snprintf(expected, sizeof expected, "NAME=LO:HI or NAME=LO:HI:log with NAME one of %s and "
+	         "LO < HI, e.g. nu=0.01:1:log", names);
 	memset(p, 0, sizeof *p);
 	const char *eq = strchr(text, '=');
 	const size_t len = eq ? (size_t)(eq - text) : 0;
-	int known = 0;
-	for (int k = 0; k < 6 && eq; k++)
-		known |= strlen(names[k]) == len && !strncmp(text, names[k], len);
-	/* repose_angle may also be written as the case file's angle */
-	if (!known)
+	if (!eq || len >= sizeof p->name || !fittable(text, len))
 		return ss_error_input("--param '%s': %s", text, expected);
 	memcpy(p->name, text, len);
 	char lo[64], hi[64], scale[16] = "";
@@ -148,46 +167,6 @@ int ss_fit_param_parse(const char *text, struct ss_fit_param *p)
 	return SS_OK;
 }
 
-/* A heap options object: the options first (the caller's pointer is to
- * them), then the copies of the texts set by name. */
-struct owned_options {
-	struct ss_fit_options o;
-	struct ss_option_texts texts;
-};
-
-struct ss_fit_options *ss_fit_options_create(void)
-{
-	struct owned_options *w = ss_alloc(1, sizeof *w, "fit options");
-	if (w)
-		ss_fit_options_init(&w->o);
-	return w ? &w->o : NULL;
-}
-
-void ss_fit_options_destroy(struct ss_fit_options *o)
-{
-	if (!o)
-		return;
-	struct owned_options *w = (struct owned_options *)o;
-	ss_option_texts_release(&w->texts);
-	ss_free(w);
-}
-
-int ss_fit_options_set(struct ss_fit_options *o, const char *key, const char *value)
-{
-	struct owned_options *w = (struct owned_options *)o;
-	if (!strcmp(key, "param")) {
-		if (o->param_count == SS_FIT_MAX_PARAMS)
-			return ss_error_input("param '%s': at most %d parameters", value,
-			                      SS_FIT_MAX_PARAMS);
-		struct ss_fit_param p;
-		const int err = ss_fit_param_parse(value, &p);
-		if (!err)
-			o->params[o->param_count++] = p;
-		return err;
-	}
-	return ss_option_set(&ss_fit_option_table, o, key, value, &w->texts);
-}
-
 int ss_fit_run_json(const struct ss_fit_options *o, char *buf, size_t size)
 {
 	char *report = NULL;
@@ -203,11 +182,4 @@ int ss_fit_run_json(const struct ss_fit_options *o, char *buf, size_t size)
 	memcpy(buf, report, n);
 	free(report);
 	return SS_OK;
-}
-
-void ss_fit_options_set_watch(struct ss_fit_options *o, struct ss_watch *w)
-{
-	o->stop_signal = w ? ss_watch_stop_flag(w) : NULL;
-	o->progress = w ? ss_watch_fit_progress : NULL;
-	o->progress_context = w;
 }

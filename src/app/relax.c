@@ -12,8 +12,8 @@
 #include <string.h>
 
 #include "app/drive.h"
+#include "app/relax_inputs.h"
 #include "io/output.h"
-#include "model/setup.h"
 #include "sandslide/comm.h"
 #include "sandslide/error.h"
 #include "sandslide/parallel.h"
@@ -54,15 +54,14 @@ static double flow_volume(struct ss_stepper *st)
 
 /* The report (ss_relax_report_json, the one formatter) to path, whole or
  * not at all. */
-static int write_report(const char *path, const struct ss_relax_options *o,
-                        const struct ss_relax_report *r)
+static int write_report(const char *path, const struct ss_relax_report *r)
 {
 	/* the numbers, and both paths with every byte escaped (\u00XX) */
-	const size_t size = 2048 + 6 * (strlen(o->dem) + strlen(r->output));
+	const size_t size = 2048 + 6 * (strlen(r->input) + strlen(r->output));
 	char *json = ss_alloc(size, 1, "the report");
 	if (!json)
 		return SS_ERR_FAIL;
-	int err = ss_relax_report_json(o, r, json, size);
+	int err = ss_relax_report_json(r, json, size);
 	char tmp[4200];
 	snprintf(tmp, sizeof tmp, "%s.partial", path);
 	FILE *f = err ? NULL : fopen(tmp, "w");
@@ -95,14 +94,14 @@ static void heights_to_raster(const struct ss_stepper *st, struct ss_raster *r)
 }
 
 /* The rows of an nx x ny raster that rank `rank`'s slab holds, as the
- * stepper will split the grid with relax's tiles (stepper.h). */
+ * stepper splits the grid with relax's tiles (stepper.h). */
 static int slab_rows(int nx, int ny, const struct ss_relax_options *o, int rank, int *first,
                      int *rows)
 {
 	struct ss_grid whole;
 	const int err = ss_grid_init(&whole, nx, ny, 1.0, 1.0, 0.0, 0.0);
 	if (!err)
-		ss_stepper_slab_rows(&whole, o->tile[0], o->tile[1], rank, first, rows);
+		ss_stepper_slab_rows(&whole, o->job.tile[0], o->job.tile[1], rank, first, rows);
 	return err;
 }
 
@@ -170,153 +169,51 @@ static int write_streamed(const char *path, enum ss_dem_format format, const str
 /* Everything one relaxation holds, released by ss_relax_run. */
 struct relax {
 	const struct ss_relax_options *o;
-	struct ss_raster dem, bedrock;
+	struct ss_relax_inputs in;        /* in.dem: the initial heights, then
+	                                   * the output raster's */
 	enum ss_dem_format format;        /* of the output */
 	struct ss_stepper st;
 	struct ss_drive drive;
 };
 
-/* The driver's rebuild: the DEM's stepper at t = 0 (model/setup.h). */
+/* The driver's rebuild: the DEM's stepper at t = 0. */
 static int rebuild(void *context, struct ss_stepper *st)
 {
 	const struct relax *x = context;
-	const struct ss_relax_options *o = x->o;
-	const struct ss_raster_setup s = {
-		.model = &o->model, .name = o->dem, .heights = &x->dem, .dx = o->read.cellsize,
-		.sides = o->sides, .nodata_type = o->nodata_type, .open_level = o->open_level,
-		.bedrock = o->bedrock ? &x->bedrock : NULL,
-		.tile_nx = o->tile[0], .tile_ny = o->tile[1],
-		.pour = o->sand_shape.kind != SS_SHAPE_NONE ? &o->sand_shape : NULL,
-		.pour_rate = o->sand_rate, .pour_duration = o->sand_duration,
-	};
-	return ss_setup_stepper_from_raster(&s, st);
+	return ss_relax_setup_stepper(x->o, &x->in, st);
 }
 
-/* A copy of a caller's raster (values, nodata and geometry: the writers'
- * metadata is not needed in memory) into r, whole (one rank). */
-static int raster_copy(const struct ss_raster *from, struct ss_raster *r)
-{
-	const size_t cells = (size_t)from->nx * (size_t)from->ny;
-	if (ss_comm_size() > 1 || from->rows != from->ny)
-		return ss_error_input("relax of a raster in memory runs on one rank, of a whole "
-		                      "raster: give the file to each rank");
-	int err = ss_raster_init(r, from->nx, from->ny);
-	if (!err && from->nodata && !(r->nodata = ss_alloc(cells, 1, "nodata flags")))
-		err = SS_ERR_FAIL;
-	if (err)
-		return err;
-	memcpy(r->values, from->values, cells * sizeof *r->values);
-	if (from->nodata)
-		memcpy(r->nodata, from->nodata, cells);
-	r->cellsize = from->cellsize;
-	r->cellsize_y = from->cellsize_y;
-	r->x0 = from->x0;
-	r->y0 = from->y0;
-	return SS_OK;
-}
-
-/* What the options need together (the table checks each alone). */
-static int check_options(const struct ss_relax_options *o)
-{
-	const int pour = o->sand_shape.kind != SS_SHAPE_NONE;
-	if (!o->dem)
-		return ss_error_input("relax needs a DEM");
-	if (pour != !isnan(o->sand_rate) || pour != !isnan(o->sand_duration))
-		return ss_error_input("--add-sand, --sand-rate and --sand-duration go together");
-	if (!isnan(o->read.zoffset) && isnan(o->read.zscale))
-		return ss_error_input("--zoffset needs --zscale");
-	return SS_OK;
-}
-
-/* This rank's rows of the raster spec: its window (dem.h), found from the
- * header as ss_stepper_init will split the grid, so that no rank holds
- * the whole raster; one rank reads it whole. */
-static int read_window(const char *spec, const char *context, struct ss_dem_read_options opt,
-                       const struct ss_relax_options *o, struct ss_raster *r)
-{
-	if (ss_comm_size() > 1) {
-		opt.rows = 0;
-		int err = ss_dem_read(spec, context, &opt, r);
-		if (!err)
-			err = slab_rows(r->nx, r->ny, o, ss_comm_rank(), &opt.row_first, &opt.rows);
-		ss_raster_release(r);
-		if (err)
-			return err;
-	}
-	return ss_dem_read(spec, context, &opt, r);
-}
-
-/* Flags for r's rows when another rank's rows have some: the snapshot's
- * nodata (snapshot.h) is given by every rank or by none. */
-static int agree_nodata(struct ss_raster *r)
-{
-	double any = r->nodata ? 1.0 : 0.0;
-	ss_comm_reduce(&any, 1, NULL, 0);
-	if (any == 0.0 || r->nodata)
-		return SS_OK;
-	const size_t cells = (size_t)r->nx * (size_t)r->rows;
-	if (!(r->nodata = ss_alloc(cells ? cells : 1, 1, "nodata flags")))
-		return SS_ERR_FAIL;
-	memset(r->nodata, 0, cells ? cells : 1);
-	return SS_OK;
-}
-
-/* The inputs and the output's name and format, all checked: every rank
- * reads its own rows, so a failure of one is agreed by all. */
-static int read_inputs_here(struct relax *x, struct ss_relax_report *rep);
-
-static int read_inputs(struct relax *x, struct ss_relax_report *rep)
-{
-	int err = ss_comm_agree(read_inputs_here(x, rep));
-	if (!err)
-		err = ss_comm_agree(agree_nodata(&x->dem));
-	return err;
-}
-
-static int read_inputs_here(struct relax *x, struct ss_relax_report *rep)
+/* The output's name and format, checked before any work: every rank
+ * checks the same, so they agree. */
+static int check_output(struct relax *x, struct ss_relax_report *rep)
 {
 	const struct ss_relax_options *o = x->o;
-	if ((o->input_raster && !o->dem) || (o->bedrock_raster && !o->bedrock))
-		SS_BUG("ss_relax_run: an input raster without its name (dem, bedrock)");
-	int err = check_options(o);
-	if (err)
-		return err;
-	if (o->output_raster)
+	if (o->output_raster) {
 		snprintf(rep->output, sizeof rep->output, "(array)");
-	else if (o->output)
-		snprintf(rep->output, sizeof rep->output, "%s", o->output);
+		if (o->output_raster->nx != x->in.dem.nx || o->output_raster->ny != x->in.dem.ny)
+			return ss_error_input("the output raster is %d x %d cells: expected the DEM's "
+			                      "%d x %d", o->output_raster->nx, o->output_raster->ny,
+			                      x->in.dem.nx, x->in.dem.ny);
+		return SS_OK;
+	}
+	if (o->job.output)
+		snprintf(rep->output, sizeof rep->output, "%s", o->job.output);
 	else
 		default_output(o->dem, rep->output, sizeof rep->output);
-	err = o->input_raster ? raster_copy(o->input_raster, &x->dem)
-	                      : read_window(o->dem, NULL, o->read, o, &x->dem);
-	if (!err && o->output_raster && (o->output_raster->nx != x->dem.nx ||
-	                                 o->output_raster->ny != x->dem.ny))
-		err = ss_error_input("the output raster is %d x %d cells: expected the DEM's "
-		                     "%d x %d", o->output_raster->nx, o->output_raster->ny,
-		                     x->dem.nx, x->dem.ny);
-	if (!err && !o->output_raster)
-		err = ss_dem_format_from_path(rep->output, "-o", &x->format);
+	int err = ss_dem_format_from_path(rep->output, "-o", &x->format);
 	if (!err && x->format == SS_DEM_GDAL && !ss_dem_gdal_available())
 		err = ss_error_input("-o %s: GeoTIFF output needs a build with GDAL (libgdal-dev); "
 		                     "write .asc, .png or .h5", rep->output);
-	if (!err && !o->output_raster)
-		err = ss_output_check_folder(rep->output, o->output == NULL);
+	if (!err)
+		err = ss_output_check_folder(rep->output, o->job.output == NULL);
 	/* refused now, not after the relaxation whose result it would be */
-	if (!err && !o->output_raster)
-		err = ss_dem_check_not_source(rep->output, &x->dem);
-	if (err || !o->bedrock)
-		return err;
-	if ((err = o->bedrock_raster ? raster_copy(o->bedrock_raster, &x->bedrock)
-	                             : read_window(o->bedrock, "--bedrock", o->read, o, &x->bedrock)))
-		return err;
-	if (x->bedrock.nx != x->dem.nx || x->bedrock.ny != x->dem.ny)
-		return ss_error_input("--bedrock %s is %d x %d cells: expected the DEM's %d x %d",
-		                      o->bedrock, x->bedrock.nx, x->bedrock.ny, x->dem.nx, x->dem.ny);
-	return SS_OK;
+	if (!err)
+		err = ss_dem_check_not_source(rep->output, &x->in.dem);
+	return err;
 }
 
 /* The initial state's measures.  What moved is counted against the DEM's
- * rows (x->dem, until write_raster overwrites them), which hold the
+ * rows (x->in.dem, until write_raster overwrites them), which hold the
  * initial height of every flow cell: no copy of the heights. */
 static int measure_before(struct relax *x, struct ss_relax_report *rep)
 {
@@ -341,23 +238,21 @@ static int open_output(struct relax *x, const struct ss_relax_report *rep)
 	d->steady_slope_tol = o->model.steady_slope_tol;
 	d->output_every = !isnan(o->output_every) ? o->output_every
 	                : series && isfinite(d->end) ? d->end / 20.0 : INFINITY;
-	d->stop_signal = o->stop_signal;
-	d->progress = o->progress;
-	d->progress_context = o->progress_context;
+	d->job = &o->job;
 	d->rebuild = rebuild;
 	d->rebuild_context = x;
 	if (o->output_raster)
 		return SS_OK;   /* nothing to claim: the caller's memory */
-	int err = ss_drive_claim(d, rep->output, o->output == NULL, o->force, 0, NULL);
+	int err = ss_drive_claim(d, rep->output, o->job.output == NULL, o->job.force, 0, NULL);
 	if (err || !series)
 		return err;
 	const struct ss_snapshot_meta meta = {
-		.title = o->dem, .history = o->history ? o->history : "",
+		.title = o->dem, .history = o->job.history ? o->job.history : "",
 		.case_text = "", .closure = ss_closure_name(o->model.closure),
 		.integrator = ss_integrator_name(x->st.integrator),
 		.repose_angle_deg = o->model.angle_deg, .nu = o->model.nu, .gamma = o->model.gamma,
-		.bedrock = x->st.bedrock, .crs_wkt = x->dem.crs_wkt, .boundary = &x->st.boundary,
-		.nodata = x->dem.nodata,
+		.bedrock = x->st.bedrock, .crs_wkt = x->in.dem.crs_wkt, .boundary = &x->st.boundary,
+		.nodata = x->in.dem.nodata,
 	};
 	return ss_drive_create(d, &meta);
 }
@@ -380,7 +275,7 @@ static void measure_after(struct relax *x, enum ss_drive_end end, struct ss_rela
 	rep->max_slope_after_deg = steepest_sand_face_deg(st);
 	/* in row order, carried from rank to rank (comm.h) */
 	double moved = 0.0, cells_moved = 0.0, none = 0.0;
-	const double *h0 = x->dem.values + (size_t)(g->offset_j - x->dem.row_first) * g->nx;
+	const double *h0 = x->in.dem.values + (size_t)(g->offset_j - x->in.dem.row_first) * g->nx;
 	ss_comm_fold_start(&moved, 1);
 	for (int j = 0; j < g->ny; j++) {
 		for (int i = 0; i < g->nx; i++) {
@@ -404,13 +299,13 @@ static int write_raster(struct relax *x, const char *path)
 {
 	if (x->format == SS_DEM_H5)
 		return SS_OK;
-	heights_to_raster(&x->st, &x->dem);
+	heights_to_raster(&x->st, &x->in.dem);
 	if (x->o->output_raster) {   /* one rank, whole (raster_copy) */
-		memcpy(x->o->output_raster->values, x->dem.values,
-		       (size_t)x->dem.nx * x->dem.ny * sizeof *x->dem.values);
+		memcpy(x->o->output_raster->values, x->in.dem.values,
+		       (size_t)x->in.dem.nx * x->in.dem.ny * sizeof *x->in.dem.values);
 		return SS_OK;
 	}
-	return write_streamed(path, x->format, &x->dem, x->o);
+	return write_streamed(path, x->format, &x->in.dem, x->o);
 }
 
 /* The guard fired: the last good state goes to a raster output too. */
@@ -429,12 +324,16 @@ int ss_relax_run(const struct ss_relax_options *o, struct ss_relax_report *rep)
 	struct relax x;
 	memset(&x, 0, sizeof x);
 	memset(rep, 0, sizeof *rep);
+	rep->input = o->dem;
+	rep->model = o->model;
 	x.o = o;
 	ss_drive_init(&x.drive, &x.st, started);
-	ss_drive_set_threads(o->threads);
+	ss_drive_set_threads(o->job.threads);
 
 	enum ss_drive_end end = SS_DRIVE_END;
-	int err = read_inputs(&x, rep);
+	int err = ss_relax_inputs_read(o, &x.in);
+	if (!err)
+		err = ss_comm_agree(check_output(&x, rep));
 	rep->read_seconds = ss_parallel_wall_seconds() - started;
 	if (!err)
 		err = rebuild(&x, &x.st);
@@ -466,10 +365,9 @@ int ss_relax_run(const struct ss_relax_options *o, struct ss_relax_report *rep)
 		rep->write_seconds = most[2];
 	}
 	if (!err && o->report)
-		err = ss_comm_agree(ss_comm_rank() == 0 ? write_report(o->report, o, rep) : SS_OK);
+		err = ss_comm_agree(ss_comm_rank() == 0 ? write_report(o->report, rep) : SS_OK);
 	err = ss_drive_finish(&x.drive, err);
 	ss_stepper_release(&x.st);
-	ss_raster_release(&x.bedrock);
-	ss_raster_release(&x.dem);
+	ss_relax_inputs_release(&x.in);
 	return err;
 }

@@ -1,7 +1,7 @@
 /*
  * relax_options.c - relax's options (relax.h): the one table the command
- * line, the options set by name and the Python module read, and the
- * options object for foreign callers.
+ * line, the options set by name and the Python module read, continued by
+ * the model's and the job's.
  */
 #include "sandslide/relax.h"
 
@@ -10,8 +10,6 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "base/strings.h"
-#include "sandslide/error.h"
 
 int ss_relax_sides_parse(const char *word, enum ss_side_kind *sides)
 {
@@ -33,11 +31,6 @@ int ss_relax_nodata_parse(const char *word, enum ss_cell_type *type)
 static int parse_sides(const char *value, void *field)
 {
 	return ss_relax_sides_parse(value, field);
-}
-
-static int parse_tile(const char *value, void *field)
-{
-	return ss_parse_tile(value, field);
 }
 
 static int parse_nodata(const char *value, void *field)
@@ -66,14 +59,10 @@ static const struct ss_option options[] = {
 	{.name = "dem", .kind = SS_OPTION_TEXT, .offset = AT(dem), .flags = SS_OPTION_NAMED_ONLY,
 	 .expected = "a path", .help = "the DEM (the command line's argument)"},
 	{.name = "output", .alias = "-o", .value_name = "OUT", .kind = SS_OPTION_TEXT,
-	 .offset = AT(output), .expected = "a path",
+	 .offset = AT(job.output), .expected = "a path",
 	 .help = ".asc, .png, .tif: the relaxed raster; .h5: the whole\n"
 	         "series with diagnostics (default out/<DEM>-relaxed\n"
 	         "with the input's extension)"},
-	{.name = "threads", .value_name = "N", .kind = SS_OPTION_INT, .offset = AT(threads),
-	 .lo = 1, .hi = 4096, .expected = "an integer from 1 to 4096",
-	 .help = "OpenMP threads (default: OMP_NUM_THREADS, else\n"
-	         "the processors this process may run on)"},
 	{.name = "sides", .value_name = "wall|open", .kind = SS_OPTION_WORD, .offset = AT(sides),
 	 .default_value = "wall", .parse = parse_sides, .expected = "wall or open",
 	 .help = "the four sides of the DEM"},
@@ -90,11 +79,6 @@ static const struct ss_option options[] = {
 	 .expected = "a path",
 	 .help = "non-erodible base, a raster of the DEM's size: only\n"
 	         "the sand above it moves"},
-	{.name = "tile", .value_name = "NXxNY", .kind = SS_OPTION_WORD, .offset = AT(tile),
-	 .parse = parse_tile, .expected = "NXxNY, e.g. 64x32",
-	 .help = "cells per tile of the sweep (default 256x128, smaller\n"
-	         "on small grids); results are the same bits for any\n"
-	         "tile size and thread count"},
 	{.name = "add-sand", .value_name = "SHAPE", .kind = SS_OPTION_WORD,
 	 .offset = AT(sand_shape), .parse = parse_sand_shape,
 	 .expected = "rect=X0,Y0,X1,Y1 (X0 < X1, Y0 < Y1) or disk=X,Y,R (R > 0), in m",
@@ -118,16 +102,20 @@ static const struct ss_option options[] = {
 	         "--max-time, else the first and the last)"},
 	{.name = "report", .value_name = "FILE.json", .kind = SS_OPTION_TEXT, .offset = AT(report),
 	 .expected = "a path", .help = "write the diagnostics for scripts"},
-	{.name = "force", .kind = SS_OPTION_FLAG, .offset = AT(force), .expected = "1 or 0",
-	 .help = "replace OUT if it exists (else refused)"},
-	{.name = "history", .kind = SS_OPTION_TEXT, .offset = AT(history),
-	 .flags = SS_OPTION_NAMED_ONLY, .expected = "a text",
-	 .help = "the output's history attribute (the command line)"},
 };
+
+static const struct ss_option_part parts[] = {
+	{&ss_job_option_table, AT(job)}, {&ss_model_option_table, AT(model)},
+};
+
+static void init(void *o)
+{
+	ss_relax_options_init(o);
+}
 
 const struct ss_option_table ss_relax_option_table = {
 	.command = "relax", .options = options, .count = sizeof options / sizeof *options,
-	.more = &ss_model_option_table, .more_offset = AT(model),
+	.parts = parts, .part_count = 2, .size = sizeof(struct ss_relax_options), .init = init,
 };
 
 void ss_relax_options_init(struct ss_relax_options *o)
@@ -135,35 +123,4 @@ void ss_relax_options_init(struct ss_relax_options *o)
 	memset(o, 0, sizeof *o);
 	ss_dem_read_options_init(&o->read);
 	ss_option_defaults(&ss_relax_option_table, o);
-}
-
-/* A heap options object: the options first (the caller's pointer is to
- * them), then the copies of the texts set by name. */
-struct owned_options {
-	struct ss_relax_options o;
-	struct ss_option_texts texts;
-};
-
-struct ss_relax_options *ss_relax_options_create(void)
-{
-	struct owned_options *w = ss_alloc(1, sizeof *w, "relax options");
-	if (!w)
-		return NULL;
-	ss_relax_options_init(&w->o);
-	return &w->o;
-}
-
-void ss_relax_options_destroy(struct ss_relax_options *o)
-{
-	if (!o)
-		return;
-	struct owned_options *w = (struct owned_options *)o;
-	ss_option_texts_release(&w->texts);
-	ss_free(w);
-}
-
-int ss_relax_options_set(struct ss_relax_options *o, const char *key, const char *value)
-{
-	return ss_option_set(&ss_relax_option_table, o, key, value,
-	                     &((struct owned_options *)o)->texts);
 }

@@ -49,7 +49,7 @@ static int restart_case(const struct ss_run_options *o, const struct ss_restart_
                         struct ss_case *c)
 {
 	memset(c, 0, sizeof *c);
-	if (o->override_count > 0)
+	if (o->overrides.count > 0)
 		return ss_error_input("--restart %s: --set and --unset cannot change a run being "
 		                      "continued (it keeps the overrides it was started with)",
 		                      o->restart);
@@ -96,21 +96,21 @@ static int resolve(struct run *r)
 	const struct ss_run_options *o = r->o;
 	int err;
 	if (!o->restart) {
-		if ((err = ss_case_load(&r->c, o->case_path, o->overrides, o->override_count)))
+		if ((err = ss_case_load(&r->c, o->case_path, o->overrides.items, o->overrides.count)))
 			return err;
-		if (o->output)
-			snprintf(r->output, sizeof r->output, "%s", o->output);
+		if (o->job.output)
+			snprintf(r->output, sizeof r->output, "%s", o->job.output);
 		else
 			default_output(o->case_path, r->output, sizeof r->output);
-		return ss_output_check_folder(r->output, o->output == NULL);
+		return ss_output_check_folder(r->output, o->job.output == NULL);
 	}
 	/* the heights later, each rank its rows (start_stepper) */
 	if ((err = ss_snapshot_read_restart_case(o->restart, &r->restart)) ||
 	    (err = restart_case(o, &r->restart, &r->c)))
 		return err;
-	if (o->output && strcmp(o->output, o->restart) != 0)
+	if (o->job.output && strcmp(o->job.output, o->restart) != 0)
 		return ss_error_input("--restart %s continues that file: drop -o %s", o->restart,
-		                      o->output);
+		                      o->job.output);
 	snprintf(r->output, sizeof r->output, "%s", o->restart);
 	return SS_OK;
 }
@@ -146,7 +146,7 @@ static enum ss_kernel kernel_of(const struct ss_run_options *o)
 static int rebuild(void *context, struct ss_stepper *st)
 {
 	const struct run *r = context;
-	return ss_setup_stepper(&r->c, r->o->tile[0], r->o->tile[1], kernel_of(r->o), st);
+	return ss_setup_stepper(&r->c, r->o->job.tile[0], r->o->job.tile[1], kernel_of(r->o), st);
 }
 
 /* The stepper of the case, where the restart file left it. */
@@ -215,23 +215,21 @@ static int open_output(struct run *r)
 	d->end = r->c.steady ? ss_model_time_limit(&r->c.model) : r->c.end;
 	d->steady_tol = r->c.steady ? r->c.model.steady_tol : 0.0;
 	d->steady_slope_tol = r->c.model.steady_slope_tol;
-	d->stop_signal = o->stop_signal;
-	d->progress = o->progress;
-	d->progress_context = o->progress_context;
+	d->job = &o->job;
 	d->on_snapshot = o->on_snapshot ? report_snapshot : NULL;
 	d->snapshot_context = r;
 	d->rebuild = rebuild;
 	d->rebuild_context = r;
 	snprintf(hint, sizeof hint, ", or --restart %s to continue that run", r->output);
-	int err = ss_drive_claim(d, r->output, !o->output && !o->restart, o->force,
+	int err = ss_drive_claim(d, r->output, !o->job.output && !o->restart, o->job.force,
 	                         o->restart != NULL, hint);
 	if (err || o->restart)
 		return err ? err : ss_drive_append(d);
-	char *overrides = ss_strings_join(o->overrides, o->override_count, "\n", 1);
+	char *overrides = ss_strings_join(o->overrides.items, o->overrides.count, "\n", 1);
 	if (!overrides)
 		return SS_ERR_FAIL;
 	const struct ss_snapshot_meta meta = {
-		.title = r->c.path, .history = o->history ? o->history : "",
+		.title = r->c.path, .history = o->job.history ? o->job.history : "",
 		.case_text = r->c.text, .closure = ss_closure_name(r->c.model.closure),
 		.integrator = ss_integrator_name(r->st.integrator),
 		.repose_angle_deg = r->c.model.angle_deg, .nu = r->c.model.nu,
@@ -283,7 +281,7 @@ int ss_run_case(const struct ss_run_options *o, struct ss_run_summary *summary)
 	memset(&r, 0, sizeof r);
 	r.o = o;
 	ss_drive_init(&r.drive, &r.st, started);
-	ss_drive_set_threads(o->threads);
+	ss_drive_set_threads(o->job.threads);
 
 	/* a restart reads the file it will write: claimed first, as a live run
 	 * may be writing it (a missing file is left to the reading to report) */

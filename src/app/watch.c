@@ -24,6 +24,7 @@
 #include <stdatomic.h>
 
 #include "sandslide/error.h"
+#include "sandslide/fit.h"
 
 struct ss_watch {
 	atomic_int stop_request;          /* 1: asked, from any thread */
@@ -97,13 +98,26 @@ static void publish(struct ss_watch *w, double time, double end, long long steps
 	atomic_store_explicit(&w->seq, s + 2, memory_order_release);
 }
 
-/* The fraction done: of the time to the end when there is one; until
- * steady, how far max |dh/dt| has fallen from the first substep's towards
- * the steady tolerance on a log scale (the decay is roughly exponential),
- * never going back; 1 only from the caller, when the call has returned. */
+/* A fit's fraction: of the closures to fit. */
+static void fit_progress(struct ss_watch *w, const struct ss_fit_progress *p)
+{
+	const double f = p->closure_count > 0 ? (double)p->closure_index / p->closure_count : NAN;
+	publish(w, NAN, NAN, 0, f, p->runs);
+	hand_over_stop(w);
+}
+
+/* The fraction done: a fit's (above); of the time to the end when there
+ * is one; until steady, how far max |dh/dt| has fallen from the first
+ * substep's towards the steady tolerance on a log scale (the decay is
+ * roughly exponential), never going back; 1 only from the caller, when
+ * the call has returned. */
 void ss_watch_progress(void *context, const struct ss_progress *p)
 {
 	struct ss_watch *w = context;
+	if (p->fit) {
+		fit_progress(w, p->fit);
+		return;
+	}
 	double f = NAN;
 	if (isfinite(p->end) && p->end > p->time_start) {
 		f = (p->time - p->time_start) / (p->end - p->time_start);
@@ -122,14 +136,6 @@ void ss_watch_progress(void *context, const struct ss_progress *p)
 		w->fraction_max = f;
 	}
 	publish(w, p->time, p->end, p->steps, f, 0);
-	hand_over_stop(w);
-}
-
-void ss_watch_fit_progress(void *context, const struct ss_fit_progress *p)
-{
-	struct ss_watch *w = context;
-	const double f = p->closure_count > 0 ? (double)p->closure_index / p->closure_count : NAN;
-	publish(w, NAN, NAN, 0, f, p->runs);
 	hand_over_stop(w);
 }
 

@@ -106,7 +106,8 @@ static const struct ss_option run_cli_options[] = {
 	         "of `sandslide render --help` apply, e.g. --label)"},
 };
 static const struct ss_option_table run_cli_table = {
-	"run", run_cli_options, sizeof run_cli_options / sizeof *run_cli_options, NULL, 0,
+	.command = "run", .options = run_cli_options,
+	.count = sizeof run_cli_options / sizeof *run_cli_options,
 };
 
 /* `run --frames`: render each snapshot the run reports. */
@@ -126,10 +127,10 @@ static int run_with_frames(struct ss_run_options *o, const struct run_cli *cli,
 	int err = cli->frames_dir ? ss_render_frames_create(&frames, cli->frames_dir, look)
 	                          : SS_OK;
 	if (!err) {
-		o->history = history;
+		o->job.history = history;
 		o->on_snapshot = frames ? render_run_snapshot : NULL;
 		o->snapshot_context = frames;
-		o->progress = watch(cli->quiet, &o->stop_signal);
+		o->job.progress = watch(cli->quiet, &o->job.stop_signal);
 		err = ss_run_case(o, &s);
 		cli_progress_done();
 	}
@@ -147,9 +148,6 @@ static int cmd_run(int argc, char **argv)
 	struct ss_run_options o;
 	struct run_cli cli = {0, NULL};
 	struct ss_render_options look;
-	struct cli_list overrides = {calloc((size_t)argc, sizeof(char *)), 0};
-	if (!overrides.v)
-		return ss_status_exit_code(ss_error_fail("out of memory"));
 	ss_run_options_init(&o);
 	ss_render_options_default(&look);
 	struct cli_command cmd = {
@@ -163,25 +161,23 @@ static int cmd_run(int argc, char **argv)
 		         "snapshot and exit 130 or 143 naming the command that continues the run.\n"
 		         "Another run writing the same output is refused, --force or not.\n"
 		         "Exit status: 0 done, 1 failure while running, 2 bad input.\n",
-		.what = "case file", .args = &o.case_path, .max_args = 1, .list = &overrides,
+		.what = "case file", .args = &o.case_path, .max_args = 1,
 	};
 	int status = cli_parse(&cmd, argc, argv, 2);
 	char *history = NULL;
 	if (status == CLI_GO_ON && !o.case_path && !o.restart)
 		status = cli_usage_error(&cmd, "run needs a case file (or --restart OUT.h5)");
-	if (status == CLI_GO_ON && cli_given_in(&cmd, 2) && !cli.frames_dir)
+	const char *look_given = cli_given_in(&cmd, &ss_render_look_option_table);
+	if (status == CLI_GO_ON && look_given && !cli.frames_dir)
 		status = cli_usage_error(&cmd, "%s sets the look of frames: it needs --frames DIR",
-		                         cli_given_in(&cmd, 2));
+		                         look_given);
 	if (status == CLI_GO_ON && !(history = ss_strings_join((const char *const *)argv, argc,
 	                                                       " ", 0)))
 		status = 1;
-	if (status == CLI_GO_ON) {
-		o.overrides = overrides.v;
-		o.override_count = overrides.n;
+	if (status == CLI_GO_ON)
 		status = exit_status(run_with_frames(&o, &cli, &look, history));
-	}
 	free(history);
-	free(overrides.v);
+	ss_option_release(&ss_run_option_table, &o);
 	return status;
 }
 
@@ -196,7 +192,9 @@ static const struct ss_option relax_cli_options[] = {
 	{.name = "quiet", .alias = "-q", .kind = SS_OPTION_FLAG,
 	 .offset = offsetof(struct relax_cli, quiet), .help = "no progress line and no summary"},
 };
-static const struct ss_option_table relax_cli_table = {"relax", relax_cli_options, 1, NULL, 0};
+static const struct ss_option_table relax_cli_table = {
+	.command = "relax", .options = relax_cli_options, .count = 1,
+};
 
 static int cmd_relax(int argc, char **argv)
 {
@@ -231,12 +229,12 @@ static int cmd_relax(int argc, char **argv)
 	char *history = ss_strings_join((const char *const *)argv, argc, " ", 0);
 	if (!history)
 		return 1;
-	o.history = history;
-	o.progress = watch(cli.quiet, &o.stop_signal);
+	o.job.history = history;
+	o.job.progress = watch(cli.quiet, &o.job.stop_signal);
 	const int err = ss_relax_run(&o, &report);
 	cli_progress_done();
 	if (!err)
-		cli_print_relax_end(&report, o.model.angle_deg, cli.quiet);
+		cli_print_relax_end(&report, cli.quiet);
 	free(history);
 	return exit_status(err);
 }
@@ -266,8 +264,8 @@ static const struct ss_option render_cli_options[] = {
 	 .help = "time the shaded style on an N x N grid (default 4096)"},
 };
 static const struct ss_option_table render_cli_table = {
-	"render", render_cli_options, sizeof render_cli_options / sizeof *render_cli_options,
-	NULL, 0,
+	.command = "render", .options = render_cli_options,
+	.count = sizeof render_cli_options / sizeof *render_cli_options,
 };
 
 static int cmd_render(int argc, char **argv)
@@ -328,7 +326,9 @@ static const struct ss_option bench_cli_options[] = {
 	{.name = "json", .kind = SS_OPTION_FLAG, .offset = offsetof(struct cli_bench, json),
 	 .help = "one JSON document instead of a table"},
 };
-static const struct ss_option_table bench_cli_table = {"bench", bench_cli_options, 1, NULL, 0};
+static const struct ss_option_table bench_cli_table = {
+	.command = "bench", .options = bench_cli_options, .count = 1,
+};
 
 static int cmd_bench(int argc, char **argv)
 {
@@ -397,16 +397,15 @@ static const struct ss_option fit_cli_options[] = {
 	{.name = "json", .kind = SS_OPTION_FLAG, .offset = offsetof(struct fit_cli, json),
 	 .help = "print the report (JSON) instead of the summary"},
 };
-static const struct ss_option_table fit_cli_table = {"fit", fit_cli_options, 2, NULL, 0};
+static const struct ss_option_table fit_cli_table = {
+	.command = "fit", .options = fit_cli_options, .count = 2,
+};
 
 static int cmd_fit(int argc, char **argv)
 {
 	struct ss_fit_options o;
 	struct fit_cli cli = {0, 0};
 	const char *args[2] = {NULL, NULL};
-	struct cli_list params = {calloc((size_t)argc, sizeof(char *)), 0};
-	if (!params.v)
-		return ss_status_exit_code(ss_error_fail("out of memory"));
 	ss_fit_options_init(&o);
 	struct cli_command cmd = {
 		.usage = "usage: sandslide fit CASE.ini OBS --param NAME=LO:HI[:log] ... "
@@ -421,38 +420,30 @@ static int cmd_fit(int argc, char **argv)
 		.outro = "Ctrl-C (SIGINT) or SIGTERM stop the fit; the report of the best so far is\n"
 		         "written and the exit status is 130 or 143.\n"
 		         "Exit status: 0 done, 1 failure while fitting, 2 bad input.\n",
-		.what = "case file or observations", .args = args, .max_args = 2, .list = &params,
+		.what = "case file or observations", .args = args, .max_args = 2,
 	};
 	int status = cli_parse(&cmd, argc, argv, 2);
 	if (status == CLI_GO_ON && !args[1])
 		status = cli_usage_error(&cmd, "fit needs a case file and observations");
-	for (int k = 0; status == CLI_GO_ON && k < params.n; k++) {
-		if (o.param_count == SS_FIT_MAX_PARAMS)
-			status = cli_usage_error(&cmd, "at most %d --param", SS_FIT_MAX_PARAMS);
-		else if (ss_fit_param_parse(params.v[k], &o.params[o.param_count++]))
-			status = 2;
-	}
 	if (status == CLI_GO_ON) {
 		char *report = NULL, *summary = NULL;
 		o.case_path = args[0];
 		o.observations = args[1];
-		const volatile sig_atomic_t *stop = NULL;
-		ss_progress_fn *shown = watch(cli.quiet || cli.json, &stop);
-		o.stop_signal = stop;
-		o.progress = shown ? cli_print_fit_progress : NULL;
+		o.job.progress = watch(cli.quiet || cli.json, &o.job.stop_signal);
 		const int err = ss_fit_run(&o, &report, &summary);
 		cli_progress_done();
 		if (!err && cli.json)
 			fputs(report, stdout);
 		else if (!err && !cli.quiet && summary)
 			printf("%s", summary);
-		if (!err && !cli.quiet && !cli.json && o.output)
-			printf("wrote %s%s%s\n", o.output, o.plot ? " and " : "", o.plot ? o.plot : "");
+		if (!err && !cli.quiet && !cli.json && o.job.output)
+			printf("wrote %s%s%s\n", o.job.output, o.plot ? " and " : "",
+			       o.plot ? o.plot : "");
 		free(report);
 		free(summary);
 		status = exit_status(err);
 	}
-	free(params.v);
+	ss_option_release(&ss_fit_option_table, &o);
 	return status;
 }
 

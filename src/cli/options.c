@@ -22,24 +22,36 @@ static int on_command_line(const struct ss_option *o)
 	return o->name && !(o->flags & SS_OPTION_NAMED_ONLY);
 }
 
-/* The tables each group continues in, as groups of their own: a table's
- * `more` options are parsed and shown like its own. */
+/* The tables that continue each group's, as groups of their own, right
+ * after it (depth first): a table's parts are parsed and shown like its
+ * own options. */
 static void expand(struct cli_command *c)
 {
 	if (c->group_count)
 		return;
-	int n = 0;
-	while (n < CLI_MAX_GROUPS && c->groups[n].table)
-		n++;
-	for (int g = 0; g < n; g++) {
-		const struct cli_group *from = &c->groups[g];
-		if (!from->table->more)
-			continue;
+	struct cli_group given[CLI_MAX_GROUPS];
+	int count = 0, n = 0;
+	while (count < CLI_MAX_GROUPS && c->groups[count].table)
+		count++;
+	memcpy(given, c->groups, (size_t)count * sizeof *given);
+	/* a stack of the groups still to place, the next on top */
+	struct cli_group stack[CLI_MAX_GROUPS];
+	int top = 0;
+	for (int g = count - 1; g >= 0; g--)
+		stack[top++] = given[g];
+	while (top > 0) {
+		const struct cli_group from = stack[--top];
 		if (n == CLI_MAX_GROUPS)
 			SS_BUG("a command of more than %d option groups", CLI_MAX_GROUPS);
-		c->groups[n++] = (struct cli_group){
-			from->table->more, (char *)from->base + from->table->more_offset, from->hidden,
-		};
+		c->groups[n++] = from;
+		for (int p = from.table->part_count - 1; p >= 0; p--) {
+			if (top == CLI_MAX_GROUPS)
+				SS_BUG("a command of more than %d option groups", CLI_MAX_GROUPS);
+			stack[top++] = (struct cli_group){
+				from.table->parts[p].table,
+				(char *)from.base + from.table->parts[p].offset, from.hidden,
+			};
+		}
 	}
 	c->group_count = n;
 }
@@ -158,19 +170,11 @@ static const struct ss_option *find(const struct cli_command *c, const char *wor
 static int store(struct cli_command *c, const struct ss_option *o, void *field,
                  const char *value)
 {
-	int bad;
-	if (o->kind == SS_OPTION_LIST) {
-		bad = o->parse && o->parse(value, NULL);
-		if (!bad) {
-			if (!c->list)
-				SS_BUG("--%s: a LIST option with no list to collect it", o->name);
-			c->list->v[c->list->n++] = value;
-		}
-	} else {
-		bad = ss_option_parse(o, value, field);
-	}
-	if (bad)
+	if (o->kind == SS_OPTION_LIST ? o->parse && o->parse(value, NULL)
+	                              : ss_option_parse(o, value, field))
 		return cli_usage_error(c, "--%s '%s': expected %s", o->name, value, o->expected);
+	if (o->kind == SS_OPTION_LIST && ss_option_list_append(field, value))
+		return 1;   /* out of memory, printed */
 	return 0;
 }
 
@@ -241,10 +245,11 @@ const char *cli_given(const struct cli_command *c, const char *name)
 	return NULL;
 }
 
-const char *cli_given_in(const struct cli_command *c, int g)
+const char *cli_given_in(const struct cli_command *c, const struct ss_option_table *t)
 {
-	for (int k = 0; k < c->groups[g].table->count; k++)
-		if (c->given[g][k])
-			return c->given[g][k];
+	for (int g = 0; g < c->group_count; g++)
+		for (int k = 0; k < c->groups[g].table->count && c->groups[g].table == t; k++)
+			if (c->given[g][k])
+				return c->given[g][k];
 	return NULL;
 }

@@ -19,17 +19,10 @@
 
 #include "sandslide/option.h"
 
-/* Where the LIST options of a command collect their words, in the order
- * given (v has room for argc). */
-struct cli_list {
-	const char **v;
-	int n;
-};
-
 /* A table and the struct its offsets point into. */
 struct cli_group {
-	const struct ss_option_table *table;   /* its `more` tables become
-	                                        * groups of their own */
+	const struct ss_option_table *table;   /* its parts become groups of
+	                                        * their own */
 	void *base;
 	int hidden;                 /* parsed, left out of the help */
 };
@@ -44,7 +37,6 @@ struct cli_command {
 	const char *what;           /* an argument, for messages: "case file" */
 	const char **args;          /* the arguments found ... */
 	int max_args;               /* ... at most this many */
-	struct cli_list *list;      /* LIST options' words (NULL: none) */
 	/* set by cli_parse */
 	int group_count;
 	int arg_count;
@@ -58,9 +50,9 @@ struct cli_command {
 int cli_parse(struct cli_command *c, int argc, char **argv, int first);
 
 /* The word that gave option `name` ("--output"; NULL if not given), and
- * the first word that gave an option of the g-th group of the command. */
+ * the first word that gave an option of table t (a group of the command). */
 const char *cli_given(const struct cli_command *c, const char *name);
-const char *cli_given_in(const struct cli_command *c, int g);
+const char *cli_given_in(const struct cli_command *c, const struct ss_option_table *t);
 
 /* The command's help: usage, intro, one line or more per option with its
  * default, outro. */

@@ -30,9 +30,27 @@ static struct {
 	int shown;                  /* a line is on the terminal */
 } progress;
 
+/* fit's line, at most four times a second. */
+static void fit_progress(const struct ss_fit_progress *p)
+{
+	const double now = ss_parallel_wall_seconds();
+	if (now - progress.last_print < 0.25)
+		return;
+	progress.last_print = now;
+	progress.shown = 1;
+	fprintf(stderr, "\r  fitting %s (%d of %d): %-11s %lld forward runs, best cost %.4g   ",
+	        p->closure, p->closure_index + 1, p->closure_count, p->stage, p->runs,
+	        p->best_cost);
+	fflush(stderr);
+}
+
 void cli_print_progress(void *context, const struct ss_progress *p)
 {
 	(void)context;
+	if (p->fit) {
+		fit_progress(p->fit);
+		return;
+	}
 	if (p->wall_seconds - progress.last_print < 0.5)
 		return;
 	progress.last_print = p->wall_seconds;
@@ -51,20 +69,6 @@ void cli_print_progress(void *context, const struct ss_progress *p)
 	}
 	fprintf(stderr, "\r  t = %.6g %s  steps %lld  %.3g cells/s  max|dh/dt| %.2e m/s   ",
 	        p->time, tail, p->steps, rate, p->rate_max);
-	fflush(stderr);
-}
-
-void cli_print_fit_progress(void *context, const struct ss_fit_progress *p)
-{
-	(void)context;
-	const double now = ss_parallel_wall_seconds();
-	if (now - progress.last_print < 0.25)
-		return;
-	progress.last_print = now;
-	progress.shown = 1;
-	fprintf(stderr, "\r  fitting %s (%d of %d): %-11s %lld forward runs, best cost %.4g   ",
-	        p->closure, p->closure_index + 1, p->closure_count, p->stage, p->runs,
-	        p->best_cost);
 	fflush(stderr);
 }
 
@@ -110,7 +114,7 @@ void cli_print_run_end(const struct ss_run_summary *s, int quiet)
 	       ss_format_bytes(s->memory_peak_bytes, peak), s->ranks > 1 ? " a rank" : "");
 }
 
-void cli_print_relax_end(const struct ss_relax_report *r, double angle_deg, int quiet)
+void cli_print_relax_end(const struct ss_relax_report *r, int quiet)
 {
 	if (ss_comm_rank() != 0)
 		return;
@@ -131,7 +135,7 @@ void cli_print_relax_end(const struct ss_relax_report *r, double angle_deg, int 
 		snprintf(ranks, sizeof ranks, "%d ranks x ", r->ranks);
 	printf("cells moved %lld, volume moved %.6g m^3, steepest sand face %.4f -> "
 	       "%.4f deg (repose %g), wall %.3f s on %s%d thread%s\n", r->cells_moved,
-	       r->volume_moved, r->max_slope_before_deg, r->max_slope_after_deg, angle_deg,
+	       r->volume_moved, r->max_slope_before_deg, r->max_slope_after_deg, r->model.angle_deg,
 	       r->wall_seconds, ranks, ss_parallel_max_threads(),
 	       ss_parallel_max_threads() == 1 ? "" : "s");
 	printf("read %.3f s, write %.3f s; memory: %.0f B per cell, peak %s%s\n",

@@ -15,18 +15,17 @@
 #include "sandslide/run.h"
 #include "sandslide/snapshot.h"
 
-/* The progress line on stderr ("\r  t = ..."), at most twice a second (a
- * process shows one; context is unused). */
+/* The progress line on stderr ("\r  t = ..."), at most twice a second, or
+ * a fit's ("\r  fitting ..."), at most four times (a process shows one;
+ * context is unused). */
 void cli_print_progress(void *context, const struct ss_progress *p);
 /* End the progress line, if one was shown. */
-/* fit's progress line (fit.h), on stderr, at most four times a second. */
-void cli_print_fit_progress(void *context, const struct ss_fit_progress *p);
 void cli_progress_done(void);
 
 /* How a run or a relaxation ended: the interruption on stderr, else (and
  * for relax also then) the summary on stdout unless quiet. */
 void cli_print_run_end(const struct ss_run_summary *s, int quiet);
-void cli_print_relax_end(const struct ss_relax_report *r, double angle_deg, int quiet);
+void cli_print_relax_end(const struct ss_relax_report *r, int quiet);
 
 /* The benchmark's callbacks; context is a struct cli_bench, zeroed but
  * for json.  cli_bench_done closes the JSON document. */

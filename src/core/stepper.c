@@ -69,6 +69,12 @@ void ss_stepper_slab_rows(const struct ss_grid *g, int tile_nx, int tile_ny, int
 	*rows = (int)((j1 < g->ny ? j1 : g->ny) - *first_row);
 }
 
+void ss_stepper_tile_size(const struct ss_stepper *st, int *tile_nx, int *tile_ny)
+{
+	*tile_nx = st->sweeper->tiling.tile_nx;
+	*tile_ny = st->sweeper->tiling.tile_ny;
+}
+
 int ss_stepper_init(struct ss_stepper *st, const struct ss_grid *g,
                     const struct ss_closure *c, const struct ss_boundary *b,
                     double cfl, int tile_nx, int tile_ny)

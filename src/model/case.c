@@ -93,16 +93,6 @@ static const struct ss_option keys[] = {
 	       .help = "cell size south to north, m (default dx)"),
 	WORD("grid.origin", origin_x, parse_pair, .default_value = "0 0",
 	     .expected = "two finite numbers 'X Y'", .help = "lower-left corner, m"),
-	NUMBER("model.delta", delta, SS_OPTION_POSITIVE, .expected = "a finite number > 0",
-	       .help = "sliding layer thickness, m"),
-	NUMBER("model.density", density, SS_OPTION_POSITIVE, .expected = "a finite number > 0",
-	       .help = "kg/m^3"),
-	NUMBER("model.gravity", gravity, .default_value = "9.81", SS_OPTION_POSITIVE,
-	       .expected = "a finite number > 0", .help = "m/s^2"),
-	NUMBER("model.viscosity", viscosity, SS_OPTION_POSITIVE, .expected = "a finite number > 0",
-	       .help = "mu, Pa s (bingham, casson)"),
-	NUMBER("model.consistency", consistency, SS_OPTION_POSITIVE,
-	       .expected = "a finite number > 0", .help = "k, Pa s^gamma (herschel-bulkley)"),
 	WORD("time.end", end, parse_end, .flags = SS_OPTION_CASE_REQUIRED,
 	     .expected = "a time in s > 0, or steady", .help = "when the run stops"),
 	NUMBER("time.output_every", output_every, .lo = 0.0, .hi = INFINITY,
@@ -138,9 +128,11 @@ static const struct ss_option keys[] = {
 #undef NUMBER
 #undef WORD
 
+static const struct ss_option_part parts[] = {{&ss_model_option_table, AT(model)}};
+
 const struct ss_option_table ss_case_option_table = {
 	.command = "case", .options = keys, .count = sizeof keys / sizeof *keys,
-	.more = &ss_model_option_table, .more_offset = AT(model),
+	.parts = parts, .part_count = 1,
 };
 
 /* Every key of the table and of the model's, in order: an index for the
@@ -182,18 +174,18 @@ struct parse {
  * NULL. */
 static const struct ss_option *find_key(const char *key, int *index, size_t *offset)
 {
-	const struct ss_option *o = ss_option_find_key(&ss_case_option_table, key, offset);
-	if (!o)
-		return NULL;
-	int n = 0;
-	for (const struct ss_option_table *t = &ss_case_option_table; t; t = t->more) {
-		if (o >= t->options && o < t->options + t->count) {
-			*index = n + (int)(o - t->options);
-			return o;
+	const struct ss_option *option[SS_OPTION_MAX];
+	size_t at[SS_OPTION_MAX];
+	const int n = ss_option_flatten(&ss_case_option_table, option, at);
+	if (n > MAX_KEYS)
+		SS_BUG("the case has %d keys: more than MAX_KEYS", n);
+	for (int k = 0; k < n; k++)
+		if (option[k]->case_key && !strcmp(option[k]->case_key, key)) {
+			*index = k;
+			*offset = at[k];
+			return option[k];
 		}
-		n += t->count;
-	}
-	SS_BUG("case key '%s' in no table", key);
+	return NULL;
 }
 
 /* The bookkeeping of "section.key", which must exist. */
@@ -515,15 +507,16 @@ static int unknown_key(struct parse *p, const char *section, const char *key)
 {
 	char known[512] = "";
 	const size_t n = strlen(section);
-	for (const struct ss_option_table *t = &ss_case_option_table; t; t = t->more) {
-		for (int k = 0; k < t->count; k++) {
-			const char *ck = t->options[k].case_key;
-			if (!ck || strncmp(ck, section, n) || ck[n] != '.')
-				continue;
-			if (known[0])
-				strncat(known, ", ", sizeof known - strlen(known) - 1);
-			strncat(known, ck + n + 1, sizeof known - strlen(known) - 1);
-		}
+	const struct ss_option *option[SS_OPTION_MAX];
+	size_t at[SS_OPTION_MAX];
+	const int count = ss_option_flatten(&ss_case_option_table, option, at);
+	for (int k = 0; k < count; k++) {
+		const char *ck = option[k]->case_key;
+		if (!ck || strncmp(ck, section, n) || ck[n] != '.')
+			continue;
+		if (known[0])
+			strncat(known, ", ", sizeof known - strlen(known) - 1);
+		strncat(known, ck + n + 1, sizeof known - strlen(known) - 1);
 	}
 	return fail_at(p, "unknown key '%s' in [%s]: expected one of %s", key, section, known);
 }
@@ -753,16 +746,17 @@ static int prescan(struct parse *p)
  * help and what it accepts say what is missing. */
 static int require_flagged(struct parse *p)
 {
-	for (const struct ss_option_table *t = &ss_case_option_table; t; t = t->more) {
-		for (int k = 0; k < t->count; k++) {
-			const struct ss_option *o = &t->options[k];
-			if (!(o->flags & SS_OPTION_CASE_REQUIRED) || is_set(p, o->case_key))
-				continue;
-			const char *dot = strchr(o->case_key, '.');
-			return ss_error_input("%s: [%.*s] is missing '%s' (%s, %s)", p->path,
-			                      (int)(dot - o->case_key), o->case_key, dot + 1, o->help,
-			                      o->expected);
-		}
+	const struct ss_option *option[SS_OPTION_MAX];
+	size_t at[SS_OPTION_MAX];
+	const int n = ss_option_flatten(&ss_case_option_table, option, at);
+	for (int k = 0; k < n; k++) {
+		const struct ss_option *o = option[k];
+		if (!(o->flags & SS_OPTION_CASE_REQUIRED) || is_set(p, o->case_key))
+			continue;
+		const char *dot = strchr(o->case_key, '.');
+		return ss_error_input("%s: [%.*s] is missing '%s' (%s, %s)", p->path,
+		                      (int)(dot - o->case_key), o->case_key, dot + 1, o->help,
+		                      o->expected);
 	}
 	return SS_OK;
 }
@@ -818,10 +812,6 @@ static int by_override(struct parse *p, const char *key)
 	return k->set && k->by_override;
 }
 
-static const char *const physical[] = {"model.delta", "model.density", "model.viscosity",
-                                       "model.consistency", "model.gravity"};
-enum { PHYSICAL = sizeof physical / sizeof *physical };
-
 static int finish_model(struct parse *p)
 {
 	struct ss_case *c = p->c;
@@ -830,10 +820,16 @@ static int finish_model(struct parse *p)
 	if (m->closure != SS_CLOSURE_HERSCHEL_BULKLEY)
 		m->gamma = 1.0;   /* the others have no exponent (the output says 1) */
 
-	/* nu, or the sliding layer it derives from: an override of one drops
-	 * the other from the file */
+	/* nu, or the sliding layer it derives from (the model's keys of
+	 * ss_model_option_is_layer, in the table's order): an override of
+	 * one drops the other from the file */
+	const char *physical[8];
+	int physical_count = 0;
+	for (int k = 0; k < ss_model_option_table.count; k++)
+		if (ss_model_option_is_layer(&ss_model_option_table.options[k]))
+			physical[physical_count++] = ss_model_option_table.options[k].case_key;
 	const char *given = NULL, *given_by_override = NULL;
-	for (int k = 0; k < PHYSICAL; k++) {
+	for (int k = 0; k < physical_count; k++) {
 		if (!given && is_set(p, physical[k]))
 			given = physical[k];
 		if (!given_by_override && by_override(p, physical[k]))
@@ -841,7 +837,7 @@ static int finish_model(struct parse *p)
 	}
 	if (given && is_set(p, "model.nu")) {
 		if (by_override(p, "model.nu") && !given_by_override) {
-			for (int k = 0; k < PHYSICAL; k++)
+			for (int k = 0; k < physical_count; k++)
 				if (is_set(p, physical[k]))
 					drop(p, physical[k], where_of(p, "model.nu"), "gives nu");
 			given = NULL;
@@ -881,24 +877,8 @@ static int finish_model(struct parse *p)
 	    (err = require(p, "model.density", "kg/m^3")) ||
 	    (err = require(p, law, hb ? "consistency k, Pa s^gamma" : "viscosity mu, Pa s")))
 		return err;
-	/* tau = rho g delta sin a_cr; doc/model.md, [Paper] eqs. 8 and 12 */
-	const double tau = c->density * c->gravity * c->delta * sin(m->angle_deg * M_PI / 180.0);
-	const double d2 = c->delta * c->delta;
-	switch (m->closure) {
-	case SS_CLOSURE_BINGHAM:
-		m->nu = tau * d2 / (6.0 * c->viscosity);
-		break;
-	case SS_CLOSURE_CASSON:
-		m->nu = tau * d2 / (30.0 * c->viscosity);
-		break;
-	case SS_CLOSURE_HERSCHEL_BULKLEY: {
-		const double g = m->gamma;
-		m->nu = pow(tau / c->consistency, 1.0 / g) * g / ((1.0 + g) * (1.0 + 2.0 * g)) * d2;
-		break;
-	}
-	default:
-		break;
-	}
+	m->nu = ss_model_nu_from_layer(m);
+	m->nu_from_layer = 1;
 	if (!(m->nu > 0.0) || !isfinite(m->nu))
 		return ss_error_input("%s: [model] the physical parameters give nu = %g m^2/s: "
 		                      "expected a finite value > 0", p->path, m->nu);

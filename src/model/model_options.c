@@ -18,10 +18,32 @@ static int parse_integrator(const char *value, void *field)
 }
 
 #define AT(m) offsetof(struct ss_model_options, m)
+/* the closures a key applies to (applies_to) */
+#define FOR(k) (1u << SS_CLOSURE_##k)
 
 static const struct ss_option options[] = {
 	{.help = "The model and its time stepping (also the case file's [model] and\n"
 	         "[time] keys: doc/model.md):\n"},
+	/* the sliding layer nu derives from: a case's keys (doc/model.md) */
+	{.case_key = "model.delta", .kind = SS_OPTION_REAL, .offset = AT(layer.delta),
+	 .lo = 0.0, .hi = INFINITY, .flags = SS_OPTION_LO_OPEN | SS_OPTION_FITTABLE,
+	 .applies_to = FOR(BINGHAM) | FOR(HERSCHEL_BULKLEY) | FOR(CASSON),
+	 .expected = "a finite number > 0", .help = "sliding layer thickness, m"},
+	{.case_key = "model.density", .kind = SS_OPTION_REAL, .offset = AT(layer.density),
+	 SS_OPTION_POSITIVE, .applies_to = FOR(BINGHAM) | FOR(HERSCHEL_BULKLEY) | FOR(CASSON),
+	 .expected = "a finite number > 0", .help = "kg/m^3"},
+	{.case_key = "model.gravity", .kind = SS_OPTION_REAL, .offset = AT(layer.gravity),
+	 .default_value = "9.81", SS_OPTION_POSITIVE,
+	 .applies_to = FOR(BINGHAM) | FOR(HERSCHEL_BULKLEY) | FOR(CASSON),
+	 .expected = "a finite number > 0", .help = "m/s^2"},
+	{.case_key = "model.viscosity", .kind = SS_OPTION_REAL, .offset = AT(layer.viscosity),
+	 .lo = 0.0, .hi = INFINITY, .flags = SS_OPTION_LO_OPEN | SS_OPTION_FITTABLE,
+	 .applies_to = FOR(BINGHAM) | FOR(CASSON), .expected = "a finite number > 0",
+	 .help = "mu, Pa s (bingham, casson)"},
+	{.case_key = "model.consistency", .kind = SS_OPTION_REAL, .offset = AT(layer.consistency),
+	 .lo = 0.0, .hi = INFINITY, .flags = SS_OPTION_LO_OPEN | SS_OPTION_FITTABLE,
+	 .applies_to = FOR(HERSCHEL_BULKLEY), .expected = "a finite number > 0",
+	 .help = "k, Pa s^gamma (herschel-bulkley)"},
 	{.name = "closure", .case_key = "model.closure", .value_name = "NAME",
 	 .kind = SS_OPTION_WORD, .offset = AT(closure), .default_value = "coulomb",
 	 .parse = parse_closure, .expected = SS_CLOSURE_NAMES,
@@ -29,13 +51,16 @@ static const struct ss_option options[] = {
 	         "herschel-bulkley or casson"},
 	{.name = "angle", .case_key = "model.repose_angle", .value_name = "DEG",
 	 .kind = SS_OPTION_REAL, .offset = AT(angle_deg), .default_value = "35", .lo = 0.0,
-	 .hi = 90.0, .flags = SS_OPTION_LO_OPEN | SS_OPTION_HI_OPEN | SS_OPTION_CASE_REQUIRED,
+	 .hi = 90.0, .flags = SS_OPTION_LO_OPEN | SS_OPTION_HI_OPEN | SS_OPTION_CASE_REQUIRED |
+	                      SS_OPTION_FITTABLE,
 	 .expected = "degrees in (0, 90)", .help = "repose angle a_cr"},
 	{.name = "gamma", .case_key = "model.gamma", .value_name = "G", .kind = SS_OPTION_REAL,
-	 .offset = AT(gamma), .default_value = "1", SS_OPTION_POSITIVE, .expected = "a number > 0",
-	 .help = "herschel-bulkley exponent (1: bingham's law)"},
+	 .offset = AT(gamma), .default_value = "1", .lo = 0.0, .hi = INFINITY,
+	 .flags = SS_OPTION_LO_OPEN | SS_OPTION_FITTABLE, .applies_to = FOR(HERSCHEL_BULKLEY),
+	 .expected = "a number > 0", .help = "herschel-bulkley exponent (1: bingham's law)"},
 	{.name = "nu", .case_key = "model.nu", .value_name = "V", .kind = SS_OPTION_REAL,
-	 .offset = AT(nu), .default_value = "1", SS_OPTION_POSITIVE, .expected = "m^2/s > 0",
+	 .offset = AT(nu), .default_value = "1", .lo = 0.0, .hi = INFINITY,
+	 .flags = SS_OPTION_LO_OPEN | SS_OPTION_FITTABLE, .expected = "m^2/s > 0",
 	 .help = "m^2/s: sets the time scale only (a case gives it,\n"
 	         "or the sliding layer it derives from)"},
 	{.name = "tol", .case_key = "time.steady_tol", .value_name = "X", .kind = SS_OPTION_REAL,
@@ -83,4 +108,35 @@ void ss_model_options_init(struct ss_model_options *m)
 double ss_model_time_limit(const struct ss_model_options *m)
 {
 	return isnan(m->max_time) ? INFINITY : m->max_time;
+}
+
+int ss_model_option_is_layer(const struct ss_option *o)
+{
+	return o->offset >= AT(layer) && o->offset < AT(layer) + sizeof(struct ss_sliding_layer);
+}
+
+int ss_model_closure(const struct ss_model_options *m, struct ss_closure *c)
+{
+	return ss_closure_init(c, m->closure, m->angle_deg, m->gamma, m->nu);
+}
+
+double ss_model_nu_from_layer(const struct ss_model_options *m)
+{
+	const struct ss_sliding_layer *l = &m->layer;
+	/* tau = rho g delta sin a_cr; doc/model.md, [Paper] eqs. 8 and 12 */
+	const double tau = l->density * l->gravity * l->delta * sin(m->angle_deg * M_PI / 180.0);
+	const double d2 = l->delta * l->delta;
+	switch (m->closure) {
+	case SS_CLOSURE_BINGHAM:
+		return tau * d2 / (6.0 * l->viscosity);
+	case SS_CLOSURE_CASSON:
+		return tau * d2 / (30.0 * l->viscosity);
+	case SS_CLOSURE_HERSCHEL_BULKLEY: {
+		const double g = m->gamma;
+		return pow(tau / l->consistency, 1.0 / g) * g / ((1.0 + g) * (1.0 + 2.0 * g)) * d2;
+	}
+	case SS_CLOSURE_COULOMB:
+		break;
+	}
+	return NAN;   /* the coulomb closure takes nu directly */
 }

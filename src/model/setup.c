@@ -60,7 +60,7 @@ static int start(const struct start *s, struct ss_stepper *st)
 		                      s->grid_what, ss_format_bytes(need, nb),
 		                      ss_format_bytes(have, hb), s->memory_advice);
 	}
-	err = ss_closure_init(&closure, m->closure, m->angle_deg, m->gamma, m->nu);
+	err = ss_model_closure(m, &closure);
 	if (!err)
 		err = ss_stepper_init(st, &g, &closure, s->boundary, m->cfl, s->tile_nx, s->tile_ny);
 	if ((err = ss_comm_agree(err))) {
@@ -106,28 +106,37 @@ static int check_grid_size(const char *path, const char *where, const char *what
 	                      g->global_ny);
 }
 
-/* This rank's rows of the raster `path`, which must be the grid's size
- * (a window, dem.h: no rank holds the whole file).  The header is read
- * first when there are other ranks, so that a file of another size is
- * named as that; `what` ("initial file", "bedrock") names it. */
-static int read_slab(const char *path, const char *where, const char *what,
-                     const struct ss_grid *g, struct ss_raster *r)
+int ss_setup_read_window(const char *spec, const char *context,
+                         struct ss_dem_read_options opt, int tile_nx, int tile_ny,
+                         struct ss_raster *r)
 {
-	struct ss_dem_read_options o;
-	ss_dem_read_options_init(&o);
-	if (!ss_grid_is_whole(g)) {   /* the header, then this rank's rows */
-		o.rows = 0;
-		int err = ss_dem_read(path, where, &o, r);
+	if (ss_comm_size() > 1) {   /* the header, then this rank's rows */
+		opt.rows = 0;
+		int err = ss_dem_read(spec, context, &opt, r);
+		struct ss_grid whole;
 		if (!err)
-			err = check_grid_size(path, where, what, g, r);
+			err = ss_grid_init(&whole, r->nx, r->ny, 1.0, 1.0, 0.0, 0.0);
+		if (!err)
+			ss_stepper_slab_rows(&whole, tile_nx, tile_ny, ss_comm_rank(), &opt.row_first,
+			                     &opt.rows);
 		ss_raster_release(r);
 		if (err)
 			return err;
-		o.row_first = (int)g->offset_j;
-		o.rows = g->ny;
 	}
-	int err = ss_dem_read(path, where, &o, r);
-	return err ? err : check_grid_size(path, where, what, g, r);
+	return ss_dem_read(spec, context, &opt, r);
+}
+
+/* This rank's rows of the raster `path`, which must be the grid's size;
+ * `what` ("initial file", "bedrock") names it. */
+static int read_slab(const char *path, const char *where, const char *what,
+                     const struct ss_stepper *st, struct ss_raster *r)
+{
+	struct ss_dem_read_options o;
+	ss_dem_read_options_init(&o);
+	int tile_nx, tile_ny;
+	ss_stepper_tile_size(st, &tile_nx, &tile_ny);
+	const int err = ss_setup_read_window(path, where, o, tile_nx, tile_ny, r);
+	return err ? err : check_grid_size(path, where, what, &st->grid, r);
 }
 
 static int initial_heights(const struct ss_case *c, struct ss_stepper *st)
@@ -135,7 +144,7 @@ static int initial_heights(const struct ss_case *c, struct ss_stepper *st)
 	const struct ss_grid *g = &st->grid;
 	if (c->initial == SS_INITIAL_FILE) {
 		struct ss_raster r;
-		int err = read_slab(c->initial_file, c->initial_where, "initial file", g, &r);
+		int err = read_slab(c->initial_file, c->initial_where, "initial file", st, &r);
 		if (!err && !isnan(r.cellsize) &&
 		    (fabs(r.cellsize - g->dx) > 1e-9 * g->dx || fabs(r.cellsize - g->dy) > 1e-9 * g->dy))
 			err = ss_error_input("%s: initial file '%s' has cellsize %g m: expected the "
@@ -182,9 +191,8 @@ static int initial_heights(const struct ss_case *c, struct ss_stepper *st)
  * cell. */
 static int load_bedrock(const struct ss_case *c, struct ss_stepper *st)
 {
-	const struct ss_grid *g = &st->grid;
 	struct ss_raster r;
-	int err = read_slab(c->bedrock_file, c->bedrock_where, "bedrock", g, &r);
+	int err = read_slab(c->bedrock_file, c->bedrock_where, "bedrock", st, &r);
 	for (size_t m = 0; !err && r.nodata && m < (size_t)r.nx * r.rows; m++)
 		if (r.nodata[m])
 			err = ss_error_input("%s: bedrock '%s' has no data at cell (%d, %d): the "

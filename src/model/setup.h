@@ -43,6 +43,15 @@ struct ss_raster_setup {
 	double pour_duration;             /*   s */
 };
 
+/* This rank's rows of the raster spec (its window, dem.h) as the stepper
+ * splits a grid of the raster's size in tiles of tile_nx x tile_ny cells
+ * (<= 0: the defaults) over the ranks (ss_stepper_slab_rows), found from
+ * the header first when there are other ranks: no rank holds the whole
+ * raster.  One rank reads it whole.  Release r either way. */
+int ss_setup_read_window(const char *spec, const char *context,
+                         struct ss_dem_read_options opt, int tile_nx, int tile_ny,
+                         struct ss_raster *r);
+
 /* st for the raster set-up s, as ss_setup_stepper (the fast kernel, the
  * default tiles, auto as relax resolves it).  On error st is released. */
 int ss_setup_stepper_from_raster(const struct ss_raster_setup *s, struct ss_stepper *st);

@@ -1,0 +1,59 @@
+/*
+ * job.c - the options every long command shares (job.h): one table, the
+ * watch that follows and stops a job from another thread.
+ */
+#include "sandslide/job.h"
+
+#include <stddef.h>
+
+#include "base/strings.h"
+#include "sandslide/watch.h"
+
+static int parse_tile(const char *value, void *field)
+{
+	return ss_parse_tile(value, field);
+}
+
+#define AT(m) offsetof(struct ss_job, m)
+
+static const struct ss_option options[] = {
+	{.name = "force", .kind = SS_OPTION_FLAG, .offset = AT(force), .expected = "1 or 0",
+	 .help = "replace the output if it exists (else refused)"},
+	{.name = "threads", .value_name = "N", .kind = SS_OPTION_INT, .offset = AT(threads),
+	 .lo = 1, .hi = 4096, .expected = "an integer from 1 to 4096",
+	 .help = "OpenMP threads (default: OMP_NUM_THREADS, else\n"
+	         "the processors this process may run on)"},
+	{.name = "tile", .value_name = "NXxNY", .kind = SS_OPTION_WORD, .offset = AT(tile),
+	 .parse = parse_tile, .expected = "NXxNY, e.g. 256x64",
+	 .help = "cells per tile of the sweep (default 256x128, smaller\n"
+	         "on small grids); results are the same bits for any\n"
+	         "tile size and thread count"},
+	{.name = "history", .kind = SS_OPTION_TEXT, .offset = AT(history),
+	 .flags = SS_OPTION_NAMED_ONLY, .expected = "a text",
+	 .help = "the output's history attribute (the command line)"},
+};
+
+const struct ss_option_table ss_job_option_table = {
+	.command = "job", .options = options, .count = sizeof options / sizeof *options,
+	.size = sizeof(struct ss_job),
+};
+
+struct ss_job *ss_job_of(const struct ss_option_table *t, void *base)
+{
+	for (int p = 0; p < t->part_count; p++) {
+		char *part = (char *)base + t->parts[p].offset;
+		if (t->parts[p].table == &ss_job_option_table)
+			return (struct ss_job *)part;
+		struct ss_job *job = ss_job_of(t->parts[p].table, part);
+		if (job)
+			return job;
+	}
+	return NULL;
+}
+
+void ss_job_set_watch(struct ss_job *job, struct ss_watch *w)
+{
+	job->stop_signal = w ? ss_watch_stop_flag(w) : NULL;
+	job->progress = w ? ss_watch_progress : NULL;
+	job->progress_context = w;
+}

@@ -1,0 +1,115 @@
+/*
+ * relax_inputs.c - the DEM and bedrock relax reads, and the stepper it sets
+ * up from them (see relax_inputs.h).
+ */
+#include "app/relax_inputs.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "model/setup.h"
+#include "sandslide/comm.h"
+#include "sandslide/error.h"
+
+/* A copy of a caller's raster (values, nodata and geometry: the writers'
+ * metadata is not needed in memory) into r, whole (one rank). */
+static int raster_copy(const struct ss_raster *from, struct ss_raster *r)
+{
+	const size_t cells = (size_t)from->nx * (size_t)from->ny;
+	if (ss_comm_size() > 1 || from->rows != from->ny)
+		return ss_error_input("relax of a raster in memory runs on one rank, of a whole "
+		                      "raster: give the file to each rank");
+	int err = ss_raster_init(r, from->nx, from->ny);
+	if (!err && from->nodata && !(r->nodata = ss_alloc(cells, 1, "nodata flags")))
+		err = SS_ERR_FAIL;
+	if (err)
+		return err;
+	memcpy(r->values, from->values, cells * sizeof *r->values);
+	if (from->nodata)
+		memcpy(r->nodata, from->nodata, cells);
+	r->cellsize = from->cellsize;
+	r->cellsize_y = from->cellsize_y;
+	r->x0 = from->x0;
+	r->y0 = from->y0;
+	return SS_OK;
+}
+
+/* What the options need together (the table checks each alone). */
+static int check_options(const struct ss_relax_options *o)
+{
+	const int pour = o->sand_shape.kind != SS_SHAPE_NONE;
+	if (!o->dem)
+		return ss_error_input("relax needs a DEM");
+	if (pour != !isnan(o->sand_rate) || pour != !isnan(o->sand_duration))
+		return ss_error_input("--add-sand, --sand-rate and --sand-duration go together");
+	if (!isnan(o->read.zoffset) && isnan(o->read.zscale))
+		return ss_error_input("--zoffset needs --zscale");
+	return SS_OK;
+}
+
+/* Flags for r's rows when another rank's rows have some: the snapshot's
+ * nodata (snapshot.h) is given by every rank or by none. */
+static int agree_nodata(struct ss_raster *r)
+{
+	double any = r->nodata ? 1.0 : 0.0;
+	ss_comm_reduce(&any, 1, NULL, 0);
+	if (any == 0.0 || r->nodata)
+		return SS_OK;
+	const size_t cells = (size_t)r->nx * (size_t)r->rows;
+	if (!(r->nodata = ss_alloc(cells ? cells : 1, 1, "nodata flags")))
+		return SS_ERR_FAIL;
+	memset(r->nodata, 0, cells ? cells : 1);
+	return SS_OK;
+}
+
+static int read_here(const struct ss_relax_options *o, struct ss_relax_inputs *in)
+{
+	if ((o->input_raster && !o->dem) || (o->bedrock_raster && !o->bedrock))
+		SS_BUG("ss_relax_run: an input raster without its name (dem, bedrock)");
+	int err = check_options(o);
+	if (err)
+		return err;
+	const int tx = o->job.tile[0], ty = o->job.tile[1];
+	err = o->input_raster ? raster_copy(o->input_raster, &in->dem)
+	                      : ss_setup_read_window(o->dem, NULL, o->read, tx, ty, &in->dem);
+	if (err || !o->bedrock)
+		return err;
+	if ((err = o->bedrock_raster
+	           ? raster_copy(o->bedrock_raster, &in->bedrock)
+	           : ss_setup_read_window(o->bedrock, "--bedrock", o->read, tx, ty, &in->bedrock)))
+		return err;
+	if (in->bedrock.nx != in->dem.nx || in->bedrock.ny != in->dem.ny)
+		return ss_error_input("--bedrock %s is %d x %d cells: expected the DEM's %d x %d",
+		                      o->bedrock, in->bedrock.nx, in->bedrock.ny, in->dem.nx,
+		                      in->dem.ny);
+	return SS_OK;
+}
+
+int ss_relax_inputs_read(const struct ss_relax_options *o, struct ss_relax_inputs *in)
+{
+	memset(in, 0, sizeof *in);
+	int err = ss_comm_agree(read_here(o, in));
+	if (!err)
+		err = ss_comm_agree(agree_nodata(&in->dem));
+	return err;
+}
+
+void ss_relax_inputs_release(struct ss_relax_inputs *in)
+{
+	ss_raster_release(&in->bedrock);
+	ss_raster_release(&in->dem);
+}
+
+int ss_relax_setup_stepper(const struct ss_relax_options *o, const struct ss_relax_inputs *in,
+                           struct ss_stepper *st)
+{
+	const struct ss_raster_setup s = {
+		.model = &o->model, .name = o->dem, .heights = &in->dem, .dx = o->read.cellsize,
+		.sides = o->sides, .nodata_type = o->nodata_type, .open_level = o->open_level,
+		.bedrock = o->bedrock ? &in->bedrock : NULL,
+		.tile_nx = o->job.tile[0], .tile_ny = o->job.tile[1],
+		.pour = o->sand_shape.kind != SS_SHAPE_NONE ? &o->sand_shape : NULL,
+		.pour_rate = o->sand_rate, .pour_duration = o->sand_duration,
+	};
+	return ss_setup_stepper_from_raster(&s, st);
+}
