@@ -148,7 +148,8 @@ struct ss_stepper {
 	                               * the error estimate) */
 	double rate_max;              /* max |dh/dt| of the last substep, m/s */
 
-	/* the parts, for src/core/ only */
+	/* the parts: their structs are src/core's (read by its files, by
+	 * bench's kernel timing and by the white-box tests) */
 	struct ss_sweeper *sweeper;   /* the kernel: fast or reference sweep,
 	                               * face rule, CFL table, timers, tiles */
 	struct ss_sources *sources;   /* the sources and the rate field */
