@@ -1,6 +1,7 @@
 # sandslide - plain GNU Makefile.
 #
-#   make            build build/sandslide, build/libsandslide.a and .so
+#   make            build build/sandslide, build/libsandslide.a and .so, and
+#                   the man page build/sandslide.1 (man -l build/sandslide.1)
 #   make lib        only the shared library build/libsandslide.so.0 (what
 #                   the Python module loads; pip's build runs it, setup.py)
 #   make deps       install the Debian packages building and running need
@@ -204,10 +205,17 @@ endif
 ifeq ($(MPI),1)
   MPIFLAG := -DSS_HAVE_MPI
 endif
+# Sources made by the build (the viewer's script as a C array): GEN, on
+# the include path of every build of the library.  The top folder is on it
+# too, for the renderer's headers that other tiers include as
+# "render/plot.h" (private to the library: include/sandslide/ is the
+# installed interface).
+GEN      := $(BUILD)/gen
 # -fPIC: the same objects make the static and the shared library (on
 # x86-64 the kernel's loops make no calls through the PLT or GOT, so the
 # sweep runs as fast: doc/performance.md#how-the-figures-were-measured).
 ALL_CFLAGS  := $(BASE) -fPIC $(WARN) $(OMPFLAG) $(SANFLAG) $(MPIFLAG) $(PATHDEF) -Iinclude -Isrc \
+               -I. -I$(GEN) \
                -DSS_VERSION='"$(VERSION)"' \
                $(DEP_CFLAGS) -MMD -MP $(CFLAGS)
 ALL_LDFLAGS := $(OMPFLAG) $(SANFLAG) $(LDFLAGS)
@@ -240,7 +248,7 @@ HEADERS  := $(wildcard include/sandslide/*.h)
         install uninstall
 SONAME   := libsandslide.so.$(SOVERSION)
 SHLIB    := libsandslide.so.$(VERSION)
-all: $(BUILD)/sandslide $(BUILD)/libsandslide.a $(BUILD)/libsandslide.so
+all: $(BUILD)/sandslide $(BUILD)/libsandslide.a $(BUILD)/libsandslide.so $(BUILD)/sandslide.1
 lib: $(BUILD)/libsandslide.so
 
 # A flags stamp: objects rebuild when the flags change (git's GIT-CFLAGS).
@@ -269,6 +277,28 @@ $(BUILD)/obj/render/%.o: render/%.c $(BUILD)/.flags
 	@mkdir -p $(@D)
 	@$(if $(Q),echo '  CC      $<')
 	$(Q)$(CC) $(ALL_CFLAGS) -c $< -o $@
+
+# The HTML viewer's script, render/viewer.js, as a C array of its bytes
+# (ss_render_viewer_js) that render/html.c includes: the page holds the
+# file's bytes exactly, less its header comment (the // lines up to the
+# first empty line, and that line: what the file says of itself).  awk,
+# od and sed only (POSIX; xxd may be missing, no Python at build time).
+# Every build that compiles html.c (the library's, the fuzz builds') has
+# the header as a prerequisite: its first compile has no .d file yet.
+VIEWER_JS := $(GEN)/render/viewer_js.h
+$(VIEWER_JS): render/viewer.js
+	@mkdir -p $(@D)
+	@$(if $(Q),echo '  GEN     $@')
+	$(Q)awk 'NR == 1 && /^\/\// { head = 1 } head && /^\/\// { next } \
+	  head && /^$$/ { head = 0; next } { head = 0; print }' $< > $@.js
+	$(Q)od -An -v -tx1 $@.js > $@.od
+	$(Q){ echo '/* render/viewer.js as bytes, less its header comment: made by the'; \
+	  echo ' * Makefile (awk, od, sed); edit render/viewer.js instead */'; \
+	  echo 'static const unsigned char ss_render_viewer_js[] = {'; \
+	  sed -e 's/ *\([0-9a-fA-F][0-9a-fA-F]\)/0x\1,/g' $@.od; \
+	  echo '};'; } > $@.tmp
+	$(Q)rm -f $@.js $@.od && mv $@.tmp $@
+$(BUILD)/obj/render/html.o: $(VIEWER_JS)
 
 $(BUILD)/libsandslide.a: $(LIB_OBJ)
 	@$(if $(Q),echo '  AR      $@')
@@ -322,7 +352,7 @@ FUZZ_CC      ?= clang
 FUZZ_BUILD   := $(BUILD)/fuzz
 FUZZ_SAN     := -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
 FUZZ_CFLAGS  := -std=c11 -D_XOPEN_SOURCE=700 -O1 -g $(WARN) -Wno-unknown-pragmas -Iinclude -Isrc \
-                -Itests/fuzz -DSS_VERSION='"$(VERSION)"' $(DEP_CFLAGS) $(FUZZ_SAN) -MMD -MP $(CFLAGS)
+                -I. -I$(GEN) -Itests/fuzz -DSS_VERSION='"$(VERSION)"' $(DEP_CFLAGS) $(FUZZ_SAN) -MMD -MP $(CFLAGS)
 FUZZ_LIB_SRC := $(LIB_SRC) $(RENDER_SRC)
 FUZZ_BIN     := $(FUZZ_NAMES:%=$(FUZZ_BUILD)/fuzz_%)
 FUZZ_REPLAY  := $(FUZZ_NAMES:%=$(FUZZ_BUILD)/replay/fuzz_%)
@@ -346,6 +376,7 @@ $(FUZZ_BUILD)/replay/%.o: %.c $(BUILD)/.flags
 	@mkdir -p $(@D)
 	@$(if $(Q),echo '  CC      $<')
 	$(Q)$(CC) $(FUZZ_CFLAGS) -c $< -o $@
+$(FUZZ_BUILD)/lf/render/html.o $(FUZZ_BUILD)/replay/render/html.o: $(VIEWER_JS)
 $(FUZZ_BUILD)/lf/libsandslide.a: $(FUZZ_LIB_SRC:%.c=$(FUZZ_BUILD)/lf/%.o)
 	$(Q)rm -f $@ && ar rcs $@ $^
 $(FUZZ_BUILD)/replay/libsandslide.a: $(FUZZ_LIB_SRC:%.c=$(FUZZ_BUILD)/replay/%.o)
@@ -358,6 +389,15 @@ $(FUZZ_BUILD)/replay/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/replay.c $(FUZZ_BUIL
 	$(Q)$(CC) $(filter-out -MMD -MP,$(FUZZ_CFLAGS)) $(filter %.c %.a,$^) $(LIBS) -o $@
 # replay/render/x.d and replay/src/io/x.d: the tiers are one level deeper
 -include $(wildcard $(FUZZ_BUILD)/*/*/*.d $(FUZZ_BUILD)/*/*/*/*.d)
+
+# The man page: doc/sandslide.1.in, written by hand, with each command's
+# options filled in by the program itself from the option tables it parses
+# (`sandslide help --roff CMD`, the --help's walk written as roff), so that
+# the page and --help cannot disagree; doc/manpage.awk puts them, and the
+# template's notes on them, where the template's blocks say.  POSIX awk.
+$(BUILD)/sandslide.1: doc/sandslide.1.in doc/manpage.awk $(BUILD)/sandslide
+	@$(if $(Q),echo '  MAN     $@')
+	$(Q)awk -v program=$(BUILD)/sandslide -f doc/manpage.awk doc/sandslide.1.in > $@
 
 # The test hooks (tests/hooks/NAME_step.c): the command line linked again
 # with the stepper's advance wrapped, as $(BUILD)/tests/sandslide-NAME, so
@@ -455,7 +495,8 @@ test-slurm: all
 
 # The tiers of src/README.md, checked by the #includes of each file: the
 # kernel knows nothing of files, printing or the command line, I/O nothing
-# of the stencil, and <hdf5.h> is in two files (tests/check_layering.sh).
+# of the stencil, and only the io/h5 files (src/io/h5_*) include <hdf5.h>
+# (tests/check_layering.sh).
 check-layering:
 	@sh tests/check_layering.sh
 
@@ -525,7 +566,7 @@ install: all
 	  -e 's|@VERSION@|$(VERSION)|' \
 	  -e 's|@REQUIRES@|$(PC_REQUIRES)|' -e 's|@OPENMP@|$(filter -fopenmp,$(OMPFLAG))|' \
 	  sandslide.pc.in > $(DESTDIR)$(PKGCONFIGDIR)/sandslide.pc
-	$(INSTALL) -m 644 doc/sandslide.1 $(DESTDIR)$(MANDIR)/man1/sandslide.1
+	$(INSTALL) -m 644 $(BUILD)/sandslide.1 $(DESTDIR)$(MANDIR)/man1/sandslide.1
 	$(INSTALL) -m 644 $(wildcard cases/*.ini cases/*.py) $(DESTDIR)$(DATADIR)/sandslide/cases/
 	$(INSTALL) -m 644 $(wildcard cases/dem/*) $(DESTDIR)$(DATADIR)/sandslide/cases/dem/
 	$(if $(PY_SRC),$(INSTALL) -m 644 $(PY_SRC) $(DESTDIR)$(PYTHONDIR)/sandslide/)

@@ -121,7 +121,7 @@ static inline double ss_render_raster_h(const struct ss_render_raster *r, int x,
  * varies smoothly instead of in flat squares per cell, and the half cell
  * beyond the last cell centre at an edge or wall, where the interpolated
  * surface is flat, takes the slope of its cell instead of a band of
- * different shading (frame.c). */
+ * different shading (plan.c). */
 void ss_render_gradient(const struct ss_render_raster *r, int x, int y, double *gx,
                         double *gy);
 
@@ -190,7 +190,7 @@ int ss_render_encode_png(const struct ss_render_image *img, int compression,
  * (an existing path is replaced only then). */
 int ss_render_write_file(const char *path, const void *data, size_t size);
 
-/* ---- series.c: a sandslide file and its cell types ------------------ */
+/* ---- source.c: a sandslide file and its cell types ------------------ */
 
 /* The file (sizes, geometry, times; heights are read through it with
  * ss_snapshot_file_read_rows) and its cell types, read once. */
@@ -210,7 +210,7 @@ void ss_render_source_close(struct ss_render_source *s);
 int ss_render_source_range(struct ss_render_source *s, long long first, long long last,
                            double *zmin, double *zmax);
 
-/* ---- frame.c: one frame from a source -------------------------------- */
+/* ---- plan.c: what the frames of a series share ----------------------- */
 
 /* Fill in a missing zmin or zmax (NAN) from the data's range [lo, hi]
  * (empty: 0..1, flat: widened by 0.5 m each way); SS_ERR_INPUT naming
@@ -276,6 +276,8 @@ int ss_render_plan_draw(const struct ss_render_plan *p, const double *pixel_h,
                         ptrdiff_t stride, const float *gx, const float *gy, double time,
                         struct ss_render_image *img, int parallel);
 
+/* ---- frame.c: one frame of a source, drawn with a plan ---------------- */
+
 /* Render snapshot t of s into img (initialised here; release it, also
  * after a failure), with its time, snapshot, source and map corner; when
  * pixel_h is not NULL, also copy there the pixel heights it was coloured
@@ -325,7 +327,7 @@ void ss_render_html_destroy(struct ss_render_html *h);
 /* video.c: 1 when ffmpeg is on PATH (ss_render_video can make a video). */
 int ss_render_ffmpeg_found(void);
 
-/* series_render.c: dir must be a writable folder, or a missing one whose
+/* command.c: dir must be a writable folder, or a missing one whose
  * parent is (created when `create`); SS_ERR_INPUT says which it is not. */
 int ss_render_check_dir(const char *dir, int create);
 

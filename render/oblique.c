@@ -23,7 +23,7 @@
  *   - cells without data (a DEM's outline, its holes) are absent: no
  *     triangle with a vertex on one is drawn, the skirt runs along the
  *     edge of the triangles that are, and a grid side that is a wall is
- *     drawn only if some cell along it has data (frame.c).
+ *     drawn only if some cell along it has data (plan.c).
  * Camera: at compass bearing view_azimuth and elevation view_elevation
  * from the centre of the scene's box (the grid with its wall sides, up to
  * the scale's top plus WALL_RISE), far enough that the box's bounding

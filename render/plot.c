@@ -1,6 +1,6 @@
 /*
- * plot.c - line plots as PNG figures (include/sandslide/plot.h): the
- * figures of `sandslide fit --plot`.
+ * plot.c - line plots as PNG figures (plot.h, beside it): the figures of
+ * `sandslide fit --plot`.
  *
  * A figure keeps copies of what it was given and draws only when written:
  * each panel into a picture of its own (so nothing of it spills into its
@@ -23,7 +23,7 @@
  * multiples of the font's magnification (ss_render_font_scale), so a
  * larger panel gets larger text and thicker lines.
  */
-#include "sandslide/plot.h"
+#include "render/plot.h"
 
 #include <math.h>
 #include <stdio.h>

@@ -6,11 +6,13 @@
 #   src/io      file formats: nothing of the stencil
 #   src/model   case and set-up: no app or CLI
 #   render/     pictures from the HDF5 output: not the kernel, not HDF5
-#               itself (it reads through src/io/snapshot_read.c)
+#               itself (it reads through snapshot.h, src/io/h5_read.c)
 #   library     nothing of src/cli
 #   include/    the installed headers: no internal header (they are not
 #               installed), only each other
-#   <hdf5.h>    only src/io/snapshot_write.c and src/io/snapshot_read.c
+#   <hdf5.h>    only in the io/h5 files, src/io/h5_*: the only code that
+#               speaks HDF5 (the reader, the writer and what they share);
+#               their headers (io/h5_*.h, which hold HDF5 types) likewise
 #
 # Prints each offending line and exits 1; prints one line and exits 0
 # when every rule holds.  Run from the top of the repository.
@@ -48,10 +50,10 @@ check "the library includes the command line (src/cli)" "cli/.*" \
 check "a public header (include/sandslide) includes an internal one, which is not installed" \
 	"(base|core|io|model|app|cli|render)/.*" include/sandslide/*
 
-hdf5=$(grep -lE '^[[:space:]]*#[[:space:]]*include[[:space:]]*<hdf5' -r src render include \
-       tests/*.c | grep -vE '^src/io/snapshot_(read|write)\.c$')
+hdf5=$(grep -lE '^[[:space:]]*#[[:space:]]*include[[:space:]]*(<hdf5|"io/h5_)' -r src render include \
+       tests/*.c | grep -vE '^src/io/h5_[a-z0-9_]+\.[ch]$')
 if [ -n "$hdf5" ]; then
-	echo "check-layering: <hdf5.h> outside src/io/snapshot_read.c and snapshot_write.c:"
+	echo "check-layering: <hdf5.h> or an io/h5 header outside the io/h5 files (src/io/h5_*):"
 	echo "$hdf5" | sed 's/^/    /'
 	fail=1
 fi

@@ -19,8 +19,8 @@
 
 #include <png.h>
 
+#include "render/plot.h"
 #include "sandslide/error.h"
-#include "sandslide/plot.h"
 
 /* ---- helpers ---------------------------------------------------------- */
 

@@ -69,10 +69,10 @@ double ss_model_time_limit(const struct ss_model_options *m);
 int ss_model_closure(const struct ss_model_options *m, struct ss_closure *c);
 
 /* nu from the sliding layer and the repose angle for m's closure
- * (bingham, herschel-bulkley, casson; doc/model.md#nu-from-the-sliding-
- * layer, [Paper] eqs. 8 and 12): the layer's keys that closure takes must
- * be set.  *nu may come out not finite or not positive: the caller says
- * where it came from. */
+ * (bingham, herschel-bulkley, casson; [Paper] eqs. 8 and 12,
+ * doc/model.md#nu-from-the-sliding-layer): the layer's keys that closure
+ * takes must be set.  The result may be not finite or not positive (the
+ * caller says where it came from); NaN for coulomb, which takes nu. */
 double ss_model_nu_from_layer(const struct ss_model_options *m);
 
 #endif

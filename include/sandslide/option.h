@@ -6,8 +6,8 @@
  * library's foreign-function callers (ss_option_object_set),
  * the case file's keys that are the same options (model_options.h), the
  * Python module's defaults (it asks ss_option_table_json), and the man
- * page's check (tests/cli/test_manpage.py).  doc/running.md#options says
- * what users see of it.
+ * page's options (the --help as roff, filled into doc/sandslide.1.in).
+ * doc/running.md#options says what users see of it.
  *
  * A value is always text, as a user types it ("35", "coulomb", "1e-9"), so
  * that a default, a command-line word, a case-file value and a Python

@@ -8,9 +8,10 @@
  * src/README.md.  The commands as functions (run.h, relax.h, render.h,
  * bench.h) are the usual entry points, which watch.h lets another thread
  * stop and follow; the kernel (grid.h, boundary.h, closure.h, stepper.h)
- * is for programs that drive the time loop themselves.  Every function returns a status
- * (error.h) and prints only error messages, which ss_error_set_quiet()
- * turns off in favour of ss_error_last_message() (the calling thread's).
+ * is for programs that drive the time loop themselves.  Every function
+ * returns a status (error.h) and prints only error messages, which
+ * ss_error_set_quiet() turns off in favour of ss_error_last_message() (the
+ * calling thread's).
  */
 #ifndef SANDSLIDE_SANDSLIDE_H
 #define SANDSLIDE_SANDSLIDE_H
@@ -34,6 +35,7 @@
 #include "sandslide/shape.h"
 #include "sandslide/case.h"
 #include "sandslide/progress.h"
+#include "sandslide/job.h"
 #include "sandslide/watch.h"
 
 #include "sandslide/run.h"
@@ -41,7 +43,6 @@
 #include "sandslide/fit.h"
 #include "sandslide/bench.h"
 #include "sandslide/render.h"
-#include "sandslide/plot.h"
 #include "sandslide/bmi.h"
 
 #endif

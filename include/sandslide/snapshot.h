@@ -1,9 +1,10 @@
 /*
  * snapshot.h - the HDF5 output of a run (doc/output.md), its XDMF
- * sidecar, and the one reader of such files.  src/io/snapshot_write.c
- * (the writer) and src/io/snapshot_read.c (every read: `info`, restarts,
- * the renderer, .h5 DEMs) are the only code that includes <hdf5.h>; no
- * HDF5 type appears here.
+ * sidecar, and the one reader of such files.  The files src/io/h5_* are
+ * the only code that includes <hdf5.h>: h5_write.c (the writer),
+ * h5_read.c (every read: the renderer, .h5 DEMs, fit's series),
+ * h5_summary.c (`info`'s summary, restarts) and h5_checked.c (the HDF5
+ * calls they share).  No HDF5 type appears here.
  *
  * Layout (netCDF-4 / CF-1.8 compatible, dimensions as HDF5 dimension scales):
  *   /height      float64 (time, y, x), chunked, extendible in time

@@ -23,12 +23,12 @@
 #include "io/observations.h"
 #include "io/output.h"
 #include "model/setup.h"
+#include "render/plot.h"
 #include "sandslide/case.h"
 #include "sandslide/closure.h"
 #include "sandslide/comm.h"
 #include "sandslide/error.h"
 #include "sandslide/parallel.h"
-#include "sandslide/plot.h"
 #include "sandslide/stepper.h"
 
 enum { PROFILE_MAX = 33, CLOSURES = 4, FRONT_SAMPLES = 4, TRACE_TIMES = 40 };

@@ -1,5 +1,5 @@
 /*
- * main.c - the `sandslide` command line (doc/sandslide.1): parse the
+ * main.c - the `sandslide` command line (doc/sandslide.1.in): parse the
  * arguments (each command's options are the library's table, option.h,
  * and a few of the command line's own, which also give its --help:
  * options.h), dispatch to the library, print what it returns (print.h) and
@@ -479,13 +479,17 @@ static int command(int argc, char **argv)
 		return main_usage_error("%s", "no command given");
 	const char *cmd = argv[1];
 	if (!strcmp(cmd, "help") && argc > 2) {   /* help CMD: that command's --help */
+		/* help --roff CMD: its options as roff, for the man page (Makefile) */
+		const int roff = argc > 3 && !strcmp(argv[2], "--roff");
+		char *name = argv[2 + roff];
+		cli_help_set_roff(roff);
 		for (int k = 0; k < COUNT(commands); k++)
-			if (!strcmp(argv[2], commands[k].name)) {
-				char *args[] = {argv[0], argv[2], "--help", NULL};
+			if (!strcmp(name, commands[k].name)) {
+				char *args[] = {argv[0], name, "--help", NULL};
 				return commands[k].run(3, args);
 			}
 		return main_usage_error("help: unknown command '%s': expected run, relax, info, "
-		                        "render, bench or fit", argv[2]);
+		                        "render, bench or fit", name);
 	}
 	if (!strcmp(cmd, "-h") || !strcmp(cmd, "--help") || !strcmp(cmd, "help")) {
 		fputs(usage_main, stdout);

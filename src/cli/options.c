@@ -98,24 +98,130 @@ static void help_option(const struct ss_option *o, FILE *f)
 	help_lines(o, f);
 }
 
+/* What the help shows of the options, in order: each option of the
+ * command line and each heading of the groups not hidden.  The plain help
+ * and the man page's roff are this one walk. */
+static void help_walk(const struct cli_command *c, FILE *f,
+                      void (*option)(const struct ss_option *o, FILE *f),
+                      void (*heading)(const char *text, FILE *f))
+{
+	for (int g = 0; g < c->group_count; g++) {
+		const struct cli_group *group = &c->groups[g];
+		for (int k = 0; k < group->table->count && !group->hidden; k++) {
+			const struct ss_option *o = &group->table->options[k];
+			if (on_command_line(o))
+				option(o, f);
+			else if (!o->name && !o->case_key)
+				heading(o->help, f);
+		}
+	}
+}
+
+static void help_heading(const char *text, FILE *f)
+{
+	fprintf(f, "\n%s", text);
+}
+
 void cli_help(const struct cli_command *c, FILE *f)
 {
 	fputs(c->usage, f);
 	if (c->intro)
 		fprintf(f, "\n%s", c->intro);
 	fputc('\n', f);
-	for (int g = 0; g < c->group_count; g++) {
-		const struct cli_group *group = &c->groups[g];
-		for (int k = 0; k < group->table->count && !group->hidden; k++) {
-			const struct ss_option *o = &group->table->options[k];
-			if (on_command_line(o))
-				help_option(o, f);
-			else if (!o->name && !o->case_key)
-				fprintf(f, "\n%s", o->help);   /* a heading */
-		}
-	}
+	help_walk(c, f, help_option, help_heading);
 	if (c->outro)
 		fprintf(f, "\n%s", c->outro);
+}
+
+/* ---- the same as man(7) roff ---------------------------------------------- */
+
+/* n characters of s, escaped for roff: a backslash, every hyphen as \-
+ * (an option's name must copy as ASCII, not as a typographic hyphen), and
+ * quotes that must stay straight for a shell. */
+static void roff_put(const char *s, size_t n, FILE *f)
+{
+	for (size_t k = 0; k < n; k++) {
+		const char c = s[k];
+		const char *escape = c == '\\' ? "\\e" : c == '-' ? "\\-"
+		                   : c == '\'' ? "\\(aq" : c == '`' ? "\\(ga" : NULL;
+		if (escape)
+			fputs(escape, f);
+		else
+			fputc(c, f);
+	}
+}
+
+/* text's '\n'-separated lines (the help's, laid out for a terminal) as
+ * one line of roff text, without the line's end: the indentation dropped,
+ * the lines joined by a blank, so that roff fills them and takes no line's
+ * last word for the end of a sentence ("e.g."); \& first when roff would
+ * take the line for a request.  Returns how many lines it wrote. */
+static int roff_line(const char *text, FILE *f)
+{
+	int words = 0;
+	for (const char *p = text; *p;) {
+		p += strspn(p, " \t");
+		const size_t n = strcspn(p, "\n");
+		if (n) {
+			if (words++)
+				fputc(' ', f);
+			else if (*p == '.' || *p == '\'')
+				fputs("\\&", f);
+			roff_put(p, n, f);
+		}
+		p += n + (p[n] == '\n');
+	}
+	return words;
+}
+
+/* ".TP" with the names in bold and the value in italics, then the text
+ * and the default as the help gives them. */
+static void roff_option(const struct ss_option *o, FILE *f)
+{
+	fprintf(f, ".\\\" option --%s\n.TP\n", o->name);
+	if (o->alias) {
+		fputs("\\fB", f);
+		roff_put(o->alias, strlen(o->alias), f);
+		fputs("\\fR, ", f);
+	}
+	fputs("\\fB\\-\\-", f);
+	roff_put(o->name, strlen(o->name), f);
+	fputs("\\fR", f);
+	if (o->value_name) {
+		fputs(" \\fI", f);
+		roff_put(o->value_name, strlen(o->value_name), f);
+		fputs("\\fR", f);
+	}
+	fputc('\n', f);
+	const int text = roff_line(o->help ? o->help : "", f);
+	if (o->default_value) {
+		fputs(text ? " (default " : "(default ", f);
+		roff_put(o->default_value, strlen(o->default_value), f);
+		fputc(')', f);
+	}
+	if (text || o->default_value)
+		fputc('\n', f);
+}
+
+static void roff_heading(const char *text, FILE *f)
+{
+	fputs(".\\\" heading\n.PP\n", f);
+	if (roff_line(text, f))
+		fputc('\n', f);
+}
+
+void cli_help_roff(const struct cli_command *c, FILE *f)
+{
+	help_walk(c, f, roff_option, roff_heading);
+}
+
+/* What -h and --help print: cli_help, or cli_help_roff after
+ * cli_help_set_roff(1).  The program's, set before a command parses. */
+static int help_roff;
+
+void cli_help_set_roff(int roff)
+{
+	help_roff = roff;
 }
 
 /* One line: the mistake, then where the options are ("sandslide run
@@ -214,7 +320,7 @@ int cli_parse(struct cli_command *c, int argc, char **argv, int first)
 		const char *a = argv[at], *inline_value;
 		int g, k;
 		if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
-			cli_help(c, stdout);
+			(help_roff ? cli_help_roff : cli_help)(c, stdout);
 			return 0;
 		}
 		if (a[0] != '-' || !a[1]) {

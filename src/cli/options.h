@@ -2,7 +2,7 @@
  * options.h - parsing a command's arguments from its option tables (the
  * library's, sandslide/option.h, and the command line's own few: --quiet,
  * --json, ...), and the --help made from the same tables, so that the two
- * cannot disagree.
+ * cannot disagree; the man page's options are that help as roff.
  *
  *   --name VALUE, --name=VALUE and the alias (-o VALUE) are accepted; a
  *   word that does not start with '-' (or is "-") is an argument.
@@ -57,6 +57,20 @@ const char *cli_given_in(const struct cli_command *c, const struct ss_option_tab
 /* The command's help: usage, intro, one line or more per option with its
  * default, outro. */
 void cli_help(const struct cli_command *c, FILE *f);
+
+/* The command's options as man(7) roff, for its man page: each option the
+ * help shows a .TP entry (bold names, the value in italics, its text and
+ * default as the help gives them), each heading a paragraph, in the
+ * help's order, each after a comment that names it (.\" option --NAME,
+ * .\" heading) for doc/manpage.awk, which puts the page's notes after
+ * their options.  The usage, intro and outro are left to the page's own
+ * words (doc/sandslide.1.in). */
+void cli_help_roff(const struct cli_command *c, FILE *f);
+
+/* What -h and --help print from then on: cli_help (roff 0, the default) or
+ * cli_help_roff (1: `sandslide help --roff CMD`, which the Makefile runs to
+ * make the man page). */
+void cli_help_set_roff(int roff);
 
 /* "sandslide: MESSAGE (see 'sandslide CMD --help')" on stderr; returns 2. */
 int cli_usage_error(const struct cli_command *c, const char *fmt, ...)

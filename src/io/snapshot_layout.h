@@ -1,6 +1,6 @@
 /*
- * snapshot_layout.h - what the HDF5 writer (snapshot_write.c) and reader
- * (snapshot_read.c) share of the file layout of doc/output.md, without
+ * snapshot_layout.h - what the HDF5 writer (h5_write.c) and reader
+ * (h5_read.c) share of the file layout of doc/output.md, without
  * any HDF5 type: the diagnostic series and the constants of the
  * definition of a sandslide file.  Not installed; snapshot.h is the
  * public interface.

@@ -1,6 +1,6 @@
 """Damaged output files: `info`, `run --restart` and `render` refuse what
 they cannot read with exit status 2 and one line that says so, and never
-believe a size the file cannot hold (src/io/snapshot_read.c checks every
+believe a size the file cannot hold (src/io/h5_checked.c checks every
 size against the file before anything of that size is allocated).
 
 The sweep flips one byte at each position of a deterministic sample of the

@@ -1,5 +1,5 @@
 /*
- * fuzz_h5.c - the HDF5 reader (src/io/snapshot_read.c, snapshot.h): what
+ * fuzz_h5.c - the HDF5 reader (src/io/h5_read.c, snapshot.h): what
  * `info`, `run --restart`, `render` and `.h5` DEMs read.
  *
  * Input: an HDF5 file.  Opened as an image in memory

@@ -42,9 +42,9 @@ int main(int argc, char **argv)
 	struct ss_relax_options o;
 	ss_relax_options_init(&o);
 	o.dem = argv[2];
-	o.output = argv[3];
-	o.threads = 1;
-	o.force = 1;
+	o.job.output = argv[3];
+	o.job.threads = 1;
+	o.job.force = 1;
 	struct ss_relax_report r;
 	const int err = ss_relax_run(&o, &r);
 	check(err == SS_OK, "ss_relax_run returns SS_OK");

@@ -2,6 +2,9 @@
  * plot.h - small line plots as PNG figures (render/plot.c), for the
  * figures of `sandslide fit --plot FIT.png`: curves over time, observations
  * as markers, cost profiles with a vertical line at the best value.
+ * Private to the library: src/app/fit.c and tests/test_plot.c include it
+ * as "render/plot.h"; it is not installed (the public headers are
+ * include/sandslide/).
  *
  * A figure is a grid of `columns` x `rows` panels of the same size; panel
  * k is in row k / columns, column k % columns (panel 0 top left).  Each

@@ -1,5 +1,5 @@
 /*
- * frames.c - frames of a run as it writes its snapshots (`sandslide run
+ * run_frames.c - frames of a run as it writes its snapshots (`sandslide run
  * --frames DIR`, render.h).
  *
  * Each snapshot is read back from the output file the run has just

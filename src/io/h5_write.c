@@ -1,12 +1,12 @@
 /*
- * snapshot_write.c - HDF5 + XDMF output (see snapshot.h for the layout);
- * the reads are in snapshot_read.c.
+ * h5_write.c - HDF5 + XDMF output (see snapshot.h for the layout);
+ * the reads are in h5_read.c.
  *
  * File types are explicit little-endian IEEE (H5T_IEEE_F64LE, H5T_STD_I8LE),
  * memory types native.  Heights are copied a band of chunk rows at a time,
  * with NaN (the CF _FillValue) at walls and at cells without data, so
  * that netCDF readers, GDAL and ParaView show them as missing rather than
- * as floor at 0 m; the reader (snapshot_read.c) gives them 0 m again.
+ * as floor at 0 m; the reader (h5_read.c) gives them 0 m again.
  * Cells without data (meta.nodata, relax's DEM) are /cell_type 3
  * (SS_SNAPSHOT_CELL_NODATA), whatever the stepper made of them; only then
  * does flag_values have a fourth value, so a run's file is as before.  HDF5's own error stack
@@ -42,6 +42,7 @@
 #include "base/comm_mpi.h"
 #include "sandslide/comm.h"
 #include "sandslide/error.h"
+#include "io/h5_checked.h"
 #include "io/snapshot_layout.h"
 #include "io/sidecar.h"
 
@@ -72,53 +73,21 @@ struct ss_snapshot {
 	                           (nx x ny, south row first), NULL: none */
 };
 
-static void quiet_hdf5(void)
-{
-	H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
-}
-
 void ss_snapshot_library_init(void)
 {
 	/* HDF5 1.10 crashes in its exit handler on a file whose close failed
 	 * (a full disk, a file-size limit); we close every file ourselves, so
 	 * it need not clean up at exit.  Only effective as the first call. */
 	H5dont_atexit();
-	quiet_hdf5();
+	ss_h5_quiet();
 }
 
-/* ---- attributes ------------------------------------------------------ */
-
-static int attr_string(hid_t obj, const char *name, const char *value)
-{
-	hid_t type = H5Tcopy(H5T_C_S1);
-	size_t len = strlen(value);
-	H5Tset_size(type, len ? len : 1);
-	H5Tset_strpad(type, H5T_STR_NULLTERM);
-	H5Tset_cset(type, H5T_CSET_UTF8);   /* the case text may hold any UTF-8 */
-	hid_t space = H5Screate(H5S_SCALAR);
-	hid_t a = H5Acreate2(obj, name, type, space, H5P_DEFAULT, H5P_DEFAULT);
-	herr_t r = a < 0 ? -1 : H5Awrite(a, type, len ? value : "");
-	if (a >= 0)
-		H5Aclose(a);
-	H5Sclose(space);
-	H5Tclose(type);
-	return r < 0 ? -1 : 0;
-}
-
-static int attr_doubles(hid_t obj, const char *name, const double *v, hsize_t n)
-{
-	hid_t space = n == 1 ? H5Screate(H5S_SCALAR) : H5Screate_simple(1, &n, NULL);
-	hid_t a = H5Acreate2(obj, name, H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT);
-	herr_t r = a < 0 ? -1 : H5Awrite(a, H5T_NATIVE_DOUBLE, v);
-	if (a >= 0)
-		H5Aclose(a);
-	H5Sclose(space);
-	return r < 0 ? -1 : 0;
-}
+/* ---- attributes (h5_checked.h) ------------------------------------------ */
 
 static int attr_units(hid_t obj, const char *units, const char *long_name)
 {
-	return attr_string(obj, "units", units) || attr_string(obj, "long_name", long_name);
+	return ss_h5_attr_write_string(obj, "units", units) ||
+	       ss_h5_attr_write_string(obj, "long_name", long_name);
 }
 
 /* ---- ranks ----------------------------------------------------------- */
@@ -176,8 +145,9 @@ static hid_t create_coordinate(hid_t file, const char *name, int n, double origi
 	/* rank 0 writes the values (independently); every rank the attributes */
 	int bad = d < 0 ||
 	          (is_root() && H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v) < 0) ||
-	          attr_units(d, "m", long_name) || attr_string(d, "axis", axis) ||
-	          (standard_name && attr_string(d, "standard_name", standard_name));
+	          attr_units(d, "m", long_name) || ss_h5_attr_write_string(d, "axis", axis) ||
+	          (standard_name &&
+	           ss_h5_attr_write_string(d, "standard_name", standard_name));
 	ss_free(v);
 	H5Sclose(space);
 	if (bad && d >= 0) {
@@ -193,7 +163,7 @@ static hid_t create_coordinate(hid_t file, const char *name, int n, double origi
 static int attr_fill_nan(hid_t d)
 {
 	const double fill = NAN;
-	return attr_doubles(d, "_FillValue", &fill, 1);
+	return ss_h5_attr_write_doubles(d, "_FillValue", &fill, 1);
 }
 
 /* Cells along a side of a /height chunk (snapshot_layout.h): a chunk is
@@ -274,7 +244,7 @@ static int write_bedrock(hid_t file, hid_t x, hid_t y, const struct ss_grid *g,
 	}
 	ss_free(block);
 	bad = bad || attr_units(d, "m", "non-erodible bedrock under the sand") ||
-	      attr_fill_nan(d) || (crs && attr_string(d, "grid_mapping", "crs")) ||
+	      attr_fill_nan(d) || (crs && ss_h5_attr_write_string(d, "grid_mapping", "crs")) ||
 	      H5DSattach_scale(d, y, 0) < 0 || H5DSattach_scale(d, x, 1) < 0;
 	if (d >= 0)
 		H5Dclose(d);
@@ -295,8 +265,9 @@ static int write_crs(hid_t file, const char *wkt)
 	const int zero = 0;
 	const int bad = d < 0 ||
 	      (is_root() && H5Dwrite(d, H5T_NATIVE_INT, H5S_ALL, H5S_ALL, H5P_DEFAULT, &zero) < 0) ||
-	      attr_string(d, "crs_wkt", wkt) || attr_string(d, "spatial_ref", wkt) ||
-	      attr_string(d, "long_name", "coordinate reference system of x and y");
+	      ss_h5_attr_write_string(d, "crs_wkt", wkt) ||
+	      ss_h5_attr_write_string(d, "spatial_ref", wkt) ||
+	      ss_h5_attr_write_string(d, "long_name", "coordinate reference system of x and y");
 	if (d >= 0)
 		H5Dclose(d);
 	H5Sclose(space);
@@ -324,7 +295,7 @@ static int write_static(struct ss_snapshot *s, const uint8_t *cell_types,
 	s->time = create_series(f, "time", "seconds", "simulated time since the start");
 	if (x < 0 || y < 0 || s->time < 0)
 		bad = 1;
-	bad = bad || attr_string(s->time, "axis", "T");
+	bad = bad || ss_h5_attr_write_string(s->time, "axis", "T");
 	bad = bad || H5DSset_scale(x, "x") < 0 || H5DSset_scale(y, "y") < 0 ||
 	      H5DSset_scale(s->time, "time") < 0;
 	bad = bad || (crs && write_crs(f, meta->crs_wkt));
@@ -349,8 +320,9 @@ static int write_static(struct ss_snapshot *s, const uint8_t *cell_types,
 	H5Pclose(dcpl);
 	H5Sclose(space);
 	bad = bad || s->height < 0 || attr_units(s->height, "m", "height of the sand surface") ||
-	      attr_string(s->height, "standard_name", "surface_altitude") ||
-	      attr_fill_nan(s->height) || (crs && attr_string(s->height, "grid_mapping", "crs")) ||
+	      ss_h5_attr_write_string(s->height, "standard_name", "surface_altitude") ||
+	      attr_fill_nan(s->height) ||
+	      (crs && ss_h5_attr_write_string(s->height, "grid_mapping", "crs")) ||
 	      H5DSattach_scale(s->height, s->time, 0) < 0 ||
 	      H5DSattach_scale(s->height, y, 1) < 0 || H5DSattach_scale(s->height, x, 2) < 0;
 
@@ -362,9 +334,9 @@ static int write_static(struct ss_snapshot *s, const uint8_t *cell_types,
 	                                 H5P_DEFAULT, H5P_DEFAULT);
 	bad = bad || ct < 0 || write_cell_types(ct, space, g, cell_types, s->nodata) ||
 	      attr_units(ct, "1", "cell type") ||
-	      attr_string(ct, "flag_meanings", meta->nodata ? "flow wall open nodata"
-	                                                    : "flow wall open") ||
-	      (crs && attr_string(ct, "grid_mapping", "crs")) ||
+	      ss_h5_attr_write_string(ct, "flag_meanings", meta->nodata ? "flow wall open nodata"
+	                                                                : "flow wall open") ||
+	      (crs && ss_h5_attr_write_string(ct, "grid_mapping", "crs")) ||
 	      H5DSattach_scale(ct, y, 0) < 0 || H5DSattach_scale(ct, x, 1) < 0;
 	if (!bad) {
 		/* an attribute: every rank writes the same values */
@@ -398,16 +370,21 @@ static int write_static(struct ss_snapshot *s, const uint8_t *cell_types,
 			         k ? " " : "", ss_side_name(k), ss_side_kind_name(meta->boundary->side[k]));
 	char source[64];
 	snprintf(source, sizeof source, SS_SNAPSHOT_SOURCE " %s", SS_VERSION);
-	bad = bad || attr_string(f, "Conventions", "CF-1.8") ||
-	      attr_string(f, "title", meta->title) || attr_string(f, "history", meta->history) ||
-	      attr_string(f, "source", source) || attr_string(f, "closure", meta->closure) ||
-	      attr_doubles(f, "repose_angle_deg", &meta->repose_angle_deg, 1) ||
-	      attr_doubles(f, "nu", &meta->nu, 1) || attr_doubles(f, "gamma", &meta->gamma, 1) ||
-	      attr_doubles(f, "dx", &g->dx, 1) || attr_doubles(f, "dy", &g->dy, 1) ||
-	      attr_string(f, "case", meta->case_text) ||
-	      (meta->integrator && attr_string(f, "integrator", meta->integrator)) ||
-	      attr_string(f, "case_overrides", meta->case_overrides ? meta->case_overrides : "") ||
-	      (meta->boundary && attr_string(f, SS_SNAPSHOT_BOUNDARY, sides));
+	bad = bad || ss_h5_attr_write_string(f, "Conventions", "CF-1.8") ||
+	      ss_h5_attr_write_string(f, "title", meta->title) ||
+	      ss_h5_attr_write_string(f, "history", meta->history) ||
+	      ss_h5_attr_write_string(f, "source", source) ||
+	      ss_h5_attr_write_string(f, "closure", meta->closure) ||
+	      ss_h5_attr_write_doubles(f, "repose_angle_deg", &meta->repose_angle_deg, 1) ||
+	      ss_h5_attr_write_doubles(f, "nu", &meta->nu, 1) ||
+	      ss_h5_attr_write_doubles(f, "gamma", &meta->gamma, 1) ||
+	      ss_h5_attr_write_doubles(f, "dx", &g->dx, 1) ||
+	      ss_h5_attr_write_doubles(f, "dy", &g->dy, 1) ||
+	      ss_h5_attr_write_string(f, "case", meta->case_text) ||
+	      (meta->integrator && ss_h5_attr_write_string(f, "integrator", meta->integrator)) ||
+	      ss_h5_attr_write_string(f, "case_overrides",
+	                              meta->case_overrides ? meta->case_overrides : "") ||
+	      (meta->boundary && ss_h5_attr_write_string(f, SS_SNAPSHOT_BOUNDARY, sides));
 	if (x >= 0)
 		H5Dclose(x);
 	if (y >= 0)
@@ -527,7 +504,7 @@ int ss_snapshot_create(struct ss_snapshot **out, const char *path,
                        const struct ss_grid *g, const uint8_t *cell_types,
                        const struct ss_snapshot_meta *meta)
 {
-	quiet_hdf5();
+	ss_h5_quiet();
 	*out = NULL;
 	struct ss_snapshot *s = snapshot_alloc(path, g);
 	if (!s)
@@ -595,15 +572,8 @@ static int write_restart_state(hid_t file, long long k, const struct ss_restart_
 		(double)r->steps, r->inflow.sum, r->inflow.carry, r->outflow.sum,
 		r->outflow.carry, (double)r->evaluations, r->rkl2_tau,
 	};
-	const char *name = ss_snapshot_restart_attribute(k);
-	if (H5Aexists(file, name) > 0) {
-		hid_t a = H5Aopen(file, name, H5P_DEFAULT);
-		const herr_t w = a >= 0 ? H5Awrite(a, H5T_NATIVE_DOUBLE, v) : -1;
-		if (a >= 0)
-			H5Aclose(a);
-		return w < 0;
-	}
-	return attr_doubles(file, name, v, SS_SNAPSHOT_RESTART_VALUES);
+	return ss_h5_attr_update_doubles(file, ss_snapshot_restart_attribute(k), v,
+	                                 SS_SNAPSHOT_RESTART_VALUES);
 }
 
 /*
@@ -841,7 +811,7 @@ static int check_append(struct ss_snapshot *s, const char *path, const struct ss
 int ss_snapshot_open_append(struct ss_snapshot **out, const char *path,
                             const struct ss_grid *g)
 {
-	quiet_hdf5();
+	ss_h5_quiet();
 	*out = NULL;
 	struct ss_snapshot *s = snapshot_alloc(path, g);
 	if (!s)

@@ -1,6 +1,6 @@
 /*
- * series.c - a sandslide output file (doc/output.md) as the renderer
- * reads it: the file through the one reader of src/io/snapshot_read.c
+ * source.c - a sandslide output file (doc/output.md) as the renderer
+ * reads it: the file through the one reader of src/io/h5_read.c
  * (snapshot.h), which checks it and serialises HDF5 between the threads
  * that render frames, and its cell types (one byte per cell, the file's
  * own: a cell without data is one, not a wall), read once.
