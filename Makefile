@@ -253,6 +253,8 @@ LIB_OBJ  += $(KERNEL_OBJ)
 MAIN_OBJ := $(CLI_SRC:src/%.c=$(BUILD)/obj/%.o)
 TEST_SRC := $(wildcard tests/test_*.c)
 TEST_BIN := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
+# The public headers, installed: include/sandslide/ holds only them (the
+# internal ones sit beside their sources, src/README.md).
 HEADERS  := $(wildcard include/sandslide/*.h)
 
 .PHONY: all lib deps deps-test deps-bench deps-slurm test check demo clean headers-check check-layering help \
@@ -338,11 +340,13 @@ $(BUILD)/tests/%: tests/%.c tests/check.h $(BUILD)/libsandslide.a $(BUILD)/.flag
 	@$(if $(Q),echo '  CC      $<')
 	$(Q)$(CC) $(ALL_CFLAGS) -Itests $< $(BUILD)/libsandslide.a $(ALL_LDFLAGS) $(LIBS) -o $@
 
-# Every public header compiles on its own.
+# Every header compiles on its own: the public ones (HEADERS, installed)
+# and the kernel's internal ones beside their sources (src/core/*.h,
+# included as "core/sweep.h").
 headers-check: $(BUILD)/.flags
 	@mkdir -p $(BUILD)/hdrcheck
-	$(Q)for h in $(HEADERS); do \
-	  printf '#include "%s"\n' "$${h#include/}" > $(BUILD)/hdrcheck/t.c && \
+	$(Q)for h in $(HEADERS) $(wildcard src/core/*.h); do \
+	  printf '#include "%s"\n' "$${h#*/}" > $(BUILD)/hdrcheck/t.c && \
 	  $(CC) $(filter-out -MMD -MP,$(ALL_CFLAGS)) -fsyntax-only $(BUILD)/hdrcheck/t.c || exit 1; \
 	done; echo "  headers compile on their own"
 

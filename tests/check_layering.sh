@@ -8,6 +8,8 @@
 #   render/     pictures from the HDF5 output: not the kernel, not HDF5
 #               itself (it reads through snapshot.h, src/io/h5_read.c)
 #   library     nothing of src/cli
+#   include/    the installed headers: no internal header (they are not
+#               installed), only each other
 #   <hdf5.h>    only in the io/h5 files, src/io/h5_*: the only code that
 #               speaks HDF5 (the reader, the writer and what they share);
 #               their headers (io/h5_*.h, which hold HDF5 types) likewise
@@ -31,8 +33,7 @@ check() {
 }
 
 core_headers="include/sandslide/grid.h include/sandslide/boundary.h
-include/sandslide/closure.h include/sandslide/face.h include/sandslide/sweep.h
-include/sandslide/stepper.h include/sandslide/diagnostics.h"
+include/sandslide/closure.h include/sandslide/stepper.h include/sandslide/diagnostics.h"
 upper="sandslide/(snapshot|dem|render|run|relax|bench|case|shape|progress)\.h"
 
 # shellcheck disable=SC2086
@@ -40,12 +41,14 @@ check "the kernel (src/core) includes a file format, stdio or an upper tier" \
 	"hdf5\.h|hdf5_hl\.h|png\.h|gdal.*\.h|cpl_.*\.h|ini\.h|stdio\.h|(io|model|app|cli)/.*|$upper" \
 	src/core/* $core_headers
 check "I/O (src/io) includes the stencil or an upper tier" \
-	"sandslide/(sweep|stepper|face)\.h|(model|app|cli)/.*" src/io/*
+	"sandslide/stepper\.h|core/.*|(model|app|cli)/.*" src/io/*
 check "the model set-up (src/model) includes an upper tier" "(app|cli)/.*" src/model/*
 check "the renderer (render/) includes the kernel, HDF5 or an upper tier" \
-	"hdf5\.h|hdf5_hl\.h|sandslide/(sweep|stepper|face|closure)\.h|(model|app|cli)/.*" render/*
+	"hdf5\.h|hdf5_hl\.h|sandslide/(stepper|closure)\.h|core/.*|(model|app|cli)/.*" render/*
 check "the library includes the command line (src/cli)" "cli/.*" \
 	src/base/* src/core/* src/model/* src/io/* src/app/* render/* include/sandslide/*
+check "a public header (include/sandslide) includes an internal one, which is not installed" \
+	"(base|core|io|model|app|cli|render)/.*" include/sandslide/*
 
 hdf5=$(grep -lE '^[[:space:]]*#[[:space:]]*include[[:space:]]*(<hdf5|"io/h5_)' -r src render include \
        tests/*.c | grep -vE '^src/io/h5_[a-z0-9_]+\.[ch]$')

@@ -12,6 +12,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "core/sources.h"
 #include "model/setup.h"
 #include "sandslide/bmi.h"
 #include "sandslide/case.h"
@@ -514,10 +515,10 @@ static void rate_is_a_source(void)
 	/* the source's cells, as the stepper has them: rate / 0.02 */
 	for (int j = 0; j < NY; j++)
 		for (int i = 0; i < NX; i++) {
-			const double *r = st.source_rate;
+			const double *r = st.sources->rate;
 			rate[j * NX + i] = r && r[ss_grid_index(&st.grid, i, j)] > 0.0 ? 0.02 : 0.0;
 		}
-	const double inflow = st.inflow;
+	const double inflow = ss_stepper_inflow(&st);
 	ss_stepper_release(&st);
 
 	struct Bmi *m = ss_bmi_create();

@@ -26,7 +26,7 @@
  *                split over the ranks (some ranks may hold none) has the
  *                bits of the serial left fold; the values are chosen so that
  *                adding per-rank partial sums would not
- *   fold many    the outflow batch's fold (stepper.c): 3000 folds of two
+ *   fold many    the outflow batch's fold (ledger.c): 3000 folds of two
  *                sums in one call (6000 running values, 48 kB a message),
  *                each of 0 to 22 values split over the ranks, a third of
  *                them +0 or -0 and left out by the ranks: every total has

@@ -29,6 +29,7 @@
 
 #include "check.h"
 #include "scale.h"
+#include "core/sweep.h"
 #include "sandslide/boundary.h"
 #include "sandslide/closure.h"
 #include "sandslide/diagnostics.h"
@@ -36,7 +37,6 @@
 #include "sandslide/grid.h"
 #include "sandslide/parallel.h"
 #include "sandslide/stepper.h"
-#include "sandslide/sweep.h"
 
 #define DEG (M_PI / 180.0)
 #define REPOSE 35.0
@@ -820,8 +820,8 @@ static struct det_result determinism_run(int threads, int tile_nx, int tile_ny)
 		advance_to(&st, 60.0);
 		res.h = malloc((size_t)nx * ny * sizeof *res.h);
 		interior(&st, res.h);
-		res.inflow = st.inflow;
-		res.outflow = st.outflow;
+		res.inflow = ss_stepper_inflow(&st);
+		res.outflow = ss_stepper_outflow(&st);
 		res.steps = st.steps;
 	}
 	ss_stepper_release(&st);

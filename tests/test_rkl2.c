@@ -33,15 +33,18 @@
 #include <string.h>
 
 #include "check.h"
+#include "core/rkl2.h"
+#include "core/sweep.h"
+#include "core/sweeper.h"
 #include "sandslide/boundary.h"
 #include "sandslide/closure.h"
 #include "sandslide/diagnostics.h"
 #include "sandslide/error.h"
 #include "sandslide/grid.h"
+#include "sandslide/model_options.h"
+#include "sandslide/option.h"
 #include "sandslide/parallel.h"
-#include "sandslide/rkl2.h"
 #include "sandslide/stepper.h"
-#include "sandslide/sweep.h"
 
 #define DEG (M_PI / 180.0)
 #define REPOSE 35.0
@@ -87,6 +90,11 @@ static int setup_full(struct ss_stepper *st, int nx, int ny, double dx, double d
 		return err;
 	st->integrator = integrator;
 	st->kernel = kernel;
+	/* RKL2's settings at the model options' defaults */
+	struct ss_model_options m;
+	ss_model_options_init(&m);
+	st->rkl2_max_stages = m.rkl2_max_stages;
+	st->rkl2_tol = m.rkl2_tol;
 	return 0;
 }
 
@@ -415,7 +423,8 @@ static int order_setup(struct ss_stepper *st, enum ss_integrator in, double cfl)
 	}
 	if (prepare(st))
 		return -1;
-	st->rkl2_tau = INFINITY;   /* nor the start-up limit */
+	if (st->rkl2)
+		st->rkl2->tau_limit = INFINITY;   /* nor the start-up limit */
 	return 0;
 }
 
@@ -425,7 +434,7 @@ static double dt_all_of(const struct ss_stepper *st)
 	const struct ss_grid *g = &st->grid;
 	const double inv_d2 = 1.0 / (g->dx * g->dx) + 1.0 / (g->dy * g->dy);
 	return st->cfl / (2.0 * st->closure.nu *
-	                  ss_cfl_bound_lookup(&st->cfl_bound, HUGE_VAL) * inv_d2);
+	                  ss_cfl_bound_lookup(&st->sweeper->cfl_bound, HUGE_VAL) * inv_d2);
 }
 
 /* RKL2 from 0 to T with targets T k/n, k = 1..n, and the given cfl (which
@@ -446,12 +455,12 @@ static int order_run(double T, int n, double cfl, double *h, long long *first)
 		const long long before = st.steps;
 		advance_to(&st, T * k / n);
 		if (k == 2)
-			stages = st.last_stages;
-		ok = st.steps == before + 1 && st.last_stages == stages;
+			stages = st.rkl2->last_stages;
+		ok = st.steps == before + 1 && st.rkl2->last_stages == stages;
 	}
 	CHECK(ok, "test set-up: the calls to T k/%d (cfl %g) did not take one super-step of "
 	      "%d stages each: %lld super-steps, last %d stages", n, cfl, stages, st.steps,
-	      st.last_stages);
+	      st.rkl2->last_stages);
 	interior(&st, h);
 	ss_stepper_release(&st);
 	return ok ? stages : -1;
@@ -597,8 +606,8 @@ static struct det_result door_run(int threads, int tile_nx, int tile_ny, enum ss
 		advance_to(&st, 0.4 * t_end);
 		advance_to(&st, t_end);
 		res.h = interior_copy(&st);
-		res.inflow = st.inflow;
-		res.outflow = st.outflow;
+		res.inflow = ss_stepper_inflow(&st);
+		res.outflow = ss_stepper_outflow(&st);
 		res.steps = st.steps;
 		res.evaluations = st.evaluations;
 	}
@@ -860,7 +869,8 @@ static void conservation_case(enum ss_closure_kind kind, enum ss_kernel kernel,
 	for (size_t k = 0; k < sizeof times / sizeof *times; k++) {
 		while (st.time < times[k]) {
 			advance_one(&st, times[k]);
-			stages_max = st.last_stages > stages_max ? st.last_stages : stages_max;
+			stages_max = st.rkl2->last_stages > stages_max ? st.rkl2->last_stages
+			                                               : stages_max;
 		}
 		struct ss_diagnostics d = diag(&st);
 		const double err = fabs((d.volume - v0) - (d.inflow - d.outflow));
@@ -1287,29 +1297,29 @@ static void test_refusals(void)
 		CHECK(ss_stepper_prepare(&st) == 0, "prepare with euler and a bedrock refused");
 	}
 	ss_stepper_release(&st);
-	CHECK(ss_integrator_resolve(SS_INTEGRATOR_AUTO, 1, 0) == SS_INTEGRATOR_EULER &&
-	      ss_integrator_resolve(SS_INTEGRATOR_AUTO, 0, 0) == SS_INTEGRATOR_RKL2 &&
-	      ss_integrator_resolve(SS_INTEGRATOR_AUTO, 0, 1) == SS_INTEGRATOR_RKL2 &&
-	      ss_integrator_resolve(SS_INTEGRATOR_AUTO, 1, 1) == SS_INTEGRATOR_EULER &&
-	      ss_integrator_resolve(SS_INTEGRATOR_RKL2, 1, 0) == SS_INTEGRATOR_RKL2 &&
-	      ss_integrator_resolve(SS_INTEGRATOR_RKL2, 0, 1) == SS_INTEGRATOR_RKL2,
-	      "auto does not resolve to euler with a bedrock, and rkl2 else (relax too)");
+	CHECK(ss_integrator_resolve(SS_INTEGRATOR_AUTO, 1) == SS_INTEGRATOR_EULER &&
+	      ss_integrator_resolve(SS_INTEGRATOR_AUTO, 0) == SS_INTEGRATOR_RKL2 &&
+	      ss_integrator_resolve(SS_INTEGRATOR_RKL2, 1) == SS_INTEGRATOR_RKL2 &&
+	      ss_integrator_resolve(SS_INTEGRATOR_EULER, 0) == SS_INTEGRATOR_EULER,
+	      "auto does not resolve to euler with a bedrock, and rkl2 else");
 
-	/* too few stages, no change allowed */
+	/* too few stages, no change allowed: refused by the model options'
+	 * table, the one place their ranges are checked (a stepper takes its
+	 * settings as given) */
 	const struct {
-		int stages;
-		double change;
-	} bad[] = {{1, 0.3}, {0, 0.3}, {-5, 0.3}, {256, 0.0}, {256, -1.0}, {256, NAN}};
+		const char *key, *value;
+	} bad[] = {{"rkl2-max-stages", "1"}, {"rkl2-max-stages", "0"}, {"rkl2-max-stages", "-5"},
+	           {"rkl2-tol", "0"}, {"rkl2-tol", "-1"}, {"rkl2-tol", "nan"}};
 	for (size_t k = 0; k < sizeof bad / sizeof *bad; k++) {
-		if (setup(&st, 8, 6, 0.1, SS_CLOSURE_COULOMB, 1.0, 0.01, sides(W, W, W, W, 0.0), 0,
-		          0, SS_INTEGRATOR_RKL2, SS_KERNEL_FAST))
-			continue;
-		st.rkl2_max_stages = bad[k].stages;
-		st.rkl2_tol = bad[k].change;
-		const int err = ss_stepper_prepare(&st);
-		CHECK(err == SS_ERR_INPUT, "prepare with rkl2_max_stages %d, rkl2_tol %g "
-		      "gave %d, not SS_ERR_INPUT", bad[k].stages, bad[k].change, err);
-		ss_stepper_release(&st);
+		struct ss_model_options m;
+		ss_model_options_init(&m);
+		const int stages = m.rkl2_max_stages;
+		const double tol = m.rkl2_tol;
+		size_t at;
+		const struct ss_option *o = ss_option_find(&ss_model_option_table, bad[k].key, &at);
+		const int err = o ? ss_option_parse(o, bad[k].value, (char *)&m + at + o->offset) : 0;
+		CHECK(o && err == -1 && m.rkl2_max_stages == stages && m.rkl2_tol == tol,
+		      "the model options took %s %s", bad[k].key, bad[k].value);
 	}
 	/* the smallest accepted */
 	if (setup(&st, 8, 6, 0.1, SS_CLOSURE_COULOMB, 1.0, 0.01, sides(W, W, W, W, 0.0), 0, 0,
@@ -1348,22 +1358,24 @@ static void restart_case(enum ss_kernel kernel, double t1, long long cut, double
 	struct ss_restart_state saved;
 	ss_stepper_restart_state(&a, &saved);
 	double *h1 = interior_copy(&a);
-	const double tau1 = a.rkl2_tau;
+	const double tau1 = a.rkl2->tau_limit;
 	advance_to(&a, t2);
 
 	if (door_room(&b, 0, 0, SS_INTEGRATOR_RKL2, kernel) == 0) {
 		ss_stepper_restore(&b, t1, h1, &saved);
-		CHECK(memcmp(&b.rkl2_tau, &tau1, sizeof tau1) == 0, "restore did not carry the "
-		      "next super-step limit: %.17g, saved %.17g", b.rkl2_tau, tau1);
+		CHECK(memcmp(&b.rkl2->tau_limit, &tau1, sizeof tau1) == 0, "restore did not carry "
+		      "the next super-step limit: %.17g, saved %.17g", b.rkl2->tau_limit, tau1);
 		advance_to(&b, t2);
 		double *ha = interior_copy(&a), *hb = interior_copy(&b);
 		CHECK(same_bits(ha, hb, cells), "%s kernel, restart at t = %.17g s: heights at "
 		      "t = %g s differ from the uninterrupted run's (max %.3g m)", kernel_name(kernel),
 		      t1, t2, max_abs_diff(ha, hb, cells));
-		CHECK(memcmp(&a.inflow, &b.inflow, sizeof a.inflow) == 0 &&
-		      memcmp(&a.outflow, &b.outflow, sizeof a.outflow) == 0,
+		const double in_a = ss_stepper_inflow(&a), out_a = ss_stepper_outflow(&a);
+		const double in_b = ss_stepper_inflow(&b), out_b = ss_stepper_outflow(&b);
+		CHECK(memcmp(&in_a, &in_b, sizeof in_a) == 0 &&
+		      memcmp(&out_a, &out_b, sizeof out_a) == 0,
 		      "%s kernel, restart at t = %.17g s: inflow/outflow %.17g/%.17g, uninterrupted "
-		      "%.17g/%.17g", kernel_name(kernel), t1, b.inflow, b.outflow, a.inflow, a.outflow);
+		      "%.17g/%.17g", kernel_name(kernel), t1, in_b, out_b, in_a, out_a);
 		CHECK(a.steps == b.steps && a.evaluations == b.evaluations,
 		      "%s kernel, restart at t = %.17g s: %lld super-steps, %lld evaluations; "
 		      "uninterrupted %lld, %lld", kernel_name(kernel), t1, b.steps, b.evaluations,

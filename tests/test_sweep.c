@@ -48,15 +48,17 @@
 
 #include "check.h"
 #include "scale.h"
+#include "core/face.h"
+#include "core/ledger.h"
+#include "core/sweep.h"
+#include "core/sweeper.h"
 #include "sandslide/boundary.h"
 #include "sandslide/closure.h"
 #include "sandslide/cpu.h"
 #include "sandslide/diagnostics.h"
-#include "sandslide/face.h"
 #include "sandslide/grid.h"
 #include "sandslide/parallel.h"
 #include "sandslide/stepper.h"
-#include "sandslide/sweep.h"
 
 #define REPOSE 35.0
 
@@ -223,13 +225,14 @@ static int compare_states(const struct ss_stepper *a, const struct ss_stepper *b
 	CHECK(same_bits(a->time, b->time) && a->steps == b->steps,
 	      "%s: time %.17g s after %lld steps (fast) vs %.17g s after %lld steps "
 	      "(reference)", what, a->time, a->steps, b->time, b->steps);
-	CHECK(same_bits(a->inflow, b->inflow),
-	      "%s: inflow %.17g (fast) vs %.17g (reference) m^3", what, a->inflow, b->inflow);
-	CHECK(same_bits(a->outflow, b->outflow),
-	      "%s: outflow %.17g (fast) vs %.17g (reference) m^3", what, a->outflow,
-	      b->outflow);
+	const double in_a = ss_stepper_inflow(a), in_b = ss_stepper_inflow(b);
+	const double out_a = ss_stepper_outflow(a), out_b = ss_stepper_outflow(b);
+	CHECK(same_bits(in_a, in_b),
+	      "%s: inflow %.17g (fast) vs %.17g (reference) m^3", what, in_a, in_b);
+	CHECK(same_bits(out_a, out_b),
+	      "%s: outflow %.17g (fast) vs %.17g (reference) m^3", what, out_a, out_b);
 	ok &= same_bits(a->time, b->time) && a->steps == b->steps &&
-	      same_bits(a->inflow, b->inflow) && same_bits(a->outflow, b->outflow);
+	      same_bits(in_a, in_b) && same_bits(out_a, out_b);
 	return ok;
 }
 
@@ -308,9 +311,11 @@ static double identity_case(const struct scenario *sc, double T, const int *tile
 	CHECK(ref.steps >= 60, "%s: test set-up: only %lld steps to T = %g s", sc->name,
 	      ref.steps, T);
 	identity_steps += ref.steps;
-	CHECK(ref.open_face_count == 0 || ref.outflow != 0.0, "%s: test set-up: no outflow "
-	      "through %zu open faces", sc->name, ref.open_face_count);
-	CHECK(sc->sources == 0 || ref.inflow > 0.0, "%s: test set-up: no inflow", sc->name);
+	CHECK(ref.ledger->open_face_count == 0 || ss_stepper_outflow(&ref) != 0.0,
+	      "%s: test set-up: no outflow through %zu open faces", sc->name,
+	      ref.ledger->open_face_count);
+	CHECK(sc->sources == 0 || ss_stepper_inflow(&ref) > 0.0, "%s: test set-up: no inflow",
+	      sc->name);
 	for (int m = 0; m < n_tiles; m++) {
 		const struct tile_case tc = tile_cases[tiles[m]];
 		for (int threads = 1; threads <= 2; threads++) {
@@ -318,7 +323,7 @@ static double identity_case(const struct scenario *sc, double T, const int *tile
 			if (build(&fast, sc, SS_KERNEL_FAST, tc.nx, tc.ny, threads))
 				continue;
 			snprintf(what, sizeof what, "%s, fast kernel tiles %dx%d, %d thread%s",
-			         sc->name, fast.tiling.tile_nx, fast.tiling.tile_ny, threads,
+			         sc->name, fast.sweeper->tiling.tile_nx, fast.sweeper->tiling.tile_ny, threads,
 			         threads > 1 ? "s" : "");
 			advance_to(&fast, T, what);
 			compare_states(&fast, &ref, what);
@@ -655,24 +660,24 @@ static void test_subcritical(void)
 	      "tan a_cr %g", s0, tc);
 
 	/* the kernel itself, with a large forced dt */
-	const double tiles = (double)st.fast.tiles;
-	const double awake0 = ss_sweep_fast_awake(&st.fast);
+	const double tiles = (double)st.sweeper->fast.tiles;
+	const double awake0 = ss_sweep_fast_awake(&st.sweeper->fast);
 	CHECK(awake0 == tiles, "subcritical: %g of %g tiles awake after prepare", awake0, tiles);
 	for (int step = 0; step < 3; step++) {
 		ss_boundary_fill_heights(g, &st.boundary, st.height);
-		const double s = ss_sweep_fast_begin(&st.fast, g, st.height, st.cell_types);
+		const double s = ss_sweep_fast_begin(&st.sweeper->fast, g, st.height, st.cell_types);
 		CHECK(s <= tc, "subcritical: step %d: the fast sweep measures slope %g > tan "
 		      "a_cr %g", step, s, tc);
-		const double rate = ss_sweep_fast_step(&st.fast, g, &st.face_rule, 1e3, NULL, NULL,
-		                                       st.cell_types, st.height, st.open_flux);
+		const double rate = ss_sweep_fast_step(&st.sweeper->fast, g, &st.sweeper->face_rule, 1e3, NULL, NULL,
+		                                       st.cell_types, st.height, st.ledger->open_flux);
 		CHECK(rate == 0.0, "subcritical: step %d: max |dh/dt| %g", step, rate);
 		CHECK(memcmp(before, st.height, storage * sizeof *before) == 0,
 		      "subcritical: step %d with dt = 1000 s changed the heights", step);
 		int flux_zero = 1;
-		for (size_t m = 0; m < st.open_face_count; m++)
-			flux_zero &= st.open_flux[m] == 0.0;
+		for (size_t m = 0; m < st.ledger->open_face_count; m++)
+			flux_zero &= st.ledger->open_flux[m] == 0.0;
 		CHECK(flux_zero, "subcritical: step %d: an open face carries flux", step);
-		const double awake = ss_sweep_fast_awake(&st.fast);
+		const double awake = ss_sweep_fast_awake(&st.sweeper->fast);
 		CHECK(awake == 0.0, "subcritical: %g of %g tiles still awake after step %d",
 		      awake, tiles, step);
 	}
@@ -744,7 +749,7 @@ static void test_max_slope(void)
 			for (int j = 0; j < ny; j++) {
 				for (int i = 0; i < nx; i++) {
 					const ptrdiff_t k = ss_grid_index(g, i, j);
-					const uint8_t t = ref.cell_type_bytes[k];
+					const uint8_t t = ref.sweeper->cell_type_bytes[k];
 					const double h = t == SS_CELL_FLOW ? amp * (rng_uniform(&r) - 0.5)
 					               : t == SS_CELL_OPEN ? sc.sides.open_level : 0.0;
 					ref.height[k] = fast.height[k] = h;
@@ -753,10 +758,10 @@ static void test_max_slope(void)
 			ss_boundary_fill_heights(g, &ref.boundary, ref.height);
 			ss_boundary_fill_heights(g, &fast.boundary, fast.height);
 			const double m = ss_sweep_max_slope(g, ref.height, ref.cell_types);
-			const double f = ss_sweep_fluxes(g, &ref.tiling, &ref.face_rule, ref.height,
-			                                 ref.cell_type_bytes, ref.flux_x, ref.flux_y);
-			ss_sweep_fast_wake_all(&fast.fast, g, fast.height, fast.cell_types);
-			const double b = ss_sweep_fast_begin(&fast.fast, g, fast.height, fast.cell_types);
+			const double f = ss_sweep_fluxes(g, &ref.sweeper->tiling, &ref.sweeper->face_rule, ref.height,
+			                                 ref.sweeper->cell_type_bytes, ref.sweeper->flux_x, ref.sweeper->flux_y);
+			ss_sweep_fast_wake_all(&fast.sweeper->fast, g, fast.height, fast.cell_types);
+			const double b = ss_sweep_fast_begin(&fast.sweeper->fast, g, fast.height, fast.cell_types);
 			cases++;
 			if (!same_bits(m, f)) {
 				mismatches++;
@@ -773,7 +778,7 @@ static void test_max_slope(void)
 		}
 		/* a NaN height: documented NaN */
 		const ptrdiff_t k = ss_grid_index(g, nx / 2, ny / 2);
-		if (ref.cell_type_bytes[k] == SS_CELL_FLOW) {
+		if (ref.sweeper->cell_type_bytes[k] == SS_CELL_FLOW) {
 			ref.height[k] = NAN;
 			const double m = ss_sweep_max_slope(g, ref.height, ref.cell_types);
 			CHECK(isnan(m), "ss_sweep_max_slope with a NaN height gave %g, not NaN", m);

@@ -15,7 +15,7 @@ on P ranks, each a slab of whole tile rows of an n x n grid (comm.h):
   - two MPI_Allreduce of 64 bytes (the largest slope before the sweep; the
     largest rate and the stop flag after it);
   - with open faces only: the outflow, not per evaluation but once per
-    batch of K evaluations (stepper.h): each rank keeps its open faces'
+    batch of K evaluations (src/core/ledger.h): each rank keeps its open faces'
     fluxes, then 2 K running sums are folded rank after rank (P - 1 hops of
     16 K bytes) and broadcast, so that every sum has the one-rank bits.
     The batch is folded when a run writes a snapshot or when it is full:
@@ -39,7 +39,7 @@ allows at most ny / tile_ny ranks (tile rows of 128 cells).
 import argparse
 import math
 
-BATCH_BYTES = 4 << 20   # SS_OUTFLOW_BATCH_BYTES (stepper.h)
+BATCH_BYTES = 4 << 20   # SS_LEDGER_BATCH_BYTES (src/core/ledger.h)
 
 
 def model(cells, a):
@@ -50,7 +50,7 @@ def model(cells, a):
     # sent per rank per evaluation (none with one rank)
     halo_bytes = 2 * 8 * stride + 2 * math.ceil(n / 256) if ranks > 1 else 0
     t_compute = cells / ranks / a.rate
-    # the outflow batch's evaluations (stepper.c: 4 MiB, a quarter of it
+    # the outflow batch's evaluations (ledger.c: 4 MiB, a quarter of it
     # for 72 B an evaluation, the rest and one evaluation's for fluxes)
     entries = BATCH_BYTES // 4 // 72
     fluxes = (BATCH_BYTES - 72 * entries) // 8

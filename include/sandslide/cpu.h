@@ -3,17 +3,19 @@
  *
  * The library is built for the baseline instruction set of x86-64 (SSE2),
  * so that it runs on any x86-64 machine; the kernel's hot loops (the face
- * flux, face.h, and the fast sweep, sweep.h) are compiled in two more
- * copies, for AVX2 and for AVX-512, and the best copy this processor runs
- * is chosen when the library first needs one.  `make NATIVE=1` builds the
- * rest for the machine it is built on; the choice is the same.
+ * flux and the fast sweep, src/core/face.c and sweep_fast.c) are compiled
+ * in two more copies, for AVX2 and for AVX-512, and the best copy this
+ * processor runs is chosen when the library first needs one.  `make
+ * NATIVE=1` builds the rest for the machine it is built on; the choice is
+ * the same.
  *
  * The paths and their bits.  The AVX-512 path computes the reciprocal
  * square roots of a face as vrsqrt14pd refined by two Newton steps, the
- * generic and AVX2 paths as 1/sqrt (face.h): the AVX-512 path gives bits of
- * its own, the generic and AVX2 paths the same bits as each other.  Every
- * other operation is the same in every path.  Each path gives the same bits
- * for any thread count and tile size, in the fast and the reference sweep.
+ * generic and AVX2 paths as 1/sqrt (doc/model.md#the-face-function): the
+ * AVX-512 path gives bits of its own, the generic and AVX2 paths the same
+ * bits as each other.  Every other operation is the same in every path.
+ * Each path gives the same bits for any thread count and tile size, in the
+ * fast and the reference sweep.
  *
  * The environment variable SANDSLIDE_CPU chooses a path:
  *   unset, "" or "auto"   the best path this processor runs (the default)

@@ -22,16 +22,24 @@ struct ss_diagnostics {
 	double wall_seconds;    /* wall time since the run started, s */
 };
 
+/* A cumulative volume as a compensated sum (Neumaier [Neumaier1974],
+ * doc/model.md#conservation): sum + carry is the total of every term added,
+ * to about one rounding however many there were. */
+struct ss_volume_sum {
+	double sum, carry;                  /* m^3 */
+};
+
 /* What a restart needs beyond the heights and the time to continue with the
- * same bits: the counters, the compensated sums of the inflow and outflow
- * and RKL2's next super-step limit (stepper.h), stored with every snapshot
- * (root attributes restart_state_even and _odd, snapshot.h). */
+ * same bits: the counters, RKL2's next super-step limit (stepper.h) and the
+ * volume ledger's inflow and outflow (src/core/ledger.h; its external
+ * volume, which only a coupled model puts in, bmi.h, is not kept), stored
+ * with every snapshot (root attributes restart_state_even and _odd,
+ * snapshot.h). */
 struct ss_restart_state {
 	long long steps;
-	double inflow_sum, inflow_carry;    /* m^3 */
-	double outflow_sum, outflow_carry;
 	long long evaluations;
 	double rkl2_tau;                    /* s; INFINITY: no limit */
+	struct ss_volume_sum inflow, outflow;
 };
 
 #endif

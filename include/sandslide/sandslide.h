@@ -7,10 +7,11 @@
  * Each header says what its part does; the tiers they belong to are in
  * src/README.md.  The commands as functions (run.h, relax.h, render.h,
  * bench.h) are the usual entry points, which watch.h lets another thread
- * stop and follow; the kernel (grid.h, stepper.h, sweep.h) is for programs
- * that drive the time loop themselves.  Every function returns a status
- * (error.h) and prints only error messages, which ss_error_set_quiet()
- * turns off in favour of ss_error_last_message() (the calling thread's).
+ * stop and follow; the kernel (grid.h, boundary.h, closure.h, stepper.h)
+ * is for programs that drive the time loop themselves.  Every function
+ * returns a status (error.h) and prints only error messages, which
+ * ss_error_set_quiet() turns off in favour of ss_error_last_message() (the
+ * calling thread's).
  */
 #ifndef SANDSLIDE_SANDSLIDE_H
 #define SANDSLIDE_SANDSLIDE_H
@@ -25,10 +26,7 @@
 #include "sandslide/grid.h"
 #include "sandslide/boundary.h"
 #include "sandslide/closure.h"
-#include "sandslide/face.h"
 #include "sandslide/diagnostics.h"
-#include "sandslide/sweep.h"
-#include "sandslide/rkl2.h"
 #include "sandslide/stepper.h"
 #include "sandslide/model_options.h"
 

@@ -6,8 +6,8 @@
  * a source switching on or off) -> the sweep -> account inflow and outflow.
  * The fast sweep (default) measures S as a by-product of the previous sweep
  * and updates in place over the active tiles; the reference sweep computes
- * every flux into two arrays, then updates (sweep.h).  Both give the same
- * bits.  The step is forward Euler with
+ * every flux into two arrays, then updates (src/core/sweep.h).  Both give
+ * the same bits.  The step is forward Euler with
  *
  *   dt = cfl / (2 nu Lambda(S) (1/dx^2 + 1/dy^2))    doc/model.md eq. (11)
  *
@@ -17,23 +17,23 @@
  * sliding.  A state with no face above the critical slope and no source
  * does not change, so the stepper jumps straight to the next event.
  *
- * RKL2 (integrator = SS_INTEGRATOR_RKL2, rkl2.h) advances the same stencil
- * by super-steps of s stages instead.  Its rules:
+ * RKL2 (integrator = SS_INTEGRATOR_RKL2) advances the same stencil by
+ * super-steps of s stages instead (doc/model.md#rkl2-super-steps; the
+ * state between super-steps and their rules: src/core/rkl2.h).  Its rules:
  *
  *   stability  tau <= dt_all (s^2 + s - 2) / 4 with dt_all forward Euler's
  *              step above for Lambda(infinity), the bound of every slope
  *              (for Coulomb max f' = f'(tan a_cr+) = cos a_cr whatever the
  *              state), so no state a stage can reach is unstable;
  *   accuracy   s <= rkl2_max_stages, and the embedded error estimate of
- *              RKC and SUNDIALS (sweep.h, ss_sweep_stage_estimate) at most
- *              rkl2_tol tan(a_cr) min(dx, dy) in the max norm.  One more
- *              evaluation after the last stage, at Y_s, writing nothing,
- *              makes the estimate of a super-step, which sets the limit of
- *              the next, tau 0.9 sqrt(tol / est), growing by at most 2x a
- *              super-step, from 4 stages at the start.  The limit is
- *              known when a super-step ends and is saved with each
- *              snapshot (restart state), so a restart from a snapshot
- *              takes the same super-steps.  The estimate, not
+ *              RKC and SUNDIALS at most rkl2_tol tan(a_cr) min(dx, dy) in
+ *              the max norm.  One more evaluation after the last stage, at
+ *              Y_s, writing nothing, makes the estimate of a super-step,
+ *              which sets the limit of the next, tau 0.9 sqrt(tol / est),
+ *              growing by at most 2x a super-step, from 4 stages at the
+ *              start.  The limit is known when a super-step ends and is
+ *              saved with each snapshot (restart state), so a restart from
+ *              a snapshot takes the same super-steps.  The estimate, not
  *              the size of the change, bounds the super-steps as a state
  *              comes to rest, where RKL2 damps the stiff remainder only by
  *              its a_s ~ 1/2 a super-step;
@@ -52,19 +52,15 @@
  *              the call to ss_stepper_advance.  Near rest RKL2 damps the
  *              grid-scale remainder at the kink of f_sl only by about a_s
  *              ~ 1/2 a super-step, and super-steps that grow while the
- *              state barely changes crawl (measured: the cone of test_rkl2
- *              at a cap of 2048 stages took 3.1 times Euler's evaluations
- *              and 385 times its simulated time to come to rest); on a
- *              long slope that still creeps, forward Euler crawls instead
- *              (a canyon DEM: 7500 evaluations when Euler polished to the
- *              end, 4790 with no polishing, 4609 with bursts).  Bursts of
- *              the super-step's cost keep either from losing more than
- *              about 2x to the other.  Steps and evaluations count the
- *              polishing steps too.
+ *              state barely changes crawl; on a long slope that still
+ *              creeps, forward Euler crawls instead.  Bursts of the
+ *              super-step's cost keep either from losing more than about
+ *              2x to the other (measured: doc/model.md#accuracy-rule).
+ *              Steps and evaluations count the polishing steps too.
  *
  * Bedrock is not supported by RKL2 (its stages have negative weights, so
- * the per-face limit of face.h cannot keep sand above the rock): a stepper
- * with a bedrock refuses it at ss_stepper_prepare.
+ * the per-face limit of doc/model.md#bedrock cannot keep sand above the
+ * rock): a stepper with a bedrock refuses it at ss_stepper_prepare.
  *
  * Steady means: no source to switch on, max |dh/dt| < steady_tol (for RKL2
  * the mean rate |Y_s - Y_0| / tau of the super-step), and no face in sand
@@ -74,7 +70,10 @@
  * just above the angle barely changes height, the more so the larger the
  * cells.
  *
- * The stepper owns its arrays; it knows nothing of files.
+ * The stepper owns its arrays; it knows nothing of files.  Its parts sit
+ * behind pointers, each in a file of src/core/ (src/README.md): the kernel
+ * it drives (sweeper.c), the sources (sources.c), the volume ledger
+ * (ledger.c) and RKL2's state (rkl2.c); stepper.c holds the rest.
  */
 #ifndef SANDSLIDE_STEPPER_H
 #define SANDSLIDE_STEPPER_H
@@ -87,19 +86,10 @@
 #include "sandslide/closure.h"
 #include "sandslide/diagnostics.h"
 #include "sandslide/grid.h"
-#include "sandslide/sweep.h"
-
-struct ss_source {
-	double rate;            /* m/s of height added on each covered flow cell */
-	double start, stop;     /* active for start <= t < stop, s */
-	ptrdiff_t *cells;       /* storage indices of the flow cells covered */
-	size_t cell_count;      /* on this rank */
-	double cell_count_all;  /* on every rank */
-};
 
 enum ss_integrator {
 	SS_INTEGRATOR_EULER,    /* forward Euler: the reference */
-	SS_INTEGRATOR_RKL2,     /* RKL2 super-steps (rkl2.h) */
+	SS_INTEGRATOR_RKL2,     /* RKL2 super-steps (doc/model.md#rkl2-super-steps) */
 	SS_INTEGRATOR_AUTO,     /* a choice for the caller to resolve with
 	                         * ss_integrator_resolve; never a stepper's */
 };
@@ -112,126 +102,62 @@ int ss_integrator_parse(const char *name, enum ss_integrator *out);
 /* The integrator a stepper uses: the one asked for, and for auto (the one
  * place this rule is written): euler with a bedrock (RKL2's stages have
  * negative weights, so the per-face limit cannot keep sand above the
- * rock), else rkl2: pouring and flowing take 9 to 16 times fewer
- * evaluations, and relaxing a DEM, now that RKL2 polishes its approach
- * to rest in bursts of Euler steps, is faster on the real DEMs measured
- * (doc/model.md#which-integrator-is-the-default; slower on large
- * terrains of many small cliffs, where --integrator euler is the choice).
- * relaxing no longer changes the rule; it is kept for the callers. */
-enum ss_integrator ss_integrator_resolve(enum ss_integrator asked, int has_bedrock,
-                                         int relaxing);
-
-#define SS_RKL2_MAX_STAGES_DEFAULT 2048
-#define SS_RKL2_TOL_DEFAULT 0.1
+ * rock), else rkl2, for run and relax alike
+ * (doc/model.md#which-integrator-is-the-default says why). */
+enum ss_integrator ss_integrator_resolve(enum ss_integrator asked, int has_bedrock);
 
 enum ss_kernel {
 	SS_KERNEL_FAST,         /* in place, active tiles (sweep_fast.c) */
 	SS_KERNEL_REFERENCE,    /* two passes, two flux arrays (sweep.c) */
 };
 
+/* The parts of a stepper, each defined in src/core/ beside its file. */
+struct ss_sweeper;
+struct ss_sources;
+struct ss_ledger;
+struct ss_rkl2;
+
 struct ss_stepper {
-	struct ss_grid grid;
-	struct ss_tiling tiling;
+	/* set by ss_stepper_init */
+	struct ss_grid grid;          /* this rank's block (below) */
 	struct ss_closure closure;
-	struct ss_face_rule face_rule;
-	enum ss_kernel kernel;        /* set before ss_stepper_prepare */
-	enum ss_integrator integrator; /* set before ss_stepper_prepare */
-	int rkl2_max_stages;          /* s <= it (>= 2) */
-	double rkl2_tol;              /* error estimate per super-step, in units
-	                               * of tan(a_cr) min(dx, dy) */
-	struct ss_sweep_fast fast;
-	struct ss_cfl_bound cfl_bound;
 	struct ss_boundary boundary;
 	double cfl;                   /* in (0, 1] */
 
+	/* set by the caller before ss_stepper_prepare (init zeroes them) */
+	enum ss_kernel kernel;
+	enum ss_integrator integrator; /* euler or rkl2 */
+	int rkl2_max_stages;          /* RKL2: s <= it, >= 2 */
+	double rkl2_tol;              /* RKL2: error estimate per super-step, in
+	                               * units of tan(a_cr) min(dx, dy), > 0
+	                               * (both: the model options' table,
+	                               * model_options.h, has the defaults and
+	                               * checks the ranges) */
+
+	/* the state */
 	double *height;               /* m, cells with halo (ss_grid_index) */
 	uint8_t *cell_types;          /* enum ss_cell_type with halo, packed
 	                               * (ss_cell_type_get, grid.h) */
-	uint8_t *cell_type_bytes;     /* the same, one byte per cell
-	                               * (reference kernel only) */
-	double *flux_x, *flux_y;      /* m^2/s per face (reference kernel only) */
-	double *open_flux;            /* m^2/s per open face (fast kernel only) */
-	double *source_rate;          /* m/s, with halo: the sources that are on
-	                               * plus the rate field; NULL when neither
-	                               * was ever set */
-	double *rate_field;           /* m/s, with halo: a source field set from
-	                               * outside (ss_stepper_set_rate_field; the
-	                               * BMI's deposition rate); NULL: none */
 	double *bedrock;              /* m, with halo; NULL without bedrock
 	                               * (-infinity where no sand lies: walls,
 	                               * open cells, open and wall ghosts) */
-	double *row_scratch;          /* ny per-row partial sums */
-	double *rkl2_y0;              /* RKL2 only: Y_0, m, with halo */
-	double *rkl2_d1, *rkl2_d2;    /*   D_{j-1}, D_{j-2} = Y - Y_0, m (sweep.h) */
-	double *rkl2_m0;              /*   M(Y_0), m/s */
-
-	struct ss_source *sources;
-	int source_count;
-	uint64_t sources_on;          /* bit k: source k is active now */
-	int rate_field_on;            /* rate_field has a non-zero cell */
-	int source_field_on;          /* source_rate is added by the sweep now
-	                               * (a source on, or the rate field) */
-	int source_field_stale;       /* rebuild source_rate at the next step */
-	double source_rate_max;       /* largest |rate| of any cell now, m/s */
-	double source_volume_rate;    /* sum of rate dx dy now, m^3/s */
-
-	struct ss_open_face *open_faces;
-	size_t open_face_count;       /* on this rank */
-	double open_face_count_all;   /* on every rank */
-
-	/* a distributed grid (comm.h): grid is this rank's slab of whole
-	 * tile rows, tiling its tiles */
-	int rank_south, rank_north;   /* ranks beside, -1: none */
-	double tiles_all;             /* tiles of the whole grid */
-	double tiles_awake;           /* tiles the coming pass sweeps, all ranks */
-	double tiles_awake_here;      /*   of them on this rank */
-	uint8_t *edges_in;            /* 2 tiles_x: the changed edges of the
-	                               * tile rows beside (sweep.h) */
-
 	double time;                  /* s */
 	long long steps;              /* substeps (RKL2: super-steps) taken */
 	long long evaluations;        /* stencil evaluations: Euler one a step,
 	                               * RKL2 s + 1 a super-step (the stages and
 	                               * the error estimate) */
-	double rkl2_tau;              /* the accuracy rule's longest next
-	                               * super-step, s (INFINITY: no limit) */
-	int last_stages;              /* s of the last super-step */
-	double inflow, outflow;       /* cumulative, m^3 */
-	double inflow_sum, inflow_carry;   /* compensated partial sums of them */
-	double external;              /* cumulative volume the caller put in or
-	                               * took out by writing heights, m^3
-	                               * (ss_stepper_book_external) */
-	double external_sum, external_carry;
-	double outflow_sum, outflow_carry; /* (on several ranks: see below) */
-	size_t outflow_batch_bytes;   /* set before ss_stepper_prepare; 0:
-	                               * SS_OUTFLOW_BATCH_BYTES (below) */
-	struct ss_outflow_batch *outflow_batch; /* stepper.c */
 	double rate_max;              /* max |dh/dt| of the last substep, m/s */
-	double tile_sweeps, tile_slots; /* for active_fraction, since last reset */
-	double seconds_measure;       /* kernel wall time, s: measuring S */
-	double seconds_sweep;         /*   and sweeping */
+
+	/* the parts: their structs are src/core's (read by its files, by
+	 * bench's kernel timing and by the white-box tests) */
+	struct ss_sweeper *sweeper;   /* the kernel: fast or reference sweep,
+	                               * face rule, CFL table, timers, tiles */
+	struct ss_sources *sources;   /* the sources and the rate field */
+	struct ss_ledger *ledger;     /* inflow, outflow, external volume; the
+	                               * open faces; the outflow batch */
+	struct ss_rkl2 *rkl2;         /* RKL2's arrays and step control; NULL
+	                               * before ss_stepper_prepare and for euler */
 };
-
-#define SS_MAX_SOURCES 64
-
-/*
- * The outflow on several ranks.  The outflow of an evaluation is a sum
- * over the open faces in list order, and the list of the whole grid is the
- * ranks' lists in rank order, so each rank's part continues the sum the
- * rank before it ended with: summed each evaluation that is a chain of
- * P - 1 messages.  Instead, with more than one rank and open faces, each
- * rank keeps its faces' non-zero fluxes of each evaluation in a batch of
- * outflow_batch_bytes and room for one more evaluation's (8 B an open face
- * of the rank), and the ranks fold the batch in one pass
- * (P - 1 messages for the whole batch) when ss_stepper_advance returns,
- * when ss_stepper_diagnostics is called and when the batch is full, then
- * add each evaluation to the ledger as one rank would have: the same bits.
- * So outflow, outflow_sum and outflow_carry are those of the current state
- * between calls to ss_stepper_advance; inside its progress callback they
- * may lag (several ranks only).  One rank adds each evaluation at once, as
- * before.
- */
-#define SS_OUTFLOW_BATCH_BYTES ((size_t)4 << 20)
 
 /* Allocate the arrays for grid g (zero heights, all flow cells).  Returns
  * SS_ERR_INPUT for a bad cfl or boundary, SS_ERR_FAIL when an allocation
@@ -245,6 +171,11 @@ struct ss_stepper {
  * tile rows is SS_ERR_INPUT.  Every function below then works on the slab
  * (masks, bedrock and heights are the slab's rows) and is collective:
  * every rank calls it, in the same order. */
+int ss_stepper_init(struct ss_stepper *st, const struct ss_grid *g,
+                    const struct ss_closure *c, const struct ss_boundary *b,
+                    double cfl, int tile_nx, int tile_ny);
+void ss_stepper_release(struct ss_stepper *st);
+
 /* The rows first_row .. first_row + rows - 1 (from the south) of the whole
  * grid g that rank `rank`'s slab holds, as ss_stepper_init splits it (the
  * tile sizes as there); rows 0 for a rank that would get no tile row.
@@ -253,10 +184,10 @@ struct ss_stepper {
 void ss_stepper_slab_rows(const struct ss_grid *g, int tile_nx, int tile_ny, int rank,
                           int *first_row, int *rows);
 
-int ss_stepper_init(struct ss_stepper *st, const struct ss_grid *g,
-                    const struct ss_closure *c, const struct ss_boundary *b,
-                    double cfl, int tile_nx, int tile_ny);
-void ss_stepper_release(struct ss_stepper *st);
+/* The cells per tile of st's sweep: the sizes ss_stepper_init was given,
+ * or the defaults they resolved to (what ss_stepper_slab_rows needs to
+ * split another grid as st's was). */
+void ss_stepper_tile_size(const struct ss_stepper *st, int *tile_nx, int *tile_ny);
 
 /* Bytes the stepper allocates for grid g with the fast kernel and that
  * integrator (for the memory check). */
@@ -282,20 +213,36 @@ int ss_stepper_add_source(struct ss_stepper *st, const uint8_t *mask,
 int ss_stepper_set_rate_field(struct ss_stepper *st, const double *rate);
 
 /* Book volume_m3 (signed) put on the grid from outside, by writing heights
- * between calls of ss_stepper_advance, into st->external (compensated, as
- * the inflow is), so that volume = initial + inflow - outflow + external. */
+ * between calls of ss_stepper_advance, as the ledger's external volume
+ * (compensated, as the inflow is), so that volume = initial + inflow -
+ * outflow + external (ss_stepper_diagnostics). */
 void ss_stepper_book_external(struct ss_stepper *st, double volume_m3);
+
+/* The ledger's cumulative volumes, m^3, as ss_stepper_diagnostics reports
+ * them (without its sums over the grid): poured in by the sources and the
+ * rate field, and gone out through open cells.  Between calls of
+ * ss_stepper_advance they are those of the current state; inside its
+ * progress callback the outflow may lag on several ranks (src/core/ledger.h:
+ * the outflow batch). */
+double ss_stepper_inflow(const struct ss_stepper *st);
+double ss_stepper_outflow(const struct ss_stepper *st);
+
+/* The kernel's wall time since ss_stepper_init, s: measuring the slopes
+ * (and the reference sweep's fluxes) and sweeping. */
+void ss_stepper_kernel_seconds(const struct ss_stepper *st, double *measure, double *sweep);
 
 /* A non-erodible bedrock (nx * ny values, m, row-major, south row first):
  * only the sand above it moves, each face limited by the thickness of the
- * cell it leaves (face.h).  Call after the cell types are final and before
+ * cell it leaves (doc/model.md#bedrock).  Call after the cell types are final and before
  * ss_stepper_prepare, which refuses a bedrock above the surface. */
 int ss_stepper_set_bedrock(struct ss_stepper *st, const double *bedrock);
 
 /* Call once heights and interior cell types are set: fills the halo types,
  * holds open cells at the open level, lists the outflow faces, sets up the
- * kernel chosen in st->kernel.  Returns SS_ERR_INPUT naming the first
- * non-finite height or the first cell whose bedrock is above the surface. */
+ * kernel chosen in st->kernel and the integrator in st->integrator (for
+ * rkl2 with the settings above: SS_BUG without them).  Returns
+ * SS_ERR_INPUT naming the first non-finite height, the first cell whose
+ * bedrock is above the surface, or rkl2 with a bedrock. */
 int ss_stepper_prepare(struct ss_stepper *st);
 
 /* How ss_stepper_advance ended.  Steady: see the top of this file. */
@@ -330,10 +277,11 @@ void ss_stepper_diagnostics(struct ss_stepper *st, struct ss_diagnostics *d);
 /*
  * The steepest face of the sand, s = |grad h| over every rank (fills the
  * halo): the faces that can carry flux whose stencil lies in sand at least
- * 1e-6 min(dx, dy) thick (ss_sweep_max_sand_slope); without a bedrock every
+ * 1e-6 min(dx, dy) thick (src/core/sweep.h); without a bedrock every
  * such face.  Bare rock may stay steeper than the repose angle for ever,
  * and a cell at the top of a rock cliff drains geometrically (a quarter of
- * its sand per face and step, face.h), so it never quite reaches 0.  What
+ * its sand per face and step, doc/model.md#bedrock), so it never quite
+ * reaches 0.  What
  * relax reports and run's /max_slope_deg are.  The time step and the
  * steady rule measure slopes their own way (stepper.c).
  */
@@ -346,13 +294,14 @@ void ss_stepper_heights_changed(struct ss_stepper *st);
 /* Time of the next source switch after t (INFINITY if none). */
 double ss_stepper_next_source_event(const struct ss_stepper *st, double t);
 
-/* The counters of the current state that a restart needs (diagnostics.h). */
+/* What a restart needs of the current state besides its heights and time:
+ * the counters and the ledger's sums (diagnostics.h). */
 void ss_stepper_restart_state(const struct ss_stepper *st, struct ss_restart_state *s);
 
 /* Put a prepared stepper in a saved state: time t (s), the heights of
  * every cell of st->grid as a snapshot stores them (nx * ny, row-major,
- * south row first) and the counters s that ss_stepper_restart_state gave.  Stepping
- * on from it gives the same bits as the run that saved it. */
+ * south row first) and the state s that ss_stepper_restart_state gave.
+ * Stepping on from it gives the same bits as the run that saved it. */
 void ss_stepper_restore(struct ss_stepper *st, double t, const double *height,
                         const struct ss_restart_state *s);
 

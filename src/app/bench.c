@@ -12,9 +12,10 @@
 #include <string.h>
 
 #include "base/strings.h"
+#include "core/ledger.h"
+#include "core/sweeper.h"
 #include "sandslide/boundary.h"
 #include "sandslide/error.h"
-#include "sandslide/face.h"
 #include "sandslide/parallel.h"
 #include "sandslide/stepper.h"
 
@@ -110,15 +111,16 @@ static void set_surface(struct ss_stepper *st, enum ss_bench_surface surface)
 static void bench_step(struct ss_stepper *st, double lambda_idle)
 {
 	const struct ss_grid *g = &st->grid;
+	struct ss_sweeper *w = st->sweeper;
 	const double inv_d2 = 1.0 / (g->dx * g->dx) + 1.0 / (g->dy * g->dy);
 	ss_boundary_fill_heights(g, &st->boundary, st->height);
-	const double s_max = ss_sweep_fast_begin(&st->fast, g, st->height, st->cell_types);
-	double lambda = st->closure.nu * ss_cfl_bound_lookup(&st->cfl_bound, s_max);
+	const double s_max = ss_sweep_fast_begin(&w->fast, g, st->height, st->cell_types);
+	double lambda = st->closure.nu * ss_cfl_bound_lookup(&w->cfl_bound, s_max);
 	lambda = lambda > 0.0 ? lambda : lambda_idle;
-	st->tile_sweeps += ss_sweep_fast_awake(&st->fast);
-	st->tile_slots += st->fast.tiles;
-	ss_sweep_fast_step(&st->fast, g, &st->face_rule, st->cfl / (2.0 * lambda * inv_d2),
-	                   NULL, NULL, st->cell_types, st->height, st->open_flux);
+	w->tile_sweeps += ss_sweep_fast_awake(&w->fast);
+	w->tile_slots += w->fast.tiles;
+	ss_sweep_fast_step(&w->fast, g, &w->face_rule, st->cfl / (2.0 * lambda * inv_d2),
+	                   NULL, NULL, st->cell_types, st->height, st->ledger->open_flux);
 }
 
 struct case_result {
@@ -153,7 +155,8 @@ static int run_case(const struct ss_bench_options *o, enum ss_bench_surface surf
 		return err;
 	}
 
-	const double lambda_idle = st.closure.nu * ss_cfl_bound_lookup(&st.cfl_bound, 2.0 * c.tan_cr);
+	struct ss_sweeper *w = st.sweeper;
+	const double lambda_idle = st.closure.nu * ss_cfl_bound_lookup(&w->cfl_bound, 2.0 * c.tan_cr);
 	bench_step(&st, lambda_idle);                 /* warm-up: every tile */
 	long long steps = o->steps;
 	if (steps <= 0) {
@@ -167,23 +170,23 @@ static int run_case(const struct ss_bench_options *o, enum ss_bench_surface surf
 	double rates[64];
 	const int repeats = o->repeats < 64 ? o->repeats : 64;
 	const double cells = (double)g.nx * g.ny;
-	st.tile_sweeps = st.tile_slots = 0.0;
+	w->tile_sweeps = w->tile_slots = 0.0;
 	for (int r = 0; r < repeats; r++) {
 		const double t0 = ss_parallel_wall_seconds();
 		for (long long k = 0; k < steps; k++)
 			bench_step(&st, lambda_idle);
 		rates[r] = cells * (double)steps / (ss_parallel_wall_seconds() - t0);
 	}
-	if (st.fast.nonfinite) {
+	if (w->fast.nonfinite) {
 		ss_stepper_release(&st);
 		return ss_error_fail("bench %s %s: a height became NaN or infinite",
 		                     surface_names[surface], bc->label);
 	}
 	double plain = 0.0;
-	for (int k = 0; k < st.fast.tiles; k++)
-		plain += st.fast.plain[k];
-	res->active_fraction = st.tile_slots > 0.0 ? st.tile_sweeps / st.tile_slots : 0.0;
-	res->plain_fraction = plain / st.fast.tiles;
+	for (int k = 0; k < w->fast.tiles; k++)
+		plain += w->fast.plain[k];
+	res->active_fraction = w->tile_slots > 0.0 ? w->tile_sweeps / w->tile_slots : 0.0;
+	res->plain_fraction = plain / w->fast.tiles;
 	res->steps = steps;
 	res->min = res->max = rates[0];
 	for (int r = 1; r < repeats; r++) {
@@ -266,7 +269,7 @@ int ss_bench_run(const struct ss_bench_options *o)
 	for (int s = 0; s < SS_BENCH_SURFACES; s++) {
 		for (int c = 0; c < o->closure_count && o->surfaces[s]; c++) {
 			for (int t = 0; t < o->thread_count; t++) {
-				struct case_result r;
+				struct case_result r = {0};
 				ss_parallel_set_threads(o->threads[t]);
 				if ((err = run_case(o, (enum ss_bench_surface)s, &o->closures[c], &r)))
 					return err;

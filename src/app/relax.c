@@ -269,8 +269,8 @@ static void measure_after(struct relax *x, enum ss_drive_end end, struct ss_rela
 	rep->evaluations = st->evaluations;
 	rep->integrator = ss_integrator_name(st->integrator);
 	rep->time = st->time;
-	rep->inflow = st->inflow;
-	rep->outflow = st->outflow;
+	rep->inflow = ss_stepper_inflow(st);
+	rep->outflow = ss_stepper_outflow(st);
 	rep->volume_after = flow_volume(st);
 	rep->max_slope_after_deg = steepest_sand_face_deg(st);
 	/* in row order, carried from rank to rank (comm.h) */

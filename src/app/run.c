@@ -263,8 +263,7 @@ static void summarise(const struct run *r, enum ss_drive_end end, struct ss_run_
 	                    ((double)st->grid.nx * st->grid.ny);
 	s->ranks = ss_comm_size();
 	s->wall_seconds = ss_parallel_wall_seconds() - r->drive.started;
-	s->measure_seconds = st->seconds_measure;
-	s->sweep_seconds = st->seconds_sweep;
+	ss_stepper_kernel_seconds(st, &s->measure_seconds, &s->sweep_seconds);
 	s->output_seconds = r->drive.seconds_output;
 	s->comm_seconds = ss_comm_seconds();
 	s->memory_peak_bytes = ss_memory_peak_bytes();

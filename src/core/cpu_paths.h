@@ -23,8 +23,8 @@
 #define SANDSLIDE_CORE_CPU_PATHS_H
 
 #include "sandslide/cpu.h"
-#include "sandslide/face.h"
-#include "sandslide/sweep.h"
+#include "core/face.h"
+#include "core/sweep.h"
 
 #define SS_PATH_GENERIC 0
 #define SS_PATH_AVX2 1

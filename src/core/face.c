@@ -13,7 +13,7 @@
  * rule's set-up and the public functions, which call the copy of the path
  * in use, are in the generic copy only.
  */
-#include "sandslide/face.h"
+#include "core/face.h"
 
 #include <math.h>
 #include <stdint.h>

@@ -4,7 +4,7 @@
  * Deliberately plain: one face per call of the face function, fluxes kept
  * in two full arrays.  The tests hold the fast sweep to it bit for bit.
  */
-#include "sandslide/sweep.h"
+#include "core/sweep.h"
 
 #include <math.h>
 #include <stddef.h>

@@ -15,7 +15,7 @@
  * the path in use once per call, in the generic copy only.  A copy calls
  * its own path's face flux.
  */
-#include "sandslide/sweep.h"
+#include "core/sweep.h"
 
 #include <math.h>
 #include <string.h>
@@ -486,7 +486,7 @@ static size_t open_slot_of(const struct ss_tiling *t, const struct ss_grid *g,
 
 /* The open faces into f->open_slots grouped by tile, f->open_first[t] ..
  * f->open_first[t + 1] those of tile t: a counting sort, stable, so each
- * tile's stay in row order (the stepper's list is). */
+ * tile's stay in row order (the ledger's list is). */
 static int sort_open_slots(struct ss_sweep_fast *f, const struct ss_grid *g,
                            const struct ss_open_face *open_faces, size_t count)
 {
@@ -708,7 +708,7 @@ struct tile_ctx {
 	const double *restrict bed;    /* bedrock, m by storage index; NULL: none */
 	const uint8_t *restrict type;  /* packed cell types (grid.h) */
 	double *restrict h;            /* heights, m by storage index, swept in place */
-	double *restrict open_flux;    /* m^2/s, by the stepper's open-face list */
+	double *restrict open_flux;    /* m^2/s, by the ledger's open-face list */
 	ptrdiff_t stride;              /* g->stride */
 	double dt;                     /* s */
 	const struct ss_sweep_stage *stage;  /* an RKL2 stage, or NULL: Euler */
@@ -1163,7 +1163,7 @@ static inline int row_edges(const struct tile_ctx *c, const struct tile *t,
 	return edges;
 }
 
-/* The fluxes of row j's faces to open cells, for the stepper's balance. */
+/* The fluxes of row j's faces to open cells, for the ledger's balance. */
 static inline void row_open_fluxes(const struct tile_ctx *c, struct tile *t,
                                    const struct row_buffers *w, const struct ring *r,
                                    int j)

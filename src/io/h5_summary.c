@@ -193,10 +193,10 @@ static int read_state(struct ss_snapshot_file *f, struct ss_restart_info *r)
 		return ss_error_input("cannot restart from '%s': its restart state is missing or "
 		                      "damaged (written by an older sandslide?)", f->name);
 	r->state.steps = (long long)v[0];
-	r->state.inflow_sum = v[1];
-	r->state.inflow_carry = v[2];
-	r->state.outflow_sum = v[3];
-	r->state.outflow_carry = v[4];
+	r->state.inflow.sum = v[1];
+	r->state.inflow.carry = v[2];
+	r->state.outflow.sum = v[3];
+	r->state.outflow.carry = v[4];
 	r->state.evaluations = (long long)v[5];
 	r->state.rkl2_tau = v[6];
 	return SS_OK;

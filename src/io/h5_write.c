@@ -569,8 +569,8 @@ static int append_value(hid_t d, long long index, double v)
 static int write_restart_state(hid_t file, long long k, const struct ss_restart_state *r)
 {
 	const double v[SS_SNAPSHOT_RESTART_VALUES] = {
-		(double)r->steps, r->inflow_sum, r->inflow_carry, r->outflow_sum,
-		r->outflow_carry, (double)r->evaluations, r->rkl2_tau,
+		(double)r->steps, r->inflow.sum, r->inflow.carry, r->outflow.sum,
+		r->outflow.carry, (double)r->evaluations, r->rkl2_tau,
 	};
 	return ss_h5_attr_update_doubles(file, ss_snapshot_restart_attribute(k), v,
 	                                 SS_SNAPSHOT_RESTART_VALUES);

@@ -17,10 +17,6 @@ static int parse_integrator(const char *value, void *field)
 	return ss_integrator_parse(value, field);
 }
 
-/* the core's defaults as the table's text */
-#define TEXT_OF(x) #x
-#define TEXT(x) TEXT_OF(x)
-
 #define AT(m) offsetof(struct ss_model_options, m)
 /* the closures a key applies to (applies_to) */
 #define FOR(k) (1u << SS_CLOSURE_##k)
@@ -83,10 +79,10 @@ static const struct ss_option options[] = {
 	         "above it)"},
 	{.name = "rkl2-max-stages", .case_key = "time.rkl2_max_stages", .value_name = "S",
 	 .kind = SS_OPTION_INT, .offset = AT(rkl2_max_stages),
-	 .default_value = TEXT(SS_RKL2_MAX_STAGES_DEFAULT), .lo = 2, .hi = 100000,
+	 .default_value = "2048", .lo = 2, .hi = 100000,
 	 .expected = "an integer from 2 to 100000", .help = "rkl2: at most S stages a super-step"},
 	{.name = "rkl2-tol", .case_key = "time.rkl2_tol", .value_name = "E", .kind = SS_OPTION_REAL,
-	 .offset = AT(rkl2_tol), .default_value = TEXT(SS_RKL2_TOL_DEFAULT), SS_OPTION_POSITIVE,
+	 .offset = AT(rkl2_tol), .default_value = "0.1", SS_OPTION_POSITIVE,
 	 .expected = "a number > 0",
 	 .help = "rkl2: error estimate of a super-step at most\n"
 	         "E tan(angle) min(dx, dy)"},

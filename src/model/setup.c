@@ -24,7 +24,6 @@ struct start {
 	double dx, dy, x0, y0;                /* m */
 	const struct ss_boundary *boundary;
 	int has_bedrock;
-	int relaxing;                         /* for ss_integrator_resolve */
 	int tile_nx, tile_ny;
 	enum ss_kernel kernel;
 	const char *integrator_what;          /* "--integrator rkl2" */
@@ -46,7 +45,7 @@ static int start(const struct start *s, struct ss_stepper *st)
 	if (err)
 		return err;
 	const enum ss_integrator integrator =
-		ss_integrator_resolve(m->integrator, s->has_bedrock, s->relaxing);
+		ss_integrator_resolve(m->integrator, s->has_bedrock);
 	if (integrator == SS_INTEGRATOR_RKL2 && s->has_bedrock)
 		return ss_error_input("%s cannot be used with %s: its stages cannot keep the sand "
 		                      "above the rock (use euler or auto)", s->integrator_what,
@@ -134,8 +133,9 @@ static int read_slab(const char *path, const char *where, const char *what,
 {
 	struct ss_dem_read_options o;
 	ss_dem_read_options_init(&o);
-	const int err = ss_setup_read_window(path, where, o, st->tiling.tile_nx,
-	                                     st->tiling.tile_ny, r);
+	int tile_nx, tile_ny;
+	ss_stepper_tile_size(st, &tile_nx, &tile_ny);
+	const int err = ss_setup_read_window(path, where, o, tile_nx, tile_ny, r);
 	return err ? err : check_grid_size(path, where, what, &st->grid, r);
 }
 
@@ -216,7 +216,7 @@ int ss_setup_stepper(const struct ss_case *c, int tile_nx, int tile_ny,
 	const struct start s = {
 		.m = &c->model, .nx = c->nx, .ny = c->ny, .dx = c->dx, .dy = c->dy,
 		.x0 = c->origin_x, .y0 = c->origin_y, .boundary = &c->boundary,
-		.has_bedrock = c->bedrock_file != NULL, .relaxing = 0, .tile_nx = tile_nx,
+		.has_bedrock = c->bedrock_file != NULL, .tile_nx = tile_nx,
 		.tile_ny = tile_ny, .kernel = kernel, .integrator_what = integrator_what,
 		.bedrock_what = "a bedrock", .grid_what = grid_what,
 		.memory_advice = " (reduce nx and ny)",
@@ -347,7 +347,7 @@ int ss_setup_stepper_from_raster(const struct ss_raster_setup *s, struct ss_step
 	const struct start start_with = {
 		.m = s->model, .nx = r->nx, .ny = r->ny, .dx = dx, .dy = dy,
 		.x0 = isnan(r->x0) ? 0.0 : r->x0, .y0 = isnan(r->y0) ? 0.0 : r->y0,
-		.boundary = &sides, .has_bedrock = s->bedrock != NULL, .relaxing = 1,
+		.boundary = &sides, .has_bedrock = s->bedrock != NULL,
 		.tile_nx = s->tile_nx, .tile_ny = s->tile_ny,
 		.kernel = SS_KERNEL_FAST, .integrator_what = "--integrator rkl2",
 		.bedrock_what = "--bedrock", .grid_what = grid_what, .memory_advice = "",

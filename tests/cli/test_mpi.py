@@ -59,7 +59,7 @@ SANDSLIDE_MPI), its batch hook SANDSLIDE_MPI_BATCH (tests/sandslide-batch);
   ncdump           reads the header and the data of an np = 3 file; its
                    summary is printed once
   outflow batch    each rank keeps its open faces' fluxes and the ranks fold
-                   them per snapshot or when the batch is full (stepper.h):
+                   them per snapshot or when the batch is full (ledger.h):
                    the batch shrunk by build-mpi/tests/sandslide-batch
                    (tests/hooks/batch_step.c) so that it fills between
                    snapshots, by its count of evaluations (the mixed cases,
@@ -1086,7 +1086,7 @@ def test_ncdump_reads_a_file_of_3_ranks(tmp_path):
 
 # ---- d. the outflow batch ----------------------------------------------------------------
 
-# Bytes of the outflow batch a rank keeps (stepper.h; SS_OUTFLOW_BATCH_BYTES,
+# Bytes of the outflow batch a rank keeps (src/core/ledger.h; SS_LEDGER_BATCH_BYTES,
 # 4 MiB, by default), set through the batch hook: 1024 B hold at most 3
 # evaluations and about 100 fluxes besides one evaluation's, so the mixed
 # cases (9 or more evaluations between snapshots) fill the batch by its

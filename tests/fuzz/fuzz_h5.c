@@ -118,7 +118,7 @@ static void check_restart(struct ss_snapshot_file *f, const double *last, int la
 		return;
 	FUZZ_CHECK(r.count == f->count && r.count >= 1 && r.nx == f->nx && r.ny == f->ny);
 	FUZZ_CHECK(r.case_text && r.case_text[0] && r.case_path && r.case_overrides);
-	FUZZ_CHECK(r.state.steps >= 0 && isfinite(r.state.inflow_sum + r.state.outflow_sum));
+	FUZZ_CHECK(r.state.steps >= 0 && isfinite(r.state.inflow.sum + r.state.outflow.sum));
 	FUZZ_CHECK(last_err == SS_OK && r.height);
 	FUZZ_CHECK(!memcmp(r.height, last, (size_t)f->nx * (size_t)f->ny * sizeof *last));
 	ss_restart_info_release(&r);

@@ -18,13 +18,13 @@
  * maxima, which do not depend on order.  Pure compute: no I/O, no
  * allocation.  The caller fills the halo first (boundary.h).
  */
-#ifndef SANDSLIDE_SWEEP_H
-#define SANDSLIDE_SWEEP_H
+#ifndef SANDSLIDE_CORE_SWEEP_H
+#define SANDSLIDE_CORE_SWEEP_H
 
 #include <stdint.h>
 
 #include "sandslide/closure.h"
-#include "sandslide/face.h"
+#include "core/face.h"
 #include "sandslide/grid.h"
 
 /*
@@ -251,7 +251,7 @@ struct ss_sweep_fast {
 	uint8_t *edges_out_south;  /* per tile of the first (last) tile row: */
 	uint8_t *edges_out_north;  /*   SS_EDGE_* bits the last plan took from
 	                              it, for the rank beside (0: not swept) */
-	/* faces to open cells, grouped by tile, in row order (see stepper) */
+	/* faces to open cells, grouped by tile, in row order (ledger.h) */
 	struct ss_open_face_slot *open_slots;
 	size_t *open_first;      /* per tile + 1: slots of tile t are
 	                            [open_first[t], open_first[t + 1]) */
@@ -265,7 +265,7 @@ enum { SS_EDGE_WEST = 1, SS_EDGE_EAST = 2, SS_EDGE_SOUTH = 4, SS_EDGE_NORTH = 8 
  * row j, buffer position x of the face in the tile's row (see sweep_fast.c)
  * and which faces of the row it belongs to. */
 struct ss_open_face_slot {
-	size_t face;             /* index in the stepper's open-face list */
+	size_t face;             /* index in the ledger's open-face list */
 	int j;                   /* cell row */
 	int x;                   /* x-face: i - i0 + 0..1; y-face: i - i0 + 1 */
 	int which;               /* 0 x-face, 1 y-face south, 2 y-face north */

@@ -26,8 +26,8 @@
  * use, so the reference sweep (one face per call) and the fast sweep (a
  * row per call) run the same instructions on every face: the same bits.
  */
-#ifndef SANDSLIDE_FACE_H
-#define SANDSLIDE_FACE_H
+#ifndef SANDSLIDE_CORE_FACE_H
+#define SANDSLIDE_CORE_FACE_H
 
 #include "sandslide/closure.h"
 
