@@ -85,9 +85,12 @@ static int write_series(const char *path, const double *times, int count, int al
 	if (!types || !h)
 		exit(2);
 	ss_cell_type_set(types, ss_grid_index(&g, 0, 0), SS_CELL_WALL);
+	struct ss_model_options model;
+	ss_model_options_init(&model);
+	model.angle_deg = 33.0;
+	model.nu = 0.1;
 	struct ss_snapshot_meta meta = {
-		.title = "test", .history = "test_observations", .case_text = "", .closure = "coulomb",
-		.repose_angle_deg = 33.0, .nu = 0.1, .gamma = 1.0,
+		.title = "test", .history = "test_observations", .case_text = "", .model = &model,
 	};
 	struct ss_snapshot *s = NULL;
 	int err = ss_snapshot_create(&s, path, &g, types, &meta);

@@ -15,7 +15,7 @@
 
 #include "sandslide/closure.h"
 #include "sandslide/option.h"
-#include "sandslide/stepper.h"
+#include "sandslide/integrator.h"
 
 /* What nu may be derived from, for the viscoplastic closures
  * (doc/model.md#nu-from-the-sliding-layer): a case's [model] keys only. */

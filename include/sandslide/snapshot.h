@@ -31,6 +31,7 @@
 #include "sandslide/boundary.h"
 #include "sandslide/diagnostics.h"
 #include "sandslide/grid.h"
+#include "sandslide/model_options.h"
 
 struct ss_snapshot;   /* opaque: owns the HDF5 handles */
 
@@ -47,12 +48,11 @@ struct ss_snapshot_meta {
 	const char *title;
 	const char *history;     /* the command line */
 	const char *case_text;   /* the whole case file */
-	const char *closure;     /* closure name */
-	const char *integrator;  /* "euler" or "rkl2" (attribute integrator), or
-	                          * NULL: not written */
-	double repose_angle_deg;
-	double nu;               /* m^2/s */
-	double gamma;
+	const struct ss_model_options *model; /* the closure, angle, nu and
+	                          * gamma written as attributes */
+	const char *integrator;  /* "euler" or "rkl2" (attribute integrator): the
+	                          * one the stepper resolved, or NULL: not
+	                          * written */
 	int deflate;             /* 0 (none) .. 9 */
 	const double *bedrock;   /* m, the grid's halo layout, or NULL */
 	const char *case_overrides; /* the --set values, one per line, or NULL */

@@ -248,9 +248,8 @@ static int open_output(struct relax *x, const struct ss_relax_report *rep)
 		return err;
 	const struct ss_snapshot_meta meta = {
 		.title = o->dem, .history = o->job.history ? o->job.history : "",
-		.case_text = "", .closure = ss_closure_name(o->model.closure),
+		.case_text = "", .model = &o->model,
 		.integrator = ss_integrator_name(x->st.integrator),
-		.repose_angle_deg = o->model.angle_deg, .nu = o->model.nu, .gamma = o->model.gamma,
 		.bedrock = x->st.bedrock, .crs_wkt = x->in.dem.crs_wkt, .boundary = &x->st.boundary,
 		.nodata = x->in.dem.nodata,
 	};

@@ -230,10 +230,8 @@ static int open_output(struct run *r)
 		return SS_ERR_FAIL;
 	const struct ss_snapshot_meta meta = {
 		.title = r->c.path, .history = o->job.history ? o->job.history : "",
-		.case_text = r->c.text, .closure = ss_closure_name(r->c.model.closure),
+		.case_text = r->c.text, .model = &r->c.model,
 		.integrator = ss_integrator_name(r->st.integrator),
-		.repose_angle_deg = r->c.model.angle_deg, .nu = r->c.model.nu,
-		.gamma = r->c.model.gamma,
 		.deflate = o->deflate, .bedrock = r->st.bedrock, .case_overrides = overrides,
 		.boundary = &r->st.boundary,
 	};

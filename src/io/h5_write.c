@@ -374,10 +374,10 @@ static int write_static(struct ss_snapshot *s, const uint8_t *cell_types,
 	      ss_h5_attr_write_string(f, "title", meta->title) ||
 	      ss_h5_attr_write_string(f, "history", meta->history) ||
 	      ss_h5_attr_write_string(f, "source", source) ||
-	      ss_h5_attr_write_string(f, "closure", meta->closure) ||
-	      ss_h5_attr_write_doubles(f, "repose_angle_deg", &meta->repose_angle_deg, 1) ||
-	      ss_h5_attr_write_doubles(f, "nu", &meta->nu, 1) ||
-	      ss_h5_attr_write_doubles(f, "gamma", &meta->gamma, 1) ||
+	      ss_h5_attr_write_string(f, "closure", ss_closure_name(meta->model->closure)) ||
+	      ss_h5_attr_write_doubles(f, "repose_angle_deg", &meta->model->angle_deg, 1) ||
+	      ss_h5_attr_write_doubles(f, "nu", &meta->model->nu, 1) ||
+	      ss_h5_attr_write_doubles(f, "gamma", &meta->model->gamma, 1) ||
 	      ss_h5_attr_write_doubles(f, "dx", &g->dx, 1) ||
 	      ss_h5_attr_write_doubles(f, "dy", &g->dy, 1) ||
 	      ss_h5_attr_write_string(f, "case", meta->case_text) ||
