@@ -233,7 +233,7 @@ static void remove_frame_folder(const char *dir, long long n)
  * to be written (frame_00000.png .. of the n chosen) nor the video. */
 static int check_not_there(const struct ss_render_series_options *o, long long n)
 {
-	if (o->force)
+	if (o->job.force)
 		return SS_OK;
 	long long first = -1, there = 0;
 	char path[4200];
@@ -410,7 +410,7 @@ int ss_render_series(const struct ss_render_series_options *o,
 	if ((err = select_frames(o, &s, &sel, &n)) ||
 	    (o->output_dir && (err = ss_render_check_dir(o->output_dir, 0))) ||
 	    (o->video && (err = check_video_path(o->video))) || (err = check_not_there(o, n)) ||
-	    (o->html && (err = ss_render_html_check_path(o->html, o->force))) ||
+	    (o->html && (err = ss_render_html_check_path(o->html, o->job.force))) ||
 	    (err = series_scale(o, &s, &zmin, &zmax)))
 		goto out_source;
 	struct ss_render_plan plan;

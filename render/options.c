@@ -109,15 +109,15 @@ static const struct ss_option series[] = {
 	 .help = "write a self-contained viewer (frames, slider, play,\n"
 	         "height under the mouse) to FILE.html; without -o,\n"
 	         "no frame folder is written"},
-	{.name = "force", .kind = SS_OPTION_FLAG, .offset = AT(force), .expected = "1 or 0",
-	 .help = "replace existing frames, video or viewer"},
 };
 
-static const struct ss_option_part parts[] = {{&ss_render_look_option_table, AT(look)}};
+static const struct ss_option_part parts[] = {
+	{&ss_job_option_table, AT(job)}, {&ss_render_look_option_table, AT(look)},
+};
 
 const struct ss_option_table ss_render_option_table = {
 	.command = "render", .options = series, .count = sizeof series / sizeof *series,
-	.parts = parts, .part_count = 1,
+	.parts = parts, .part_count = 2,
 };
 
 void ss_render_series_options_init(struct ss_render_series_options *o)

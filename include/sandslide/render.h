@@ -33,6 +33,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include "sandslide/job.h"
 #include "sandslide/option.h"
 
 enum ss_render_style {
@@ -184,14 +185,14 @@ struct ss_render_series_options {
 	                             * slider, play/pause, the colour bar, and
 	                             * the height under the mouse from heights
 	                             * embedded quantised to 16 bits), or NULL */
-	int force;                  /* replace frames, a video and a viewer that
-	                             * exist; else SS_ERR_INPUT before anything is
-	                             * written */
+	struct ss_job job;          /* force: replace frames, a video and a viewer
+	                             * that exist (else SS_ERR_INPUT before
+	                             * anything is written); threads (job.h) */
 	struct ss_render_options look;
 };
 
-/* `sandslide render`'s options (option.h), continued by the look's at
- * look; the command line's parser and help read them. */
+/* `sandslide render`'s options (option.h), continued by the job's at job
+ * and the look's at look; the command line's parser and help read them. */
 extern const struct ss_option_table ss_render_option_table;
 
 /* Every field at the table's default (look too). */

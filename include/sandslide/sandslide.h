@@ -27,6 +27,7 @@
 #include "sandslide/boundary.h"
 #include "sandslide/closure.h"
 #include "sandslide/diagnostics.h"
+#include "sandslide/integrator.h"
 #include "sandslide/stepper.h"
 #include "sandslide/model_options.h"
 

@@ -19,6 +19,7 @@
 
 #include <signal.h>
 
+#include "sandslide/job.h"
 #include "sandslide/progress.h"
 
 struct ss_watch;
@@ -42,6 +43,12 @@ void ss_watch_stop(struct ss_watch *w);
  * yet, the values are then 0 and NaN). */
 long long ss_watch_read(const struct ss_watch *w, double *time, double *end, long long *steps,
                         double *fraction, long long *runs);
+
+/* Attach watch w to a command's job (job.h): its stop flag becomes the
+ * job's stop_signal and its callback the progress, replacing any set; w
+ * NULL detaches (no stop signal, no progress).  w must outlive the
+ * command's call. */
+void ss_job_set_watch(struct ss_job *job, struct ss_watch *w);
 
 /* What ss_job_set_watch installs: the stop flag, and the callback
  * (context: the watch), which must both be installed: the callback sets

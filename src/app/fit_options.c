@@ -95,11 +95,13 @@ static const struct ss_option options[] = {
 	         "along each parameter"},
 };
 
-static const struct ss_option_part parts[] = {{&ss_job_option_table, AT(job)}};
+static const struct ss_option_part parts[] = {
+	{&ss_job_option_table, AT(job)}, {&ss_job_stepping_option_table, AT(job)},
+};
 
 const struct ss_option_table ss_fit_option_table = {
 	.command = "fit", .options = options, .count = sizeof options / sizeof *options,
-	.parts = parts, .part_count = 1, .size = sizeof(struct ss_fit_options),
+	.parts = parts, .part_count = 2, .size = sizeof(struct ss_fit_options),
 };
 
 void ss_fit_options_init(struct ss_fit_options *o)

@@ -105,7 +105,8 @@ static const struct ss_option options[] = {
 };
 
 static const struct ss_option_part parts[] = {
-	{&ss_job_option_table, AT(job)}, {&ss_model_option_table, AT(model)},
+	{&ss_job_option_table, AT(job)}, {&ss_job_stepping_option_table, AT(job)},
+	{&ss_model_option_table, AT(model)},
 };
 
 static void init(void *o)
@@ -115,7 +116,7 @@ static void init(void *o)
 
 const struct ss_option_table ss_relax_option_table = {
 	.command = "relax", .options = options, .count = sizeof options / sizeof *options,
-	.parts = parts, .part_count = 2, .size = sizeof(struct ss_relax_options), .init = init,
+	.parts = parts, .part_count = 3, .size = sizeof(struct ss_relax_options), .init = init,
 };
 
 void ss_relax_options_init(struct ss_relax_options *o)

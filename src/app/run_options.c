@@ -60,11 +60,13 @@ static const struct ss_option options[] = {
 	 .help = "HDF5 deflate level of /height, 0 (off) to 9"},
 };
 
-static const struct ss_option_part parts[] = {{&ss_job_option_table, AT(job)}};
+static const struct ss_option_part parts[] = {
+	{&ss_job_option_table, AT(job)}, {&ss_job_stepping_option_table, AT(job)},
+};
 
 const struct ss_option_table ss_run_option_table = {
 	.command = "run", .options = options, .count = sizeof options / sizeof *options,
-	.parts = parts, .part_count = 1, .size = sizeof(struct ss_run_options),
+	.parts = parts, .part_count = 2, .size = sizeof(struct ss_run_options),
 };
 
 void ss_run_options_init(struct ss_run_options *o)

@@ -139,6 +139,13 @@ void ss_watch_progress(void *context, const struct ss_progress *p)
 	hand_over_stop(w);
 }
 
+void ss_job_set_watch(struct ss_job *job, struct ss_watch *w)
+{
+	job->stop_signal = w ? ss_watch_stop_flag(w) : NULL;
+	job->progress = w ? ss_watch_progress : NULL;
+	job->progress_context = w;
+}
+
 long long ss_watch_read(const struct ss_watch *w, double *time, double *end, long long *steps,
                         double *fraction, long long *runs)
 {

@@ -243,7 +243,7 @@ static int cmd_relax(int argc, char **argv)
 
 /* What the command line adds to render's options (render.h). */
 struct render_cli {
-	int threads, quiet, bench, bench_n, no_label, no_colorbar;
+	int quiet, bench, bench_n, no_label, no_colorbar;
 };
 
 #define RENDER_CLI(m) offsetof(struct render_cli, m)
@@ -252,11 +252,6 @@ static const struct ss_option render_cli_options[] = {
 	 .help = "no time label on a video's frames (--video draws one)"},
 	{.name = "no-colorbar", .kind = SS_OPTION_FLAG, .offset = RENDER_CLI(no_colorbar),
 	 .help = "no colour bar on a video's frames (--video adds one)"},
-	{.name = "threads", .value_name = "N", .kind = SS_OPTION_INT,
-	 .offset = RENDER_CLI(threads), .lo = 1, .hi = 4096,
-	 .expected = "an integer from 1 to 4096",
-	 .help = "OpenMP threads (default: OMP_NUM_THREADS, else\n"
-	         "the processors this process may run on)"},
 	{.name = "quiet", .alias = "-q", .kind = SS_OPTION_FLAG, .offset = RENDER_CLI(quiet),
 	 .help = "no summary"},
 	{.name = "bench", .value_name = "[N]", .kind = SS_OPTION_OPTIONAL_INT,
@@ -291,7 +286,7 @@ static int cmd_render(int argc, char **argv)
 	const int status = cli_parse(&cmd, argc, argv, 2);
 	if (status != CLI_GO_ON)
 		return status;
-	ss_parallel_set_threads(cli.threads > 0 ? cli.threads : ss_parallel_default_threads(1));
+	ss_parallel_set_threads(o.job.threads > 0 ? o.job.threads : ss_parallel_default_threads(1));
 	if (cli.bench) {
 		struct ss_render_bench_report report;
 		const int err = ss_render_bench(cli.bench_n, 5, &report);

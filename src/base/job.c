@@ -1,13 +1,12 @@
 /*
- * job.c - the options every long command shares (job.h): one table, the
- * watch that follows and stops a job from another thread.
+ * job.c - the options the commands share (job.h): two tables, and the job
+ * in an options struct (its parts).
  */
 #include "sandslide/job.h"
 
 #include <stddef.h>
 
 #include "base/strings.h"
-#include "sandslide/watch.h"
 
 static int parse_tile(const char *value, void *field)
 {
@@ -23,6 +22,14 @@ static const struct ss_option options[] = {
 	 .lo = 1, .hi = 4096, .expected = "an integer from 1 to 4096",
 	 .help = "OpenMP threads (default: OMP_NUM_THREADS, else\n"
 	         "the processors this process may run on)"},
+};
+
+const struct ss_option_table ss_job_option_table = {
+	.command = "job", .options = options, .count = sizeof options / sizeof *options,
+	.size = sizeof(struct ss_job),
+};
+
+static const struct ss_option stepping[] = {
 	{.name = "tile", .value_name = "NXxNY", .kind = SS_OPTION_WORD, .offset = AT(tile),
 	 .parse = parse_tile, .expected = "NXxNY, e.g. 256x64",
 	 .help = "cells per tile of the sweep (default 256x128, smaller\n"
@@ -33,8 +40,8 @@ static const struct ss_option options[] = {
 	 .help = "the output's history attribute (the command line)"},
 };
 
-const struct ss_option_table ss_job_option_table = {
-	.command = "job", .options = options, .count = sizeof options / sizeof *options,
+const struct ss_option_table ss_job_stepping_option_table = {
+	.command = "job", .options = stepping, .count = sizeof stepping / sizeof *stepping,
 	.size = sizeof(struct ss_job),
 };
 
@@ -49,11 +56,4 @@ struct ss_job *ss_job_of(const struct ss_option_table *t, void *base)
 			return job;
 	}
 	return NULL;
-}
-
-void ss_job_set_watch(struct ss_job *job, struct ss_watch *w)
-{
-	job->stop_signal = w ? ss_watch_stop_flag(w) : NULL;
-	job->progress = w ? ss_watch_progress : NULL;
-	job->progress_context = w;
 }
