@@ -33,7 +33,8 @@
  * ss_restart_state).  Files written before the two hold one
  * restart_state, of the last snapshot; those written before RKL2 have
  * its first 5 values. */
-#define SS_SNAPSHOT_RESTART_VALUES 7
+#define SS_SNAPSHOT_RESTART_VALUES 9
+#define SS_SNAPSHOT_RESTART_VALUES_RKL2 7
 #define SS_SNAPSHOT_RESTART_VALUES_OLD 5
 
 static inline const char *ss_snapshot_restart_attribute(long long snapshot)
