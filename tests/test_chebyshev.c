@@ -8,7 +8,10 @@
  *   p_s(0) = 1: a state at rest stays at rest;
  *   a constant rate c adds c tau over the super-step (tau its length);
  *   every rate of [a, b] is damped to at most 1/T_s(sigma), and every rate
- *   of (0, a) decays (0 < p_s < 1): nothing in [0, b] grows.
+ *   of (0, a) decays (0 < p_s < 1): nothing in [0, b] grows;
+ *   the rate of one mode is found again from what a super-step did to it
+ *   (ss_chebyshev_slow_rate): to 1 % below a, to 10 % from a to the first
+ *   zero of p_s (where (1 - p_s) / lambda need not fall monotonically).
  */
 #include "check.h"
 
@@ -66,8 +69,34 @@ static void the_stages_give_the_chebyshev_polynomial(void)
 	}
 }
 
+/* One mode y' = -lambda y through a super-step: its change over its rate
+ * at the start names lambda, wherever it lies below the first zero. */
+static void the_rate_of_one_mode_is_found_again(void)
+{
+	const int stages[] = {2, 8, 13, 64, 500};
+	for (size_t n = 0; n < sizeof stages / sizeof *stages; n++) {
+		const int s = stages[n];
+		const double b = 7.0, a = b / ((double)s * s);
+		struct ss_chebyshev ch;
+		ss_chebyshev_init(&ch, s, a, b);
+		const double zero = ch.theta - ch.delta * cos(M_PI / (2.0 * s));
+		const double where[] = {1e-4, 0.01, 0.3, 1.0, 1.7, 0.99 * zero / a};
+		for (size_t k = 0; k < sizeof where / sizeof *where; k++) {
+			const double lambda = where[k] * a;
+			double tau;
+			const double change = 1.0 - superstep(s, a, b, lambda, 0.0, 1.0, &tau);
+			CHECK_REL(ss_chebyshev_slow_rate(&ch, change / lambda), lambda,
+			          lambda <= a ? 0.01 : 0.1,
+			          "s = %d: the rate %g a of one mode", s, where[k]);
+		}
+		CHECK(ss_chebyshev_slow_rate(&ch, ch.tau) == 0.0,
+		      "s = %d: a change of tau times the rate is slower than anything", s);
+	}
+}
+
 int main(void)
 {
 	RUN(the_stages_give_the_chebyshev_polynomial);
+	RUN(the_rate_of_one_mode_is_found_again);
 	return check_report();
 }

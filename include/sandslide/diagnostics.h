@@ -41,8 +41,6 @@ struct ss_restart_state {
 	double rkl2_tau;                    /* s; INFINITY: no limit */
 	int rest_stages;                    /* the approach to rest's next
 	                                     * super-step (0: not begun) */
-	double rest_rate;                   /* its last rate, m/s (INFINITY:
-	                                     * none yet) */
 	struct ss_volume_sum inflow, outflow;
 };
 

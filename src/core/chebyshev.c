@@ -54,3 +54,24 @@ double ss_chebyshev_factor(const struct ss_chebyshev *c, double lambda)
 	}
 	return t1 / u1;
 }
+
+double ss_chebyshev_slow_rate(const struct ss_chebyshev *c, double ratio)
+{
+	if (!(ratio < c->tau))
+		return 0.0;
+	/* p_s falls from 1 at lambda = 0 to 0 at the first zero of T_s, where
+	 * (theta - lambda) / delta = cos(pi / 2s); (1 - p_s) / lambda falls
+	 * with it from tau: bisect there, in log lambda */
+	const double zero = c->theta - c->delta * cos(M_PI / (2.0 * c->s));
+	if (!(ratio > 1.0 / zero))
+		return 1.0 / ratio;   /* beyond the first zero: 1 - p_s is about 1 */
+	double lo = 1e-12 * zero, hi = zero;
+	for (int k = 0; k < 100 && hi > lo * (1.0 + 1e-6); k++) {
+		const double mid = sqrt(lo * hi);
+		if ((1.0 - ss_chebyshev_factor(c, mid)) / mid > ratio)
+			lo = mid;
+		else
+			hi = mid;
+	}
+	return sqrt(lo * hi);
+}

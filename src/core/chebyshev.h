@@ -65,4 +65,11 @@ struct ss_chebyshev_stage ss_chebyshev_next(struct ss_chebyshev *c, int j);
  * the tests). */
 double ss_chebyshev_factor(const struct ss_chebyshev *c, double lambda);
 
+/* The rate lambda of the mode that dominates a super-step, from what the
+ * super-step did to it: ratio = (its change) / (its rate at the start),
+ * which for one mode is (1 - p_s(lambda)) / lambda.  0 when ratio >= tau
+ * (slower than the super-step tells apart), 1 / ratio beyond the first
+ * zero of p_s. */
+double ss_chebyshev_slow_rate(const struct ss_chebyshev *c, double ratio);
+
 #endif

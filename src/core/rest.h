@@ -19,15 +19,18 @@
  *             falls below SS_REST_EXCESS nu Lambda(inf) / min(dx, dy),
  *             the rate of a face steeper than the repose angle by that
  *             excess in slope (SS_REST_EXCESS_RKL2 after RKL2), with
- *             steady asked for, no source on and none to come; the stages
- *             start at the last super-step's (Euler: SS_REST_START_STAGES);
+ *             steady asked for, no source on and none to come; the first
+ *             super-step has SS_REST_START_STAGES;
  *   steps     super-steps of s stages damping [b / s^2, b]; their length
  *             is the slow modes' tau (chebyshev.h), not accurate in time,
  *             and the steady rule reads their mean rate |Y_s - Y_0| / tau
  *             as it reads RKL2's;
- *   stages    doubled (up to rkl2_max_stages) after a super-step whose
- *             rate fell by less than SS_REST_TARGET: the slow modes
- *             dominate, and a longer super-step reaches them;
+ *   stages    from the rate lambda of the mode that dominated the last
+ *             super-step (ss_chebyshev_slow_rate, from its change and its
+ *             rate at the start): s = sqrt(b / lambda), lambda at the lower
+ *             end, at most twice the last s and rkl2_max_stages.  Never
+ *             more: a slow mode past the first zero of p_s changes sign,
+ *             and the faces it pushes below the repose angle stop there;
  *   exit      only by steady (or the caller's end); heights changed from
  *             outside start over.
  *
@@ -43,19 +46,18 @@
 #ifndef SANDSLIDE_CORE_REST_H
 #define SANDSLIDE_CORE_REST_H
 
-/* The excess slope below whose rate the approach to rest begins, after
- * forward Euler and after RKL2, which leaves 10 times more of the
- * grid-scale remainder whose sign a super-step may flip (a face pushed
- * below the angle stops there): measured on the room of test_rkl2, whose
- * end state stays within 0.1 tan(a) dx of forward Euler's at 1e-3, not
- * at 1e-2. */
+/* The excess slope below whose rate the approach to rest begins: at 1e-2
+ * the end states of fractal and real DEMs stay within 0.03 tan(a) dx of
+ * forward Euler's (doc/model.md#the-approach-to-rest has the table); 1e-3
+ * halves that for up to 1.4 times the evaluations, 1e-1 lets the grid
+ * scale remainder at the start of the approach leave 0.13.  After RKL2,
+ * which keeps up to 0.7 of that remainder a super-step (rkl2.h), 1e-3:
+ * the drained room of test_rkl2 ends 0.12 tan(a) dx from forward Euler's
+ * end state at 1e-2 and 0.009 at 1e-3, in fewer evaluations. */
 #define SS_REST_EXCESS 1e-2
 #define SS_REST_EXCESS_RKL2 1e-3
-/* The stages of a first super-step after forward Euler. */
+/* The stages of a first super-step. */
 #define SS_REST_START_STAGES 8
-/* A super-step whose rate falls by less than this makes the next twice as
- * long in stages. */
-#define SS_REST_TARGET 0.3
 
 struct ss_stepper;
 
@@ -65,8 +67,6 @@ struct ss_rest {
 	double entry_rate;          /* m/s: the rate below which it begins */
 	double b;                   /* the largest rate of the stencil, 1/s */
 	int stages;                 /* of the next super-step; 0: not begun */
-	double rate;                /* the last super-step's mean rate, m/s
-	                             * (INFINITY: none yet) */
 	long long steps;            /* super-steps taken */
 	long long evaluations;      /* spent approaching rest */
 };
@@ -77,9 +77,8 @@ int ss_rest_create(struct ss_rest **out, const struct ss_stepper *st);
 void ss_rest_destroy(struct ss_rest *r);
 
 /* Whether the approach begins after a step of rate `rate` (m/s) that
- * ended with no source on and none to come, the last super-step s stages
- * long (0: forward Euler); if so it has begun. */
-int ss_rest_begins(struct ss_rest *r, double rate, int last_stages);
+ * ended with no source on and none to come; if so it has begun. */
+int ss_rest_begins(struct ss_rest *r, double rate);
 
 /* The length of the next super-step, s (its slow modes' tau). */
 double ss_rest_length(const struct ss_rest *r);

@@ -439,7 +439,7 @@ static enum ss_advance_end advance(struct ss_stepper *st, double t_target,
 		/* near rest (rest.h): the approach begins with the rate the
 		 * ranks agreed on */
 		if (rest && !resting && b.may_be_steady && !src->rate_on)
-			ss_rest_begins(rest, st->rate_max, rkl2 ? st->rkl2->last_stages : 0);
+			ss_rest_begins(rest, st->rate_max);
 	}
 	/* on a target: the slopes are measured here, not by the next step */
 	if (steady_candidate) {
@@ -534,7 +534,6 @@ void ss_stepper_restart_state(const struct ss_stepper *st, struct ss_restart_sta
 	s->evaluations = st->evaluations;
 	s->rkl2_tau = st->rkl2 ? st->rkl2->tau_limit : INFINITY;
 	s->rest_stages = st->rest_state ? st->rest_state->stages : 0;
-	s->rest_rate = st->rest_state ? st->rest_state->rate : INFINITY;
 	s->inflow = st->ledger->inflow;
 	s->outflow = st->ledger->outflow;
 }
@@ -556,7 +555,6 @@ void ss_stepper_restore(struct ss_stepper *st, double t, const double *height,
 	ss_stepper_heights_changed(st);   /* (it starts the approach over) */
 	if (st->rest_state) {
 		st->rest_state->stages = s->rest_stages;
-		st->rest_state->rate = s->rest_rate;
 	}
 }
 
