@@ -62,7 +62,7 @@ CHANGED_ON_PURPOSE = {
                            r"uncertainty\.\w+\.(std|low|high))"),
 }
 H5_NAMES = ["height", "time", "cell_type", "x", "y", "volume", "inflow", "outflow",
-            "external", "max_height", "max_slope_deg", "steps", "evaluations",
+            "external", "max_height", "max_slope_deg", "steps", "stencil_evaluations",
             "active_fraction", "bedrock"]
 # each case shortened: (case, overrides) that run in about a second
 SHORT = {
