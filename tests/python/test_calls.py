@@ -191,10 +191,11 @@ def test_without_a_thread_safe_hdf5_runs_take_turns(tmp_path, monkeypatch):
     for t in threads:
         t.join(timeout=60)
     assert not errors and len(spans) == 2, f"runs failed or hung: {errors!r}"
-    (a0, a1), (b0, b1) = spans[1], spans[2]
-    ends = sorted([(a0, a1), (b0, b1)])
-    # the second waited for the first: it ended at least its own run time later
-    assert ends[1][1] - ends[0][1] > 0.5 * (ends[0][1] - ends[0][0]), \
+    # by the time they ended (whichever took the lock first, which need not
+    # be the one started first): the second waited for the first, so it
+    # ended at least about its own run time, the first's, after it
+    first, second = sorted(spans.values(), key=lambda span: span[1])
+    assert second[1] - first[1] > 0.5 * (first[1] - first[0]), \
         f"the runs overlapped under the HDF5 lock: {spans}"
 
 
