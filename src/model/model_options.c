@@ -79,9 +79,10 @@ static const struct ss_option options[] = {
 	{.name = "integrator", .case_key = "time.integrator", .value_name = "NAME",
 	 .kind = SS_OPTION_WORD, .offset = AT(integrator), .default_value = "auto",
 	 .parse = parse_integrator, .expected = SS_INTEGRATOR_NAMES,
-	 .help = "euler, rkl2 (super-steps) or auto: rkl2, or\n"
-	         "euler with a bedrock (rkl2 cannot keep sand\n"
-	         "above it)"},
+	 .help = "euler, rkl2 (super-steps) or auto: euler to\n"
+	         "relax a DEM (then the approach to rest), euler\n"
+	         "with a bedrock (rkl2 cannot keep sand above\n"
+	         "it), else rkl2"},
 	{.name = "rest", .case_key = "time.rest", .value_name = "NAME", .kind = SS_OPTION_WORD,
 	 .offset = AT(rest), .default_value = "chebyshev", .parse = parse_rest,
 	 .expected = SS_REST_NAMES,
