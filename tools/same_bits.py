@@ -14,9 +14,10 @@ must keep:
             kernel and the reference kernel, Euler and RKL2, 1 and 2
             threads, and on each kernel path this processor runs
             (SANDSLIDE_CPU=generic|avx2|avx512)
-  relax     cases/dem/terrain.asc: the defaults (raster and report),
-            Euler, a series (.h5), poured sand, open nodata and sides, a
-            bedrock; --dems DIR adds every DIR/*.asc (tools/real_dems.py)
+  relax     cases/dem/terrain.asc with forward Euler, the path both
+            builds have (issue 35): raster and report, a series (.h5),
+            poured sand, open nodata and sides, a bedrock; --dems DIR adds
+            every DIR/*.asc (tools/real_dems.py)
   fit       a cone twin (nu free), the report
   python    the README's relax example and python/examples/
             wind_deposition.py (the BMI), each build's module and library
@@ -57,6 +58,11 @@ TIMING = {"wall_seconds", "read_seconds", "write_seconds", "seconds", "seconds_p
 # has still differs.
 #   issue 36 item 5: fit's interval counts the forward model's own error
 #   (doc/fit.md#how-sure): 2 more forward runs per closure, wider intervals
+#   issue 35: relax's default became forward Euler with the approach to
+#   rest (doc/model.md#the-approach-to-rest), which steady runs take too,
+#   and RKL2 no longer polishes near rest: the paths kept are compared, by
+#   running relax with --integrator euler in both builds and giving a NEW
+#   that has the approach `rest off` (Runner.sandslide)
 CHANGED_ON_PURPOSE = {
     "fit.json": re.compile(r"\.forward_runs|\.closures\[\d+\]\.(evaluations|"
                            r"uncertainty\.\w+\.(std|low|high))"),
@@ -133,10 +139,26 @@ class Runner:
         self.work = work
         self.verbose = verbose
         self.results = []
+        self.has_rest = {}          # build -> its relax takes --rest
+
+    def rest_off(self, which, args):
+        """args, with the approach to rest off where the build has one."""
+        build = self.builds[which]
+        if build not in self.has_rest:
+            h = subprocess.run([os.path.join(build, "sandslide"), "help", "relax"],
+                               capture_output=True, text=True).stdout
+            self.has_rest[build] = "--rest " in h
+        if not self.has_rest[build] or "--restart" in args:
+            return list(args)
+        if args[0] == "relax":
+            return list(args) + ["--rest", "off"]
+        if args[0] == "run":
+            return list(args) + ["--set", "time.rest=off"]
+        return list(args)
 
     def sandslide(self, which, args, env=None, mpi=0):
         build = self.builds[which]
-        cmd = [os.path.join(build, "sandslide")] + args
+        cmd = [os.path.join(build, "sandslide")] + self.rest_off(which, args)
         # threads that spin in a busy machine's barriers lose their core for
         # ages (doc/running.md); waiting passively changes no bit
         e = dict(os.environ, OMP_WAIT_POLICY="passive", **(env or {}))
@@ -249,7 +271,8 @@ def run_relax(r, quick, dems):
     for dem_name, dem in inputs:
         for label, extra, out in variants if dem == terrain else variants[:1]:
             def produce(which, d, dem=dem, extra=extra, out=out):
-                ex = list(extra)
+                # the path both builds have (issue 35: CHANGED_ON_PURPOSE)
+                ex = list(extra) if "--integrator" in extra else ["--integrator", "euler"] + extra
                 if "BEDROCK" in ex:
                     rock = os.path.join(d, "rock.asc")
                     write_bedrock(dem, rock, 2.0)
@@ -289,7 +312,7 @@ import numpy as np
 import sandslide
 y, x = np.mgrid[0:60, 0:60] + 0.5
 pile = np.maximum(20 - np.hypot(x - 30, y - 30), 0)
-relaxed, report = sandslide.relax(pile, dx=1.0, angle=33)
+relaxed, report = sandslide.relax(pile, dx=1.0, angle=33, **json.loads(sys.argv[3]))
 np.save(sys.argv[1], relaxed)
 json.dump(report, open(sys.argv[2], "w"))
 """
@@ -303,9 +326,13 @@ def run_python(r, quick):
                     SANDSLIDE_LIBRARY=os.path.join(build, "libsandslide.so.0"))
 
     def relax(which, d):
+        # the path both builds have (issue 35: CHANGED_ON_PURPOSE)
+        options = {"integrator": "euler"}
+        if r.rest_off(which, ["relax"]) != ["relax"]:
+            options["rest"] = "off"
         subprocess.run([sys.executable, "-c", README_RELAX, os.path.join(d, "relaxed.npy"),
-                        os.path.join(d, "report.json")], env=env_of(which), check=True,
-                       capture_output=True)
+                        os.path.join(d, "report.json"), json.dumps(options)],
+                       env=env_of(which), check=True, capture_output=True)
     r.compare("python relax (README)", relax, ["relaxed.npy", "report.json"])
     if quick:
         return
@@ -324,7 +351,8 @@ def run_mpi(r, quick):
     terrain = os.path.join(CASES, "dem", "terrain.asc")
     work = [("door", ["run", os.path.join(CASES, "door.ini"), "-q", "--set", "time.end=40",
                       "--tile", "60x8"], "out.h5"),
-            ("terrain", ["relax", terrain, "-q", "--tile", "96x16", "--max-time", "3000"],
+            ("terrain", ["relax", terrain, "-q", "--tile", "96x16", "--max-time", "3000",
+                         "--integrator", "euler"],
              "out.h5")]
     for name, args, out in work:
         def serial(d, args=args, out=out):

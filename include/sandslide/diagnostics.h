@@ -39,6 +39,8 @@ struct ss_restart_state {
 	long long steps;
 	long long evaluations;
 	double rkl2_tau;                    /* s; INFINITY: no limit */
+	int rest_stages;                    /* the approach to rest's next
+	                                     * super-step (0: not begun) */
 	struct ss_volume_sum inflow, outflow;
 };
 

@@ -41,6 +41,7 @@ struct ss_model_options {
 	double max_time;                  /* s: a steady run stops here anyway;
 	                                   * NaN: no such limit */
 	enum ss_integrator integrator;    /* auto: ss_integrator_resolve */
+	enum ss_rest_mode rest;           /* the approach to rest (integrator.h) */
 	int rkl2_max_stages;              /* RKL2: stages per super-step */
 	double rkl2_tol;                  /* RKL2: error estimate per super-step,
 	                                   * in tan(a_cr) min(dx, dy) */

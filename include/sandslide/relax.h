@@ -100,6 +100,9 @@ struct ss_relax_report {
 	double max_slope_after_deg;
 	long long steps;                  /* substeps (RKL2: super-steps) */
 	long long evaluations;            /* stencil evaluations */
+	long long rest_steps;             /* of the steps: super-steps of the
+	                                     approach to rest (doc/model.md) */
+	long long rest_evaluations;       /* of the evaluations: theirs */
 	const char *integrator;           /* "euler" or "rkl2" */
 	double time;                      /* simulated, s */
 	double wall_seconds;

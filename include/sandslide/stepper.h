@@ -98,6 +98,7 @@ struct ss_sweeper;
 struct ss_sources;
 struct ss_ledger;
 struct ss_rkl2;
+struct ss_rest;
 
 struct ss_stepper {
 	/* set by ss_stepper_init */
@@ -109,7 +110,11 @@ struct ss_stepper {
 	/* set by the caller before ss_stepper_prepare (init zeroes them) */
 	enum ss_kernel kernel;
 	enum ss_integrator integrator; /* euler or rkl2 */
-	int rkl2_max_stages;          /* RKL2: s <= it, >= 2 */
+	enum ss_rest_mode rest;       /* the approach to rest when steady is
+	                               * asked for (src/core/rest.h; not with
+	                               * a bedrock) */
+	int rkl2_max_stages;          /* RKL2 and the approach to rest: s <= it,
+	                               * >= 2 */
 	double rkl2_tol;              /* RKL2: error estimate per super-step, in
 	                               * units of tan(a_cr) min(dx, dy), > 0
 	                               * (both: the model options' table,
@@ -139,6 +144,9 @@ struct ss_stepper {
 	                               * open faces; the outflow batch */
 	struct ss_rkl2 *rkl2;         /* RKL2's arrays and step control; NULL
 	                               * before ss_stepper_prepare and for euler */
+	struct ss_rest *rest_state;   /* the approach to rest; NULL before
+	                               * ss_stepper_prepare, when off, and with
+	                               * a bedrock */
 };
 
 /* Allocate the arrays for grid g (zero heights, all flow cells).  Returns
@@ -171,9 +179,10 @@ void ss_stepper_slab_rows(const struct ss_grid *g, int tile_nx, int tile_ny, int
  * split another grid as st's was). */
 void ss_stepper_tile_size(const struct ss_stepper *st, int *tile_nx, int *tile_ny);
 
-/* Bytes the stepper allocates for grid g with the fast kernel and that
- * integrator (for the memory check). */
-double ss_stepper_memory_bytes(const struct ss_grid *g, enum ss_integrator integrator);
+/* Bytes the stepper allocates for grid g with the fast kernel, that
+ * integrator and approach to rest (for the memory check). */
+double ss_stepper_memory_bytes(const struct ss_grid *g, enum ss_integrator integrator,
+                               enum ss_rest_mode rest);
 
 /* Add a source of rate m/s on the cells where mask (nx * ny, row-major,
  * south row first) is non-zero; call after the cell types are final.
@@ -209,6 +218,11 @@ void ss_stepper_book_external(struct ss_stepper *st, double volume_m3);
 double ss_stepper_inflow(const struct ss_stepper *st);
 double ss_stepper_outflow(const struct ss_stepper *st);
 
+/* What the approach to rest took of the steps and evaluations since
+ * ss_stepper_prepare (0 when it did not begin; src/core/rest.h). */
+void ss_stepper_rest_counts(const struct ss_stepper *st, long long *steps,
+                            long long *evaluations);
+
 /* The kernel's wall time since ss_stepper_init, s: measuring the slopes
  * (and the reference sweep's fluxes) and sweeping. */
 void ss_stepper_kernel_seconds(const struct ss_stepper *st, double *measure, double *sweep);
@@ -229,7 +243,7 @@ int ss_stepper_prepare(struct ss_stepper *st);
 
 /* How ss_stepper_advance ended.  Steady: see the top of this file. */
 enum ss_advance_end {
-	SS_ADVANCE_REACHED,     /* time == t_target */
+	SS_ADVANCE_REACHED,     /* time == t_target (samples: time >= t_target) */
 	SS_ADVANCE_STEADY,      /* steady (when requested) */
 	SS_ADVANCE_NONFINITE,   /* a rate or height became NaN or infinite */
 	SS_ADVANCE_STALLED,     /* dt fell below the resolution of the clock */
@@ -246,6 +260,12 @@ struct ss_advance_options {
 	void *context;          /* passed to progress, called after each substep */
 	const volatile sig_atomic_t *stop; /* NULL, or checked after each substep
 	                                    * (set by a signal handler) */
+	int samples;            /* t_target is where the caller samples the
+	                         * state, not an event: no step is shortened to
+	                         * end on it, and the call returns after the
+	                         * step that reaches or passes it (relax: its
+	                         * steps do not depend on when snapshots are
+	                         * taken) */
 };
 
 enum ss_advance_end ss_stepper_advance(struct ss_stepper *st, double t_target,

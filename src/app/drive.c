@@ -133,7 +133,9 @@ static int replay(const struct ss_drive *d, struct ss_stepper *st, long long las
 	while (st->steps < last_step && st->time < d->end &&
 	       (e == SS_ADVANCE_REACHED || e == SS_ADVANCE_STEPS)) {
 		o.max_steps = last_step - st->steps;
-		e = ss_stepper_advance(st, next_target(d, st->time, &k), &o);
+		const double target = next_target(d, st->time, &k);
+		o.samples = d->samples && target < d->end;
+		e = ss_stepper_advance(st, target, &o);
 	}
 	if (st->steps != last_step)
 		return ss_error_fail("taking the steps since the last snapshot again ended at "
@@ -244,7 +246,7 @@ static int stalled(const struct ss_drive *d)
 int ss_drive_run(struct ss_drive *d, enum ss_drive_end *end)
 {
 	struct ss_stepper *st = d->stepper;
-	const struct ss_advance_options adv = {
+	struct ss_advance_options adv = {
 		.steady_tol = d->steady_tol,
 		.steady_slope_tol = d->steady_slope_tol,
 		.progress = d->job && d->job->progress ? report_progress : NULL,
@@ -256,7 +258,11 @@ int ss_drive_run(struct ss_drive *d, enum ss_drive_end *end)
 	d->evaluations_start = st->evaluations;
 	*end = SS_DRIVE_END;
 	for (long long k = 1; st->time < d->end;) {
-		const enum ss_advance_end e = ss_stepper_advance(st, next_target(d, st->time, &k), &adv);
+		/* the end is an event; with samples, the targets before it are
+		 * not (drive.h) */
+		const double target = next_target(d, st->time, &k);
+		adv.samples = d->samples && target < d->end;
+		const enum ss_advance_end e = ss_stepper_advance(st, target, &adv);
 		if (e == SS_ADVANCE_STALLED)
 			return stalled(d);
 		/* steady or stopped before the clock moved: that state is the

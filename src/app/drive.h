@@ -65,6 +65,12 @@ struct ss_drive {
 	double steady_tol;      /* m/s; <= 0: never steady */
 	double steady_slope_tol; /* stepper.h; <= 0: the default 1e-6 */
 	double started;         /* wall clock when the command started, s */
+	int samples;            /* the targets before `end` are where snapshots
+	                           sample the state, not events: the steps pass
+	                           them (stepper.h), and a snapshot is stamped
+	                           with the time of the step that reached its
+	                           target, so that the steps do not depend on
+	                           output_every (relax) */
 	const struct ss_job *job;   /* its stop signal, checked after every
 	                           substep, and its progress after every
 	                           substep (NULL: neither) */

@@ -180,7 +180,7 @@ struct relax {
 static int rebuild(void *context, struct ss_stepper *st)
 {
 	const struct relax *x = context;
-	return ss_relax_setup_stepper(x->o, &x->in, st);
+	return ss_relax_setup_stepper(x->o, &x->in, 1, st);
 }
 
 /* The output's name and format, checked before any work: every rank
@@ -239,6 +239,7 @@ static int open_output(struct relax *x, const struct ss_relax_report *rep)
 	d->output_every = !isnan(o->output_every) ? o->output_every
 	                : series && isfinite(d->end) ? d->end / 20.0 : INFINITY;
 	d->job = &o->job;
+	d->samples = 1;   /* the steps do not depend on when snapshots are taken */
 	d->rebuild = rebuild;
 	d->rebuild_context = x;
 	if (o->output_raster)
@@ -266,6 +267,7 @@ static void measure_after(struct relax *x, enum ss_drive_end end, struct ss_rela
 	rep->end = rep->steady ? "steady" : rep->interrupted ? "interrupted" : "max time";
 	rep->steps = st->steps;
 	rep->evaluations = st->evaluations;
+	ss_stepper_rest_counts(st, &rep->rest_steps, &rep->rest_evaluations);
 	rep->integrator = ss_integrator_name(st->integrator);
 	rep->time = st->time;
 	rep->inflow = ss_stepper_inflow(st);
@@ -354,7 +356,7 @@ int ss_relax_run(const struct ss_relax_options *o, struct ss_relax_report *rep)
 	if (!err) {   /* the output is written: the peak is the run's */
 		const struct ss_grid *g = &x.st.grid;
 		rep->ranks = ss_comm_size();
-		rep->bytes_per_cell = ss_stepper_memory_bytes(g, x.st.integrator) /
+		rep->bytes_per_cell = ss_stepper_memory_bytes(g, x.st.integrator, x.st.rest) /
 		                      fmax((double)g->nx * g->ny, 1.0);
 		/* the largest rank's: the job waits for it */
 		double most[3] = {ss_memory_peak_bytes(), rep->read_seconds, rep->write_seconds};

@@ -101,12 +101,12 @@ void ss_relax_inputs_release(struct ss_relax_inputs *in)
 }
 
 int ss_relax_setup_stepper(const struct ss_relax_options *o, const struct ss_relax_inputs *in,
-                           struct ss_stepper *st)
+                           int steady, struct ss_stepper *st)
 {
 	const struct ss_raster_setup s = {
 		.model = &o->model, .name = o->dem, .heights = &in->dem, .dx = o->read.cellsize,
 		.sides = o->sides, .nodata_type = o->nodata_type, .open_level = o->open_level,
-		.bedrock = o->bedrock ? &in->bedrock : NULL,
+		.bedrock = o->bedrock ? &in->bedrock : NULL, .steady = steady,
 		.tile_nx = o->job.tile[0], .tile_ny = o->job.tile[1],
 		.pour = o->sand_shape.kind != SS_SHAPE_NONE ? &o->sand_shape : NULL,
 		.pour_rate = o->sand_rate, .pour_duration = o->sand_duration,

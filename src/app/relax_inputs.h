@@ -25,8 +25,9 @@ int ss_relax_inputs_read(const struct ss_relax_options *o, struct ss_relax_input
 void ss_relax_inputs_release(struct ss_relax_inputs *in);
 
 /* st prepared at t = 0 from the inputs and the options (model/setup.h):
- * what relax starts from, and what its guard rebuilds. */
+ * what relax starts from, and what its guard rebuilds; steady: it will
+ * be stepped until steady (relax; not the BMI, which drives it). */
 int ss_relax_setup_stepper(const struct ss_relax_options *o, const struct ss_relax_inputs *in,
-                           struct ss_stepper *st);
+                           int steady, struct ss_stepper *st);
 
 #endif

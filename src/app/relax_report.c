@@ -47,6 +47,8 @@ static const struct ss_field fields[] = {
 	FIELD("memory_peak_bytes", SS_FIELD_REAL, memory_peak_bytes),
 	LINE("integrator", SS_FIELD_TEXT, integrator),
 	FIELD("stencil_evaluations", SS_FIELD_COUNT, evaluations),
+	FIELD("rest_steps", SS_FIELD_COUNT, rest_steps),
+	FIELD("rest_evaluations", SS_FIELD_COUNT, rest_evaluations),
 	FIELD("slope_tol", SS_FIELD_REAL, model.steady_slope_tol),
 	LINE("cells_moved", SS_FIELD_COUNT, cells_moved),
 	FIELD("volume_moved", SS_FIELD_REAL, volume_moved),

@@ -257,7 +257,7 @@ static void summarise(const struct run *r, enum ss_drive_end end, struct ss_run_
 	s->integrator = ss_integrator_name(st->integrator);
 	s->stages_max = st->rkl2_max_stages;
 	s->cells = (double)st->grid.global_nx * st->grid.global_ny;
-	s->bytes_per_cell = ss_stepper_memory_bytes(&st->grid, st->integrator) /
+	s->bytes_per_cell = ss_stepper_memory_bytes(&st->grid, st->integrator, st->rest) /
 	                    ((double)st->grid.nx * st->grid.ny);
 	s->ranks = ss_comm_size();
 	s->wall_seconds = ss_parallel_wall_seconds() - r->drive.started;

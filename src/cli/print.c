@@ -125,10 +125,14 @@ void cli_print_relax_end(const struct ss_relax_report *r, int quiet)
 	}
 	if (quiet)
 		return;
-	printf("wrote %s: %d x %d cells, %s after %lld %s (t = %g s, %lld stencil "
+	char rest[64] = "";
+	if (r->rest_steps > 0)
+		snprintf(rest, sizeof rest, " and %lld super-steps to rest", r->rest_steps);
+	printf("wrote %s: %d x %d cells, %s after %lld %s%s (t = %g s, %lld stencil "
 	       "evaluations)\n", r->output, r->nx, r->ny, r->steady ? "steady"
 	       : r->interrupted ? "NOT steady (interrupted)" : "NOT steady by --max-time",
-	       r->steps, strcmp(r->integrator, "rkl2") ? "steps (euler)" : "super-steps (rkl2)",
+	       r->steps - r->rest_steps,
+	       strcmp(r->integrator, "rkl2") ? "steps (euler)" : "super-steps (rkl2)", rest,
 	       r->time, r->evaluations);
 	char ranks[48] = "", peak[32];
 	if (r->ranks > 1)

@@ -26,9 +26,30 @@ int ss_integrator_parse(const char *name, enum ss_integrator *out)
 	return -1;
 }
 
-enum ss_integrator ss_integrator_resolve(enum ss_integrator asked, int has_bedrock)
+enum ss_integrator ss_integrator_resolve(enum ss_integrator asked, int has_bedrock,
+                                         int relaxing)
 {
 	if (asked != SS_INTEGRATOR_AUTO)
 		return asked;
-	return has_bedrock ? SS_INTEGRATOR_EULER : SS_INTEGRATOR_RKL2;
+	return has_bedrock || relaxing ? SS_INTEGRATOR_EULER : SS_INTEGRATOR_RKL2;
+}
+
+static const char *const rest_names[] = {
+	[SS_REST_OFF] = "off", [SS_REST_CHEBYSHEV] = "chebyshev",
+};
+
+const char *ss_rest_mode_name(enum ss_rest_mode rest)
+{
+	return rest_names[rest];
+}
+
+int ss_rest_mode_parse(const char *name, enum ss_rest_mode *out)
+{
+	for (int k = 0; k < 2; k++) {
+		if (strcmp(name, rest_names[k]) == 0) {
+			*out = (enum ss_rest_mode)k;
+			return 0;
+		}
+	}
+	return -1;
 }

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "core/ledger.h"
+#include "core/stages.h"
 #include "core/sources.h"
 #include "core/sweep.h"
 #include "core/sweeper.h"
@@ -140,13 +141,22 @@ static void control(struct ss_rkl2 *r, double tau, double estimate)
  * once a super-step, after the estimate (the stages need nothing summed
  * over them but the outflow).
  */
-double ss_rkl2_superstep(struct ss_stepper *st, double tau)
+double ss_rkl2_superstep(struct ss_stepper *st, double tau,
+                         const struct ss_advance_options *o, int *stopped)
 {
 	struct ss_rkl2 *r = st->rkl2;
 	int s = ss_rkl2_stages_for(tau / r->dt_all);
 	s = s < st->rkl2_max_stages ? s : st->rkl2_max_stages;
 	double change = 0.0, awake = 0.0, estimate = 0.0;
+	const long long evaluations = st->evaluations;
+	*stopped = 0;
 	for (int j = 1; j <= s; j++) {
+		if (j > 1 && ss_stages_stop(st, o)) {   /* taken back (stages.h) */
+			ss_stages_take_back(st, r->y0);
+			st->evaluations = evaluations;
+			*stopped = 1;
+			return 0.0;
+		}
 		const struct ss_rkl2_stage k = ss_rkl2_stage(s, j);
 		const struct ss_sweep_stage stage = {
 			.first = j == 1, .mu = k.mu, .nu = k.nu,

@@ -61,6 +61,7 @@ int ss_rkl2_stages_for(double ratio);
  * everywhere (the fast sweep relies on it for the tiles it skips).
  */
 struct ss_stepper;
+struct ss_advance_options;
 
 struct ss_rkl2 {
 	double *y0;             /* Y_0, m, with halo (ss_grid_index) */
@@ -94,8 +95,12 @@ static inline double ss_rkl2_longest(const struct ss_rkl2 *r)
  * stages as its length needs (at most rkl2_max_stages), from the state the
  * stepper measured; then the accuracy rule sets the next limit.  Counts
  * the evaluations and books the inflow and outflow (ledger.h).  Returns
- * max |Y_s - Y_0| (as max |D_s|), m, INFINITY on NaN.
+ * max |Y_s - Y_0| (as max |D_s|), m, INFINITY on NaN.  Between its stages
+ * the caller's progress and stop flag (o, stages.h): *stopped when a stop
+ * took the super-step back (the state, its evaluations and the ledger as
+ * they were before it).
  */
-double ss_rkl2_superstep(struct ss_stepper *st, double tau);
+double ss_rkl2_superstep(struct ss_stepper *st, double tau,
+                         const struct ss_advance_options *o, int *stopped);
 
 #endif

@@ -11,7 +11,9 @@
 #include <string.h>
 
 #include "core/ledger.h"
+#include "core/rest.h"
 #include "core/rkl2.h"
+#include "core/stages.h"
 #include "core/sources.h"
 #include "core/sweep.h"
 #include "core/sweeper.h"
@@ -19,12 +21,15 @@
 #include "sandslide/cpu.h"
 #include "sandslide/error.h"
 
-double ss_stepper_memory_bytes(const struct ss_grid *g, enum ss_integrator integrator)
+double ss_stepper_memory_bytes(const struct ss_grid *g, enum ss_integrator integrator,
+                               enum ss_rest_mode rest)
 {
 	/* the heights and the sources' rates (doubles) and the packed types,
-	 * and RKL2's Y_0, D_{j-1}, D_{j-2} and M(Y_0); the fast sweep's ring
-	 * rows and buffers are below 2 % of that */
-	const double doubles = integrator == SS_INTEGRATOR_RKL2 ? 6.0 : 2.0;
+	 * and the stages' Y_0, D_{j-1}, D_{j-2} and M(Y_0) (RKL2's, also the
+	 * approach to rest's); the fast sweep's ring rows and buffers are
+	 * below 2 % of that */
+	const int stages = integrator == SS_INTEGRATOR_RKL2 || rest == SS_REST_CHEBYSHEV;
+	const double doubles = stages ? 6.0 : 2.0;
 	return (double)ss_grid_storage_cells(g) * (doubles * sizeof(double) + 0.25);
 }
 
@@ -99,6 +104,7 @@ int ss_stepper_init(struct ss_stepper *st, const struct ss_grid *g,
 
 void ss_stepper_release(struct ss_stepper *st)
 {
+	ss_rest_destroy(st->rest_state);
 	ss_rkl2_destroy(st->rkl2);
 	ss_ledger_destroy(st->ledger);
 	ss_sources_destroy(st->sources);
@@ -181,6 +187,10 @@ static int prepare_parts(struct ss_stepper *st)
 		err = ss_ledger_list_open_faces(st->ledger, &st->grid, st->cell_types);
 	if (!err && st->integrator == SS_INTEGRATOR_RKL2)
 		err = ss_rkl2_create(&st->rkl2, st);
+	/* the approach to rest's stages have negative weights, as RKL2's:
+	 * with a bedrock the integrator's own steps go on to the end */
+	if (!err && st->rest == SS_REST_CHEBYSHEV && !st->bedrock)
+		err = ss_rest_create(&st->rest_state, st);
 	return err ? err : ss_sweeper_prepare(st);
 }
 
@@ -209,6 +219,8 @@ void ss_stepper_heights_changed(struct ss_stepper *st)
 {
 	ss_boundary_fill_heights(&st->grid, &st->boundary, st->height);
 	ss_sweeper_wake_all(st);
+	if (st->rest_state)   /* what moves now is the caller's: start over */
+		st->rest_state->stages = 0;
 }
 
 double ss_stepper_next_source_event(const struct ss_stepper *st, double t)
@@ -237,6 +249,13 @@ double ss_stepper_outflow(const struct ss_stepper *st)
 	return ss_volume_sum_total(&st->ledger->outflow);
 }
 
+void ss_stepper_rest_counts(const struct ss_stepper *st, long long *steps,
+                            long long *evaluations)
+{
+	*steps = st->rest_state ? st->rest_state->steps : 0;
+	*evaluations = st->rest_state ? st->rest_state->evaluations : 0;
+}
+
 void ss_stepper_kernel_seconds(const struct ss_stepper *st, double *measure, double *sweep)
 {
 	*measure = st->sweeper->seconds_measure;
@@ -260,7 +279,8 @@ static struct step_start step_begin(struct ss_stepper *st, double t_target,
 	const double next_switch = ss_sources_next_event(st->sources, st->time);
 	/* a state is steady only if no source will switch on later */
 	b.may_be_steady = o->steady_tol > 0.0 && isinf(next_switch);
-	b.next_event = fmin(next_switch, t_target);
+	/* a target the caller samples at is no event: steps pass it */
+	b.next_event = o->samples ? next_switch : fmin(next_switch, t_target);
 	b.s_max = ss_sweeper_measure(st);
 	return b;
 }
@@ -325,6 +345,18 @@ static void euler_step(struct ss_stepper *st, double dt)
 	st->evaluations++;
 }
 
+int ss_stages_stop(struct ss_stepper *st, const struct ss_advance_options *o)
+{
+	if (o->progress)
+		o->progress(o->context, st);
+	/* every rank decides on the same value: a signal reaches the ranks at
+	 * different times */
+	double asked = o->stop && *o->stop ? 1.0 : 0.0;
+	if (ss_comm_size() > 1)
+		ss_comm_reduce(&asked, 1, NULL, 0);
+	return asked != 0.0;
+}
+
 static enum ss_advance_end advance(struct ss_stepper *st, double t_target,
                                    const struct ss_advance_options *o)
 {
@@ -335,14 +367,10 @@ static enum ss_advance_end advance(struct ss_stepper *st, double t_target,
 	const double slope_tol = o->steady_slope_tol > 0.0 ? o->steady_slope_tol : 1e-6;
 	const struct ss_sources *src = st->sources;
 	const int rkl2 = st->integrator == SS_INTEGRATOR_RKL2;
+	struct ss_rest *rest = st->rest_state;
 
 	long long steps_left = o->max_steps > 0 ? o->max_steps : -1;
 	int steady_candidate = 0;
-	/* polishing near rest (stepper.h): the forward-Euler steps left in the
-	 * burst, the stages of this call's last super-step (a burst's length),
-	 * and whether a burst just ended (the next step is a super-step) */
-	long long polish_left = 0;
-	int stages = 0, burst_ended = 0;
 	while (st->time < t_target) {
 		if (steps_left == 0)
 			return SS_ADVANCE_STEPS;
@@ -351,21 +379,14 @@ static enum ss_advance_end advance(struct ss_stepper *st, double t_target,
 			st->rate_max = NAN;
 			return SS_ADVANCE_NONFINITE;
 		}
-		if (steady_candidate) {
-			if (slopes_settled(st, b.s_max, slope_tol))
-				return SS_ADVANCE_STEADY;
-			/* RKL2 near rest: a burst of forward-Euler steps, as
-			 * many as the last super-step had stages (stepper.h) */
-			if (rkl2 && polish_left == 0 && !burst_ended)
-				polish_left = stages > 0 ? stages : 1;
-		}
-		const int polish = polish_left > 0;
+		if (steady_candidate && slopes_settled(st, b.s_max, slope_tol))
+			return SS_ADVANCE_STEADY;
 
 		const double lambda = c->nu * ss_cfl_bound_lookup(&st->sweeper->cfl_bound, b.s_max);
 		double dt = lambda > 0.0 ? st->cfl / (2.0 * lambda * inv_d2) : INFINITY;
 		/* RKL2: stable for every state its stages can reach, also when
 		 * a source is about to raise a flat state past the onset */
-		if (rkl2 && !polish && (lambda > 0.0 || src->rate_on))
+		if (rkl2 && (lambda > 0.0 || src->rate_on))
 			dt = ss_rkl2_longest(st->rkl2);
 		if (src->rate_on && source_rise / src->rate_max < dt)
 			dt = source_rise / src->rate_max;
@@ -380,28 +401,45 @@ static enum ss_advance_end advance(struct ss_stepper *st, double t_target,
 			continue;
 		}
 
-		const int lands = st->time + dt >= b.next_event;
-		if (lands)
-			dt = b.next_event - st->time;
-		else if (st->time + dt == st->time)
-			return SS_ADVANCE_STALLED;
-
-		if (rkl2 && !polish) {
-			const double change = ss_rkl2_superstep(st, dt);
-			stages = st->rkl2->last_stages;
-			st->rate_max = change / dt;
-			burst_ended = 0;
+		/* the approach to rest, unless a super-step would pass a target
+		 * the caller needs it to end on (the step below lands there) */
+		const int resting = rest && rest->stages > 0 && b.may_be_steady && !src->rate_on &&
+		                    st->time + ss_rest_length(rest) <= b.next_event;
+		/* a stop between the stages of a super-step takes it back: time,
+		 * steps and all as they were (stages.h) */
+		int stopped = 0;
+		if (resting) {
+			double tau;
+			const double change = ss_rest_superstep(st, &tau, o, &stopped);
+			if (stopped)
+				return SS_ADVANCE_INTERRUPTED;
+			st->rate_max = change / tau;
+			st->time += tau;
 		} else {
-			euler_step(st, dt);
-			if (polish && --polish_left == 0)
-				burst_ended = 1;
+			const int lands = st->time + dt >= b.next_event;
+			if (lands)
+				dt = b.next_event - st->time;
+			else if (st->time + dt == st->time)
+				return SS_ADVANCE_STALLED;
+			if (rkl2) {
+				const double change = ss_rkl2_superstep(st, dt, o, &stopped);
+				if (stopped)
+					return SS_ADVANCE_INTERRUPTED;
+				st->rate_max = change / dt;
+			} else {
+				euler_step(st, dt);
+			}
+			st->time = lands ? b.next_event : st->time + dt;
 		}
-		st->time = lands ? b.next_event : st->time + dt;
 		st->steps++;
 		steps_left--;
 		const int end = step_end(st, o, &b, &steady_candidate);
 		if (end >= 0)
 			return (enum ss_advance_end)end;
+		/* near rest (rest.h): the approach begins with the rate the
+		 * ranks agreed on */
+		if (rest && !resting && b.may_be_steady && !src->rate_on)
+			ss_rest_begins(rest, st->rate_max);
 	}
 	/* on a target: the slopes are measured here, not by the next step */
 	if (steady_candidate) {
@@ -495,6 +533,7 @@ void ss_stepper_restart_state(const struct ss_stepper *st, struct ss_restart_sta
 	s->steps = st->steps;
 	s->evaluations = st->evaluations;
 	s->rkl2_tau = st->rkl2 ? st->rkl2->tau_limit : INFINITY;
+	s->rest_stages = st->rest_state ? st->rest_state->stages : 0;
 	s->inflow = st->ledger->inflow;
 	s->outflow = st->ledger->outflow;
 }
@@ -513,7 +552,10 @@ void ss_stepper_restore(struct ss_stepper *st, double t, const double *height,
 		st->rkl2->tau_limit = s->rkl2_tau;
 	st->ledger->inflow = s->inflow;
 	st->ledger->outflow = s->outflow;
-	ss_stepper_heights_changed(st);
+	ss_stepper_heights_changed(st);   /* (it starts the approach over) */
+	if (st->rest_state) {
+		st->rest_state->stages = s->rest_stages;
+	}
 }
 
 int ss_stepper_first_nonfinite(const struct ss_stepper *st, int *i, int *j)

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "core/ledger.h"
+#include "core/stages.h"
 #include "core/sources.h"
 #include "sandslide/comm.h"
 #include "sandslide/error.h"
@@ -70,6 +71,38 @@ void ss_sweeper_wake_all(struct ss_stepper *st)
 {
 	if (st->kernel == SS_KERNEL_FAST)
 		ss_sweep_fast_wake_all(&st->sweeper->fast, &st->grid, st->height, st->cell_types);
+}
+
+void ss_stages_take_back(struct ss_stepper *st, const double *y0)
+{
+	struct ss_sweeper *w = st->sweeper;
+	const struct ss_grid *g = &st->grid;
+	if (st->kernel == SS_KERNEL_FAST) {
+		/* the tiles swept so far in the super-step: the others did not
+		 * change (a tile is left out of a stage only when it cannot) */
+		struct ss_sweep_fast *f = &w->fast;
+		for (int k = 0; k < f->tiles; k++) {
+			if (!f->superstep_swept[k])
+				continue;
+			const struct ss_tile_span sp = ss_tiling_span(&w->tiling, g,
+			                                              k % w->tiling.tiles_x,
+			                                              k / w->tiling.tiles_x);
+			for (int j = sp.j0; j < sp.j1; j++) {
+				const ptrdiff_t k0 = ss_grid_index(g, sp.i0, j);
+				memcpy(st->height + k0, y0 + k0, (size_t)(sp.i1 - sp.i0) * sizeof(double));
+			}
+		}
+		memset(f->superstep_swept, 0, (size_t)f->tiles);
+		memset(f->moving_superstep, 0, (size_t)f->tiles);
+		memset(f->edges_superstep, 0, (size_t)f->tiles);
+	} else {   /* every cell, every stage */
+		for (int j = 0; j < g->ny; j++) {
+			const ptrdiff_t k0 = ss_grid_index(g, 0, j);
+			memcpy(st->height + k0, y0 + k0, (size_t)g->nx * sizeof(double));
+		}
+	}
+	ss_boundary_fill_heights(g, &st->boundary, st->height);
+	ss_sweeper_wake_all(st);
 }
 
 void ss_sweeper_mark_sources(struct ss_stepper *st)

@@ -352,10 +352,19 @@ int ss_h5_attr_update_doubles(hid_t obj, const char *name, const double *v, hsiz
 {
 	if (H5Aexists(obj, name) > 0) {
 		hid_t a = H5Aopen(obj, name, H5P_DEFAULT);
-		const herr_t w = a >= 0 ? H5Awrite(a, H5T_NATIVE_DOUBLE, v) : -1;
+		const hid_t space = a >= 0 ? H5Aget_space(a) : -1;
+		const hssize_t count = space >= 0 ? H5Sget_simple_extent_npoints(space) : -1;
+		if (space >= 0)
+			H5Sclose(space);
+		/* one of another length (an older file's) is made again */
+		const herr_t w = a < 0 ? -1 : (hsize_t)count == n ? H5Awrite(a, H5T_NATIVE_DOUBLE, v)
+		                                                  : 1;
 		if (a >= 0)
 			H5Aclose(a);
-		return w < 0 ? -1 : 0;
+		if (w <= 0)
+			return w < 0 ? -1 : 0;
+		if (H5Adelete(obj, name) < 0)
+			return -1;
 	}
 	return ss_h5_attr_write_doubles(obj, name, v, n);
 }

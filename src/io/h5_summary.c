@@ -175,21 +175,23 @@ static int read_case(struct ss_snapshot_file *f, struct ss_restart_info *r)
 static int read_state(struct ss_snapshot_file *f, struct ss_restart_info *r)
 {
 	const struct ss_h5_file *in = &f->h5->in;
-	double v[SS_SNAPSHOT_RESTART_VALUES] = {NAN, NAN, NAN, NAN, NAN, NAN, NAN};
+	double v[SS_SNAPSHOT_RESTART_VALUES] = {NAN, NAN, NAN, NAN, NAN, NAN, NAN, 0.0};
 	/* the last snapshot's by its parity; one restart_state in older files */
 	const char *name = ss_snapshot_restart_attribute(f->count - 1);
 	if (H5Aexists(in->file, name) <= 0)
 		name = "restart_state";
 	if (ss_h5_attr_read_doubles(in->file, name, SS_SNAPSHOT_RESTART_VALUES, v) &&
+	    ss_h5_attr_read_doubles(in->file, name, SS_SNAPSHOT_RESTART_VALUES_RKL2, v) &&
 	    !ss_h5_attr_read_doubles(in->file, name, SS_SNAPSHOT_RESTART_VALUES_OLD, v)) {
 		/* before RKL2: Euler's evaluations are its steps */
 		v[5] = v[0];
 		v[6] = INFINITY;
 	}
-	/* the counts are stored as doubles: below 2^63 to be ones; the
-	 * super-step limit is a positive time or infinity */
+	/* the counts are stored as doubles: below 2^63 (the stages 2^31) to
+	 * be ones; the super-step limit is a positive time or infinity */
 	if (!(v[0] >= 0.0 && v[0] < 0x1p63) || !(v[5] >= 0.0 && v[5] < 0x1p63) ||
-	    !(v[6] > 0.0) || !isfinite(v[1] + v[2] + v[3] + v[4]))
+	    !(v[6] > 0.0) || !isfinite(v[1] + v[2] + v[3] + v[4]) ||
+	    !(v[7] >= 0.0 && v[7] < 0x1p31 && v[7] == floor(v[7])))
 		return ss_error_input("cannot restart from '%s': its restart state is missing or "
 		                      "damaged (written by an older sandslide?)", f->name);
 	r->state.steps = (long long)v[0];
@@ -199,6 +201,7 @@ static int read_state(struct ss_snapshot_file *f, struct ss_restart_info *r)
 	r->state.outflow.carry = v[4];
 	r->state.evaluations = (long long)v[5];
 	r->state.rkl2_tau = v[6];
+	r->state.rest_stages = (int)v[7];
 	return SS_OK;
 }
 

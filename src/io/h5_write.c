@@ -561,7 +561,8 @@ static int append_value(hid_t d, long long index, double v)
 }
 
 /* The restart state of snapshot k (steps, inflow sum and carry, outflow
- * sum and carry, evaluations, RKL2's next super-step limit): a restart
+ * sum and carry, evaluations, RKL2's next super-step limit, the approach
+ * to rest's stages): a restart
  * continues the compensated sums with the very same bits.  Even snapshots
  * write root attribute restart_state_even, odd ones restart_state_odd, so
  * that the state of the last complete snapshot is never the one being
@@ -570,7 +571,7 @@ static int write_restart_state(hid_t file, long long k, const struct ss_restart_
 {
 	const double v[SS_SNAPSHOT_RESTART_VALUES] = {
 		(double)r->steps, r->inflow.sum, r->inflow.carry, r->outflow.sum,
-		r->outflow.carry, (double)r->evaluations, r->rkl2_tau,
+		r->outflow.carry, (double)r->evaluations, r->rkl2_tau, (double)r->rest_stages,
 	};
 	return ss_h5_attr_update_doubles(file, ss_snapshot_restart_attribute(k), v,
 	                                 SS_SNAPSHOT_RESTART_VALUES);

@@ -29,11 +29,13 @@
 /* Root attributes restart_state_even and restart_state_odd: the restart
  * state of the last snapshot of even and of odd index (steps, inflow sum
  * and carry, outflow sum and carry, stencil evaluations, RKL2's next
- * super-step limit (s, or infinity); diagnostics.h, struct
+ * super-step limit (s, or infinity), the approach to rest's next
+ * super-step in stages (0: not begun); diagnostics.h, struct
  * ss_restart_state).  Files written before the two hold one
  * restart_state, of the last snapshot; those written before RKL2 have
- * its first 5 values. */
-#define SS_SNAPSHOT_RESTART_VALUES 7
+ * its first 5 values, those before the approach to rest its first 7. */
+#define SS_SNAPSHOT_RESTART_VALUES 8
+#define SS_SNAPSHOT_RESTART_VALUES_RKL2 7
 #define SS_SNAPSHOT_RESTART_VALUES_OLD 5
 
 static inline const char *ss_snapshot_restart_attribute(long long snapshot)

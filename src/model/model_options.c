@@ -17,6 +17,11 @@ static int parse_integrator(const char *value, void *field)
 	return ss_integrator_parse(value, field);
 }
 
+static int parse_rest(const char *value, void *field)
+{
+	return ss_rest_mode_parse(value, field);
+}
+
 #define AT(m) offsetof(struct ss_model_options, m)
 /* the closures a key applies to (applies_to) */
 #define FOR(k) (1u << SS_CLOSURE_##k)
@@ -74,9 +79,17 @@ static const struct ss_option options[] = {
 	{.name = "integrator", .case_key = "time.integrator", .value_name = "NAME",
 	 .kind = SS_OPTION_WORD, .offset = AT(integrator), .default_value = "auto",
 	 .parse = parse_integrator, .expected = SS_INTEGRATOR_NAMES,
-	 .help = "euler, rkl2 (super-steps) or auto: rkl2, or\n"
-	         "euler with a bedrock (rkl2 cannot keep sand\n"
-	         "above it)"},
+	 .help = "euler, rkl2 (super-steps) or auto: euler to\n"
+	         "relax a DEM (then the approach to rest), euler\n"
+	         "with a bedrock (rkl2 cannot keep sand above\n"
+	         "it), else rkl2"},
+	{.name = "rest", .case_key = "time.rest", .value_name = "NAME", .kind = SS_OPTION_WORD,
+	 .offset = AT(rest), .default_value = "chebyshev", .parse = parse_rest,
+	 .expected = SS_REST_NAMES,
+	 .help = "the approach to rest of a run until steady:\n"
+	         "chebyshev super-steps once the motion is slow\n"
+	         "(not with a bedrock), or off: the integrator's\n"
+	         "own steps to the end (doc/model.md)"},
 	{.name = "rkl2-max-stages", .case_key = "time.rkl2_max_stages", .value_name = "S",
 	 .kind = SS_OPTION_INT, .offset = AT(rkl2_max_stages),
 	 .default_value = "2048", .lo = 2, .hi = 100000,

@@ -24,6 +24,8 @@ struct start {
 	double dx, dy, x0, y0;                /* m */
 	const struct ss_boundary *boundary;
 	int has_bedrock;
+	int steady;                           /* the run goes on until steady */
+	int relaxing;                         /* a raster relaxed (relax) */
 	int tile_nx, tile_ny;
 	enum ss_kernel kernel;
 	const char *integrator_what;          /* "--integrator rkl2" */
@@ -45,13 +47,16 @@ static int start(const struct start *s, struct ss_stepper *st)
 	if (err)
 		return err;
 	const enum ss_integrator integrator =
-		ss_integrator_resolve(m->integrator, s->has_bedrock);
+		ss_integrator_resolve(m->integrator, s->has_bedrock, s->relaxing);
 	if (integrator == SS_INTEGRATOR_RKL2 && s->has_bedrock)
 		return ss_error_input("%s cannot be used with %s: its stages cannot keep the sand "
 		                      "above the rock (use euler or auto)", s->integrator_what,
 		                      s->bedrock_what);
+	/* the approach to rest: for a run until steady, and not with a
+	 * bedrock (its stages have negative weights, as RKL2's) */
+	const enum ss_rest_mode rest = s->steady && !s->has_bedrock ? m->rest : SS_REST_OFF;
 	/* the memory of one rank's slab, times the ranks on this node */
-	const double need = ss_stepper_memory_bytes(&g, integrator) / ss_comm_size() *
+	const double need = ss_stepper_memory_bytes(&g, integrator, rest) / ss_comm_size() *
 	                    ss_comm_node_ranks();
 	const double have = ss_memory_available_bytes();
 	if (have > 0.0 && need > have) {
@@ -69,6 +74,7 @@ static int start(const struct start *s, struct ss_stepper *st)
 	}
 	st->kernel = s->kernel;
 	st->integrator = integrator;
+	st->rest = rest;
 	st->rkl2_max_stages = m->rkl2_max_stages;
 	st->rkl2_tol = m->rkl2_tol;
 	return SS_OK;
@@ -216,7 +222,7 @@ int ss_setup_stepper(const struct ss_case *c, int tile_nx, int tile_ny,
 	const struct start s = {
 		.m = &c->model, .nx = c->nx, .ny = c->ny, .dx = c->dx, .dy = c->dy,
 		.x0 = c->origin_x, .y0 = c->origin_y, .boundary = &c->boundary,
-		.has_bedrock = c->bedrock_file != NULL, .tile_nx = tile_nx,
+		.has_bedrock = c->bedrock_file != NULL, .steady = c->steady, .tile_nx = tile_nx,
 		.tile_ny = tile_ny, .kernel = kernel, .integrator_what = integrator_what,
 		.bedrock_what = "a bedrock", .grid_what = grid_what,
 		.memory_advice = " (reduce nx and ny)",
@@ -347,7 +353,8 @@ int ss_setup_stepper_from_raster(const struct ss_raster_setup *s, struct ss_step
 	const struct start start_with = {
 		.m = s->model, .nx = r->nx, .ny = r->ny, .dx = dx, .dy = dy,
 		.x0 = isnan(r->x0) ? 0.0 : r->x0, .y0 = isnan(r->y0) ? 0.0 : r->y0,
-		.boundary = &sides, .has_bedrock = s->bedrock != NULL,
+		.boundary = &sides, .has_bedrock = s->bedrock != NULL, .steady = s->steady,
+		.relaxing = 1,
 		.tile_nx = s->tile_nx, .tile_ny = s->tile_ny,
 		.kernel = SS_KERNEL_FAST, .integrator_what = "--integrator rkl2",
 		.bedrock_what = "--bedrock", .grid_what = grid_what, .memory_advice = "",

@@ -36,6 +36,9 @@ struct ss_raster_setup {
 	                                   * raster (where an open side or cell
 	                                   * lets sand leave) */
 	const struct ss_raster *bedrock;  /* the same size and rows, or NULL */
+	int steady;                       /* the run goes on until steady (relax;
+	                                   * not the BMI, which drives it): the
+	                                   * approach to rest (stepper.h) */
 	int tile_nx, tile_ny;             /* cells per tile; <= 0: relax's
 	                                   * defaults */
 	const struct ss_shape *pour;      /* sand poured from t = 0, or NULL: */

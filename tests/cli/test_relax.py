@@ -195,8 +195,38 @@ def test_series_output_is_a_sandslide_file(tmp_path):
           tmp_path)
     with h5open(tmp_path / "series.h5") as f:
         assert f["height"].shape == (5, 16, 24)
-        assert list(f["time"][:]) == [0.0, 0.5, 1.0, 1.5, 2.0]
+        # stamped with the time of the step that reached each target
+        # (the steps do not shorten to land on them); the end is exact
+        t = list(f["time"][:])
+        assert t[0] == 0.0 and t[-1] == 2.0, t
+        assert all(target <= t[k] < t[k + 1] for k, target in enumerate([0.5, 1.0, 1.5], 1)), \
+            f"snapshot times {t} are not the first step ends at or after 0.5, 1, 1.5"
         assert f["volume"][-1] == pytest.approx(f["volume"][0], rel=1e-12)
+
+
+@pytest.mark.parametrize("integrator", ["auto", "rkl2"])
+def test_the_relaxed_surface_does_not_depend_on_the_snapshots(tmp_path, integrator):
+    """Snapshots watch a relaxation; they do not change it: the same steps,
+    evaluations, end time and bits with and without --output-every."""
+    write_asc(tmp_path / "cliff.asc", cliff(30, 20))
+    reports = {}
+    for name, extra in (("plain.asc", []), ("often.h5", ["--output-every", "7"]),
+                        ("seldom.h5", ["--output-every", "150"])):
+        relax(["cliff.asc", "-o", name, "--integrator", integrator, "--report",
+               name + ".json"] + extra, tmp_path)
+        reports[name] = json.loads((tmp_path / (name + ".json")).read_text())
+    _, plain = read_asc(tmp_path / "plain.asc")
+    for name in ("often.h5", "seldom.h5"):
+        r, p = reports[name], reports["plain.asc"]
+        assert r["steady"] and p["steady"], (r, p)
+        for key in ("steps", "stencil_evaluations", "time", "rest_steps"):
+            assert r[key] == p[key], \
+                f"{integrator}, {name}: {key} {r[key]!r}, without snapshots {p[key]!r}"
+        with h5open(tmp_path / name) as f:
+            assert f["height"].shape[0] > 2, f"{name}: test set-up: too few snapshots"
+            assert np.array_equal(f["height"][-1], plain), \
+                f"{integrator}, {name}: the relaxed surface differs from the one " \
+                f"without snapshots by up to {np.abs(f['height'][-1] - plain).max()!r} m"
 
 
 def png16(path, grey, text=None):

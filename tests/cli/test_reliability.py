@@ -9,6 +9,7 @@ import re
 import resource
 import signal
 import subprocess
+import sys
 
 import h5py
 import numpy as np
@@ -382,6 +383,46 @@ def test_relax_signal_keeps_the_input_and_every_snapshot(tmp_path, sig):
         assert f["steps"][-1] == 31 and np.all(np.diff(f["steps"][:]) > 0), f["steps"][:]
         assert np.isfinite(f["height"][:]).all()
     assert not list(tmp_path.glob(".*.lock")), "the claim of the output was left behind"
+
+
+@pytest.mark.parametrize("call, evaluations", [(1, 1), (4, 0)])
+def test_a_stop_inside_a_super_step_waits_at_most_one_evaluation(tmp_path, call, evaluations):
+    """A stop request is answered within one evaluation of the stencil, not
+    at the end of a super-step of hundreds of stages: the super-step it
+    comes in is taken back, and the interrupt's snapshot is the state after
+    the step before.  Paused at the end of step 3 (call 1: the stop is seen
+    after stage 1 of step 4) and after stage 3 of step 4 (call 4: at once),
+    with two busy processes beside it, as on a loaded machine; the latency
+    is counted in evaluations (tests/hooks/pause_step.c), not seconds."""
+    write_cliff(tmp_path / "cliff.asc", 60, 40)
+    busy = [subprocess.Popen([sys.executable, "-c", "while True: pass"]) for _ in range(2)]
+    try:
+        marker = tmp_path / "paused"
+        env = dict(pause_env(3, marker), SANDSLIDE_TEST_PAUSE_CALL=str(call))
+        p = subprocess.Popen([hook_binary(SANDSLIDE_PAUSE), "relax", "cliff.asc", "-o", "cut.h5",
+                              "--integrator", "rkl2", "--threads", "2"], cwd=tmp_path,
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+        try:
+            wait_paused(p, marker, 3)
+        except BaseException:
+            p.kill()
+            p.communicate()
+            raise
+        p.send_signal(signal.SIGINT)
+        _, err = p.communicate(timeout=60)
+    finally:
+        for b in busy:
+            b.kill()
+            b.wait()
+    assert p.returncode == 130, (p.returncode, err)
+    said = re.search(r"pause hook: (\d+) evaluations after the stop signal", err)
+    assert said, f"the hook saw no stop signal:\n{err}"
+    assert int(said.group(1)) == evaluations, \
+        f"paused at report {call} of step 3: the stop came {said.group(1)} evaluations " \
+        f"after the signal, expected {evaluations}\n{err}"
+    assert "(step 3)" in err, f"the super-step the stop came in was not taken back:\n{err}"
+    with h5open(tmp_path / "cut.h5") as f:
+        assert f["steps"][-1] == 3 and np.isfinite(f["height"][-1]).all(), f["steps"][:]
 
 
 def test_relax_signal_with_a_raster_output_writes_the_surface_then(tmp_path):

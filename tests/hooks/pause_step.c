@@ -24,7 +24,16 @@
  * progress callback, so a signal sent during the pause stops the run after
  * substep N + 1, every time: the interrupt's snapshot is after step N + 1.
  * A restart continues the step count, so N counts from the start of the
- * original run.  Under MPI every rank pauses after step N until its own
+ * original run.
+ *
+ * The progress callback also comes between the stages of a super-step
+ * (src/core/stages.h), with the steps before it: with
+ * SANDSLIDE_TEST_PAUSE_CALL=k it pauses at the k-th report that sees step
+ * N (default 1, the end of step N; k > 1, after stage k - 1 of step N +
+ * 1).  Once it goes on after a stop signal it counts the reports that
+ * still come, one per evaluation of the stencil, and says on stderr
+ * "pause hook: K evaluations after the stop signal": how long a stop
+ * request waits.  Under MPI every rank pauses after step N until its own
  * handler ran (mpirun passes the signal on to each), and the ranks agree
  * to stop after step N + 1 (stepper.c, step_end); each writes the same
  * file.  A signal that comes before step N stops the run earlier, as in
@@ -49,6 +58,10 @@ struct hook {
 	double seconds;                       /* the longest wait */
 	int silent;                           /* no word when it ends */
 	const char *marker;                   /* NULL: none */
+	long long pause_call;                 /* the report at step N to pause at */
+	long long calls;                      /* reports seen at step N */
+	int stopped;                          /* went on after a stop signal */
+	long long after;                      /* reports since */
 	const struct ss_advance_options *caller;
 };
 
@@ -77,10 +90,12 @@ static double now(void)
 
 static void pause_here(void *context, const struct ss_stepper *seen)
 {
-	const struct hook *h = context;
+	struct hook *h = context;
 	if (h->caller->progress)
 		h->caller->progress(h->caller->context, seen);
-	if (seen->steps != h->pause_step)
+	if (h->stopped)
+		h->after++;
+	if (seen->steps != h->pause_step || ++h->calls != h->pause_call)
 		return;
 	const volatile sig_atomic_t *stop = h->caller->stop;
 	if (!stop) {
@@ -103,6 +118,7 @@ static void pause_here(void *context, const struct ss_stepper *seen)
 		}
 		nanosleep(&ms, NULL);
 	}
+	h->stopped = 1;
 }
 
 enum ss_advance_end __wrap_ss_stepper_advance(struct ss_stepper *st, double t_target,
@@ -114,10 +130,18 @@ enum ss_advance_end __wrap_ss_stepper_advance(struct ss_stepper *st, double t_ta
 	const char *file = getenv("SANDSLIDE_TEST_PAUSE_FILE");
 	const char *secs = getenv("SANDSLIDE_TEST_PAUSE_SECONDS");
 	const char *silent = getenv("SANDSLIDE_TEST_PAUSE_SILENT");
+	const char *call = getenv("SANDSLIDE_TEST_PAUSE_CALL");
+	/* the reports at step N seen by earlier calls of this one run */
+	static long long calls;
 	struct hook h = {atoll(env), secs && *secs ? atof(secs) : 60.0,
-	                 silent && !strcmp(silent, "1"), file && *file ? file : NULL, o};
+	                 silent && !strcmp(silent, "1"), file && *file ? file : NULL,
+	                 call && *call ? atoll(call) : 1, calls, 0, 0, o};
 	struct ss_advance_options hooked = *o;
 	hooked.progress = pause_here;
 	hooked.context = &h;
-	return __real_ss_stepper_advance(st, t_target, &hooked);
+	const enum ss_advance_end e = __real_ss_stepper_advance(st, t_target, &hooked);
+	calls = h.calls;
+	if (h.stopped)
+		fprintf(stderr, "pause hook: %lld evaluations after the stop signal\n", h.after);
+	return e;
 }
