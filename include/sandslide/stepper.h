@@ -209,6 +209,11 @@ void ss_stepper_book_external(struct ss_stepper *st, double volume_m3);
 double ss_stepper_inflow(const struct ss_stepper *st);
 double ss_stepper_outflow(const struct ss_stepper *st);
 
+/* Of the tiles of the grid, the fraction each stencil evaluation since
+ * ss_stepper_init swept, on average (the fast sweep skips sleeping tiles;
+ * the reference sweep sweeps all: 1); 0 before the first evaluation. */
+double ss_stepper_swept_fraction(const struct ss_stepper *st);
+
 /* The kernel's wall time since ss_stepper_init, s: measuring the slopes
  * (and the reference sweep's fluxes) and sweeping. */
 void ss_stepper_kernel_seconds(const struct ss_stepper *st, double *measure, double *sweep);

@@ -1,0 +1,63 @@
+"""No silent surprises (issue 36 item 3): what a command will cost is told or
+refused before the work, and what it did is counted as it was done."""
+import re
+
+import h5py
+import pytest
+
+from conftest import BASE, edit, run, run_ok
+
+
+def write(tmp_path, text, name="case.ini"):
+    p = tmp_path / name
+    p.write_text(text)
+    return p
+
+
+def test_run_prints_the_projected_output_size_first(tmp_path):
+    case = write(tmp_path, BASE)
+    out = tmp_path / "o.h5"
+    r = run_ok(["run", case, "-o", out])
+    first = r.stdout.splitlines()[0]
+    m = re.fullmatch(r"writing (\S+): ([\d.]+ \w+) \((\d+) snapshots of ([\d.]+ \w+)\); "
+                     r"([\d.]+ \w+) free", first)
+    assert m, r.stdout
+    with h5py.File(out, "r") as f:
+        assert int(m.group(3)) == f["time"].shape[0] == 3
+
+
+def test_run_refuses_an_output_larger_than_the_free_space(tmp_path):
+    """A run that would fill its file system is refused before it starts,
+    naming the output_every that fits (1e-12 s apart: 1e12 snapshots)."""
+    case = write(tmp_path, BASE)
+    out = tmp_path / "o.h5"
+    r = run(["run", case, "-o", out, "--set", "time.output_every=1e-12"])
+    assert r.returncode == 2, r.stderr
+    assert "more than the" in r.stderr and "free on its file system" in r.stderr, r.stderr
+    m = re.search(r"--set time\.output_every=([\d.e+-]+) or more \((\d+) snapshots\)",
+                  r.stderr)
+    assert m, r.stderr
+    assert 1e-12 < float(m.group(1)) <= 1.0
+    assert len(r.stderr.strip().splitlines()) == 1, r.stderr
+    assert not out.exists() and not (tmp_path / "o.h5.partial").exists()
+    assert r.stdout == ""
+
+
+QUIET = edit(edit(edit(BASE, "nx = 20", "nx = 512"), "ny = 16", "ny = 512"),
+             "height = 0.2", "height = 0") + """
+[source pile]
+rect = 1 1 1.5 1.5
+rate = 0.1
+"""
+
+
+def test_run_rate_counts_only_the_cells_swept(tmp_path):
+    """Sand poured on a corner of a 512^2 grid: the fast sweep skips the
+    sleeping tiles, and the rate counts only the cells it swept."""
+    case = write(tmp_path, edit(QUIET, "end = 1", "end = 2"))
+    r = run_ok(["run", case, "-o", tmp_path / "o.h5"])
+    m = re.search(r"([\d.e+]+) cell-updates/s \(swept tiles only; ([\d.e+]+) counting every "
+                  r"cell\)", r.stdout)
+    assert m, r.stdout
+    swept, every = float(m.group(1)), float(m.group(2))
+    assert 0 < swept < every / 3, r.stdout
