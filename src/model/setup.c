@@ -32,6 +32,37 @@ struct start {
 	const char *memory_advice;            /* " (reduce nx and ny)", or "" */
 };
 
+/* The bytes a stepper of nx x ny cells of this rank's share and the ranks
+ * on its node need (dx, dy and the origin do not matter). */
+static double stepper_node_bytes(const struct ss_grid *g, enum ss_integrator integrator)
+{
+	return ss_stepper_memory_bytes(g, integrator) / ss_comm_size() * ss_comm_node_ranks();
+}
+
+int ss_setup_check_raster_memory(const char *name, int nx, int ny, int rasters,
+                                 const struct ss_model_options *m, int has_bedrock)
+{
+	struct ss_grid g;
+	int err = ss_grid_init(&g, nx, ny, 1.0, 1.0, 0.0, 0.0);
+	if (err)
+		return err;
+	const double cells = (double)nx * (double)ny;
+	/* a raster: values (8 B) and nodata flags (1 B) a cell, split over the
+	 * ranks as the stepper is */
+	const double raster = rasters * cells * (sizeof(double) + 1.0) / ss_comm_size() *
+	                      ss_comm_node_ranks();
+	const double need = raster + stepper_node_bytes(&g, ss_integrator_resolve(m->integrator,
+	                                                                        has_bedrock));
+	const double have = ss_memory_available_bytes();
+	if (have > 0.0 && need > have) {
+		char nb[32], hb[32];
+		return ss_error_input("%s: %d x %d cells need %s of memory; this machine has %s "
+		                      "available", name, nx, ny, ss_format_bytes(need, nb),
+		                      ss_format_bytes(have, hb));
+	}
+	return SS_OK;
+}
+
 /* The grid, the integrator auto resolves to, the memory check, the closure
  * and the stepper (its grid then this rank's slab): what every set-up
  * starts with.  On error st is released. */
@@ -51,8 +82,7 @@ static int start(const struct start *s, struct ss_stepper *st)
 		                      "above the rock (use euler or auto)", s->integrator_what,
 		                      s->bedrock_what);
 	/* the memory of one rank's slab, times the ranks on this node */
-	const double need = ss_stepper_memory_bytes(&g, integrator) / ss_comm_size() *
-	                    ss_comm_node_ranks();
+	const double need = stepper_node_bytes(&g, integrator);
 	const double have = ss_memory_available_bytes();
 	if (have > 0.0 && need > have) {
 		char nb[32], hb[32];

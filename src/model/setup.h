@@ -52,6 +52,14 @@ int ss_setup_read_window(const char *spec, const char *context,
                          struct ss_dem_read_options opt, int tile_nx, int tile_ny,
                          struct ss_raster *r);
 
+/* SS_ERR_INPUT "NAME: NX x NY cells need X of memory; this machine has Y
+ * available" when `rasters` whole rasters of nx x ny cells (values and
+ * nodata flags) and the stepper of model m (with a bedrock or not) need
+ * more than the machine has: checked from a raster's header, before a
+ * command reads the raster or does any work. */
+int ss_setup_check_raster_memory(const char *name, int nx, int ny, int rasters,
+                                 const struct ss_model_options *m, int has_bedrock);
+
 /* st for the raster set-up s, as ss_setup_stepper (the fast kernel, the
  * default tiles, auto as relax resolves it).  On error st is released. */
 int ss_setup_stepper_from_raster(const struct ss_raster_setup *s, struct ss_stepper *st);

@@ -61,3 +61,37 @@ def test_run_rate_counts_only_the_cells_swept(tmp_path):
     assert m, r.stdout
     swept, every = float(m.group(1)), float(m.group(2))
     assert 0 < swept < every / 3, r.stdout
+
+
+# A valid ESRI ASCII header of 100000 x 100000 cells with three values: the
+# size alone must be refused, before any value is read.
+HUGE_ASC = ("ncols 100000\nnrows 100000\nxllcorner 0\nyllcorner 0\ncellsize 5\n"
+            "NODATA_value -9999\n1 2 3\n")
+
+
+def refused_for_memory(r):
+    assert r.returncode == 2, (r.returncode, r.stderr)
+    assert re.search(r"100000 x 100000 cells need [\d.]+ \w+ of memory; this machine has "
+                     r"[\d.]+ \w+ available", r.stderr), r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1, r.stderr
+
+
+def test_relax_refuses_a_raster_too_large_for_memory_up_front(tmp_path):
+    dem = tmp_path / "huge.asc"
+    dem.write_text(HUGE_ASC)
+    out = tmp_path / "out.asc"
+    r = run(["relax", dem, "-o", out], timeout=30)
+    refused_for_memory(r)
+    assert not out.exists()
+
+
+def test_fit_refuses_a_grid_too_large_for_memory_up_front(tmp_path):
+    """The case's grid is checked before the observations are read."""
+    small = write(tmp_path, BASE, "small.ini")
+    run_ok(["run", small, "-o", tmp_path / "obs.h5", "--quiet"])
+    big = write(tmp_path, edit(edit(BASE, "nx = 20", "nx = 100000"), "ny = 16",
+                               "ny = 100000"), "big.ini")
+    r = run(["fit", big, tmp_path / "obs.h5", "--param", "nu=0.05:0.2", "-o",
+             tmp_path / "fit.json"], timeout=30)
+    refused_for_memory(r)
+    assert not (tmp_path / "fit.json").exists()
