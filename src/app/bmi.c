@@ -222,7 +222,7 @@ static int setup_dem(struct bmi_state *s, const struct config *cf)
 		err = ss_error_input("BMI initialize: %s: %d x %d cells is more than the BMI's int "
 		                     "sizes can count", o->dem, in.dem.nx, in.dem.ny);
 	if (!err)
-		err = ss_relax_setup_stepper(o, &in, &s->st);
+		err = ss_relax_setup_stepper(o, &in, &s->st, NULL);
 	if (!err && !end)
 		s->end = isfinite(o->model.max_time) ? o->model.max_time : INFINITY;
 	ss_relax_inputs_release(&in);

@@ -129,7 +129,7 @@ void ss_relax_inputs_release(struct ss_relax_inputs *in)
 }
 
 int ss_relax_setup_stepper(const struct ss_relax_options *o, const struct ss_relax_inputs *in,
-                           struct ss_stepper *st)
+                           struct ss_stepper *st, struct ss_pour_cover *cover)
 {
 	const struct ss_raster_setup s = {
 		.model = &o->model, .name = o->dem, .heights = &in->dem, .dx = o->read.cellsize,
@@ -138,6 +138,7 @@ int ss_relax_setup_stepper(const struct ss_relax_options *o, const struct ss_rel
 		.tile_nx = o->job.tile[0], .tile_ny = o->job.tile[1],
 		.pour = o->sand_shape.kind != SS_SHAPE_NONE ? &o->sand_shape : NULL,
 		.pour_rate = o->sand_rate, .pour_duration = o->sand_duration,
+		.pour_cover = cover,
 	};
 	return ss_setup_stepper_from_raster(&s, st);
 }

@@ -170,6 +170,14 @@ void cli_print_relax_end(const struct ss_relax_report *r, int quiet)
 	 * cells: what the volume change is made of */
 	printf("volume %.9g -> %.9g m^3: poured %.6g m^3, left through open cells and "
 	       "sides %.6g m^3\n", r->volume_before, r->volume_after, r->inflow, r->outflow);
+	/* a pour partly on cells without data pours less than its area
+	 * suggests: say how much landed where */
+	if (r->pour_cells_nodata > 0)
+		printf("note: --add-sand covers %lld cells, %lld of them without data: the %.6g m^3 "
+		       "was poured on the other %lld, centres x %g .. %g, y %g .. %g\n",
+		       r->pour_cells, r->pour_cells_nodata, r->inflow,
+		       r->pour_cells - r->pour_cells_nodata, r->pour_extent[0], r->pour_extent[1],
+		       r->pour_extent[2], r->pour_extent[3]);
 }
 
 void cli_bench_header(void *context, const struct ss_bench_header *h)

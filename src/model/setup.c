@@ -320,6 +320,45 @@ static int lowest_height(const struct ss_raster_setup *s, double *level)
 	return SS_OK;
 }
 
+/* Where the pour of mask lands (all ranks' cells); SS_ERR_INPUT when every
+ * cell it covers is without data: the sources pour on flow cells only, so
+ * such a pour would pour nothing and report "poured 0 m^3" as a success. */
+static int pour_cover(const struct ss_stepper *st, const uint8_t *mask,
+                      struct ss_pour_cover *out)
+{
+	const struct ss_grid *g = &st->grid;
+	/* the extent as maxima: -x_min, x_max, -y_min, y_max */
+	double most[4] = {-INFINITY, -INFINITY, -INFINITY, -INFINITY}, count[2] = {0.0, 0.0};
+	for (int j = 0; j < g->ny; j++) {
+		for (int i = 0; i < g->nx; i++) {
+			if (!mask[(size_t)j * g->nx + i])
+				continue;
+			count[0]++;
+			if (ss_cell_type_get(st->cell_types, ss_grid_index(g, i, j)) != SS_CELL_FLOW) {
+				count[1]++;
+				continue;
+			}
+			const double x = ss_grid_x(g, i), y = ss_grid_y(g, j);
+			most[0] = fmax(most[0], -x);
+			most[1] = fmax(most[1], x);
+			most[2] = fmax(most[2], -y);
+			most[3] = fmax(most[3], y);
+		}
+	}
+	ss_comm_reduce(most, 4, count, 2);
+	if (count[1] == count[0])
+		return ss_error_input("--add-sand covers %.0f cell%s, all without data: nothing would "
+		                      "be poured (give a region on cells with data)", count[0],
+		                      count[0] == 1 ? "" : "s");
+	if (out) {
+		*out = (struct ss_pour_cover){
+			.cells = (long long)count[0], .nodata = (long long)count[1],
+			.x_min = -most[0], .x_max = most[1], .y_min = -most[2], .y_max = most[3],
+		};
+	}
+	return SS_OK;
+}
+
 /* The raster's heights and nodata cells into st (this rank's rows), the
  * bedrock, the poured sand. */
 static int fill_from_raster(const struct ss_raster_setup *s, struct ss_stepper *st)
@@ -353,6 +392,8 @@ static int fill_from_raster(const struct ss_raster_setup *s, struct ss_stepper *
 	if (!mask)
 		return ss_comm_agree(SS_ERR_FAIL);
 	err = rasterize(s->pour, &g, mask, "--add-sand");
+	if (!err)
+		err = pour_cover(st, mask, s->pour_cover);
 	if (!err)
 		err = ss_stepper_add_source(st, mask, s->pour_rate, 0.0, s->pour_duration);
 	ss_free(mask);

@@ -23,6 +23,16 @@
 int ss_setup_stepper(const struct ss_case *c, int tile_nx, int tile_ny,
                      enum ss_kernel kernel, struct ss_stepper *st);
 
+/* Where poured sand lands: the cells a pour's shape covers, of them those
+ * without data (walls or open cells, where nothing is poured), and the
+ * extent of the centres of the others (poured on). */
+struct ss_pour_cover {
+	long long cells;                  /* cell centres the shape covers */
+	long long nodata;                 /*   of them without data */
+	double x_min, x_max;              /* m: the centres poured on (NaN */
+	double y_min, y_max;              /*   when none is) */
+};
+
 /* What relax builds its stepper from: a raster and the model. */
 struct ss_raster_setup {
 	const struct ss_model_options *model;
@@ -41,6 +51,9 @@ struct ss_raster_setup {
 	const struct ss_shape *pour;      /* sand poured from t = 0, or NULL: */
 	double pour_rate;                 /*   m/s */
 	double pour_duration;             /*   s */
+	struct ss_pour_cover *pour_cover; /* out: where it lands (NULL: not
+	                                   * wanted); a pour on no cell with
+	                                   * data is refused */
 };
 
 /* This rank's rows of the raster spec (its window, dem.h) as the stepper

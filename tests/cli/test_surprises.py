@@ -1,5 +1,6 @@
 """No silent surprises (issue 36 item 3): what a command will cost is told or
 refused before the work, and what it did is counted as it was done."""
+import json
 import re
 
 import h5py
@@ -95,3 +96,40 @@ def test_fit_refuses_a_grid_too_large_for_memory_up_front(tmp_path):
              tmp_path / "fit.json"], timeout=30)
     refused_for_memory(r)
     assert not (tmp_path / "fit.json").exists()
+
+
+def half_nodata(tmp_path):
+    """20 x 20 cells of 1 m at height 1; the western 10 columns without data."""
+    row = " ".join(["-9999"] * 10 + ["1"] * 10)
+    p = tmp_path / "half.asc"
+    p.write_text("ncols 20\nnrows 20\nxllcorner 0\nyllcorner 0\ncellsize 1\n"
+                 "NODATA_value -9999\n" + "\n".join([row] * 20) + "\n")
+    return p
+
+
+POUR = ["--sand-rate", "0.01", "--sand-duration", "10"]
+
+
+@pytest.mark.parametrize("nodata", ["wall", "open"])
+def test_relax_refuses_sand_poured_only_on_cells_without_data(tmp_path, nodata):
+    dem = half_nodata(tmp_path)
+    out = tmp_path / "out.asc"
+    r = run(["relax", dem, "--add-sand", "disk=3,10,2", *POUR, "--nodata", nodata, "-o", out])
+    assert r.returncode == 2, (r.stdout, r.stderr)
+    assert re.fullmatch(r"sandslide: --add-sand covers 12 cells, all without data: nothing "
+                        r"would be poured \(give a region on cells with data\)\n", r.stderr)
+    assert not out.exists()
+
+
+def test_relax_says_where_sand_partly_on_nodata_was_poured(tmp_path):
+    """A disk of 32 cells across the edge of the data: 16 without data, and
+    0.01 m/s x 10 s on each of the other 16 cells of 1 m^2 is 1.6 m^3."""
+    dem = half_nodata(tmp_path)
+    rep = tmp_path / "r.json"
+    r = run_ok(["relax", dem, "--add-sand", "disk=10,10,3", *POUR, "-o", tmp_path / "o.asc",
+                "--report", rep])
+    assert ("note: --add-sand covers 32 cells, 16 of them without data: the 1.6 m^3 was poured "
+            "on the other 16, centres x 10.5 .. 12.5, y 7.5 .. 12.5") in r.stdout, r.stdout
+    report = json.loads(rep.read_text())
+    assert report["pour_cells"] == 32 and report["pour_cells_nodata"] == 16
+    assert report["inflow"] == pytest.approx(1.6, rel=1e-12)
