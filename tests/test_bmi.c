@@ -472,12 +472,88 @@ static void set_value_leaves_walls(void)
 	for (int c = 0; c < 24; c++) {
 		const int wall = c % 6 < 2 && c / 6 < 2;   /* rect 0 0 1 1 of 0.5 m cells */
 		walls += wall;
-		CHECK(back[c] == (wall ? before[c] : 0.5), "cell %d: %g", c, back[c]);
+		/* a wall has no elevation: NaN, before and after */
+		CHECK(wall ? isnan(back[c]) && isnan(before[c]) : back[c] == 0.5, "cell %d: %g", c,
+		      back[c]);
 	}
 	CHECK(walls == 4, "four wall cells");
 	CHECK_REL(external(m), 20 * 0.3 * 0.25, 1e-12, "flow cells counted only");
 	ss_bmi_destroy(m);
 	remove(check_file("walled.ini"));
+}
+
+/* The elevation is NaN on walls and on cells without data, as relax gives
+ * it (Python's relax, the .h5 output), never the 0 m the stepper holds
+ * there, which a coupled model would take for a cliff; get_value_at_indices
+ * agrees, and a get then set round trip is accepted and changes nothing. */
+static void elevation_is_nan_without_data(const char *nodata)
+{
+	enum { DX = 8, DY = 6 };
+	double dem[DX * DY];
+	FILE *f = fopen(check_file("holes.asc"), "w");
+	CHECK(f != NULL, "holes.asc");
+	if (!f)
+		return;
+	fprintf(f, "ncols %d\nnrows %d\nxllcorner 0\nyllcorner 0\ncellsize 1\n"
+	        "NODATA_value -9999\n", DX, DY);
+	for (int j = DY - 1; j >= 0; j--)           /* north row first */
+		for (int i = 0; i < DX; i++) {
+			/* a void inside and a clipped western edge; a slope that slides */
+			const int none = i == 0 || (i == 4 && j == 3);
+			dem[j * DX + i] = none ? NAN : 5.0 + 1.5 * i;
+			if (none)
+				fputs("-9999", f);
+			else
+				fprintf(f, "%.17g", dem[j * DX + i]);
+			fputs(i == DX - 1 ? "\n" : " ", f);
+		}
+	fclose(f);
+	char cfg[256];
+	snprintf(cfg, sizeof cfg, "[bmi]\ndem = holes.asc\ntime_step = 0.5\nend = 2\n"
+	         "nodata = %s\n", nodata);
+	check_write_file(check_file("holes.cfg"), cfg);
+	struct Bmi *m = ss_bmi_create();
+	CHECK(m && m->initialize(m, check_file("holes.cfg")) == BMI_SUCCESS, "%s",
+	      ss_error_last_message());
+	if (!m || !m->data) {
+		ss_bmi_destroy(m);
+		return;
+	}
+	double got[DX * DY], at[DX * DY], want[DX * DY];
+	int inds[DX * DY];
+	for (int c = 0; c < DX * DY; c++)
+		inds[c] = c;
+	CHECK(m->update_until(m, 1.0) == BMI_SUCCESS, "update_until");
+	CHECK(m->get_value(m, ELEV, got) == BMI_SUCCESS, "get_value");
+	CHECK(m->get_value_at_indices(m, ELEV, at, inds, DX * DY) == BMI_SUCCESS, "at indices");
+	struct ss_relax_options *o = ss_option_object_create(&ss_relax_option_table);
+	CHECK(o && !ss_option_object_set(o, "nodata", nodata) &&
+	      !ss_option_object_set(o, "max-time", "1"), "relax options");
+	CHECK(o && ss_relax_heights(o, DX, DY, 1.0, 1.0, dem, NULL, want, NULL, 0) == SS_OK, "%s",
+	      ss_error_last_message());
+	ss_option_object_destroy(o);
+	int nans = 0;
+	for (int c = 0; c < DX * DY; c++) {
+		nans += isnan(got[c]);
+		CHECK(isnan(got[c]) == isnan(dem[c]) && isnan(want[c]) == isnan(dem[c]),
+		      "--nodata %s, cell %d: %g, relax's %g", nodata, c, got[c], want[c]);
+		CHECK(memcmp(&got[c], &at[c], sizeof at[c]) == 0, "cell %d at indices", c);
+	}
+	CHECK(nans == DY + 1, "--nodata %s: %d NaN cells", nodata, nans);
+	double external0 = external(m), back[DX * DY];
+	CHECK(m->set_value(m, ELEV, got) == BMI_SUCCESS, "set what get gave: %s",
+	      ss_error_last_message());
+	CHECK(m->get_value(m, ELEV, back) == BMI_SUCCESS && same_bits(back, got, DX * DY) &&
+	      external(m) == external0, "the round trip changed something");
+	ss_bmi_destroy(m);
+	remove(check_file("holes.cfg"));
+	remove(check_file("holes.asc"));
+}
+
+static void elevation_is_nan_on_walls_and_nodata(void)
+{
+	elevation_is_nan_without_data("wall");
+	elevation_is_nan_without_data("open");
 }
 
 /* The deposition rate is a source: a rate field on a rectangle gives the
@@ -713,6 +789,7 @@ int main(void)
 	RUN(set_value_round_trips);
 	RUN(set_then_run_is_a_run_from_a_file);
 	RUN(set_value_leaves_walls);
+	RUN(elevation_is_nan_on_walls_and_nodata);
 	RUN(rate_is_a_source);
 	RUN(bedrock_and_erosion);
 	RUN(config_names_a_case_or_a_dem);

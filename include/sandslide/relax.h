@@ -96,6 +96,11 @@ struct ss_relax_report {
 	double volume_moved;              /* half the sum of |h - h0| dx dy, m^3 */
 	double volume_before, volume_after; /* m^3, flow cells */
 	double inflow, outflow;           /* m^3 */
+	long long pour_cells;             /* --add-sand: the cells it covers */
+	long long pour_cells_nodata;      /*   of them without data, where
+	                                     nothing is poured */
+	double pour_extent[4];            /*   the centres poured on: x min,
+	                                     x max, y min, y max, m */
 	double max_slope_before_deg;      /* steepest face that can move sand */
 	double max_slope_after_deg;
 	long long steps;                  /* substeps (RKL2: super-steps) */

@@ -31,6 +31,22 @@ struct ss_run_snapshot {
 	int any_open_side;           /* a side of the grid is open */
 };
 
+/* What a run is about to write, told once its input is checked and before
+ * its output is touched (ss_run_options.on_plan). */
+struct ss_run_plan {
+	const char *output;          /* the output file */
+	double snapshots;            /* snapshots it will add; INFINITY: a
+	                              * steady run without max_time */
+	int at_most;                 /* a steady run: it may stop sooner */
+	double snapshot_bytes;       /* bytes each adds without deflate
+	                              * (ss_snapshot_bytes) */
+	double bytes;                /* snapshots x snapshot_bytes */
+	double free_bytes;           /* free on the output's file system;
+	                              * < 0: unknown */
+	int deflate;                 /* the deflate level: bytes is then an
+	                              * upper bound */
+};
+
 struct ss_run_options {
 	const char *case_path;
 	struct ss_job job;           /* output (NULL: out/<case name>.h5),
@@ -50,6 +66,12 @@ struct ss_run_options {
 	 * non-zero return (a status, message printed) stops the run. */
 	int (*on_snapshot)(void *context, const struct ss_run_snapshot *s);
 	void *snapshot_context;
+	/* Called once before the output is touched (NULL: not called), e.g.
+	 * to print the projected size.  A run with a fixed end and no deflate
+	 * whose projection exceeds the free space is refused (SS_ERR_INPUT,
+	 * naming the time.output_every that fits) before this is called. */
+	void (*on_plan)(void *context, const struct ss_run_plan *p);
+	void *plan_context;
 };
 
 /* run's options: name, kind, default, range, help of each (option.h),
@@ -86,6 +108,10 @@ struct ss_run_summary {
 	double memory_peak_bytes;    /* the largest peak resident memory of
 	                                any rank (ss_memory_peak_bytes) */
 	double cells;                /* of the grid */
+	double cell_updates_here;    /* cells this process updated: of its
+	                              * evaluations, the cells of the tiles
+	                              * they swept (ss_stepper_swept_fraction:
+	                              * the fast sweep skips sleeping tiles) */
 	double wall_seconds;         /* the whole run */
 	double measure_seconds;      /* measuring the largest slope */
 	double sweep_seconds;        /* sweeping */

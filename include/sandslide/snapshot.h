@@ -89,6 +89,11 @@ int ss_snapshot_create(struct ss_snapshot **out, const char *path,
                        const struct ss_grid *g, const uint8_t *cell_types,
                        const struct ss_snapshot_meta *meta);
 
+/* The bytes one more snapshot of grid g (the whole grid's) adds to a file
+ * without deflate: whole chunks of /height and 1 KiB for its time series
+ * and chunk index; deflate makes it smaller. */
+double ss_snapshot_bytes(const struct ss_grid *g);
+
 /* Append one snapshot (height with the grid's halo layout; walls and
  * cells without data are written as NaN, the _FillValue, so cell_types in
  * the same layout) and, when state is not NULL, the restart state (root

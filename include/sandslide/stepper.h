@@ -223,6 +223,11 @@ double ss_stepper_outflow(const struct ss_stepper *st);
 void ss_stepper_rest_counts(const struct ss_stepper *st, long long *steps,
                             long long *evaluations);
 
+/* Of the tiles of the grid, the fraction each stencil evaluation since
+ * ss_stepper_init swept, on average (the fast sweep skips sleeping tiles;
+ * the reference sweep sweeps all: 1); 0 before the first evaluation. */
+double ss_stepper_swept_fraction(const struct ss_stepper *st);
+
 /* The kernel's wall time since ss_stepper_init, s: measuring the slopes
  * (and the reference sweep's fluxes) and sweeping. */
 void ss_stepper_kernel_seconds(const struct ss_stepper *st, double *measure, double *sweep);

@@ -180,7 +180,8 @@ def main(argv=None):
     print(f"left by the open east end {r['sand__time_integral_of_outflow_volume_flux']:.15g} m3")
     print(f"balance: held + outflow - delivered = {held - r['delivered']:.3g} m3 "
           f"({abs(held - r['delivered']) / r['delivered']:.2g} relative)")
-    print(f"drift: {r['h'].max():.4f} m high, steepest sand face "
+    # the wall's cells have no elevation: get_value gives NaN there
+    print(f"drift: {np.nanmax(r['h']):.4f} m high, steepest sand face "
           f"{r['sand_surface__max_of_slope_angle']:.6f} deg")
     if a.png:
         draw(r, a.png)

@@ -58,6 +58,9 @@ struct bmi_state {
 	double *rate_next;   /* the same room: a set is built here, and the two
 	                      * swap when the stepper takes it */
 	int cells;           /* nx * ny (fits an int: checked) */
+	uint8_t *nodata;     /* ny * nx [y][x]: 1 where a DEM has no data
+	                      * (walls or open cells by its nodata option);
+	                      * NULL: none (a case, or a DEM without) */
 };
 
 static struct bmi_state *state(struct Bmi *self)
@@ -222,7 +225,16 @@ static int setup_dem(struct bmi_state *s, const struct config *cf)
 		err = ss_error_input("BMI initialize: %s: %d x %d cells is more than the BMI's int "
 		                     "sizes can count", o->dem, in.dem.nx, in.dem.ny);
 	if (!err)
-		err = ss_relax_setup_stepper(o, &in, 0, &s->st);
+		err = ss_relax_setup_stepper(o, &in, 0, &s->st, NULL);
+	/* kept for get_value: a cell without data has no elevation */
+	if (!err && in.dem.nodata) {
+		const size_t cells = (size_t)in.dem.nx * (size_t)in.dem.ny;
+		if (!(s->nodata = ss_alloc(cells, 1, "the BMI's nodata flags"))) {
+			ss_stepper_release(&s->st);
+			err = SS_ERR_FAIL;
+		} else
+			memcpy(s->nodata, in.dem.nodata, cells);
+	}
 	if (!err && !end)
 		s->end = isfinite(o->model.max_time) ? o->model.max_time : INFINITY;
 	ss_relax_inputs_release(&in);
@@ -291,6 +303,7 @@ static int bmi_initialize(struct Bmi *self, const char *config_file)
 		}
 	}
 	if (err) {
+		ss_free(s->nodata);
 		ss_free(s);
 		return BMI_FAILURE;
 	}
@@ -344,6 +357,7 @@ static int bmi_finalize(struct Bmi *self)
 	ss_stepper_release(&s->st);
 	ss_free(s->rate);
 	ss_free(s->rate_next);
+	ss_free(s->nodata);
 	ss_free(s);
 	self->data = NULL;
 	return BMI_SUCCESS;
@@ -515,7 +529,10 @@ static double diagnostic(struct bmi_state *s, const struct var *v)
 }
 
 /* The grid-0 variable v at the flat [y][x] index c: the bedrock is NaN
- * where no sand can lie (walls, open cells: the stepper's -infinity). */
+ * where no sand can lie (walls, open cells: the stepper's -infinity); the
+ * elevation is NaN on walls and cells without data, as the .h5 output and
+ * Python's relax give it: the stepper holds 0 or the open level there,
+ * which a coupled model would take for a cliff (doc/bmi.md). */
 static double grid_value(const struct bmi_state *s, const struct var *v, int c)
 {
 	switch (v - vars) {
@@ -524,7 +541,13 @@ static double grid_value(const struct bmi_state *s, const struct var *v, int c)
 		const double b = s->st.bedrock[at_of(&s->st, c)];
 		return isinf(b) ? NAN : b;
 	}
-	default: return s->st.height[at_of(&s->st, c)];
+	default: {
+		const ptrdiff_t at = at_of(&s->st, c);
+		if ((s->nodata && s->nodata[c]) ||
+		    ss_cell_type_get(s->st.cell_types, at) == SS_CELL_WALL)
+			return NAN;
+		return s->st.height[at];
+	}
 	}
 }
 

@@ -876,6 +876,12 @@ static int prepare(struct fit *f)
 	if ((err = ss_case_load(&f->base, o->case_path, NULL, 0)) || (err = parse_closures(f)) ||
 	    (err = assign_params(f)))
 		return err;
+	/* before the observations are read: the case's grid, the stepper and
+	 * fit's own arrays (flow flags, floor, simulated heights and
+	 * thickness: about three rasters) must fit in memory */
+	if ((err = ss_setup_check_raster_memory(f->base.path, f->base.nx, f->base.ny, 3,
+	                                        &f->base.model, f->base.bedrock_file != NULL)))
+		return err;
 	if (o->job.output && ((err = ss_output_check_folder(o->job.output, 0)) ||
 	                      (err = ss_output_check_absent(o->job.output, o->job.force, NULL))))
 		return err;

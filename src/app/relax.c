@@ -13,6 +13,7 @@
 
 #include "app/drive.h"
 #include "app/relax_inputs.h"
+#include "model/setup.h"
 #include "io/output.h"
 #include "sandslide/comm.h"
 #include "sandslide/error.h"
@@ -174,13 +175,14 @@ struct relax {
 	enum ss_dem_format format;        /* of the output */
 	struct ss_stepper st;
 	struct ss_drive drive;
+	struct ss_pour_cover cover;       /* where --add-sand's sand lands */
 };
 
 /* The driver's rebuild: the DEM's stepper at t = 0. */
 static int rebuild(void *context, struct ss_stepper *st)
 {
-	const struct relax *x = context;
-	return ss_relax_setup_stepper(x->o, &x->in, 1, st);
+	struct relax *x = context;
+	return ss_relax_setup_stepper(x->o, &x->in, 1, st, &x->cover);
 }
 
 /* The output's name and format, checked before any work: every rank
@@ -338,6 +340,14 @@ int ss_relax_run(const struct ss_relax_options *o, struct ss_relax_report *rep)
 	rep->read_seconds = ss_parallel_wall_seconds() - started;
 	if (!err)
 		err = rebuild(&x, &x.st);
+	if (!err && o->sand_shape.kind != SS_SHAPE_NONE) {
+		rep->pour_cells = x.cover.cells;
+		rep->pour_cells_nodata = x.cover.nodata;
+		rep->pour_extent[0] = x.cover.x_min;
+		rep->pour_extent[1] = x.cover.x_max;
+		rep->pour_extent[2] = x.cover.y_min;
+		rep->pour_extent[3] = x.cover.y_max;
+	}
 	if (!err)
 		err = measure_before(&x, rep);
 	if (!err)

@@ -62,11 +62,39 @@ static int agree_nodata(struct ss_raster *r)
 	return SS_OK;
 }
 
+/* The memory the DEM's size asks for, from its header (or the caller's
+ * raster), before any raster is read: a raster too large for the machine
+ * is refused at once (exit 2), as run and bench refuse a grid, rather than
+ * failing to allocate after minutes of reading. */
+static int check_memory(const struct ss_relax_options *o)
+{
+	struct ss_raster header;
+	int err = SS_OK;
+	int nx, ny;
+	if (o->input_raster) {
+		nx = o->input_raster->nx;
+		ny = o->input_raster->ny;
+	} else {
+		struct ss_dem_read_options opt = o->read;
+		opt.rows = 0;   /* the header alone */
+		if ((err = ss_dem_read(o->dem, NULL, &opt, &header)))
+			return err;
+		nx = header.nx;
+		ny = header.ny;
+		ss_raster_release(&header);
+	}
+	/* the copy or the read, and the bedrock's */
+	return ss_setup_check_raster_memory(o->dem, nx, ny, o->bedrock ? 2 : 1, &o->model,
+	                                    o->bedrock != NULL);
+}
+
 static int read_here(const struct ss_relax_options *o, struct ss_relax_inputs *in)
 {
 	if ((o->input_raster && !o->dem) || (o->bedrock_raster && !o->bedrock))
 		SS_BUG("ss_relax_run: an input raster without its name (dem, bedrock)");
 	int err = check_options(o);
+	if (!err)
+		err = check_memory(o);
 	if (err)
 		return err;
 	const int tx = o->job.tile[0], ty = o->job.tile[1];
@@ -101,7 +129,7 @@ void ss_relax_inputs_release(struct ss_relax_inputs *in)
 }
 
 int ss_relax_setup_stepper(const struct ss_relax_options *o, const struct ss_relax_inputs *in,
-                           int steady, struct ss_stepper *st)
+                           int steady, struct ss_stepper *st, struct ss_pour_cover *cover)
 {
 	const struct ss_raster_setup s = {
 		.model = &o->model, .name = o->dem, .heights = &in->dem, .dx = o->read.cellsize,
@@ -110,6 +138,7 @@ int ss_relax_setup_stepper(const struct ss_relax_options *o, const struct ss_rel
 		.tile_nx = o->job.tile[0], .tile_ny = o->job.tile[1],
 		.pour = o->sand_shape.kind != SS_SHAPE_NONE ? &o->sand_shape : NULL,
 		.pour_rate = o->sand_rate, .pour_duration = o->sand_duration,
+		.pour_cover = cover,
 	};
 	return ss_setup_stepper_from_raster(&s, st);
 }

@@ -10,6 +10,8 @@
 #include "sandslide/relax.h"
 #include "sandslide/stepper.h"
 
+struct ss_pour_cover;   /* model/setup.h */
+
 struct ss_relax_inputs {
 	struct ss_raster dem;       /* this rank's rows (a window, dem.h): the
 	                             * initial surface, later the output's */
@@ -26,8 +28,9 @@ void ss_relax_inputs_release(struct ss_relax_inputs *in);
 
 /* st prepared at t = 0 from the inputs and the options (model/setup.h):
  * what relax starts from, and what its guard rebuilds; steady: it will
- * be stepped until steady (relax; not the BMI, which drives it). */
+ * be stepped until steady (relax; not the BMI, which drives it); *cover
+ * (NULL: not wanted) where --add-sand's sand lands. */
 int ss_relax_setup_stepper(const struct ss_relax_options *o, const struct ss_relax_inputs *in,
-                           int steady, struct ss_stepper *st);
+                           int steady, struct ss_stepper *st, struct ss_pour_cover *cover);
 
 #endif

@@ -56,6 +56,8 @@ static const struct ss_field fields[] = {
 	FIELD("volume_after", SS_FIELD_REAL, volume_after),
 	LINE("inflow", SS_FIELD_REAL, inflow),
 	FIELD("outflow", SS_FIELD_REAL, outflow),
+	LINE("pour_cells", SS_FIELD_COUNT, pour_cells),
+	FIELD("pour_cells_nodata", SS_FIELD_COUNT, pour_cells_nodata),
 	LINE("max_slope_before_deg", SS_FIELD_REAL, max_slope_before_deg),
 	FIELD("max_slope_after_deg", SS_FIELD_REAL, max_slope_after_deg),
 };

@@ -29,6 +29,7 @@ struct run {
 	struct ss_stepper st;
 	struct ss_drive drive;
 	char output[4096];
+	struct ss_run_plan plan;          /* the output's projected size */
 };
 
 /* "cases/door.ini" -> "out/door.h5" */
@@ -205,6 +206,94 @@ static int report_snapshot(void *context, const char *path, long long index, dou
 	return r->o->on_snapshot(r->o->snapshot_context, &s);
 }
 
+/* The snapshots a run from t0 to end writes, output_every apart (drive.c's
+ * targets: k * output_every clipped to end), with snapshot 0 if first. */
+static double snapshots_between(double t0, double end, double output_every, int first)
+{
+	double n = first ? 1.0 : 0.0;
+	if (!(end > t0))
+		return n;
+	if (isinf(end))
+		return isinf(output_every) ? n + 1.0 : INFINITY;
+	if (isfinite(output_every)) {
+		const double k_min = floor(t0 / output_every) + 1.0;
+		const double k_max = ceil(end / output_every) - 1.0;
+		if (k_max >= k_min)
+			n += k_max - k_min + 1.0;
+	}
+	return n + 1.0;   /* the one at end */
+}
+
+/* x rounded up to two significant digits, for a value a user types. */
+static double round_up_2(double x)
+{
+	const double unit = pow(10.0, floor(log10(x)) - 1.0);
+	return ceil(x / unit) * unit;
+}
+
+/* The output's projected size into r->plan, refused when a run with a
+ * fixed end and no deflate would fill its file system: a long run that
+ * fails at the snapshot that does not fit has spent its time for a file
+ * that fills the disk.  A steady run's count is only an upper bound, and
+ * deflate's ratio is not known before the first snapshot, so those are
+ * told, not refused (the check before each snapshot still stops a full
+ * disk, h5_write.c).  From the case's grid, before the set-up allocates
+ * it: a grid of 10^8 cells takes seconds to set up. */
+static int plan_output(struct run *r)
+{
+	struct ss_grid g;
+	int err = ss_grid_init(&g, r->c.nx, r->c.ny, r->c.dx, r->c.dy, 0.0, 0.0);
+	if (err)
+		return err;
+	const int first = r->o->restart == NULL;
+	const double t0 = first ? 0.0 : r->restart.time;
+	const double end = r->c.steady ? ss_model_time_limit(&r->c.model) : r->c.end;
+	struct ss_run_plan p = {
+		.output = r->output, .at_most = r->c.steady,
+		.snapshots = snapshots_between(t0, end, r->c.output_every, first),
+		.snapshot_bytes = ss_snapshot_bytes(&g), .deflate = r->o->deflate,
+	};
+	p.bytes = p.snapshots * p.snapshot_bytes;
+	p.free_bytes = ss_comm_rank() == 0 ? ss_output_free_bytes(r->output) : 0.0;
+	ss_comm_broadcast(&p.free_bytes, sizeof p.free_bytes, 0);
+	r->plan = p;
+	/* a grid too large for memory is the set-up's to refuse, naming its
+	 * [grid] line: the more basic complaint */
+	const int bedrock = r->c.bedrock_file != NULL;
+	const double memory = ss_stepper_memory_bytes(&g, ss_integrator_resolve(
+		r->c.model.integrator, bedrock, 0), r->c.steady && !bedrock ? r->c.model.rest :
+		SS_REST_OFF) / ss_comm_size() * ss_comm_node_ranks();
+	const double available = ss_memory_available_bytes();
+	if (available > 0.0 && memory > available)
+		return SS_OK;
+	if (!r->c.steady && !p.deflate && p.free_bytes >= 0.0 && p.bytes > p.free_bytes) {
+		char need[32], each[32], have[32];
+		const double fit = floor(p.free_bytes / p.snapshot_bytes);
+		const double fixed = snapshots_between(t0, end, INFINITY, first);
+		char advice[160];
+		if (fit < fixed) {
+			snprintf(advice, sizeof advice, "not even the %.0f at the start and end fit: "
+			         "use a coarser grid or free some space", fixed);
+		} else {
+			/* output_every = span / (inner snapshots that fit), rounded up
+			 * and checked against the count drive.c will make */
+			const double span = end - t0, inner = fit - fixed;
+			double every = inner > 0.0 ? round_up_2(span / inner) : round_up_2(end);
+			while (snapshots_between(t0, end, every, first) > fit)
+				every = round_up_2(every * 1.01);
+			snprintf(advice, sizeof advice, "give --set time.output_every=%g or more (%.0f "
+			         "snapshots) or a coarser grid", every,
+			         snapshots_between(t0, end, every, first));
+		}
+		return ss_error_input("'%s' would grow by %s (%.0f snapshots of %s), more than the "
+		                      "%s free on its file system: %s", r->output,
+		                      ss_format_bytes(p.bytes, need), p.snapshots,
+		                      ss_format_bytes(p.snapshot_bytes, each),
+		                      ss_format_bytes(p.free_bytes, have), advice);
+	}
+	return SS_OK;
+}
+
 /* Claim the output, then continue its series or create it with snapshot 0. */
 static int open_output(struct run *r)
 {
@@ -257,6 +346,8 @@ static void summarise(const struct run *r, enum ss_drive_end end, struct ss_run_
 	s->integrator = ss_integrator_name(st->integrator);
 	s->stages_max = st->rkl2_max_stages;
 	s->cells = (double)st->grid.global_nx * st->grid.global_ny;
+	s->cell_updates_here = (double)s->evaluations_here * s->cells *
+	                       ss_stepper_swept_fraction(st);
 	s->bytes_per_cell = ss_stepper_memory_bytes(&st->grid, st->integrator, st->rest) /
 	                    ((double)st->grid.nx * st->grid.ny);
 	s->ranks = ss_comm_size();
@@ -290,7 +381,12 @@ int ss_run_case(const struct ss_run_options *o, struct ss_run_summary *summary)
 	if (!err)
 		err = resolve(&r);
 	if (!err)
+		err = plan_output(&r);
+	if (!err)
 		err = start_stepper(&r);
+	/* told once the set-up has checked everything else */
+	if (!err && o->on_plan)
+		o->on_plan(o->plan_context, &r.plan);
 	if (!err)
 		err = open_output(&r);
 	if (!err)

@@ -43,6 +43,7 @@ static const struct ss_field fields[] = {
 	LINE("integrator", SS_FIELD_TEXT, integrator),
 	FIELD("stages_max", SS_FIELD_INT, stages_max),
 	LINE("cells", SS_FIELD_REAL, cells),
+	FIELD("cell_updates_here", SS_FIELD_REAL, cell_updates_here),
 	FIELD("bytes_per_cell", SS_FIELD_REAL, bytes_per_cell),
 	FIELD("memory_peak_bytes", SS_FIELD_REAL, memory_peak_bytes),
 	FIELD("threads", SS_FIELD_INT, threads),

@@ -130,6 +130,7 @@ static int run_with_frames(struct ss_run_options *o, const struct run_cli *cli,
 		o->job.history = history;
 		o->on_snapshot = frames ? render_run_snapshot : NULL;
 		o->snapshot_context = frames;
+		o->on_plan = cli->quiet ? NULL : cli_print_run_plan;
 		o->job.progress = watch(cli->quiet, &o->job.stop_signal);
 		err = ss_run_case(o, &s);
 		cli_progress_done();

@@ -79,6 +79,26 @@ void cli_progress_done(void)
 	progress.shown = 0;
 }
 
+void cli_print_run_plan(void *context, const struct ss_run_plan *p)
+{
+	(void)context;
+	if (ss_comm_rank() != 0)
+		return;
+	char each[32], all[32], have[32] = "";
+	ss_format_bytes(p->snapshot_bytes, each);
+	if (p->free_bytes >= 0.0)
+		snprintf(have, sizeof have, "%s", ss_format_bytes(p->free_bytes, all));
+	if (isinf(p->snapshots))
+		printf("writing %s: %s a snapshot%s, as many as the run takes to be steady; %s%s\n",
+		       p->output, each, p->deflate ? " before deflate" : "", have,
+		       *have ? " free" : "free space unknown");
+	else
+		printf("writing %s: %s%s (%.0f snapshot%s of %s%s); %s%s\n", p->output,
+		       p->at_most ? "at most " : "", ss_format_bytes(p->bytes, all), p->snapshots,
+		       p->snapshots == 1 ? "" : "s", each, p->deflate ? " before deflate" : "",
+		       *have ? have : "free space unknown", *have ? " free" : "");
+}
+
 void cli_print_run_end(const struct ss_run_summary *s, int quiet)
 {
 	if (ss_comm_rank() != 0)
@@ -105,11 +125,16 @@ void cli_print_run_end(const struct ss_run_summary *s, int quiet)
 		snprintf(ranks, sizeof ranks, "%d ranks x ", s->ranks);
 		snprintf(mpi, sizeof mpi, ", mpi %.3f s", s->comm_seconds);
 	}
+	/* the rate counts the cells of the tiles swept, not those the fast
+	 * sweep skipped as asleep: a large quiet grid would otherwise claim
+	 * rates no memory system can feed (doc/running.md) */
+	const double kernel = fmax(s->measure_seconds + s->sweep_seconds, 1e-9);
 	printf("wall %.3f s: slope %.3f s, sweep %.3f s, output %.3f s%s; %lld stencil "
-	       "evaluations, %.3g cell-updates/s on %s%d thread%s; %.0f B per cell, peak %s%s\n",
+	       "evaluations, %.3g cell-updates/s (swept tiles only; %.3g counting every cell) "
+	       "on %s%d thread%s; %.0f B per cell, peak %s%s\n",
 	       s->wall_seconds, s->measure_seconds, s->sweep_seconds, s->output_seconds, mpi,
-	       s->evaluations, (double)s->evaluations_here * s->cells /
-	       fmax(s->measure_seconds + s->sweep_seconds, 1e-9), ranks, s->threads,
+	       s->evaluations, s->cell_updates_here / kernel,
+	       (double)s->evaluations_here * s->cells / kernel, ranks, s->threads,
 	       s->threads == 1 ? "" : "s", s->bytes_per_cell,
 	       ss_format_bytes(s->memory_peak_bytes, peak), s->ranks > 1 ? " a rank" : "");
 }
@@ -149,6 +174,14 @@ void cli_print_relax_end(const struct ss_relax_report *r, int quiet)
 	 * cells: what the volume change is made of */
 	printf("volume %.9g -> %.9g m^3: poured %.6g m^3, left through open cells and "
 	       "sides %.6g m^3\n", r->volume_before, r->volume_after, r->inflow, r->outflow);
+	/* a pour partly on cells without data pours less than its area
+	 * suggests: say how much landed where */
+	if (r->pour_cells_nodata > 0)
+		printf("note: --add-sand covers %lld cells, %lld of them without data: the %.6g m^3 "
+		       "was poured on the other %lld, centres x %g .. %g, y %g .. %g\n",
+		       r->pour_cells, r->pour_cells_nodata, r->inflow,
+		       r->pour_cells - r->pour_cells_nodata, r->pour_extent[0], r->pour_extent[1],
+		       r->pour_extent[2], r->pour_extent[3]);
 }
 
 void cli_bench_header(void *context, const struct ss_bench_header *h)

@@ -25,6 +25,8 @@ void cli_progress_done(void);
 /* How a run or a relaxation ended: the interruption on stderr, else (and
  * for relax also then) the summary on stdout unless quiet. */
 void cli_print_run_end(const struct ss_run_summary *s, int quiet);
+/* ss_run_options.on_plan: the output's projected size (context: NULL) */
+void cli_print_run_plan(void *context, const struct ss_run_plan *p);
 void cli_print_relax_end(const struct ss_relax_report *r, int quiet);
 
 /* The benchmark's callbacks; context is a struct cli_bench, zeroed but

@@ -145,6 +145,8 @@ double ss_rest_superstep(struct ss_stepper *st, double *tau,
 	ss_comm_reduce(largest, 2, &awake, 1);
 	change = largest[0];
 	st->sweeper->tile_sweeps += awake / s;
+	st->sweeper->tiles_evaluated += awake;
+	st->sweeper->tile_evaluation_slots += s * st->sweeper->tiles_all;
 	r->steps++;
 	*tau = ch.tau;
 	if (!isfinite(change))

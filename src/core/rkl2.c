@@ -189,6 +189,8 @@ double ss_rkl2_superstep(struct ss_stepper *st, double tau,
 	double max[2] = {change, estimate};
 	ss_comm_reduce(max, 2, &awake, 1);
 	st->sweeper->tile_sweeps += awake / (s + 1);
+	st->sweeper->tiles_evaluated += awake;
+	st->sweeper->tile_evaluation_slots += (s + 1) * st->sweeper->tiles_all;
 	control(r, tau, max[1]);
 	r->last_stages = s;
 	return isfinite(max[0]) ? max[0] : INFINITY;

@@ -256,6 +256,13 @@ void ss_stepper_rest_counts(const struct ss_stepper *st, long long *steps,
 	*evaluations = st->rest_state ? st->rest_state->evaluations : 0;
 }
 
+double ss_stepper_swept_fraction(const struct ss_stepper *st)
+{
+	const struct ss_sweeper *w = st->sweeper;
+	return w->tile_evaluation_slots > 0.0 ? w->tiles_evaluated / w->tile_evaluation_slots
+	                                      : 0.0;
+}
+
 void ss_stepper_kernel_seconds(const struct ss_stepper *st, double *measure, double *sweep)
 {
 	*measure = st->sweeper->seconds_measure;

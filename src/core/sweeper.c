@@ -192,6 +192,8 @@ double ss_sweeper_euler(struct ss_stepper *st, double dt)
 	const double t0 = ss_parallel_wall_seconds();
 	double rate_max;
 	w->tile_sweeps += w->tiles_awake;
+	w->tiles_evaluated += w->tiles_awake;
+	w->tile_evaluation_slots += w->tiles_all;
 	if (st->kernel == SS_KERNEL_FAST) {
 		rate_max = ss_sweep_fast_step(&w->fast, g, &w->face_rule, dt, src, st->bedrock,
 		                              st->cell_types, st->height, st->ledger->open_flux);

@@ -46,6 +46,11 @@ struct ss_sweeper {
 
 	double tile_sweeps, tile_slots; /* for active_fraction, since the last
 	                                 * ss_stepper_diagnostics */
+	double tiles_evaluated;         /* tiles each stencil evaluation swept,
+	                                 * all ranks, summed since create */
+	double tile_evaluation_slots;   /*   and tiles_all per evaluation: the
+	                                 * cell-update rate counts only the
+	                                 * cells of swept tiles */
 	double seconds_measure;         /* kernel wall time, s: measuring S */
 	double seconds_sweep;           /*   and sweeping */
 };

@@ -11,6 +11,7 @@
 #include <string.h>
 #include <sys/file.h>
 #include <sys/stat.h>
+#include <sys/statvfs.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -45,6 +46,16 @@ int ss_output_check_folder(const char *path, int default_folder)
 	if (stat(path, &sb) == 0 && S_ISDIR(sb.st_mode))
 		return ss_error_input("cannot write '%s': it is a folder", path);
 	return SS_OK;
+}
+
+double ss_output_free_bytes(const char *path)
+{
+	char dir[4096];
+	struct statvfs fs;
+	folder_of(path, dir, sizeof dir);
+	if (statvfs(dir, &fs) != 0 && statvfs(".", &fs) != 0)
+		return -1.0;
+	return (double)fs.f_bavail * (double)fs.f_frsize;
 }
 
 static int rank0_make_folder(const char *path)

@@ -23,6 +23,11 @@
  * not. */
 int ss_output_check_folder(const char *path, int default_folder);
 
+/* The bytes free to this user on the file system that will hold path (that
+ * of its folder, or of the working folder while a default folder is still
+ * to be made); a negative value when it cannot be told. */
+double ss_output_free_bytes(const char *path);
+
 /* Make the folder of path if it is missing (one level); SS_ERR_FAIL says
  * why it cannot be. */
 int ss_output_make_folder(const char *path);

@@ -34,6 +34,44 @@ struct start {
 	const char *memory_advice;            /* " (reduce nx and ny)", or "" */
 };
 
+/* The bytes a stepper of nx x ny cells of this rank's share and the ranks
+ * on its node need (dx, dy and the origin do not matter). */
+static double stepper_node_bytes(const struct ss_grid *g, enum ss_integrator integrator,
+                                 enum ss_rest_mode rest)
+{
+	return ss_stepper_memory_bytes(g, integrator, rest) / ss_comm_size() *
+	       ss_comm_node_ranks();
+}
+
+int ss_setup_check_raster_memory(const char *name, int nx, int ny, int rasters,
+                                 const struct ss_model_options *m, int has_bedrock)
+{
+	struct ss_grid g;
+	int err = ss_grid_init(&g, nx, ny, 1.0, 1.0, 0.0, 0.0);
+	if (err)
+		return err;
+	const double cells = (double)nx * (double)ny;
+	/* a raster: values (8 B) and nodata flags (1 B) a cell, split over the
+	 * ranks as the stepper is */
+	const double raster = rasters * cells * (sizeof(double) + 1.0) / ss_comm_size() *
+	                      ss_comm_node_ranks();
+	/* auto as a run (fit) or a relax resolves it, whichever needs more */
+	const enum ss_rest_mode rest = has_bedrock ? SS_REST_OFF : m->rest;
+	const double run = stepper_node_bytes(&g, ss_integrator_resolve(m->integrator, has_bedrock,
+	                                                                0), rest);
+	const double relax = stepper_node_bytes(&g, ss_integrator_resolve(m->integrator,
+	                                                                  has_bedrock, 1), rest);
+	const double need = raster + fmax(run, relax);
+	const double have = ss_memory_available_bytes();
+	if (have > 0.0 && need > have) {
+		char nb[32], hb[32];
+		return ss_error_input("%s: %d x %d cells need %s of memory; this machine has %s "
+		                      "available", name, nx, ny, ss_format_bytes(need, nb),
+		                      ss_format_bytes(have, hb));
+	}
+	return SS_OK;
+}
+
 /* The grid, the integrator auto resolves to, the memory check, the closure
  * and the stepper (its grid then this rank's slab): what every set-up
  * starts with.  On error st is released. */
@@ -56,8 +94,7 @@ static int start(const struct start *s, struct ss_stepper *st)
 	 * bedrock (its stages have negative weights, as RKL2's) */
 	const enum ss_rest_mode rest = s->steady && !s->has_bedrock ? m->rest : SS_REST_OFF;
 	/* the memory of one rank's slab, times the ranks on this node */
-	const double need = ss_stepper_memory_bytes(&g, integrator, rest) / ss_comm_size() *
-	                    ss_comm_node_ranks();
+	const double need = stepper_node_bytes(&g, integrator, rest);
 	const double have = ss_memory_available_bytes();
 	if (have > 0.0 && need > have) {
 		char nb[32], hb[32];
@@ -296,6 +333,45 @@ static int lowest_height(const struct ss_raster_setup *s, double *level)
 	return SS_OK;
 }
 
+/* Where the pour of mask lands (all ranks' cells); SS_ERR_INPUT when every
+ * cell it covers is without data: the sources pour on flow cells only, so
+ * such a pour would pour nothing and report "poured 0 m^3" as a success. */
+static int pour_cover(const struct ss_stepper *st, const uint8_t *mask,
+                      struct ss_pour_cover *out)
+{
+	const struct ss_grid *g = &st->grid;
+	/* the extent as maxima: -x_min, x_max, -y_min, y_max */
+	double most[4] = {-INFINITY, -INFINITY, -INFINITY, -INFINITY}, count[2] = {0.0, 0.0};
+	for (int j = 0; j < g->ny; j++) {
+		for (int i = 0; i < g->nx; i++) {
+			if (!mask[(size_t)j * g->nx + i])
+				continue;
+			count[0]++;
+			if (ss_cell_type_get(st->cell_types, ss_grid_index(g, i, j)) != SS_CELL_FLOW) {
+				count[1]++;
+				continue;
+			}
+			const double x = ss_grid_x(g, i), y = ss_grid_y(g, j);
+			most[0] = fmax(most[0], -x);
+			most[1] = fmax(most[1], x);
+			most[2] = fmax(most[2], -y);
+			most[3] = fmax(most[3], y);
+		}
+	}
+	ss_comm_reduce(most, 4, count, 2);
+	if (count[1] == count[0])
+		return ss_error_input("--add-sand covers %.0f cell%s, all without data: nothing would "
+		                      "be poured (give a region on cells with data)", count[0],
+		                      count[0] == 1 ? "" : "s");
+	if (out) {
+		*out = (struct ss_pour_cover){
+			.cells = (long long)count[0], .nodata = (long long)count[1],
+			.x_min = -most[0], .x_max = most[1], .y_min = -most[2], .y_max = most[3],
+		};
+	}
+	return SS_OK;
+}
+
 /* The raster's heights and nodata cells into st (this rank's rows), the
  * bedrock, the poured sand. */
 static int fill_from_raster(const struct ss_raster_setup *s, struct ss_stepper *st)
@@ -329,6 +405,8 @@ static int fill_from_raster(const struct ss_raster_setup *s, struct ss_stepper *
 	if (!mask)
 		return ss_comm_agree(SS_ERR_FAIL);
 	err = rasterize(s->pour, &g, mask, "--add-sand");
+	if (!err)
+		err = pour_cover(st, mask, s->pour_cover);
 	if (!err)
 		err = ss_stepper_add_source(st, mask, s->pour_rate, 0.0, s->pour_duration);
 	ss_free(mask);

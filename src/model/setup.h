@@ -23,6 +23,16 @@
 int ss_setup_stepper(const struct ss_case *c, int tile_nx, int tile_ny,
                      enum ss_kernel kernel, struct ss_stepper *st);
 
+/* Where poured sand lands: the cells a pour's shape covers, of them those
+ * without data (walls or open cells, where nothing is poured), and the
+ * extent of the centres of the others (poured on). */
+struct ss_pour_cover {
+	long long cells;                  /* cell centres the shape covers */
+	long long nodata;                 /*   of them without data */
+	double x_min, x_max;              /* m: the centres poured on (NaN */
+	double y_min, y_max;              /*   when none is) */
+};
+
 /* What relax builds its stepper from: a raster and the model. */
 struct ss_raster_setup {
 	const struct ss_model_options *model;
@@ -44,6 +54,9 @@ struct ss_raster_setup {
 	const struct ss_shape *pour;      /* sand poured from t = 0, or NULL: */
 	double pour_rate;                 /*   m/s */
 	double pour_duration;             /*   s */
+	struct ss_pour_cover *pour_cover; /* out: where it lands (NULL: not
+	                                   * wanted); a pour on no cell with
+	                                   * data is refused */
 };
 
 /* This rank's rows of the raster spec (its window, dem.h) as the stepper
@@ -54,6 +67,14 @@ struct ss_raster_setup {
 int ss_setup_read_window(const char *spec, const char *context,
                          struct ss_dem_read_options opt, int tile_nx, int tile_ny,
                          struct ss_raster *r);
+
+/* SS_ERR_INPUT "NAME: NX x NY cells need X of memory; this machine has Y
+ * available" when `rasters` whole rasters of nx x ny cells (values and
+ * nodata flags) and the stepper of model m (with a bedrock or not) need
+ * more than the machine has: checked from a raster's header, before a
+ * command reads the raster or does any work. */
+int ss_setup_check_raster_memory(const char *name, int nx, int ny, int rasters,
+                                 const struct ss_model_options *m, int has_bedrock);
 
 /* st for the raster set-up s, as ss_setup_stepper (the fast kernel, the
  * default tiles, auto as relax resolves it).  On error st is released. */

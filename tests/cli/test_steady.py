@@ -27,7 +27,10 @@ def test_subcritical_state_is_steady_at_once(tmp_path, base_case):
     # one snapshot: a second at t = 0 would make the time axis non-unique
     assert list(times) == [0.0] and h.shape[0] == 1, \
         f"steady at once: snapshots at t = {list(times)}, expected the one at 0"
-    assert r.stdout.startswith(f"wrote {out}: 1 snapshot to t = 0 s, 0 "), r.stdout
+    # the projected size comes first (doc/running.md#run), then the summary
+    lines = r.stdout.splitlines()
+    assert lines[0].startswith(f"writing {out}: at most ") and \
+        lines[1].startswith(f"wrote {out}: 1 snapshot to t = 0 s, 0 "), r.stdout
 
 
 def test_relax_steady_at_once_writes_one_snapshot(tmp_path):
