@@ -10,8 +10,10 @@
  * in the environment, the height of the middle cell becomes NaN right
  * after substep N (in the progress callback, chained before the caller's),
  * as a kernel bug would leave it; without it the program is sandslide.
- * The guard's own replay stops one step short of N, so it never meets the
- * NaN again.
+ * Once only: the progress callback also comes between the stages of a
+ * super-step (src/core/stages.h), with the steps before it, and the
+ * guard's own replay takes the steps up to the one that was not finite
+ * again, which must not meet the NaN again.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -32,7 +34,9 @@ struct hook {
 static void poison(void *context, const struct ss_stepper *seen)
 {
 	const struct hook *h = context;
-	if (seen->steps == h->nan_step) {
+	static int poisoned;
+	if (seen->steps == h->nan_step && !poisoned) {
+		poisoned = 1;
 		const struct ss_grid *g = &h->st->grid;
 		h->st->height[ss_grid_index(g, g->nx / 2, g->ny / 2)] = NAN;
 	}
