@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """The defaults on a quiet and on a busy machine (issue 36, item 1).
 
-Runs `make demo`'s command (sandslide run cases/door.ini) and the README's
-Python example (the code block under "From Python", its relax call timed)
+Runs `make demo`'s command (sandslide run cases/door.ini) and the Python
+example of README.md#from-python (its code block, the relax call timed)
 with the default threads and with one thread (--threads 1, threads=1),
 each with and without competing busy-loop processes (`sh -c 'while :; do
 :; done'`, two by default: one per core of a 2-core machine), all
@@ -52,7 +52,7 @@ exec(compile(sys.stdin.read(), "README.md", "exec"))
 
 
 def readme_python(root):
-    """The code block of the README's "From Python" section."""
+    """The first ```python block under the heading of README.md#from-python."""
     with open(os.path.join(root, "README.md")) as f:
         text = f.read()
     m = re.search(r"^## From Python\n.*?```python\n(.*?)```", text, re.S | re.M)
@@ -103,7 +103,8 @@ def run_python(root, code, threads, env):
                        env=env, capture_output=True, text=True)
     m = re.search(r"SECONDS ([0-9.]+)", r.stderr)
     if r.returncode != 0 or not m:
-        sys.exit(f"busy_bench: the README's Python example failed:\n{r.stderr}")
+        sys.exit(f"busy_bench: the Python example of README.md#from-python failed:\n"
+                 f"{r.stderr}")
     return float(m.group(1)), None
 
 
@@ -154,7 +155,7 @@ def main():
             print(f"round {rnd + 1} of {a.rounds} done", file=sys.stderr)
 
     print(f"# {root}: median of {a.rounds} interleaved runs; demo = wall time of "
-          f"`sandslide {' '.join(words)}`, python = the README's relax call")
+          f"`sandslide {' '.join(words)}`, python = README.md#from-python's relax call")
     print(f"{'workload':8} {'load':8} {'threads':>9} {'median s':>9} {'[min, max]':>19} "
           f"{'ratio to 1 thread':>18}")
     for workload in ("demo", "python"):
