@@ -26,11 +26,10 @@ int ss_parallel_default_threads(int share);
 void ss_parallel_use_default_threads(int share);
 
 /* Cells each thread needs before another thread is worth its start and its
- * barriers.  Measured with `sandslide bench --surface supercritical`
- * (doc/running.md#threads): with a passive wait 2 threads lose up to 40 %
- * on 64^2 cells and are even with 1 at 256^2 and 512^2 on a loaded 2-core
- * machine, and a busy machine gains nothing from a second thread below
- * that either. */
+ * barriers.  Measured with `sandslide bench --surface supercritical` on a
+ * loaded 2-core machine, passive wait (doc/running.md#threads): 2 threads
+ * made 0.58 to 0.63 of one thread's rate on 64^2 cells, 0.94 to 0.97 on
+ * 512^2. */
 #define SS_PARALLEL_CELLS_PER_THREAD 65536.0
 
 /* The threads for a sweep of `cells` cells in `tile_rows` rows of tiles

@@ -499,7 +499,8 @@ static int command(int argc, char **argv)
 #else
 		       "off",
 #endif
-		       ss_parallel_processors(), ss_parallel_wait_policy(), ss_dem_gdal_available() ? "on" : "off",
+		       ss_parallel_processors(), ss_parallel_wait_policy(),
+		       ss_dem_gdal_available() ? "on" : "off",
 		       ss_comm_library() ? ss_comm_library() : "off", ss_cpu_path_name(ss_cpu_path()));
 		return 0;
 	}
@@ -524,8 +525,9 @@ static int command(int argc, char **argv)
  * the process started with.  So when neither variable is set, this
  * program starts itself again with OMP_WAIT_POLICY=passive added, from
  * the executable's .preinit_array: before any library's constructor, so
- * the first start costs the loading only (a few ms), not the
- * initialisation of HDF5 and GDAL.  Should the exec fail (no /proc), the
+ * the first start costs the loading only, not the initialisation of HDF5
+ * and GDAL (0.08 s more for `sandslide version` on a loaded 2-core
+ * machine: 0.23 s against 0.15 s with the variable set).  Should the exec fail (no /proc), the
  * run goes on with the runtime's default, which `sandslide version`
  * then names.
  */
