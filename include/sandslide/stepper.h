@@ -152,6 +152,9 @@ struct ss_stepper {
 /* Allocate the arrays for grid g (zero heights, all flow cells).  Returns
  * SS_ERR_INPUT for a bad cfl or boundary, SS_ERR_FAIL when an allocation
  * fails (callers that know the case check ss_stepper_memory_bytes first).
+ * A default thread count of the calling thread is lowered to what this
+ * rank's cells and tile rows can use (ss_parallel_threads_for); a count
+ * asked for is kept.
  *
  * In a run of several ranks (comm.h) g is the whole grid and st->grid
  * becomes this rank's slab: the tiling of the whole grid (the tile sizes

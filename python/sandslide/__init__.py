@@ -161,8 +161,9 @@ _THREADS_DOC = """threads : int, optional
         4096 (read at each call, so os.environ counts), else the
         processors this process may run on (its CPU affinity: taskset, a
         batch system's cpuset), divided by the MPI ranks sharing the node
-        (one outside MPI).  The count is this call's own: calls in other
-        threads keep theirs."""
+        (one outside MPI), and at most one per 65536 cells of the grid.
+        The count is this call's own: calls in other threads keep
+        theirs."""
 
 _PROGRESS_DOC = """progress : bool, optional
         Show a progress bar while the call runs: tqdm's when tqdm can be

@@ -88,6 +88,19 @@ def _load():
                       "`make install`, or set SANDSLIDE_LIBRARY to its path")
 
 
+def _passive_wait_by_default():
+    """OMP_WAIT_POLICY=passive unless OMP_WAIT_POLICY or GOMP_SPINCOUNT is
+    set: OpenMP threads that spin at every barrier (libgomp's default, about
+    3 ms) lose their core to any other process and slow a call down up to
+    tenfold on a busy machine (doc/running.md#threads).  libgomp reads the
+    variables once, when it is loaded, which is with the library below
+    unless something in this process loaded it first (then that first
+    reading stays)."""
+    if "OMP_WAIT_POLICY" not in os.environ and "GOMP_SPINCOUNT" not in os.environ:
+        os.environ["OMP_WAIT_POLICY"] = "passive"
+
+
+_passive_wait_by_default()
 lib = _load()
 
 # What the module calls, with the types of relax.h, run.h, fit.h, error.h

@@ -25,9 +25,10 @@ void ss_drive_init(struct ss_drive *d, struct ss_stepper *st, double started)
 
 void ss_drive_set_threads(int threads)
 {
-	if (threads <= 0)
-		threads = ss_parallel_default_threads(ss_comm_node_ranks());
-	ss_parallel_set_threads(threads);
+	if (threads > 0)
+		ss_parallel_set_threads(threads);
+	else
+		ss_parallel_use_default_threads(ss_comm_node_ranks());
 }
 
 int ss_drive_claim(struct ss_drive *d, const char *output, int make_folder, int force,

@@ -98,7 +98,8 @@ void ss_drive_init(struct ss_drive *d, struct ss_stepper *st, double started);
 
 /* Use `threads` OpenMP threads, or for 0 ss_parallel_default_threads:
  * OMP_NUM_THREADS, else the processors this process may run on divided
- * among the node's ranks (comm.h), at least one. */
+ * among the node's ranks (comm.h), at least one, which the stepper then
+ * lowers for a small grid (ss_parallel_threads_for). */
 void ss_drive_set_threads(int threads);
 
 /* Claim `output` for this run (unless it already holds the claim): make

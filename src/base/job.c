@@ -21,7 +21,8 @@ static const struct ss_option options[] = {
 	{.name = "threads", .value_name = "N", .kind = SS_OPTION_INT, .offset = AT(threads),
 	 .lo = 1, .hi = 4096, .expected = "an integer from 1 to 4096",
 	 .help = "OpenMP threads (default: OMP_NUM_THREADS, else\n"
-	         "the processors this process may run on)"},
+	         "the processors this process may run on, fewer on\n"
+	         "a small grid)"},
 };
 
 const struct ss_option_table ss_job_option_table = {

@@ -20,6 +20,7 @@
 #include "sandslide/comm.h"
 #include "sandslide/cpu.h"
 #include "sandslide/error.h"
+#include "sandslide/parallel.h"
 
 double ss_stepper_memory_bytes(const struct ss_grid *g, enum ss_integrator integrator,
                                enum ss_rest_mode rest)
@@ -86,6 +87,10 @@ int ss_stepper_init(struct ss_stepper *st, const struct ss_grid *g,
 		tiling.tiles_y = (rows + tiling.tile_ny - 1) / tiling.tile_ny;
 	}
 	g = &st->grid;
+	/* a default thread count follows this rank's work: on a small grid the
+	 * threads of every parallel loop would cost more at its barriers than
+	 * they share out (parallel.h); a count asked for stays */
+	ss_parallel_threads_for((double)g->nx * (double)g->ny, tiling.tiles_y);
 	st->closure = *c;
 	st->boundary = *b;
 	st->cfl = cfl;

@@ -12,6 +12,7 @@ the library), timed from the signal to its exit.  Random surfaces use
 fixed seeds (printed in the messages that need them).
 """
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -164,6 +165,45 @@ def test_each_call_has_its_own_thread_count(tmp_path, monkeypatch):
     monkeypatch.setenv("OMP_NUM_THREADS", "3")
     s = sandslide.run(tmp_path / "tiny.ini", tmp_path / "t3.h5")
     assert s["threads"] == 3, f"threads=None with OMP_NUM_THREADS=3 ran with {s['threads']}"
+
+
+def test_a_small_grid_runs_on_one_thread_unless_asked(tmp_path, monkeypatch):
+    """threads=None on a 20 x 16 grid: one thread, as a second one would
+    only wait at the barriers of each step (doc/running.md#threads)."""
+    if len(os.sched_getaffinity(0)) < 2:
+        pytest.skip("this process may use one CPU: one thread anyway")
+    monkeypatch.delenv("OMP_NUM_THREADS", raising=False)
+    (tmp_path / "tiny.ini").write_text(CASE)
+    s = sandslide.run(tmp_path / "tiny.ini", tmp_path / "a.h5")
+    assert s["threads"] == 1, f"threads=None on a 20 x 16 grid ran with {s['threads']}"
+    s = sandslide.run(tmp_path / "tiny.ini", tmp_path / "b.h5", threads=2)
+    assert s["threads"] == 2, f"threads=2 ran with {s['threads']}"
+
+
+def test_importing_makes_idle_threads_sleep_unless_the_user_chose(tmp_path):
+    """OMP_WAIT_POLICY=passive is set before the library (and libgomp with
+    it) loads; libgomp's OMP_DISPLAY_ENV shows what it read."""
+    code = "import os, sandslide; print(os.environ.get('OMP_WAIT_POLICY'))"
+
+    def start(**extra):
+        env = {k: v for k, v in os.environ.items()
+               if k not in ("OMP_WAIT_POLICY", "GOMP_SPINCOUNT")}
+        env.update(extra, OMP_DISPLAY_ENV="verbose",
+                   PYTHONPATH=os.path.dirname(os.path.dirname(sandslide.__file__)))
+        r = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
+                           text=True, timeout=60)
+        assert r.returncode == 0, r.stderr
+        spin = re.search(r"GOMP_SPINCOUNT = '(\d+)'", r.stderr)
+        return r.stdout.strip(), int(spin.group(1)) if spin else None
+
+    said, spin = start()
+    assert said == "passive", f"OMP_WAIT_POLICY after the import: {said}"
+    if spin is not None:    # libgomp (another runtime does not show it)
+        assert spin == 0, f"libgomp read a spin count of {spin}: not passive"
+    said, spin = start(OMP_WAIT_POLICY="active")
+    assert said == "active" and spin in (None, 30000000000), "the user's policy not kept"
+    said, spin = start(GOMP_SPINCOUNT="1000")
+    assert said == "None" and spin in (None, 1000), "the user's GOMP_SPINCOUNT not kept"
 
 
 def test_without_a_thread_safe_hdf5_runs_take_turns(tmp_path, monkeypatch):
