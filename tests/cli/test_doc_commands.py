@@ -1,55 +1,55 @@
 """The commands of the README and the manual run, in order, in a fresh copy
-of the checkout, and print the figures the pages show beside them.
+of the checkout, and print the figures the pages show beside them; so do
+the commands in the shipped cases' headers.
 
-Which commands (tests/README.md#the-commands-of-the-docs says the same):
+tests/README.md#the-commands-of-the-docs says the same, for readers:
 
 - The pages: README.md, then doc/*.md in the order of doc/README.md's
   table, then tests/README.md; each page's commands in their order, all in
-  one scratch copy (what `git ls-files` lists, as it is in the working
-  tree, and the build folder of SANDSLIDE as `build/`: a fresh clone after
-  `make`), with build/ first on PATH, then the folder of this Python.
-- A command is a line of a code block, an indented block or a ```sh,
-  ```shell, ```bash or ```console fence (a line ending in a backslash goes on in the next),
-  whose first word, after `$ ` and `NAME=value` settings, is `sandslide`,
-  `./build/sandslide`, `make`, `python3`, `/usr/bin/python3`, `tools/...`,
-  `python/examples/...`, `cc`, `nice`, `/usr/bin/time`, `mpirun`, `srun`
-  or `sudo`.  Other lines (formulas, case-file lines, messages, Python
-  code) are not commands; neither is code in running text (`...` spans):
-  a page that wants a command run puts it in a block.
-- A block with a synopsis, a line holding `[...]` (options) or `A|B` (a
-  choice), shows a form, not a command: none of it runs.
-- Parts of a command joined by `&&` are checked separately against SKIP:
-  a skipped part is left out and the rest runs.  SKIP says why each is
-  left out (what CI lacks or does elsewhere).
-- SHORTEN rewrites the runs that take minutes (a run to an earlier end, a
-  smaller grid, a benchmark's dry run); set SANDSLIDE_DOC_FULL=1 to run
-  every command as written.  The figures of a shortened command are not
-  checked.
+  one copy of the checkout (the files git lists, as they are in the working
+  tree, and the build as `make` leaves it, without build/tests/: a fresh
+  clone after `make`), with its build/ first on PATH, then the folder of
+  this Python.  The `command:` line of each cases/*.ini header runs in a
+  second copy, its `runtime:` lines taken as its comment.
+- A command is a line of an indented code block or of a sh, shell, bash
+  or console fence (a line ending in a backslash goes on in the next)
+  whose first word, after `$ ` and `NAME=value` settings, is one of
+  RUNNERS.  Other lines (formulas, case-file lines, messages, Python) are
+  not commands; neither is code in running text: a page that wants a
+  command run puts it in a block.
+- A block with a synopsis, a command holding `[...]` (options) or `a|b`
+  (a choice), shows a form: none of it runs.
+- The parts of a command joined by `&&` are checked one by one against
+  SKIP: a part left out is left out with its reason, the rest runs.  A
+  command that needs what is missing (REQUIRES) is left out, saying so.
+- SHORTEN rewrites the runs that take minutes; SANDSLIDE_DOC_FULL=1 runs
+  every command as written.  The figures of a shortened or left-out
+  command, and of the commands after it in its block, are not checked.
 - Every command runs with SANDSLIDE_CPU=generic (the kernel every x86-64
-  runs and the docs' figures are measured on; AVX2 gives its bits, AVX-512
-  other ones: doc/model.md#builds-and-processors), OMP_NUM_THREADS=2 and
+  runs, whose counts the pages give: AVX-512 rounds differently,
+  doc/model.md#builds-and-processors), OMP_NUM_THREADS=2,
   OMP_WAIT_POLICY=passive, and must exit 0.
 
 The figures:
 
-- A block whose commands start with `$ ` shows, under each, lines the
-  command prints (all of them or some, in order).  Each must be printed,
-  the same text and the same numbers, but for measurements: seconds
-  (`wall X s`, `slope`, `sweep`, `output`, `read`, `write`, `in X s`),
-  rates (`X .../s`) and memory (`peak X MiB`).
+- Under a command written `$ ...`, the lines it prints (all or some, in
+  order): each must be printed with the same text and numbers, but for
+  measurements (MEASURED_BEFORE, MEASURED_AFTER): seconds (`wall X s`,
+  `slope`, `sweep`, `output`, `read`, `write`, `in X s`), rates
+  (`X .../s`) and memory (`peak X MiB`).
 - In a command's comment, `N snapshots`, `N frames`, `N steps`,
-  `N super-steps` and `N (stencil) evaluations` must be printed by it as
-  such, and `in N s` or `about N s` (or `min`) is its wall time.
-- A measurement more than 3 times off (either way) is a warning, shown in
-  pytest's summary: machines differ, and CI's is shared (a 2-thread run of
-  a small case has been seen ten times slower under load: tests/README.md#ci);
+  `N super-steps` and `N (stencil) evaluations` must be printed by it so,
+  and `in N s` or `about N s` (or `min`) is its wall time.
+- A measurement more than 3 times off (either way) is a warning in
+  pytest's summary: machines differ, and CI's is shared (under load a
+  2-thread run of a small case has been ten times slower: tests/README.md#ci);
   more than 30 times off fails, as no machine explains that.  Times under
   0.5 s are not compared.
 """
+import functools
 import glob
 import os
 import re
-import shlex
 import shutil
 import subprocess
 import sys
@@ -103,12 +103,12 @@ REQUIRES = [
     (r"-m pytest", "pytest", lambda: importable("pytest")),
 ]
 
-# (pattern of a command, [(regex, replacement), ...], why): unless
-# SANDSLIDE_DOC_FULL=1.  A replacement "+ ARGS" appends ARGS.
+# (pattern of a command, [(regex, replacement), ...] applied to it, why):
+# unless SANDSLIDE_DOC_FULL=1.
 SHORTEN = [
     (r"^(\./build/)?sandslide bench$",
      [(r"$", " --nx 1024 --ny 1024 --repeats 1 --steps 2")],
-     "8192^2 cells, every closure: a minute; 1024^2, one timing of 2 steps"),
+     "8192^2 cells (GBs), every closure, 5 timings each: 1024^2, one timing of 2 steps"),
     (r"^(\./build/)?sandslide bench --nx",
      [(r"$", " --repeats 1 --steps 2")], "one timing of 2 steps"),
     (r"^sandslide run cases/door\.ini -o out/door480\.h5",
@@ -123,9 +123,9 @@ SHORTEN = [
      [(r"tests/python$", "tests/python/test_module.py")],
      "the Python module's whole suite (`make test` runs it): one file of it"),
     (r"cases/fractal_dem\.py 4096",
-     [(r" 4096 ", " 256 ")], "a 4096^2 terrain (minutes, 2 GiB): 256^2"),
+     [(r" 4096 ", " 256 ")], "a 4096^2 terrain, relaxed in a minute: 256^2"),
     (r"^sandslide run cases/door\.ini -o out/door240\.h5 --threads 1",
-     [(r"time\.end=300", "time.end=20")], "the door at 240 x 160 to 300 s: a minute; to 20 s"),
+     [(r"time\.end=300", "time.end=20")], "the door at 240 x 160 to 300 s: 20 s of wall time; to 20 s"),
 ]
 
 # Measurements in a command's output: the number is preceded by one of
@@ -437,16 +437,20 @@ def environment(scratch):
     flags = [w for w in os.environ.get("SANDSLIDE_MAKEFLAGS", "").split() if not w.startswith("BUILD=")]
     env["MAKEFLAGS"] = " ".join(["BUILD=build"] + flags)
     env.update(SANDSLIDE_CPU="generic", OMP_NUM_THREADS="2", OMP_WAIT_POLICY="passive",
-               HOME=os.path.join(scratch, ".home"), LC_ALL="C.UTF-8")
+               HOME=os.path.join(scratch, ".home"), LC_ALL="C.UTF-8",
+               # a pytest the pages run keeps its files in the copy
+               PYTEST_ADDOPTS="--basetemp=" + os.path.join(scratch, ".pytest-tmp"))
     os.makedirs(env["HOME"], exist_ok=True)
     return env
 
 
+@functools.lru_cache(maxsize=None)
 def importable(module):
     r = subprocess.run([sys.executable, "-c", f"import {module}"], capture_output=True)
     return r.returncode == 0
 
 
+@functools.lru_cache(maxsize=None)
 def build_has(feature):
     r = subprocess.run([SANDSLIDE, "--version"], capture_output=True, text=True)
     return f"{feature}: on" in r.stdout
