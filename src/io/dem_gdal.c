@@ -239,11 +239,12 @@ static int read_dataset(GDALDatasetH ds, const char *path, const char *context,
 		}
 		const double h = offset + scale * v;
 		if (!isfinite(h))
-			return ss_error_input_at(context, "%s: height %g at row %zu, column %zu (from the "
-			                         "north-west) is not finite: heights must be finite numbers "
-			                         "(mark missing cells with the band's nodata value)", path,
-			                         h, k / (size_t)nx + 1 + (size_t)file_first,
-			                         k % (size_t)nx + 1);
+			return ss_error_input_at(context, "%s: height %g of %s is not finite: heights "
+			                         "must be finite numbers (mark missing cells with the band's "
+			                         "nodata value)", path, h,
+			                         SS_RASTER_CELL(r, (long long)(k % (size_t)nx),
+			                                        r->ny - 1 - (long long)(k / (size_t)nx) -
+			                                        file_first));
 		r->values[k] = h;
 	}
 	flip_rows(r->values, nx, rows);
