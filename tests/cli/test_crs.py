@@ -217,3 +217,21 @@ def test_a_file_gdal_cannot_open_is_said_what_it_is(tmp_path, content, what):
     assert r.returncode == 2 and r.stderr.startswith(
         f"sandslide: cannot read 'dem.tif' as a GDAL raster: {what}; expected an ESRI ASCII "
         "grid (.asc)"), r.stderr
+
+
+@needs_gdal_build
+def test_a_bad_height_is_named_by_its_cell_in_map_coordinates(tmp_path):
+    """A GeoTIFF's infinite height is named as every message names a cell:
+    (i, j) from the south-west, its centre in the raster's own (map)
+    coordinates, not a row and column from the file's north-west corner."""
+    g = gdal()
+    heights = np.array(ROWS, dtype=np.float64)
+    heights[2, 5] = np.inf   # file row 2 from the north of 10: j = 7
+    ds = g.GetDriverByName("GTiff").Create(str(tmp_path / "dem.tif"), 12, 10, 1, g.GDT_Float64)
+    ds.SetGeoTransform([500000, 1, 0, 5200010, 0, -1])
+    ds.GetRasterBand(1).WriteArray(heights)
+    ds = None
+    r = run(["relax", "dem.tif", "-o", "x.asc"], cwd=tmp_path)
+    assert r.returncode == 2 and r.stderr.startswith(
+        "sandslide: dem.tif: height inf of cell (5, 7) at x = 500005.5 m, y = 5200007.5 m is "
+        "not finite"), r.stderr
