@@ -67,7 +67,7 @@ WARN_RATIO = 3.0
 FAIL_RATIO = 30.0
 
 RUNNERS = re.compile(r"^(sandslide|\./build/sandslide|make|python3|/usr/bin/python3|tools/\S+|"
-                     r"python/examples/\S+|cc|nice|/usr/bin/time|mpirun|srun|sudo)$")
+                     r"python/examples/\S+|cc|nice|/usr/bin/time|mpirun|srun|sudo|gdaldem)$")
 ASSIGN = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*=")
 FENCES = {"sh", "shell", "bash", "console"}
 
@@ -97,6 +97,7 @@ SKIP = [
 REQUIRES = [
     (r"\.tif\b", "a build with GDAL", lambda: build_has("GDAL")),
     (r"--video\b", "ffmpeg", lambda: shutil.which("ffmpeg") is not None),
+    (r"^gdaldem ", "gdaldem (gdal-bin)", lambda: shutil.which("gdaldem") is not None),
     (r"relax_dem\.py", "GDAL's Python bindings (python3-gdal)", lambda: importable("osgeo")),
     (r"wind_deposition\.py .*--png", "matplotlib (python3-matplotlib)",
      lambda: importable("matplotlib")),
