@@ -17,6 +17,8 @@ tests/README.md#the-commands-of-the-docs says the same, for readers:
   RUNNERS.  Other lines (formulas, case-file lines, messages, Python) are
   not commands; neither is code in running text: a page that wants a
   command run puts it in a block.
+- A ```python fence runs as `PYTHONPATH=python python3 -` with its code,
+  in its place among the page's commands.
 - A block with a synopsis, a command holding `[...]` (options) or `a|b`
   (a choice), shows a form: none of it runs.
 - The parts of a command joined by `&&` are checked one by one against
@@ -87,6 +89,11 @@ SKIP = [
      "builds tests/install/relax_dem.c both ways"),
     (r"-m venv|\.venv/",
      "pip into a virtual environment: tests/python/test_pip.py does it, offline"),
+    (r'"scan\.h5"',
+     "a fit to the reader's observations (scan.h5): tests/python/test_module.py fits a twin"),
+    (r'gdal\.Open\("terrain\.tif"\)',
+     "the reader's own GeoTIFF (terrain.tif): python/examples/relax_dem.py, run above, "
+     "does the same with cases/dem/terrain.asc"),
     (r"--dems DIR\b",
      "the real DEMs of `make deps-bench` (R's and OpenFOAM's packages, not in CI; "
      "tools/real_dems.py writes them to DIR)"),
@@ -102,6 +109,9 @@ REQUIRES = [
     (r"wind_deposition\.py .*--png", "matplotlib (python3-matplotlib)",
      lambda: importable("matplotlib")),
     (r"-m pytest", "pytest", lambda: importable("pytest")),
+    (r"sandslide\.open\(", "xarray with netCDF4 (python3-xarray, python3-netcdf4)",
+     lambda: importable("xarray") and importable("netCDF4")),
+    (r"\.plot\(", "matplotlib (python3-matplotlib)", lambda: importable("matplotlib")),
 ]
 
 # (pattern of a command, [(regex, replacement), ...] applied to it, why):
@@ -306,6 +316,25 @@ def commands_of(page):
         if any(is_synopsis(c[1]) for c in candidates):
             continue
         out += [Command(page, n, c, m, e, start) for n, c, m, e in candidates]
+    # Python fences run too, as a reader pastes them into python3 in the
+    # checkout (PYTHONPATH=python), in their place among the commands
+    for start, code in python_blocks(text):
+        out.append(Command(page, start, "PYTHONPATH=python python3 - <<'PY'\n" + code + "\nPY",
+                           "", [], start))
+    return sorted(out, key=lambda c: c.line)
+
+
+def python_blocks(text):
+    """(first line number, code) of each ```python fence."""
+    out = []
+    lines = text.split("\n")
+    k = 0
+    while k < len(lines):
+        if lines[k].strip() == "```python":
+            end = next(e for e in range(k + 1, len(lines)) if lines[e].strip().startswith("```"))
+            out.append((k + 2, "\n".join(lines[k + 1:end])))
+            k = end
+        k += 1
     return out
 
 
@@ -573,7 +602,7 @@ def run_commands(commands, scratch, title):
             pytest.fail(f"{cmd.where()}: `{cmd.run}` ran for 600 s")
         elapsed = time.monotonic() - t0
         note = f"  (shortened: {cmd.shortened})" if cmd.shortened else ""
-        log.append(f"  {elapsed:5.1f}s {cmd.where()}: {cmd.run}{note}")
+        log.append(f"  {elapsed:5.1f}s {cmd.where()}: {cmd.run.split(chr(10))[0]}{note}")
         if r.returncode != 0:
             # go on: the failures after it may or may not follow from it
             failed.append(f"{cmd.where()}: `{cmd.run}` exited {r.returncode}:\n"
