@@ -12,10 +12,15 @@
 #                   benchmarks (BENCH_ALL=1: those of --all too); not tests
 #   make deps-slurm add Slurm and munge for `make MPI=1 test-slurm`
 #   make test       build and run every test (C programs, then CLI tests)
+#   make test-hooks the hooked sandslide binaries the CLI tests run
+#                   (build/tests/sandslide-nan, -pause; `make test` builds them):
+#                   with `make`, what one CLI test file run alone needs
 #   make install    bin, lib (.so and .a), headers, sandslide.pc, the man
 #                   page, the example cases and the Python module under
 #                   PREFIX (/usr/local), staged in DESTDIR; make uninstall
-#   make demo       run the default case (cases/door.ini -> out/door.h5)
+#   make demo       build, then run the door case into out/demo.h5 (again on
+#                   every call: its own file, so that `sandslide run
+#                   cases/door.ini`, the README's next step, finds out/door.h5 free)
 #   make OPENMP=0   build without OpenMP (pragmas must still compile)
 #   make NATIVE=1   build for this machine's processor (-march=native); the
 #                   default build runs on any x86-64 (AVX-512 chosen at run time)
@@ -424,6 +429,11 @@ HOOK_NAN   := $(BUILD)/tests/sandslide-nan
 HOOK_PAUSE := $(BUILD)/tests/sandslide-pause
 HOOK_BATCH := $(BUILD)/tests/sandslide-batch
 HOOK_BIN   := $(HOOK_NAN) $(HOOK_PAUSE)
+# `make` leaves them out (they are no part of what it installs); `make
+# test` builds them, and so does `make test-hooks`, which tests/README.md's
+# recipe for one CLI test file names
+.PHONY: test-hooks
+test-hooks: $(HOOK_BIN)
 $(HOOK_BIN) $(HOOK_BATCH): $(BUILD)/tests/sandslide-%: tests/hooks/%_step.c $(MAIN_OBJ) \
              $(BUILD)/libsandslide.a $(BUILD)/.flags
 	@mkdir -p $(@D)
@@ -453,7 +463,7 @@ endif
 C_TESTS   ?= $(notdir $(TEST_BIN))
 CLI_TESTS ?= tests/cli
 PY_TESTS  ?= tests/python
-test check: all $(TEST_BIN) $(HOOK_BIN) headers-check check-layering $(FUZZ_REPLAY)
+test check: all $(TEST_BIN) test-hooks headers-check check-layering $(FUZZ_REPLAY)
 	@fail=0; for t in $(addprefix $(BUILD)/tests/,$(C_TESTS)); do \
 	  echo "== $$t"; OMP_NUM_THREADS=$${OMP_NUM_THREADS:-2} ./$$t || fail=1; \
 	done; \
@@ -600,7 +610,7 @@ uninstall:
 
 demo: all
 	@mkdir -p out
-	./$(BUILD)/sandslide run cases/door.ini -o out/door.h5
+	./$(BUILD)/sandslide run cases/door.ini -o out/demo.h5 --force
 
 # `make deps`: what building and running need (DEB_BUILD, DEB_RUN, and
 # with MPI=1 Open MPI); `make deps-test`: what the test suite adds

@@ -247,9 +247,9 @@ static void asc_malformed_is_refused(void)
 		{"ncols 1073741824\nnrows 1073741824\nxllcorner 0\nyllcorner 0\ncellsize 1\n1\n",
 		 {"ends after 1 of 1073741824 x 1073741824"}},
 		{"ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2\nnan 4\n",
-		 {"bad.asc:7", "row 2, column 1", "finite"}},
+		 {"bad.asc:7", "(cell (0, 0) at x = 0.5 m, y = 0.5 m)", "finite"}},
 		{"ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 inf\n3 4\n",
-		 {"bad.asc:6", "row 1, column 2", "finite"}},
+		 {"bad.asc:6", "(cell (1, 1) at x = 1.5 m, y = 1.5 m)", "finite"}},
 		{"ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2\n3 four\n",
 		 {"bad.asc:7", "'four'", "not a number"}},
 		{"ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2\n3 4\n5\n",
@@ -625,7 +625,7 @@ static void writes_are_atomic_and_spare_the_input(void)
 	capture_begin();
 	err = ss_dem_write(check_file("old.asc"), SS_DEM_AUTO, &b);
 	msg = capture_end();
-	CHECK(err == SS_ERR_FAIL && strstr(msg, "column 4, row 1"), "a NaN height is not written: %s",
+	CHECK(err == SS_ERR_FAIL && strstr(msg, "height nan of cell (3, 0) at x = -2.25 m, y = 100000.225 m is not finite"), "a NaN height is not written: %s",
 	      msg);
 	char *old = slurp(check_file("old.asc"), &n1);
 	CHECK(old && !strcmp(old, "keep me\n"), "the earlier file is untouched");

@@ -172,7 +172,7 @@ static void hdf5_refusals(void)
 	CHECK(write_series(check_file("allnan.h5"), ok, 2, 1) == SS_OK, "writing allnan.h5");
 	refused(check_file("allnan.h5"), "no observed value", (const char *)NULL);
 	CHECK(write_series(check_file("inf.h5"), ok, 2, -1) == SS_OK, "writing inf.h5");
-	refused(check_file("inf.h5"), "infinite at time 1 s, column 3, row 2", (const char *)NULL);
+	refused(check_file("inf.h5"), "infinite at time 1 s, cell (2, 1) at x = -0.75 m, y = 10.75 m:", (const char *)NULL);
 
 	/* not HDF5 under an HDF5 name, and an HDF5 file cut short */
 	check_write_file(check_file("text.h5"), "time,path\n0,a.asc\n");
@@ -246,7 +246,7 @@ static void raster_csv_of_hdf5(void)
 	/* a NaN height that is not a wall's is no DEM (dem.h): its message,
 	 * after the CSV's line */
 	CHECK(write_series(check_file("last.h5"), times, 2, 0) == SS_OK, "writing last.h5");
-	csv_refused("h5nan.csv", "time,path\n3,last.h5\n", 2, "last.h5: height nan at column 5");
+	csv_refused("h5nan.csv", "time,path\n3,last.h5\n", 2, "last.h5: height nan of cell (4, 3) at x = 0.25 m, y = 11.75 m is not finite");
 	CHECK(write_series(check_file("last.h5"), times, 2, 2) == SS_OK, "writing last.h5");
 	check_write_file(check_file("h5.csv"), "time,path\n3,last.h5\n4,last.h5\n");
 	struct ss_observations o;

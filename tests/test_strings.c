@@ -125,10 +125,23 @@ static void test_json_numbers(void)
 	      !strcmp(json(-INFINITY, 6, buf, sizeof buf), "null"), "non-finite: null");
 }
 
+/* The one way messages name a cell: index from the south-west, centre in
+ * the raster's units to 15 digits (a centre 0 + 14.5 * 0.1 reads 1.45). */
+static void test_cell_names(void)
+{
+	const char *a = SS_CELL(2, 14, 2.5 * 0.1, 14.5 * 0.1);
+	CHECK(!strcmp(a, "cell (2, 14) at x = 0.25 m, y = 1.45 m"), "%s", a);
+	const char *b = SS_CELL(0, 3, 263811.5, 5479330.25);
+	CHECK(!strcmp(b, "cell (0, 3) at x = 263811.5 m, y = 5479330.25 m"), "%s", b);
+	const char *c = SS_CELL(7, 1, NAN, 1.5);
+	CHECK(!strcmp(c, "cell (7, 1)"), "without coordinates: %s", c);
+}
+
 int main(void)
 {
 	RUN(test_examples);
 	RUN(test_round_trip);
 	RUN(test_json_numbers);
+	RUN(test_cell_names);
 	return check_report();
 }

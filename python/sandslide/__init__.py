@@ -725,6 +725,9 @@ def open(path: PathLike, *, timedelta: bool = False, **kwargs: Any) -> xarray.Da
     ------
     ImportError
         Without xarray, or without netCDF4 or h5netcdf for it.
+    InputError
+        A file that is not a sandslide output, or is damaged: the message
+        is the one ``sandslide info`` prints.
 
     Notes
     -----
@@ -754,7 +757,17 @@ def open(path: PathLike, *, timedelta: bool = False, **kwargs: Any) -> xarray.Da
         raise ImportError("sandslide.open needs netCDF4 or h5netcdf for xarray: install "
                           "Debian package python3-netcdf4 (or python3-h5netcdf)")
     decode = kwargs.pop("decode_timedelta", bool(timedelta))
-    ds = xarray.open_dataset(os.fspath(path), engine=engine, decode_timedelta=False, **kwargs)
+    try:
+        ds = xarray.open_dataset(os.fspath(path), engine=engine, decode_timedelta=False,
+                                 **kwargs)
+    except (OSError, ValueError):
+        # netCDF's "[Errno -101] NetCDF: HDF error" says nothing of what is
+        # wrong; the library's reader says what `sandslide info` says (which
+        # dataset is damaged, or that it is not an output at all)
+        if not os.path.isfile(os.fspath(path)):
+            raise
+        _native.explain_output(os.fspath(path))
+        raise
     # A run killed between a snapshot's two flushes leaves height and the
     # diagnostics one longer than time, which netCDF reads as one more time
     # that was never written (the default fill value, 9.97e36): the

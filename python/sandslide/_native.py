@@ -47,6 +47,12 @@ class RunError(Error, RuntimeError):
     """A failure while running (SS_ERR_FAIL; the CLI's exit status 1)."""
 
 
+# Their public names: a traceback, repr() and pickle say sandslide.InputError,
+# the name the user catches, not the private module that defines them.
+for _cls in (Error, InputError, RunError):
+    _cls.__module__ = "sandslide"
+
+
 def _candidates():
     """(description, path or name) in the order they are tried."""
     here = os.path.dirname(os.path.abspath(__file__))
@@ -126,6 +132,8 @@ _PROTOTYPES = {
     "ss_watch_stop": (None, [_P]),
     "ss_watch_read": (ctypes.c_longlong, [_P, _P, _P, _P, _P, _P]),
     "ss_snapshot_threadsafe": (_I, []),
+    "ss_snapshot_read_summary": (_I, [_S, _P]),
+    "ss_snapshot_summary_release": (None, [_P]),
 }
 for _name, (_res, _args) in _PROTOTYPES.items():
     try:
@@ -174,6 +182,27 @@ def check(status, message=None, keywords=None):
     if keywords is not None:
         message = translate_message(message, keywords)
     raise cls(message or f"sandslide: the library returned status {status}")
+
+
+def explain_output(path):
+    """Raise the InputError `sandslide info PATH` would print, if the
+    library finds PATH is not a readable sandslide output (damaged, not
+    HDF5, not sandslide's); return quietly if it reads it."""
+    # struct ss_snapshot_summary is read and released in place; its size
+    # (under 1 KiB, snapshot.h) is well inside the buffer
+    summary = ctypes.create_string_buffer(4096)
+    locked = not HDF5_THREADSAFE
+    if locked:
+        hdf5_lock.acquire()
+    try:
+        status = lib.ss_snapshot_read_summary(os.fsencode(path), summary)
+    finally:
+        if locked:
+            hdf5_lock.release()
+    if status == SS_OK:
+        lib.ss_snapshot_summary_release(summary)
+        return
+    check(status)
 
 
 def translate_message(message, keywords):

@@ -180,9 +180,9 @@ static void keep_last_good_state(struct ss_drive *d)
 	snprintf(t->cell, sizeof t->cell, "a cell");
 	const struct ss_grid *g = &st->grid;
 	if (ss_stepper_first_nonfinite(st, &i, &j))   /* global (i, j) */
-		snprintf(t->cell, sizeof t->cell, "cell (%d, %d) at x = %s m, y = %s m", i, j,
-		         SS_REAL(g->origin_x + (i + 0.5) * g->dx),
-		         SS_REAL(g->origin_y + (j + 0.5) * g->dy));
+		snprintf(t->cell, sizeof t->cell, "%s",
+		         SS_CELL(i, j, g->origin_x + (i + 0.5) * g->dx,
+		                 g->origin_y + (j + 0.5) * g->dy));
 	t->step = st->steps;
 	t->time = st->time;
 	t->snapshots = ss_drive_snapshots(d);

@@ -61,8 +61,9 @@ static const struct ss_option options[] = {
 	{.name = "output", .alias = "-o", .value_name = "OUT", .kind = SS_OPTION_TEXT,
 	 .offset = AT(job.output), .expected = "a path",
 	 .help = ".asc, .png, .tif: the relaxed raster; .h5: the whole\n"
-	         "series with diagnostics (default out/<DEM>-relaxed\n"
-	         "with the input's extension)"},
+	         "series with diagnostics, and beside it OUT.xmf and\n"
+	         "OUT.h5.aux.xml as run writes (default\n"
+	         "out/<DEM>-relaxed with the input's extension)"},
 	{.name = "sides", .value_name = "wall|open", .kind = SS_OPTION_WORD, .offset = AT(sides),
 	 .default_value = "wall", .parse = parse_sides, .expected = "wall or open",
 	 .help = "the four sides of the DEM"},

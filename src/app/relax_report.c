@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "base/report.h"
+#include "base/strings.h"
 #include "sandslide/error.h"
 
 static const char *closure_name(int kind)
@@ -81,9 +82,11 @@ static int raster_from(const char *what, int nx, int ny, double dx, double dy,
 	r->cellsize_y = dy;
 	for (size_t m = 0; m < cells; m++) {
 		if (isinf(values[m]))
-			return ss_error_input("%s: cell (%zu, %zu) (column from the west, row from the "
-			                      "south) is %g: expected a finite height, or NaN for no "
-			                      "data", what, m % (size_t)nx, m / (size_t)nx, values[m]);
+			return ss_error_input("%s: %s is %g: expected a finite height, or NaN for no "
+			                      "data", what,
+			                      SS_CELL((long long)(m % (size_t)nx), (long long)(m / (size_t)nx),
+			                              (m % (size_t)nx + 0.5) * dx,
+			                              (m / (size_t)nx + 0.5) * dy), values[m]);
 		if (!isnan(values[m])) {
 			r->values[m] = values[m];
 			continue;

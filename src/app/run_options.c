@@ -32,7 +32,9 @@ static const struct ss_option options[] = {
 	{.name = "output", .alias = "-o", .value_name = "OUT.h5", .kind = SS_OPTION_TEXT,
 	 .offset = AT(job.output), .expected = "a path",
 	 .help = "output file (default out/<case name>.h5; its folder\n"
-	         "must exist unless it is the default out/)"},
+	         "must exist unless it is the default out/); beside it\n"
+	         "OUT.xmf (XDMF, for ParaView) and OUT.h5.aux.xml\n"
+	         "(GDAL's georeferencing of an .h5 name)"},
 	{.name = "restart", .value_name = "OUT.h5", .kind = SS_OPTION_TEXT, .offset = AT(restart),
 	 .expected = "a path",
 	 .help = "continue the run in OUT.h5 from its last snapshot,\n"

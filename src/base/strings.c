@@ -139,6 +139,20 @@ const char *ss_real_text(double x, char buf[SS_REAL_TEXT_SIZE])
 	return buf;
 }
 
+const char *ss_cell_text(long long i, long long j, double x, double y,
+                         char buf[SS_CELL_TEXT_SIZE])
+{
+	if (isnan(x) || isnan(y))
+		snprintf(buf, SS_CELL_TEXT_SIZE, "cell (%lld, %lld)", i, j);
+	else
+		/* 15 digits: a centre x0 + (i + 0.5) dx is rounded, and the
+		 * file's decimals (1.45, not 1.4500000000000002) are what the
+		 * user finds the cell by */
+		snprintf(buf, SS_CELL_TEXT_SIZE, "cell (%lld, %lld) at x = %.15g m, y = %.15g m", i,
+		         j, x, y);
+	return buf;
+}
+
 void ss_strbuf_json_number(struct ss_strbuf *b, double x, int digits)
 {
 	if (!isfinite(x)) {

@@ -59,4 +59,21 @@ const char *ss_real_text(double x, char buf[SS_REAL_TEXT_SIZE]);
  * block, for printf's arguments: printf("x = %s m", SS_REAL(x)). */
 #define SS_REAL(x) ss_real_text((x), (char[SS_REAL_TEXT_SIZE]){0})
 
+/* The one way a message names a cell: "cell (i, j) at x = X m, y = Y m",
+ * i the column from the west and j the row from the south, both from 0
+ * (doc/model.md's indices), and x, y its centre in the grid's or the
+ * raster's own coordinates (a DEM's map coordinates), to 15 digits.
+ * Without coordinates (x or y NaN: a raster that gives none) just
+ * "cell (i, j)".  Returns buf. */
+#define SS_CELL_TEXT_SIZE (32 + 2 * SS_REAL_TEXT_SIZE + 2 * 24)
+const char *ss_cell_text(long long i, long long j, double x, double y,
+                         char buf[SS_CELL_TEXT_SIZE]);
+#define SS_CELL(i, j, x, y) \
+	ss_cell_text((i), (j), (x), (y), (char[SS_CELL_TEXT_SIZE]){0})
+/* SS_CELL of cell (i, j) of a rank's block of struct ss_grid *g (grid.h,
+ * included where it is used): its index in the whole grid, its centre. */
+#define SS_GRID_CELL(g, i, j)                                               \
+	SS_CELL((g)->offset_i + (i), (g)->offset_j + (j), ss_grid_x((g), (i)), \
+	        ss_grid_y((g), (j)))
+
 #endif

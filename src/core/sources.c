@@ -7,6 +7,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "base/strings.h"
 #include "sandslide/comm.h"
 #include "sandslide/error.h"
 
@@ -150,12 +151,12 @@ int ss_sources_set_field(struct ss_sources *s, const struct ss_grid *g,
 				if (ss_cell_type_get(cell_types, k) != SS_CELL_FLOW)
 					continue;
 				if (!isfinite(r))
-					return ss_error_input("rate field: cell (%d, %d) is %g m/s: "
-					                      "expected a finite rate", i, j, r);
+					return ss_error_input("rate field: %s is %g m/s: expected a "
+					                      "finite rate", SS_GRID_CELL(g, i, j), r);
 				if (r < 0.0 && with_bedrock)
-					return ss_error_input("rate field: cell (%d, %d) is %g m/s: a "
-					                      "negative rate (erosion) needs a model "
-					                      "without a bedrock", i, j, r);
+					return ss_error_input("rate field: %s is %g m/s: a negative "
+					                      "rate (erosion) needs a model without a "
+					                      "bedrock", SS_GRID_CELL(g, i, j), r);
 				any |= r != 0.0;
 			}
 		if (!s->rate && !(s->rate = ss_alloc(n, sizeof(double), "source rates")))

@@ -10,6 +10,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "base/strings.h"
 #include "core/ledger.h"
 #include "core/rest.h"
 #include "core/rkl2.h"
@@ -141,9 +142,8 @@ int ss_stepper_set_bedrock(struct ss_stepper *st, const double *bedrock)
 			const double b = bedrock[(size_t)j * g->nx + i];
 			const ptrdiff_t k = ss_grid_index(g, i, j);
 			if (!isfinite(b))
-				return ss_error_input("bedrock of cell (%lld, %lld) at x = %g m, y = %g m "
-				                      "is %g: it must be finite", g->offset_i + i,
-				                      g->offset_j + j, ss_grid_x(g, i), ss_grid_y(g, j), b);
+				return ss_error_input("bedrock of %s is %g: it must be finite",
+				                      SS_GRID_CELL(g, i, j), b);
 			if (ss_cell_type_get(st->cell_types, k) == SS_CELL_FLOW)
 				st->bedrock[k] = b;
 		}
@@ -167,16 +167,12 @@ static int check_cells(struct ss_stepper *st)
 			else if (st->height[k] == 0.0)
 				st->height[k] = 0.0;   /* no -0: h + 0 then keeps every bit */
 			if (!isfinite(st->height[k]))
-				return ss_error_input("initial height of cell (%lld, %lld) at x = %g m, "
-				                      "y = %g m is %g: heights must be finite",
-				                      g->offset_i + i, g->offset_j + j, ss_grid_x(g, i),
-				                      ss_grid_y(g, j), st->height[k]);
+				return ss_error_input("initial height of %s is %g: heights must be finite",
+				                      SS_GRID_CELL(g, i, j), st->height[k]);
 			if (st->bedrock && type == SS_CELL_FLOW && st->bedrock[k] > st->height[k])
-				return ss_error_input("bedrock of cell (%lld, %lld) at x = %g m, y = %g m "
-				                      "is %.17g m, above the surface %.17g m: the "
-				                      "surface must be at or above the bedrock",
-				                      g->offset_i + i, g->offset_j + j, ss_grid_x(g, i),
-				                      ss_grid_y(g, j), st->bedrock[k], st->height[k]);
+				return ss_error_input("bedrock of %s is %.17g m, above the surface %.17g m: "
+				                      "the surface must be at or above the bedrock",
+				                      SS_GRID_CELL(g, i, j), st->bedrock[k], st->height[k]);
 		}
 	}
 	return SS_OK;

@@ -272,12 +272,20 @@ static int read_h5(const char *spec, const char *context, const struct ss_dem_re
 	const size_t n = ss_raster_cells(r);
 	for (size_t k = 0; k < n; k++) {
 		if (!isfinite(r->values[k]))
-			return ss_error_input_at(context, "%s: height %g at column %zu, row %zu (from the south) "
-			                         "is not finite: heights must be finite numbers", spec,
-			                         r->values[k], k % (size_t)r->nx + 1,
-			                         k / (size_t)r->nx + 1 + (size_t)r->row_first);
+			return ss_error_input_at(context, "%s: height %g of %s is not finite: heights must "
+			                         "be finite numbers", spec, r->values[k],
+			                         SS_RASTER_CELL(r, (long long)(k % (size_t)r->nx),
+			                                        (long long)(k / (size_t)r->nx) +
+			                                        r->row_first));
 	}
 	return SS_OK;
+}
+
+const char *ss_raster_cell_text(const struct ss_raster *r, long long i, long long j, char *buf)
+{
+	const double dy = isnan(r->cellsize_y) ? r->cellsize : r->cellsize_y;
+	const double x0 = isnan(r->x0) ? 0.0 : r->x0, y0 = isnan(r->y0) ? 0.0 : r->y0;
+	return ss_cell_text(i, j, x0 + (i + 0.5) * r->cellsize, y0 + (j + 0.5) * dy, buf);
 }
 
 static int check_options(const struct ss_dem_read_options *o, enum ss_dem_format format,
@@ -621,9 +629,9 @@ int ss_dem_writer_put(struct ss_dem_writer *w, const double *values, const uint8
 			w->row[i] = none && none[i] ? w->nodata : v[i];
 		for (int i = 0; i < nx && !w->err; i++)
 			if (!(none && none[i]) && !isfinite(v[i]))
-				w->err = ss_error_fail("cannot write '%s': height %g at column %d, row %d "
-				                       "(from the south) is not finite", w->path, v[i],
-				                       i + 1, w->head->ny - w->line);
+				w->err = ss_error_fail("cannot write '%s': height %g of %s is not finite",
+				                       w->path, v[i],
+				                       SS_RASTER_CELL(w->head, i, w->head->ny - 1 - w->line));
 		if (w->err)
 			break;
 		w->err = w->format == SS_DEM_ASC ? ss_dem_asc_rows(w, w->row, 1)

@@ -206,17 +206,18 @@ static int store_value(struct ss_raster *r, const char *tok, int line, int row, 
 	const double nodata = r->nodata_value;
 	double v;
 	if (to_double(tok, &v))
-		return ss_error_input_at(context, "%s:%d: '%s' (row %d, column %d) is not a number",
-		                         path, line, tok, row + 1, i + 1);
+		return ss_error_input_at(context, "%s:%d: '%s' (%s) is not a number", path, line, tok,
+		                         SS_RASTER_CELL(r, i, r->ny - 1 - row));
 	if (r->has_nodata_value && (v == nodata || (isnan(v) && isnan(nodata)))) {
 		if (!r->nodata && !(r->nodata = ss_alloc(ss_raster_cells(r), 1, "nodata flags")))
 			return SS_ERR_FAIL;
 		r->nodata[m] = 1;
 		v = 0.0;
 	} else if (!isfinite(v)) {
-		return ss_error_input_at(context, "%s:%d: height '%s' (row %d, column %d) is not "
-		                         "finite: heights must be finite numbers (mark missing "
-		                         "cells with NODATA_value)", path, line, tok, row + 1, i + 1);
+		return ss_error_input_at(context, "%s:%d: height '%s' (%s) is not finite: heights "
+		                         "must be finite numbers (mark missing cells with "
+		                         "NODATA_value)", path, line, tok,
+		                         SS_RASTER_CELL(r, i, r->ny - 1 - row));
 	}
 	r->values[m] = v;
 	return SS_OK;

@@ -22,6 +22,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include <cpl_error.h>
 #include <cpl_string.h>
@@ -160,6 +161,18 @@ static int read_dataset(GDALDatasetH ds, const char *path, const char *context,
 			return ss_error_input_at(context, "'%s' has a rotated geotransform (terms %g, %g): "
 			                         "expected a north-up raster; resample it first, e.g. "
 			                         "gdalwarp", path, gt[2], gt[4]);
+		/* a south-up (or east-to-west) raster is the same cells in another
+		 * order: gdalwarp's output is north-up, and nearest-neighbour at
+		 * the same cell size moves each cell whole, values unchanged */
+		if (gt[1] != 0.0 && gt[5] != 0.0 && isfinite(gt[1]) && isfinite(gt[5]) &&
+		    !(gt[1] > 0.0 && gt[5] < 0.0) && isfinite(gt[0]) && isfinite(gt[3]))
+			return ss_error_input_at(context, "'%s' is %s (pixel size %s x %s): expected a "
+			                         "north-up raster (width > 0, height < 0 in the "
+			                         "geotransform); flip it first, e.g. gdalwarp -r near "
+			                         "-tr %s %s '%s' dem-north-up.tif", path,
+			                         gt[5] > 0.0 ? "south-up" : "stored east to west",
+			                         SS_REAL(gt[1]), SS_REAL(gt[5]), SS_REAL(fabs(gt[1])),
+			                         SS_REAL(fabs(gt[5])), path);
 		if (!(gt[1] > 0.0 && gt[5] < 0.0 && isfinite(gt[0]) && isfinite(gt[3])))
 			return ss_error_input_at(context, "'%s' has pixel size %s x %s: expected a north-up "
 			                         "raster (width > 0, height < 0 in the geotransform)", path,
@@ -226,11 +239,12 @@ static int read_dataset(GDALDatasetH ds, const char *path, const char *context,
 		}
 		const double h = offset + scale * v;
 		if (!isfinite(h))
-			return ss_error_input_at(context, "%s: height %g at row %zu, column %zu (from the "
-			                         "north-west) is not finite: heights must be finite numbers "
-			                         "(mark missing cells with the band's nodata value)", path,
-			                         h, k / (size_t)nx + 1 + (size_t)file_first,
-			                         k % (size_t)nx + 1);
+			return ss_error_input_at(context, "%s: height %g of %s is not finite: heights "
+			                         "must be finite numbers (mark missing cells with the band's "
+			                         "nodata value)", path, h,
+			                         SS_RASTER_CELL(r, (long long)(k % (size_t)nx),
+			                                        r->ny - 1 - (long long)(k / (size_t)nx) -
+			                                        file_first));
 		r->values[k] = h;
 	}
 	flip_rows(r->values, nx, rows);
@@ -247,6 +261,58 @@ static int read_dataset(GDALDatasetH ds, const char *path, const char *context,
 	return SS_OK;
 }
 
+/*
+ * What the file at path is, for a GDAL that opened none of it and said
+ * nothing ("no reason given" told the user nothing): empty, text (its
+ * first line), a format known by its first bytes, or bytes of no raster
+ * format.  Virtual paths (/vsizip/...) that fopen cannot read get "".
+ */
+static void describe_file(const char *path, char *out, size_t size)
+{
+	static const struct { const char *magic; size_t n; const char *what; } known[] = {
+		{"\x89HDF\r\n\x1a\n", 8, "an HDF5 file (name it .h5 to read it as a sandslide one)"},
+		{"\x89PNG\r\n\x1a\n", 8, "a PNG image (name it .png)"},
+		{"\x1f\x8b", 2, "a gzip archive (unpack it first)"},
+		{"PK\x03\x04", 4, "a zip archive (unpack it, or give /vsizip/FILE.zip/NAME)"},
+		{"%PDF", 4, "a PDF document"},
+	};
+	unsigned char head[64];
+	*out = '\0';
+	FILE *f = fopen(path, "rb");
+	if (!f)
+		return;
+	const size_t n = fread(head, 1, sizeof head, f);
+	long bytes = fseek(f, 0, SEEK_END) == 0 ? ftell(f) : -1;
+	fclose(f);
+	if (n == 0) {
+		snprintf(out, size, "it is an empty file");
+		return;
+	}
+	for (size_t k = 0; k < sizeof known / sizeof known[0]; k++)
+		if (n >= known[k].n && memcmp(head, known[k].magic, known[k].n) == 0) {
+			snprintf(out, size, "it is %s", known[k].what);
+			return;
+		}
+	int text = 1;
+	size_t line = n;   /* the first line's length within head */
+	for (size_t k = 0; k < n && text; k++) {
+		const unsigned char c = head[k];
+		text = c == '\n' || c == '\r' || c == '\t' || (c >= 0x20 && c != 0x7f);
+		if ((c == '\n' || c == '\r') && line == n)
+			line = k;
+	}
+	if (text && n >= 5 && strncasecmp((const char *)head, "ncols", 5) == 0) {
+		snprintf(out, size, "it is an ESRI ASCII grid (name it .asc)");
+	} else if (text) {
+		const int shown = line < 40 ? (int)line : 40;
+		snprintf(out, size, "it is a text file of %ld bytes, starting '%.*s'%s", bytes, shown,
+		         (const char *)head, (long)shown < bytes && line > (size_t)shown ? "..." : "");
+	} else {
+		snprintf(out, size, "it is %ld bytes of binary data in no raster format GDAL knows",
+		         bytes);
+	}
+}
+
 int ss_dem_read_gdal(const char *path, const char *context, const struct ss_dem_read_options *opt,
                      struct ss_raster *r)
 {
@@ -254,8 +320,12 @@ int ss_dem_read_gdal(const char *path, const char *context, const struct ss_dem_
 	int err;
 	GDALDatasetH ds = GDALOpenEx(path, GDAL_OF_RASTER | GDAL_OF_READONLY, NULL, NULL, NULL);
 	if (!ds) {
+		char what[160] = "";
+		const char *m = CPLGetLastErrorMsg();
+		if (!(m && *m))
+			describe_file(path, what, sizeof what);
 		err = ss_error_input_at(context, "cannot read '%s' as a GDAL raster: %s; expected "
-		                        SS_DEM_ACCEPTED_READ, path, gdal_message());
+		                        SS_DEM_ACCEPTED_READ, path, *what ? what : gdal_message());
 	} else {
 		err = read_dataset(ds, path, context, opt, r);
 		GDALClose(ds);
@@ -369,6 +439,58 @@ int ss_dem_gdal_identify(const char *path)
 {
 	(void)path;
 	return 0;
+}
+
+/*
+ * What the file at path is, for a GDAL that opened none of it and said
+ * nothing ("no reason given" told the user nothing): empty, text (its
+ * first line), a format known by its first bytes, or bytes of no raster
+ * format.  Virtual paths (/vsizip/...) that fopen cannot read get "".
+ */
+static void describe_file(const char *path, char *out, size_t size)
+{
+	static const struct { const char *magic; size_t n; const char *what; } known[] = {
+		{"\x89HDF\r\n\x1a\n", 8, "an HDF5 file (name it .h5 to read it as a sandslide one)"},
+		{"\x89PNG\r\n\x1a\n", 8, "a PNG image (name it .png)"},
+		{"\x1f\x8b", 2, "a gzip archive (unpack it first)"},
+		{"PK\x03\x04", 4, "a zip archive (unpack it, or give /vsizip/FILE.zip/NAME)"},
+		{"%PDF", 4, "a PDF document"},
+	};
+	unsigned char head[64];
+	*out = '\0';
+	FILE *f = fopen(path, "rb");
+	if (!f)
+		return;
+	const size_t n = fread(head, 1, sizeof head, f);
+	long bytes = fseek(f, 0, SEEK_END) == 0 ? ftell(f) : -1;
+	fclose(f);
+	if (n == 0) {
+		snprintf(out, size, "it is an empty file");
+		return;
+	}
+	for (size_t k = 0; k < sizeof known / sizeof known[0]; k++)
+		if (n >= known[k].n && memcmp(head, known[k].magic, known[k].n) == 0) {
+			snprintf(out, size, "it is %s", known[k].what);
+			return;
+		}
+	int text = 1;
+	size_t line = n;   /* the first line's length within head */
+	for (size_t k = 0; k < n && text; k++) {
+		const unsigned char c = head[k];
+		text = c == '\n' || c == '\r' || c == '\t' || (c >= 0x20 && c != 0x7f);
+		if ((c == '\n' || c == '\r') && line == n)
+			line = k;
+	}
+	if (text && n >= 5 && strncasecmp((const char *)head, "ncols", 5) == 0) {
+		snprintf(out, size, "it is an ESRI ASCII grid (name it .asc)");
+	} else if (text) {
+		const int shown = line < 40 ? (int)line : 40;
+		snprintf(out, size, "it is a text file of %ld bytes, starting '%.*s'%s", bytes, shown,
+		         (const char *)head, (long)shown < bytes && line > (size_t)shown ? "..." : "");
+	} else {
+		snprintf(out, size, "it is %ld bytes of binary data in no raster format GDAL knows",
+		         bytes);
+	}
 }
 
 int ss_dem_read_gdal(const char *path, const char *context, const struct ss_dem_read_options *opt,

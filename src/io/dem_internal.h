@@ -8,7 +8,16 @@
 #include <stddef.h>
 #include <stdio.h>
 
+#include "base/strings.h"
 #include "sandslide/dem.h"
+
+/* Cell (i, j) of r (column from the west, row from the south of the whole
+ * raster) named as every message names a cell (SS_CELL, base/strings.h):
+ * its centre in the raster's coordinates, from 0 where the file gives no
+ * corner, as the writers place it; just "cell (i, j)" without a cell
+ * size.  Returns buf (SS_CELL_TEXT_SIZE bytes). */
+const char *ss_raster_cell_text(const struct ss_raster *r, long long i, long long j, char *buf);
+#define SS_RASTER_CELL(r, i, j) ss_raster_cell_text((r), (i), (j), (char[SS_CELL_TEXT_SIZE]){0})
 
 /* What the extension-less error messages list as accepted. */
 #define SS_DEM_ACCEPTED_READ                                                    \

@@ -317,9 +317,9 @@ static int greys_to_heights(const struct png_reader *rd, const struct grey_map *
 			const double h = g->given ? g->zoffset + g->zscale * grey
 			               : grey == 65535 ? g->m.zmax : g->m.zmin + (grey - 1) * g->zscale;
 			if (!isfinite(h))
-				return ss_error_input_at(context, "%s: grey %d at row %d, column %d (from "
-				                         "the north-west) gives height %g: the range is too "
-				                         "large", path, grey, row + 1, i + 1, h);
+				return ss_error_input_at(context, "%s: grey %d of %s gives height %g: the "
+				                         "range is too large", path, grey,
+				                         SS_RASTER_CELL(r, i, r->ny - 1 - row), h);
 			r->values[j * r->nx + i] = h;
 		}
 	}

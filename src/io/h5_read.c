@@ -24,6 +24,7 @@
 
 #include <hdf5.h>
 
+#include "base/strings.h"
 #include "sandslide/error.h"
 #include "sandslide/grid.h"
 #include "io/h5_checked.h"
@@ -37,6 +38,11 @@ int ss_snapshot_threadsafe(void)
 	hbool_t safe = 0;
 	return H5is_library_threadsafe(&safe) >= 0 && safe;
 }
+
+
+/* The centre of cell k along an axis from edge x0 (0 when unknown) in steps
+ * of d, as the raster readers name cells (NaN without d: no coordinates). */
+#define CENTRE(x0, d, k) ((isnan(x0) ? 0.0 : (x0)) + ((double)(k) + 0.5) * (d))
 
 /* ---- a series of a sandslide file -------------------------------------- */
 
@@ -322,10 +328,13 @@ int ss_snapshot_file_read_cell_flags(struct ss_snapshot_file *f, int j0, int row
 	const size_t n = (size_t)rows * (size_t)f->nx;
 	for (size_t k = 0; k < n && !err; k++)
 		if (out[k] > SS_SNAPSHOT_CELL_NODATA)
-			err = ss_h5_damaged(&f->h5->in, "/cell_type holds %d at column %zu, row "
-			                    "%zu (from the south): expected 0 (flow), 1 (wall), 2 "
-			                    "(open) or 3 (no data)", out[k], k % (size_t)f->nx + 1,
-			                    j0 + k / (size_t)f->nx + 1);
+			err = ss_h5_damaged(&f->h5->in, "/cell_type holds %d at %s: expected 0 "
+			                    "(flow), 1 (wall), 2 (open) or 3 (no data)", out[k],
+			                    SS_CELL((long long)(k % (size_t)f->nx),
+			                            j0 + (long long)(k / (size_t)f->nx),
+			                            CENTRE(f->origin_x, f->dx, k % (size_t)f->nx),
+			                            CENTRE(f->origin_y, f->dy,
+			                                   j0 + (long long)(k / (size_t)f->nx))));
 	return err;
 }
 
@@ -545,10 +554,12 @@ static int series_walls(const struct ss_h5_file *in, struct ss_height_series *s)
 	ss_h5_var_close(&v);
 	for (size_t k = 0; k < cells && !err; k++) {
 		if (types[k] > SS_SNAPSHOT_CELL_NODATA)
-			err = ss_error_input("'%s': /cell_type holds %d at column %zu, row %zu (from "
-			                     "the south): expected 0 (flow), 1 (wall), 2 (open) or 3 "
-			                     "(no data)", in->name, types[k], k % (size_t)s->nx + 1,
-			                     k / (size_t)s->nx + 1);
+			err = ss_error_input("'%s': /cell_type holds %d at %s: expected 0 (flow), 1 "
+			                     "(wall), 2 (open) or 3 (no data)", in->name, types[k],
+			                     SS_CELL((long long)(k % (size_t)s->nx),
+			                             (long long)(k / (size_t)s->nx),
+			                             CENTRE(s->origin_x, s->dx, k % (size_t)s->nx),
+			                             CENTRE(s->origin_y, s->dy, k / (size_t)s->nx)));
 		if (types[k] != SS_CELL_WALL && types[k] != SS_SNAPSHOT_CELL_NODATA)
 			continue;
 		for (long long t = 0; t < s->count; t++)

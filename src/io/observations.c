@@ -202,6 +202,10 @@ static int parse_time(const struct csv *c, const char *text, double prev, int sa
 
 /* ---- heights from an HDF5 series --------------------------------------- */
 
+/* The centre of cell k along an axis from edge x0 (0 when unknown) in steps
+ * of d, as the raster readers name cells (NaN without d: no coordinates). */
+#define CENTRE(x0, d, k) ((isnan(x0) ? 0.0 : (x0)) + ((double)(k) + 0.5) * (d))
+
 /* The series' values checked, and counted into o->observed; none says
  * in a message that nothing is observed. */
 static int check_heights(struct ss_observations *o, const char *none)
@@ -212,10 +216,13 @@ static int check_heights(struct ss_observations *o, const char *none)
 		const double *h = o->height + (size_t)k * cells;
 		for (size_t m = 0; m < cells; m++) {
 			if (isinf(h[m]))
-				return ss_error_input("'%s': a height is infinite at time %s s, column %zu, "
-				                      "row %zu (from the south): expected heights in m, NaN "
-				                      "where not observed", o->path, SS_REAL(o->time[k]),
-				                      m % (size_t)o->nx + 1, m / (size_t)o->nx + 1);
+				return ss_error_input("'%s': a height is infinite at time %s s, %s: expected "
+				                      "heights in m, NaN where not observed", o->path,
+				                      SS_REAL(o->time[k]),
+				                      SS_CELL((long long)(m % (size_t)o->nx),
+				                              (long long)(m / (size_t)o->nx),
+				                              CENTRE(o->origin_x, o->dx, m % (size_t)o->nx),
+				                              CENTRE(o->origin_y, o->dy, m / (size_t)o->nx)));
 			o->observed += !isnan(h[m]);
 		}
 	}

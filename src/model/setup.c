@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "base/strings.h"
 #include "sandslide/comm.h"
 #include "sandslide/dem.h"
 #include "sandslide/error.h"
@@ -238,10 +239,11 @@ static int load_bedrock(const struct ss_case *c, struct ss_stepper *st)
 	int err = read_slab(c->bedrock_file, c->bedrock_where, "bedrock", st, &r);
 	for (size_t m = 0; !err && r.nodata && m < (size_t)r.nx * r.rows; m++)
 		if (r.nodata[m])
-			err = ss_error_input("%s: bedrock '%s' has no data at cell (%d, %d): the "
-			                     "bedrock needs a value in every cell", c->bedrock_where,
-			                     c->bedrock_file, (int)(m % (size_t)r.nx),
-			                     (int)(m / (size_t)r.nx) + r.row_first);
+			err = ss_error_input("%s: bedrock '%s' has no data at %s: the bedrock needs a "
+			                     "value in every cell", c->bedrock_where, c->bedrock_file,
+			                     SS_GRID_CELL(&st->grid, (int)(m % (size_t)r.nx),
+			                                  (int)(m / (size_t)r.nx + r.row_first -
+			                                        st->grid.offset_j)));
 	if (!err)   /* the window: this rank's rows */
 		err = ss_stepper_set_bedrock(st, r.values);
 	ss_raster_release(&r);

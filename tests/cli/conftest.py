@@ -209,7 +209,8 @@ def hook_binary(path):
     """path, which must be a hook binary that was built: a test that needs it
     fails (it is not skipped) when it is missing."""
     assert os.path.isfile(path) and os.access(path, os.X_OK), \
-        f"{path} not found: `make test` builds it (or set the variable naming it)"
+        f"{path} not found: `make test-hooks` builds it (so does `make test`; or set the " \
+        f"variable naming it)"
     return path
 
 

@@ -195,11 +195,13 @@ def asc_grid(nx=20, ny=16, bad=None):
 
 
 def b_asc_nonfinite(token):
-    # row 3, column 5 counted from the north-west corner, as in the file
+    # row 3, column 5 counted from the north-west corner, as in the file:
+    # cell (4, 13) from the south-west of 16 rows, as every message names it
     t = edit(BASE, "type = flat\nheight = 0.2\n", "type = file\nfile = init.asc\n")
     data = asc_grid(bad=((3, 5), token))
     asc_line = 5 + 3   # five header lines, then the rows
-    return Bad(f"asc-{token}", t, ["init.asc", "finite", "row 3", "column 5",
+    return Bad(f"asc-{token}", t, ["init.asc", "finite",
+                                   "(cell (4, 13) at x = 0.45 m, y = 1.35 m)",
                                    f"init.asc:{asc_line}"],
                None, files={"init.asc": data}, names_case=False)
 
@@ -295,7 +297,7 @@ def bad_inputs():
         b_asc_nonfinite("inf"),
         b_initial_file("initial-file-not-a-number", "word.asc",
                        asc_grid(bad=((2, 3), "sand")),
-                       ["sand", "row 2", "column 3", "word.asc:7"], at_case=False),
+                       ["sand", "(cell (2, 14) at x = 0.25 m, y = 1.45 m)", "word.asc:7"], at_case=False),
         b_initial_file("initial-file-unknown-extension", "init.tif", b"II*\0", [".asc", ".h5"]),
         b_value("grid-too-large", "nx = 20\nny = 16\n", "nx = 2000000\nny = 2000000\n",
                 ["memory", "2000000", "TiB"], needle="nx = 2000000"),

@@ -167,3 +167,71 @@ def test_input_prj_is_never_replaced(tmp_path):
     assert not (tmp_path / "dem.ASC").exists()
     assert (tmp_path / "dem.prj").read_text() == UTM33N_ESRI + "\n"
     assert sorted(os.listdir(tmp_path)) == ["dem.asc", "dem.prj"]
+
+
+@needs_gdal_build
+def test_south_up_geotiff_is_refused_with_the_gdalwarp_that_flips_it(tmp_path):
+    """A south-up GeoTIFF (pixel height > 0) is refused, exit 2, with the
+    command that makes it north-up; that command, run, gives a raster that
+    relaxes to the very bits of the north-up original."""
+    g = gdal()
+    (tmp_path / "plain.asc").write_text(asc_text(ROWS, cellsize=1.0))
+    g.Translate(str(tmp_path / "north.tif"), str(tmp_path / "plain.asc"), outputSRS="EPSG:32633",
+                outputBounds=[500000, 5200010, 500012, 5200000], outputType=g.GDT_Float64)
+    # the same cells, bottom row first: the first file row is the south one
+    north = g.Open(str(tmp_path / "north.tif"))
+    heights = north.GetRasterBand(1).ReadAsArray()
+    south = g.GetDriverByName("GTiff").Create(str(tmp_path / "south.tif"), 12, 10, 1,
+                                               g.GDT_Float64)
+    south.SetGeoTransform([500000, 1, 0, 5200000, 0, 1])
+    south.SetProjection(north.GetProjection())
+    south.GetRasterBand(1).WriteArray(heights[::-1])
+    south = north = None
+    r = run(["relax", "south.tif", "-o", "x.asc"], cwd=tmp_path)
+    fix = "gdalwarp -r near -tr 1 1 'south.tif' dem-north-up.tif"
+    assert r.returncode == 2 and r.stderr == (
+        "sandslide: 'south.tif' is south-up (pixel size 1 x 1): expected a north-up raster "
+        f"(width > 0, height < 0 in the geotransform); flip it first, e.g. {fix}\n"), r.stderr
+    assert not (tmp_path / "x.asc").exists()
+    g.Warp(str(tmp_path / "dem-north-up.tif"), str(tmp_path / "south.tif"),
+           options="-r near -tr 1 1")   # fix's options, through GDAL's Python
+    run_ok(["relax", "north.tif", "-o", "a.asc", "-q"], cwd=tmp_path)
+    run_ok(["relax", "dem-north-up.tif", "-o", "b.asc", "-q"], cwd=tmp_path)
+    assert (tmp_path / "a.asc").read_text() == (tmp_path / "b.asc").read_text()
+
+
+@needs_gdal_build
+@pytest.mark.parametrize("content,what", [
+    (b"hello world\n", "it is a text file of 12 bytes, starting 'hello world'"),
+    (b"", "it is an empty file"),
+    (b"ncols 3\nnrows 2\n", "it is an ESRI ASCII grid (name it .asc)"),
+    (b"\x89HDF\r\n\x1a\n" + bytes(40), "it is an HDF5 file (name it .h5 to read it as a "
+                                       "sandslide one)"),
+    (bytes(range(7, 250)), "it is 243 bytes of binary data in no raster format GDAL knows"),
+])
+def test_a_file_gdal_cannot_open_is_said_what_it_is(tmp_path, content, what):
+    """GDAL gives no reason for a .tif it cannot open; the message says
+    what the file is instead of "no reason given"."""
+    (tmp_path / "dem.tif").write_bytes(content)
+    r = run(["relax", "dem.tif", "-o", "x.asc"], cwd=tmp_path)
+    assert r.returncode == 2 and r.stderr.startswith(
+        f"sandslide: cannot read 'dem.tif' as a GDAL raster: {what}; expected an ESRI ASCII "
+        "grid (.asc)"), r.stderr
+
+
+@needs_gdal_build
+def test_a_bad_height_is_named_by_its_cell_in_map_coordinates(tmp_path):
+    """A GeoTIFF's infinite height is named as every message names a cell:
+    (i, j) from the south-west, its centre in the raster's own (map)
+    coordinates, not a row and column from the file's north-west corner."""
+    g = gdal()
+    heights = np.array(ROWS, dtype=np.float64)
+    heights[2, 5] = np.inf   # file row 2 from the north of 10: j = 7
+    ds = g.GetDriverByName("GTiff").Create(str(tmp_path / "dem.tif"), 12, 10, 1, g.GDT_Float64)
+    ds.SetGeoTransform([500000, 1, 0, 5200010, 0, -1])
+    ds.GetRasterBand(1).WriteArray(heights)
+    ds = None
+    r = run(["relax", "dem.tif", "-o", "x.asc"], cwd=tmp_path)
+    assert r.returncode == 2 and r.stderr.startswith(
+        "sandslide: dem.tif: height inf of cell (5, 7) at x = 500005.5 m, y = 5200007.5 m is "
+        "not finite"), r.stderr

@@ -5,7 +5,7 @@ import re
 
 import pytest
 
-from conftest import run
+from conftest import BASE, asc_text, run, run_ok
 
 
 @pytest.mark.parametrize("args,where", [
@@ -122,3 +122,21 @@ def test_unset_drops_a_key_and_a_section(door):
                                                      "SECTION.KEY"), r.stderr
     r = run(DOOR + ["--force", "--set", "time.end"], cwd=door)
     assert r.returncode == 2 and "expected SECTION.KEY=VALUE" in r.stderr, r.stderr
+
+
+@pytest.mark.parametrize("command", ["run", "relax"])
+def test_help_names_the_sidecars_an_h5_output_writes(tmp_path, command):
+    """An .h5 output leaves two more files beside it; --help says which,
+    and they are what the command writes."""
+    text = " ".join(run_ok([command, "--help"]).stdout.split())
+    assert "OUT.xmf (XDMF, for ParaView) and OUT.h5.aux.xml (GDAL's georeferencing" in text \
+        if command == "run" else "beside it OUT.xmf and OUT.h5.aux.xml as run writes" in text, text
+    if command == "run":
+        (tmp_path / "case.ini").write_text(BASE)
+        run_ok(["run", "case.ini", "-o", "o.h5", "-q"], cwd=tmp_path)
+    else:
+        (tmp_path / "dem.asc").write_text(asc_text([[0.0, 0.0, 0.0], [0.0, 3.0, 0.0],
+                                                    [0.0, 0.0, 0.0]]))
+        run_ok(["relax", "dem.asc", "-o", "o.h5", "-q"], cwd=tmp_path)
+    assert sorted(p.name for p in tmp_path.iterdir() if p.name.startswith("o.")) == \
+        ["o.h5", "o.h5.aux.xml", "o.xmf"]

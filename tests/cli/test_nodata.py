@@ -269,7 +269,7 @@ def test_the_guards_snapshot_keeps_the_cells_without_data(tmp_path):
     the reopened series knows its cells without data."""
     from conftest import SANDSLIDE_NAN
     if not os.access(SANDSLIDE_NAN, os.X_OK):
-        pytest.fail(f"{SANDSLIDE_NAN} is missing: make builds it (build/tests/sandslide-nan)")
+        pytest.fail(f"{SANDSLIDE_NAN} is missing: `make test-hooks` builds it")
     h0, nodata = clipped_dem()
     y, x = (np.mgrid[0:h0.shape[0], 0:h0.shape[1]] + 0.5) * DX
     h0 = h0 + np.maximum(0.0, math.tan(math.radians(60)) * (0.6 - np.hypot(x - 2.2, y - 1.8)))

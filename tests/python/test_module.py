@@ -324,6 +324,18 @@ def test_error_classes():
     assert issubclass(sandslide.RunError, RuntimeError)
 
 
+def test_errors_print_their_public_names():
+    """A traceback names the class the user catches, sandslide.InputError,
+    not the private module that defines it."""
+    import traceback
+    for cls in (sandslide.Error, sandslide.InputError, sandslide.RunError):
+        assert f"{cls.__module__}.{cls.__qualname__}" == "sandslide." + cls.__name__
+    with pytest.raises(sandslide.InputError) as e:
+        sandslide.relax(np.zeros((3, 3)), -1.0)
+    last = traceback.format_exception_only(e.type, e.value)[-1]
+    assert last == "sandslide.InputError: dx='-1': expected m > 0\n", last
+
+
 def test_other_inputs_are_converted():
     h0 = pile_on_ramp(12, 14)
     want, _ = sandslide.relax(h0, 1.0, threads=1)
@@ -441,6 +453,28 @@ def test_open_gives_a_dataset(tmp_path, case):
         secs = ds["time"].values / np.timedelta64(1, "s")
         assert ds["time"].dtype.kind == "m" and list(secs) == [0.0, 0.5, 1.0], \
             f"timedelta=True gives {ds['time'].values!r}: expected timedelta64 of 0, 0.5, 1 s"
+
+
+@pytest.mark.filterwarnings("ignore:numpy.ndarray size changed")
+def test_open_of_a_damaged_file_says_what_info_says(tmp_path, case):
+    """netCDF says "[Errno -101] NetCDF: HDF error"; open says what
+    `sandslide info` says of the same file."""
+    pytest.importorskip("xarray", reason="python3-xarray is not installed")
+    out = tmp_path / "tiny.h5"
+    sandslide.run(case, out, threads=1)
+    data = out.read_bytes()
+    (tmp_path / "cut.h5").write_bytes(data[:len(data) // 2])
+    (tmp_path / "text.h5").write_text("height,time\n")
+    for name, why in (("cut.h5", "is damaged: HDF5 cannot open it (truncated file"),
+                      ("text.h5", "is not an HDF5 file")):
+        r = subprocess.run([SANDSLIDE, "info", name], cwd=tmp_path, capture_output=True,
+                           text=True)
+        assert r.returncode == 2 and r.stderr.startswith("sandslide: '"), r.stderr
+        with pytest.raises(sandslide.InputError) as e:
+            sandslide.open(tmp_path / name)
+        said = r.stderr.strip()[len("sandslide: "):].replace(f"'{name}'",
+                                                             f"'{tmp_path / name}'")
+        assert str(e.value) == said and why in said, (str(e.value), said)
 
 
 def test_version():
