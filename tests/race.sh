@@ -139,6 +139,8 @@ check "render oblique" "$bin" render fast.h5 -o oblique --frames -1 --style obli
 	done
 } >cliff.asc
 check "relax" "$bin" relax cliff.asc -o cliff-relaxed.asc --max-time 2
+# until steady: forward Euler, then the approach to rest's super-steps
+check "relax to rest, tiles 8x4" "$bin" relax cliff.asc -o cliff-rest.asc --tile 8x4
 check "bench" "$bin" bench --nx 300 --ny 200 --tile 32x16 --closure bingham \
 	--surface supercritical --repeats 1 --steps 2 --threads 2
 
