@@ -94,6 +94,9 @@ SKIP = [
     (r'gdal\.Open\("terrain\.tif"\)',
      "the reader's own GeoTIFF (terrain.tif): python/examples/relax_dem.py, run above, "
      "does the same with cases/dem/terrain.asc"),
+    (r"tools/busy_bench\.py",
+     "a benchmark of minutes with two busy loops beside it, measured against another "
+     "checkout (DIR): run by hand"),
     (r"--dems DIR\b",
      "the real DEMs of `make deps-bench` (R's and OpenFOAM's packages, not in CI; "
      "tools/real_dems.py writes them to DIR)"),
