@@ -157,7 +157,7 @@ SHORTEN = [
 # Measurements in a command's output: the number is preceded by one of
 # these words, or followed by a rate's unit.
 MEASURED_BEFORE = re.compile(r"(?:\bwall|\bslope|\bsweep|\boutput|\bread|\bwrite|\bin|\bpeak) $")
-MEASURED_AFTER = re.compile(r"^ ?[\w.-]*/s\b|^ ?MiB\b|^ ?GiB\b")
+MEASURED_AFTER = re.compile(r"^ ?[\w.-]*/s\b|^ ?MiB\b|^ ?GiB\b|^ counting every\b")
 SECONDS_AFTER = re.compile(r"^ ?s\b")
 NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?")
 COUNT_WORDS = r"snapshots|frames|super-steps|steps|stencil evaluations|evaluations"
