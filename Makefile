@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # sandslide - plain GNU Makefile.
 #
 #   make            build build/sandslide, build/libsandslide.a and .so, and

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """setup.py - what pyproject.toml cannot say: the shared library, built by
 the project's Makefile, goes into the package.
 

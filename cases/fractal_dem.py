@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: BSD-3-Clause
 """Write a synthetic terrain with steep cliffs as an ESRI ASCII grid or a GeoTIFF.
 
     /usr/bin/python3 cases/fractal_dem.py N OUT.asc|OUT.tif [--seed S] [--cellsize M]

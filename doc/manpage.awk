@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # manpage.awk - the man page from its template, doc/sandslide.1.in:
 #
 #   awk -v program=build/sandslide -f doc/manpage.awk doc/sandslide.1.in > build/sandslide.1

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * bench.c - `sandslide render --bench N`: throughput of the shaded style.
  *
  * A synthetic N x N snapshot in memory (a cone with ripples, wall blocks,

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * colormap.c - colour maps of height and the names of styles and maps.
  *
  * dune     perceptually uniform: built in CIELAB so that lightness L* rises

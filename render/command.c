@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * command.c - `sandslide render`: the chosen snapshots of a file as
  * frames (all of them in time order, or a Python slice of them in its
  * order), a video of them and a viewer (render.h).

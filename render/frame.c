@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * frame.c - one frame: its pixel heights, read from a snapshot of a
  * source (a block of rows at a time through the resampler, or whole when
  * the picture has a pixel per cell or enlarges the grid) or taken from a

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * html.c - `sandslide render --html FILE.html`: the frames of a series in
  * one self-contained page that opens from a file:// URL (no server, no
  * network, no external script, font or style sheet), with a slider,

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * internal.h - what the files of render/ share and nothing else sees (the
  * public interface is include/sandslide/render.h).  No HDF5 or libpng type
  * appears here: the files are read through include/sandslide/snapshot.h,

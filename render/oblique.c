@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * oblique.c - a perspective view of the sand surface from an elevated
  * camera, like the 3-D panels of [Paper] Figs. 5-6, drawn in software as
  * z-buffered triangles.

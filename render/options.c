@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * options.c - render's options (render.h): the table of the look of frames
  * (also run --frames's) and the table of `sandslide render`, which the
  * command line's parser and help read.

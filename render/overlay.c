@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * overlay.c - what is drawn over a picture: the time label and the colour
  * bar, with their text in the renderer's font (text.c: DejaVu Sans through
  * FreeType), sized with the picture (ss_render_font_px).

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * plan.c - what the frames of a series share: the look's options checked,
  * the picture's size, and the plan (struct ss_render_plan: resampling
  * weights, pixel types, height scale, the frame's layout with its wall

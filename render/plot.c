@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * plot.c - line plots as PNG figures (plot.h, beside it): the figures of
  * `sandslide fit --plot`.
  *

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * plot.h - small line plots as PNG figures (render/plot.c), for the
  * figures of `sandslide fit --plot FIT.png`: curves over time, observations
  * as markers, cost profiles with a vertical line at the best value.

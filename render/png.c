@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * png.c - pictures in memory and their PNG encoding (step 3 of a frame).
  *
  * libpng's simplified API cannot write text chunks, and the frames must

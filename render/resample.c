@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * resample.c - cells onto pixels (step 1 of a frame, render.h).
  *
  * A picture of width x height pixels covers the grid of nx x ny cells, so

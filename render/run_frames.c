@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * run_frames.c - frames of a run as it writes its snapshots (`sandslide run
  * --frames DIR`, render.h).
  *

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * shade.c - the two map styles (step 2 of a frame, render.h).
  *
  * shaded   colour = colour map of height x brightness.  The brightness is

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * source.c - a sandslide output file (doc/output.md) as the renderer
  * reads it: the file through the one reader of src/io/h5_read.c
  * (snapshot.h), which checks it and serialises HDF5 between the threads

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * text.c - text in a real font: DejaVu Sans (Debian's fonts-dejavu-core),
  * rasterised by FreeType, drawn antialiased into the renderer's 8-bit RGB
  * pictures: the time label, the colour bar (overlay.c) and the figures of

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * video.c - frames to a video with ffmpeg, when it is installed.
  *
  * ffmpeg is found on PATH and started directly (posix_spawn, no shell, so

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // viewer.js - what the page of `sandslide render --html` does (html.c):
 // the slider, play/pause and speed, the frame's time, the colour bar,
 // and the height and position under the mouse and at a pinned point.

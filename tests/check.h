@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * check.h - a tiny test harness (git test-lib, redis testhelp).
  *
  *   CHECK(expr, fmt, ...)              fails with file:line, expr and message

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: BSD-3-Clause
 # check_layering.sh - the tiers of src/README.md, checked by the #includes
 # of each file (`make check-layering`, run by `make test`):
 #

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: BSD-3-Clause
 # tests/race.sh BUILD - the data-race check that `make race` runs.
 #
 # BUILD holds sandslide and the C tests built with clang -fsanitize=thread

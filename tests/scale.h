@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * scale.h - smaller test cases under slow instrumentation.
  *
  * SANDSLIDE_TEST_SCALE, a factor in (0, 1] (default 1), multiplies the

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * test_api.c - the entry points for foreign callers (options objects,
  * option.h; relax_report.c, run_report.c): options set by name are
  * checked as the command line checks them and own their text; the JSON formatters say when a buffer is too

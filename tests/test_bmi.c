@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * test_bmi.c - the BMI 2.0 C interface (sandslide/bmi.h), called as the
  * bmi-tester project's stages call a component: bootstrap, info, time,
  * vars, grid, value; then the bits: k updates give the heights `sandslide

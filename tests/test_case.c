@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * test_case.c - the command line's overrides of a case (case.h): an
  * override wins, a key of the file it makes redundant is dropped with a
  * note, the same conflict inside the file (or between two overrides) is an

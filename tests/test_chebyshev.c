@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * test_chebyshev.c - the coefficients of a Chebyshev super-step towards
  * rest (core/chebyshev.h), run on the scalar problem y' = -lambda y, whose
  * exact answer over a super-step is its polynomial p_s(lambda):

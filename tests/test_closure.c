@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * test_closure.c - the sliding closures of closure.h against doc/model.md#closures:
  * f_sl of every closure against the table formulas written out here
  * independently, exact zeros at and below the critical slope, the degeneracy

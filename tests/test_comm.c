@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * test_comm.c - the ranks of a distributed run (comm.h) and the halo fill
  * of a slab (boundary.h, grid.h), with any number of ranks:
  *

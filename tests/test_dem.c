@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * test_dem.c - raster input and output (dem.h): round trips keep what each
  * format can hold, malformed files are refused with messages that name the
  * place, and writes are atomic and never touch the input.

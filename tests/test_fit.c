@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * test_fit.c - the numerics of fit's cost functionals (app/fit_cost.h,
  * doc/fit.md F2-F3) and the words of --param (fit.h).  The fits themselves
  * are twin experiments driven through the command line:

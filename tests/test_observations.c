@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * test_observations.c - the observations `sandslide fit` reads
  * (src/io/observations.h): each kind is read with the right values, and
  * every refusal is SS_ERR_INPUT with one message naming the file (and the

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * test_options.c - the option tables (sandslide/option.h): one table per
  * command, and the model's options the same wherever they are given.
  *

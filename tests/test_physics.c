@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * test_physics.c - physical properties of the whole engine (doc/model.md),
  * checked end to end through the stepper:
  *

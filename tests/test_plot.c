@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * test_plot.c - pixel-level properties of the line plots (plot.h).
  *
  * Every figure is written as a PNG and decoded here with libpng's

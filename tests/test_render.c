@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * test_render.c - pixel-level properties of the renderer (render.h).
  *
  * PNGs are decoded here with libpng directly, not with the renderer's own

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * test_rest.c - the approach to rest (src/core/rest.h): Chebyshev
  * super-steps once a run that asked to come to rest moves slowly.
  *

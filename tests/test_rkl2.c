@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * test_rkl2.c - RKL2 super-time-stepping (rkl2.h, stepper.h): the method on
  * its own, then end to end through the stepper against forward Euler.
  *

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * test_strings.c - numbers as text (src/base/strings.h): ss_real_text, the
  * shortest text that reads back as the same double, for the numbers people
  * read that must be exact (coordinates, cell sizes, tolerances), and

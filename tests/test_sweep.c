@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * test_sweep.c - the two sweep kernels and the face function (sweep.h,
  * face.h, stepper.h):
  *

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * test_watch.c - a call watched and stopped from another thread (watch.h),
  * and each thread's own last message (error.c): what the Python module
  * relies on to stop a call on Ctrl-C and to run calls side by side.

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: BSD-3-Clause
 # bench_compare.sh OLD NEW ROUNDS [bench options] - two sandslide binaries'
 # `bench --json` side by side: ROUNDS rounds, the binary that goes first
 # alternating (ABBA, so an order effect cancels), then per case the median

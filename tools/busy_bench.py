@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """The defaults on a quiet and on a busy machine (issue 36, item 1).
 
 Runs `make demo`'s command (sandslide run cases/door.ini) and the Python

@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: BSD-3-Clause
 """compare_outputs.py A.h5 B.h5 - are two sandslide outputs the same bits?
 
 Compares /height, /time, /cell_type, /x, /y, /bedrock (if any) and every

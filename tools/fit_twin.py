@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: BSD-3-Clause
 """A twin experiment for `sandslide fit` (doc/fit.md), the benchmark of
 doc/performance.md#fitting-the-cone.
 

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * font_bench.c - the measurement behind render/text.c's choice of FreeType
  * over Cairo (render/README.md#text-freetype-not-cairo): the text of a
  * door frame (the time label and the colour bar's seven labels, at the

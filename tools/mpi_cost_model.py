@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: BSD-3-Clause
 """mpi_cost_model.py - what a distributed run costs per step, 1e8 to 1e11 cells.
 
     tools/mpi_cost_model.py [--cells-per-rank 1e8] [--rate 3e9] [--latency 2e-6]

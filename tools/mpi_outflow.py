@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: BSD-3-Clause
 """mpi_outflow.py - what folding the outflow once a batch, not once an
 evaluation, saves: two MPI builds side by side on cases with open sides.
 

@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: BSD-3-Clause
 """mpi_overhead.py - the cost of MPI on one machine, measured side by side.
 
     tools/mpi_overhead.py [--n 4096] [--steps 150] [--rounds 3]

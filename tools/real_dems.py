@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: BSD-3-Clause
 """real_dems.py - real DEMs from Debian packages, written as ESRI ASCII grids.
 
 A benchmark helper, never a test.  Writes measured terrain (not synthetic)

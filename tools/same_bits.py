@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: BSD-3-Clause
 """same_bits.py OLD NEW - do two sandslide builds give the same bits?
 
 Runs the same workloads with two builds of sandslide and compares what

@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: BSD-3-Clause
 """time_to_solution.py - wall time to the same solution, euler against rkl2.
 
 A benchmark, never a test.  Runs `sandslide run` on two workloads with each

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * bench.h - `sandslide bench`: throughput of the fast sweep on synthetic
  * surfaces, next to the machine's memory bandwidth measured in the same run.
  *

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * bmi.h - sandslide as a component of the CSDMS Basic Model Interface
  * (BMI 2.0, https://bmi.csdms.org), in the C binding's layout.
  *

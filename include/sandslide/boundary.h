@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * boundary.h - the halo ring of a block: the four sides of the grid are
  * wall, open or periodic (doc/model.md#cell-types-and-sides).
  *

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * case.h - the case file (doc/case-file.md): an INI file parsed with inih,
  * plus the command line's overrides, "SECTION.KEY=VALUE" (--set) and
  * "SECTION.KEY" or "SECTION" (--unset).

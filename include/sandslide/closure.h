@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * closure.h - the sliding term f_sl(s) of the degenerate parabolic sliding
  * model (DPSM) and everything derived from it point-wise.
  *

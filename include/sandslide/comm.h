@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * comm.h - the ranks of a distributed run, and the only calls to MPI
  * (src/base/comm.c; with MPI=0 every function is the one-rank case).
  *

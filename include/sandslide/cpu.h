@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * cpu.h - which instruction-set path the kernel runs, chosen at run time.
  *
  * The library is built for the baseline instruction set of x86-64 (SSE2),

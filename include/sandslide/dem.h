@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * dem.h - raster heights in and out (digital elevation models).
  *
  * Formats (SS_DEM_*), chosen from the path or given explicitly:

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * diagnostics.h - the per-snapshot record of a run (doc/output.md) and the
  * counters a restart needs: what the stepper measures and the snapshot
  * writer stores, shared by both without either knowing the other.

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * error.h - status codes, the one error printer, programmer-error aborts and
  * checked aligned allocation.
  *

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * fit.h - `sandslide fit`: which closure and which parameters reproduce
  * observations of a real or synthetic experiment, how sure that is, and
  * whether the data can tell at all.  The inverse problem the paper leaves

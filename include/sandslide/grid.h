@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * grid.h - a rectangular block of cells with a halo ring.
  *
  * Cells (i, j), i = 0..nx-1 west to east, j = 0..ny-1 south to north, are

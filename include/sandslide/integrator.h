@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * integrator.h - the time integrators a stepper may use (stepper.h,
  * doc/model.md#forward-euler, #rkl2-super-steps), their names, and the one
  * rule of `auto`.  Apart from stepper.h so that what only names an

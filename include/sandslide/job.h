@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * job.h - what the commands share, whatever they compute: where the output
  * goes and whether it may replace it, the threads, the tiles of the sweep,
  * the command line for the output's history, and how another party follows

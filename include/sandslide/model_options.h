@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * model_options.h - the options of the model and its time stepping that
  * `run` and `relax` share: one table (ss_model_option_table), read as
  * case-file keys by the case parser ([model] closure, [time] cfl, ...) and

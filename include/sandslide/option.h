@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * option.h - a command's options as one table: for each option its name,
  * kind, where its value goes, default, range, help, and the case-file key
  * it also is.  Everything else is made from the tables: the command line's

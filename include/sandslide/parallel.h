@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * parallel.h - the only place that calls omp_* (so the code builds with
  * OPENMP=0, where these report one thread), and the clock that times runs.
  */

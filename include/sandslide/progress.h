@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * progress.h - what `run`, `relax` and `fit` report as they go (a job's
  * progress, job.h): after each substep, and for a fit after each forward
  * run too.  The library calls back; the command line decides whether and

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * relax.h - `sandslide relax`: a DEM in, the surface relaxed to the repose
  * angle out (quasi-static shaping of piles on real terrain).
  *

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * render.h - pictures of snapshots (doc/rendering.md): PNG heightmaps, frame
  * sequences and videos.  The code is in render/; `sandslide render` and
  * `sandslide run --frames` reach it.  The numerical kernel knows nothing of

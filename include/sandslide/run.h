@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * run.h - `sandslide run`: case file in, HDF5 snapshots out.
  *
  * Everything that can be checked is checked before the output file is

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * sandslide.h - the whole public interface in one include, for programs
  * that link the library (pkg-config --cflags --libs sandslide):
  *

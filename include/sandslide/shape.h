@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * shape.h - regions of the case file (walls, open cells, sources) and their
  * rasterisation: a cell belongs to a shape when its centre does (rect and
  * disk boundaries included, polygons by the even-odd rule), or, for a mask,

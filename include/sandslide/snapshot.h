@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * snapshot.h - the HDF5 output of a run (doc/output.md), its XDMF
  * sidecar, and the one reader of such files.  The files src/io/h5_* are
  * the only code that includes <hdf5.h>: h5_write.c (the writer),

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * stepper.h - time integration of the DPSM on one block (doc/model.md#forward-euler).
  *
  * Each substep: fill the halo -> the largest face slope S of the current

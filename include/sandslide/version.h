@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * version.h - the library's version, for a program that links it to report
  * or check (the command line's --version prints it).
  */

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * watch.h - a run, relax or fit watched and stopped from another thread,
  * through flat functions (for callers that cannot lay out the options'
  * structs, such as Python's ctypes).

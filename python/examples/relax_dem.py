@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: BSD-3-Clause
 """Relax a DEM raster to the angle of repose with sandslide.relax_raster.
 
     PYTHONPATH=python /usr/bin/python3 python/examples/relax_dem.py terrain.tif \

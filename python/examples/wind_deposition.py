@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """wind_deposition.py - sand blown over a wall settles in its lee, and
 sandslide avalanches the drift: two models coupled through the BMI.
 

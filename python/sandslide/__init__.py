@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """sandslide from Python: sand surfaces relaxed to the angle of repose.
 
     import sandslide

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The shared library libsandslide.so.0 through ctypes: finding it, the
 prototypes of the functions the module calls, and their status codes as
 exceptions.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """sandslide as a Python BMI 2.0 component: SandslideBmi, the methods of
 bmipy's Bmi over the library's C BMI (include/sandslide/bmi.h).
 

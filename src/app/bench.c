@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * bench.c - `sandslide bench` (see bench.h): the figures go to the caller's
  * callbacks as each case ends, so a long benchmark shows its rows as it
  * goes.

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * bmi.c - sandslide behind the CSDMS Basic Model Interface (bmi.h): a case
  * file set up as `sandslide run` sets it up, stepped without output, its
  * heights read and written as one uniform_rectilinear grid.

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * drive.c - the time loop of `run` and `relax` (see drive.h).
  */
 #include "app/drive.h"

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * drive.h - the time loop that `run` and `relax` share.
  *
  * A prepared stepper is advanced through the target times k * output_every,

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * fit.c - `sandslide fit` (fit.h): forward runs through the library, the
  * cost functionals, the search (a coarse grid, then NLopt's BOBYQA), the
  * uncertainty (the noise and the forward model's own error) and the

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * fit_cost.c - the support as a front sees it, and the observed support of
  * a front (fit_cost.h).
  */

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * fit_cost.h - the pieces of fit's cost functionals that are plain
  * numerics on arrays (doc/fit.md#cost-functionals): the support indicator
  * and the observed support of a front.  No files, no stepper.

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * fit_internal.h - what fit.c (the search, the forward runs, the
  * uncertainty) and fit_report.c (the report, the summary and the figure)
  * share: one fit's state.  doc/fit.md gives the equations (F0-F10).

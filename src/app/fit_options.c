@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * fit_options.c - fit's options (fit.h): the one table the command line,
  * the options set by name and the Python module read, continued by the
  * job's (job.h); --param's words; the report in a buffer for foreign

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * fit_report.c - what `sandslide fit` reports (fit_internal.h): the JSON
  * report (doc/fit.md#the-report), the summary for people, and the figure
  * FIT.png.

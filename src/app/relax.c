@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * relax.c - `sandslide relax` (see relax.h): DEM -> stepper -> the shared
  * time loop (drive.h) -> the steady surface, in the input's format or as a
  * series.

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * relax_inputs.c - the DEM and bedrock relax reads, and the stepper it sets
  * up from them (see relax_inputs.h).
  */

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * relax_inputs.h - what relax reads and the stepper it sets up from it: one
  * input path for `relax` (relax.c) and the BMI's DEM configs (bmi.c), so
  * that a DEM relaxed either way is read, checked and set up alike.

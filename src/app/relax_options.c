@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * relax_options.c - relax's options (relax.h): the one table the command
  * line, the options set by name and the Python module read, continued by
  * the model's and the job's.

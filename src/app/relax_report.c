@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * relax_report.c - relax's report as JSON (its field table, report.h), and
  * relax for callers that cannot lay out its structs (see relax.h): on
  * arrays, and on files with the report in a buffer.  Python's ctypes

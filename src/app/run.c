@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * run.c - `sandslide run` (see run.h): case -> set-up -> the shared time
  * loop (drive.h) -> snapshots.
  */

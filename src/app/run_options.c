@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * run_options.c - run's options (run.h): the one table the command line,
  * the options set by name and the Python module read, continued by the
  * job's (job.h).  The case's own keys are the case file's table (case.h),

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * run_report.c - run's summary as JSON (its field table, report.h), and
  * run with the summary in a buffer, for callers that cannot lay out its
  * structs (see run.h).  Python's ctypes module (python/sandslide) is the

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * watch.c - a call's stop flag and progress, shared between the thread
  * running it and any other (see watch.h).
  *

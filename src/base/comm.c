@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * comm.c - the ranks of a distributed run (see comm.h).  The only file
  * that calls MPI; built with MPI when SS_HAVE_MPI is defined (make MPI=1),
  * else every function is the one-rank case.

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * comm_mpi.h - the communicator itself, for the parallel HDF5 file access
  * of the snapshot writer and reader (make MPI=1 only).
  */

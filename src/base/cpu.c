@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * cpu.c - the processor check and the kernel path in use (see cpu.h).
  *
  * The path is one integer read for every row of faces by every thread, and

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * error.c - one message per error, programmer-error aborts, checked
  * allocation.  See error.h for the conventions.
  */

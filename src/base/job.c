@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * job.c - the options the commands share (job.h): two tables, and the job
  * in an options struct (its parts).
  */

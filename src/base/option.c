@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * option.c - reading options from their tables (see sandslide/option.h).
  */
 #include "sandslide/option.h"

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * parallel.c - thin wrapper over the OpenMP runtime (see parallel.h).
  */
 #define _GNU_SOURCE   /* sched_getaffinity, CPU_COUNT */

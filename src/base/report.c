@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * report.c - reports as JSON from their field tables (see report.h).
  */
 #include "base/report.h"

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * report.h - a command's report as JSON, written from a table of its
  * fields (name, kind, place in the report's struct, where a line breaks),
  * as the option tables describe the options: each report is a table in its

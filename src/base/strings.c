@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * strings.c - string helpers (see strings.h).
  */
 #include "base/strings.h"

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * strings.h - the few string helpers more than one tier needs.
  */
 #ifndef SANDSLIDE_BASE_STRINGS_H

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * version.c - the version the Makefile gives (VERSION), compiled into the
  * library rather than the headers, so that a program linked against the
  * shared library reports the one it runs with.

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * main.c - the `sandslide` command line (doc/sandslide.1.in): parse the
  * arguments (each command's options are the library's table, option.h,
  * and a few of the command line's own, which also give its --help:

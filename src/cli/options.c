@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * options.c - arguments parsed from the option tables, and their help (see
  * options.h).
  */

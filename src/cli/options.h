@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * options.h - parsing a command's arguments from its option tables (the
  * library's, sandslide/option.h, and the command line's own few: --quiet,
  * --json, ...), and the --help made from the same tables, so that the two

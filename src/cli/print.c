@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * print.c - what the commands print (see print.h).
  */
 #include "cli/print.h"

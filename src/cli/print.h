@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * print.h - what the commands print: the progress line of a run, the
  * summaries, the benchmark's table or JSON and `info`.  The library
  * returns its figures in structs and callbacks; this is their only reader

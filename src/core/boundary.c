@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * boundary.c - halo fill for wall, open and periodic sides (see boundary.h).
  *
  * One routine serves both fields: the x sides first (rows 0..ny-1), then the

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * chebyshev.c - Chebyshev super-steps towards rest (chebyshev.h).
  */
 #include "core/chebyshev.h"

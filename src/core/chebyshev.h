@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * chebyshev.h - the coefficients of a Chebyshev super-step towards rest:
  * Chebyshev acceleration of forward Euler (the Chebyshev semi-iterative
  * method; Golub & Varga, Numer. Math. 3, 1961; Saad, "Iterative Methods

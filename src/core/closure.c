@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * closure.c - closure set-up, names and the tabulated CFL bound.
  * The point-wise formulas are static inline in closure.h.
  */

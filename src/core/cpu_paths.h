@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * cpu_paths.h - the kernel's hot loops compiled once per instruction-set
  * path (include/sandslide/cpu.h), and the calls that choose one.
  *

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * face.c - the point-wise face flux (see face.h for the formulas).
  *
  * Faces are taken in chunks that fit the first-level cache: one loop forms

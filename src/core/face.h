@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * face.h - the point-wise face flux that every sweep calls (doc/model.md#face-flux):
  *
  *   F = -nu f_sl(s) g_n / s,   s = sqrt(g_n^2 + g_t^2),   0 when s <= tan a_cr

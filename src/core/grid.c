@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * grid.c - block geometry (see grid.h).
  */
 #include "sandslide/grid.h"

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * integrator.c - integrators by name, and auto's rule (integrator.h).
  */
 #include "sandslide/integrator.h"

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * ledger.c - the stepper's volume ledger and, on several ranks, its
  * outflow batch (see ledger.h).
  *

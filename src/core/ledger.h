@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * ledger.h - the stepper's volume ledger (doc/model.md#conservation): the
  * volume poured in (inflow), gone out through open cells (outflow) and put
  * in or taken out from outside by writing heights (external), each a

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * rest.c - a stepper's approach to rest: Chebyshev super-steps once the
  * motion is slow (rest.h).
  */

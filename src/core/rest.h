@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * rest.h - a stepper's approach to rest (doc/model.md#the-approach-to-rest):
  * once a run that asked to come to rest moves slowly, Chebyshev
  * super-steps (chebyshev.h) take it the rest of the way.

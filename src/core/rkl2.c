@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * rkl2.c - RKL2 coefficients from their closed formulas, and a stepper's
  * super-steps with them: the stages, the error estimate, the accuracy rule
  * (rkl2.h, stepper.h).

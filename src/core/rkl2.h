@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * rkl2.h - the coefficients of second-order Runge-Kutta-Legendre
  * super-time-stepping (RKL2; [Meyer2014]: Meyer, Balsara & Aslam,
  * J. Comput. Phys. 257, 2014, section 3; the recurrence PLUTO, Idefix,

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * sources.c - the sources and the rate field of a stepper, summed into the
  * field the sweep adds (see sources.h).
  */

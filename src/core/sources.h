@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * sources.h - what the stepper pours (doc/model.md#sources): the case's
  * sources, each a rate on a set of flow cells while start <= t < stop, and
  * the rate field set from outside (the BMI's deposition rate), summed into

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * stages.h - what the super-steps (rkl2.c, rest.c) share between their
  * stages: the caller hears of the progress and may stop a super-step
  * after any of its stages, which then is taken back to where it began, so

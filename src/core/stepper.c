@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * stepper.c - the stepper's life (init, prepare, restore, release) and its
  * advance loop: adaptive forward-Euler substeps or RKL2 super-steps,
  * events, the steady rule, diagnostics (see stepper.h for the rules).  The

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * sweep.c - the reference two-pass stencil (see sweep.h for the scheme).
  *
  * Deliberately plain: one face per call of the face function, fluxes kept

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * sweep.h - the finite-volume stencil of doc/model.md#discretisation, in two passes over
  * cache-sized tiles (the reference kernel: simple, each face computed once
  * and stored).

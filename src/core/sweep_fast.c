@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * sweep_fast.c - the in-place sweep over active tiles (see sweep.h).
  *
  * Row buffers: in a tile of columns [i0, i1) (W = i1 - i0 cells) a buffer

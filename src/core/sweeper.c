@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * sweeper.c - the kernel a stepper drives: the fast or the reference sweep
  * behind one call per pass, its timers and tile counts (see sweeper.h).
  */

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * sweeper.h - the kernel a stepper drives, behind one call per pass: the
  * fast sweep (sweep_fast.c, the default) or the reference sweep (sweep.c),
  * chosen by st->kernel; the face rule and the CFL table of its closure;

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * dem.c - raster input and output (see dem.h): the format from the path,
  * read options, the HDF5 reader, and the atomic write every writer goes
  * through.  The formats themselves are in dem_asc.c, dem_png.c and

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * dem_asc.c - ESRI ASCII grids (see dem.h).
  *
  * Header "key value" lines (any case, any order): ncols, nrows, xllcorner or

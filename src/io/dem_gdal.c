@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * dem_gdal.c - GeoTIFF and other GDAL rasters (see dem.h), only when built
  * with GDAL (the Makefile defines SS_HAVE_GDAL when pkg-config finds it).
  * Without it dem.c refuses these formats before calling in here.

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * dem_internal.h - what the raster format files (dem_*.c) share with dem.c.
  * Not installed; dem.h is the public interface.
  */

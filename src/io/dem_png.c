@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * dem_png.c - 16-bit greyscale PNG heightmaps (see dem.h).
  *
  * The format is the renderer's gray16 style (render/shade.c, render/png.c),

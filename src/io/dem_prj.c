@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * dem_prj.c - the CRS of an ESRI ASCII grid: the ".prj" file beside it
  * (see dem.h).
  *

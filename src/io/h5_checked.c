@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * h5_checked.c - the HDF5 calls that the reader (h5_read.c, h5_summary.c)
  * and the writer (h5_write.c) share (h5_checked.h): HDF5's error printing
  * turned off, a file opened for reading, attributes read and written,

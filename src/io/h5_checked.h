@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * h5_checked.h - the HDF5 calls the files of src/io/h5_* share
  * (h5_checked.c): the reader (h5_read.c, h5_summary.c) opens files, reads
  * attributes and datasets through them, every size a file states checked

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * h5_read.c - the snapshot reader (snapshot.h): the one definition of a
  * sandslide file, checked as it is opened, and what is read of one: the
  * rows of a snapshot and the cell types a block at a time (the renderer's

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * h5_read.h - what the summaries (h5_summary.c: `info`'s summary, the
  * restart state) read of an open sandslide file through the snapshot
  * reader (h5_read.c) besides snapshot.h.  Internal, with HDF5 types: only

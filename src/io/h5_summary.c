@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * h5_summary.c - what is read of a whole sandslide file at once
  * (snapshot.h): `sandslide info`'s summary (the attributes, every
  * diagnostic series, the cell counts), which ss_snapshot_open_append also

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * h5_write.c - HDF5 + XDMF output (see snapshot.h for the layout);
  * the reads are in h5_read.c.
  *

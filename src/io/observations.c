@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * observations.c - the observations `sandslide fit` reads (observations.h):
  * the kind from the file, then one reader per kind, each checking what the
  * fit will rely on (times in order, one grid, something observed, enough

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * observations.h - what `sandslide fit` fits a sliding law to: the
  * observed states of a real or synthetic experiment, read and checked.
  *

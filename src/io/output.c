@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * output.c - checks and claims of an output path (output.h), shared by run
  * and relax.
  */

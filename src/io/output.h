@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * output.h - what a command checks and claims before it writes an output:
  * its folder (before anything is computed, so that a long run does not end
  * unable to write its result), that it is not already there unless it may

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * png_check.c - chunk lengths of a PNG checked against its file's size
  * before libpng reads it (see png_check.h).
  */

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * png_check.h - what libpng does not check before it reads a PNG.
  *
  * libpng allocates (and clears) a chunk's stated length before it reads the

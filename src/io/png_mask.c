@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * png_mask.c - mask images decoded with libpng's simplified API (see
  * png_mask.h).
  */

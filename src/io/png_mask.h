@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * png_mask.h - a case region's mask image (doc/case-file.md): any PNG,
  * read as 8-bit grey; a pixel that is not black is inside the region.
  */

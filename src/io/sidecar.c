@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * sidecar.c - the files beside an HDF5 output that other tools read
  * (sidecar.h): GDAL's .aux.xml and the XDMF sidecar.
  *

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * sidecar.h - the files beside an HDF5 output that other tools read.  Not
  * installed.
  *

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * snapshot_layout.h - what the HDF5 writer (h5_write.c) and reader
  * (h5_read.c) share of the file layout of doc/output.md, without
  * any HDF5 type: the diagnostic series and the constants of the

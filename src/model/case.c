@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * case.c - case file parser (see case.h; every key is documented in
  * doc/case-file.md and cases/reference.ini).
  *

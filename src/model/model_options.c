@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * model_options.c - the options run and relax share (model_options.h):
  * one table, one default and one range each.
  */

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * setup.c - from a case or a raster to a ready stepper (see setup.h).  Both
  * go through start() (grid, integrator, memory, closure, stepper) and
  * add_source() (a region's rates, and the check that it covers a cell), so

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * setup.h - the initial state of a run, prepared for stepping: from a case
  * (run) or from a raster (relax), through the same steps: grid, integrator
  * (ss_integrator_resolve), memory check, closure, stepper, cell types,

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * shape.c - rasterising case regions onto the grid (see shape.h).
  *
  * Mask images are decoded by io/png_mask.c; the image's top row is the

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Shared helpers for the sandslide command-line and file-format tests.
 
 The binary is found through the environment variable SANDSLIDE (an

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Bad input (doc/case-file.md#errors): exit status 2, one 'sandslide: ' line on
 stderr naming file:line (or the --set argument) and what would be accepted,
 and nothing written: an existing output keeps its bytes, no new file appears.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """`sandslide bench` (doc/performance.md#the-sweep): the JSON document parses, names every
 case asked for, and its figures are positive and consistent; bad options
 exit 2.  Throughput itself is never asserted: the machines are shared."""

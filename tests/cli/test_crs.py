@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The CRS of an ESRI ASCII grid, kept in the .prj beside it
 (doc/dem.md#cell-size-and-crs): `relax dem.asc` with the dem.prj GDAL wrote
 gives a GeoTIFF, an .asc (+ .prj) and an .h5 whose CRS GDAL reads as the

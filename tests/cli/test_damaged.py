@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Damaged output files: `info`, `run --restart` and `render` refuse what
 they cannot read with exit status 2 and one line that says so, and never
 believe a size the file cannot hold (src/io/h5_checked.c checks every

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """doc/dem.md#the-face-slope-and-gdaldem-slope: the figures it gives for
 `gdaldem slope` on cases/dem/terrain.asc relaxed at 33 deg are what
 gdaldem measures now (its largest slope, the cells above 33.001 deg and

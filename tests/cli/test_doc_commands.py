@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The commands of the README and the manual run, in order, in a fresh copy
 of the checkout, and print the figures the pages show beside them; so do
 the commands in the shipped cases' headers.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The documentation resolves inside the repository (doc/README.md).
 
 - Every reference to a Markdown file in a comment (or string) of src/,

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The output opens as it is in the tools users have: GDAL (gdalinfo, QGIS),
 xarray and CDO.  ParaView and VTK's netCDF-CF reader are in
 test_paraview.py.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """sandslide fit (doc/fit.md): twin experiments.
 
 Observations are made by `sandslide run` with known parameters, then

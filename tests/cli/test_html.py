@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """`sandslide render --html`: the self-contained viewer of a run.
 
 The file: nothing in it reaches outside it (no http:, no external script,

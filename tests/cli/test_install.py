@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """make install into a temporary DESTDIR, and a C program built against it.
 
 What a user who installs sandslide gets: the program, the shared library

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The man page `make` builds beside sandslide ($(BUILD)/sandslide.1).
 
 doc/sandslide.1.in is written by hand but for each command's options,

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Messages that point at the real mistake (issue 16): a usage error is one
 line that ends with where the options are; `sandslide help CMD` prints that
 command's help; a missing GDAL raster says so."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """nu from the sliding layer's parameters (doc/model.md#nu-from-the-sliding-layer):
 
     tau = density * gravity * delta * sin(a_cr)

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Distributed runs (issue 14): `mpirun -np N build-mpi/sandslide` against the
 serial build/sandslide, bit for bit.
 

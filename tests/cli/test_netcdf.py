@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """doc/output.md: the output opens as a netCDF-4 dataset, with time, y and x
 as dimensions (HDF5 dimension scales) and every variable on them."""
 import re

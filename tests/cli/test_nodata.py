@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """`sandslide relax` of a DEM with cells without data (issue 16, item 6).
 
 A real DEM is mostly a clipped region: nodata all round an irregular

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The HDF5 output matches doc/output.md, and the XDMF sidecar matches it."""
 import math
 import xml.etree.ElementTree as ET

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """One run owns its output (issue 12): a run or relaxation aimed at an
 output (or its .partial) that a live run is writing is refused with exit 2,
 --force or not; it never deletes or replaces a file it did not create; of

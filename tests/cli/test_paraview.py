@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """ParaView opens a run's XDMF sidecar OUT.xmf with its default reader
 (whatever paraview.simple.OpenDataFile picks: XDMF3 in ParaView 5.11) and
 shows every snapshot's heights and the cell types where h5py finds them,

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """A portable build (include/sandslide/cpu.h, Makefile NATIVE): the default
 build runs on any x86-64 processor, and chooses at run time the best copy
 of the kernel's hot loops the processor runs (generic, avx2, avx512);

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """`sandslide relax`: DEMs relaxed to the repose angle (issue 5).
 
 Physical properties (steady slopes, volume, bedrock), round trips through

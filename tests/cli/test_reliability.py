@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Nothing lost, nothing crashes (issue 6): overwrite refusal, interrupts and
 restarts bit for bit, write failures, the non-finite guard.
 

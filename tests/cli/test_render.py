@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """`sandslide render` and `sandslide run --frames` through the command line
 (doc/rendering.md): frames written in time order with their times, frame
 selection, bad input (exit 2, nothing written), the video with and without

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """RKL2 super-steps from the command line: [time] integrator and its keys,
 relax --integrator, the output's /stencil_evaluations and integrator
 attribute, restarts and threads bit for bit, bad values, and the steady

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Runs through the command line: --set, help and version, info, quiet and
 progress, default output, crash safety, determinism, the shipped cases.
 

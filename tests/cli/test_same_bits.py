@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The same bits as before a refactor (issue 34, "one job, one concern per
 file"): the commit before it, f9026b5, is built from this checkout's
 history in a git worktree (under the build folder, kept between runs), and

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """end = steady (doc/model.md#the-steady-rule): stop when max |dh/dt| < steady_tol, but never
 while a source is still to switch on."""
 import numpy as np

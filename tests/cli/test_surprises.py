@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """No silent surprises (issue 36 item 3): what a command will cost is told or
 refused before the work, and what it did is counted as it was done."""
 import json

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The thread count without --threads: OMP_NUM_THREADS when set (what a
 batch system grants the job), else the CPUs this process may run on
 (sched_getaffinity: taskset, a cpuset), not every processor of the

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * fuzz.h - what the fuzz harnesses (tests/fuzz/fuzz_*.c) share.
  *
  * Each harness defines LLVMFuzzerTestOneInput and is linked either with

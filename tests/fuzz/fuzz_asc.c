@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * fuzz_asc.c - the ESRI ASCII grid reader, ss_dem_read on a .asc file
  * (src/io/dem.c, src/io/dem_asc.c).
  *

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * fuzz_case.c - the case-file parser, ss_case_parse (src/model/case.c).
  *
  * Input: the case text, then up to four --set overrides, each after a NUL

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * fuzz_dem.h - what the DEM reader harnesses (fuzz_asc.c, fuzz_png.c)
  * check of a raster that ss_dem_read accepted (include/sandslide/dem.h):
  *

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * fuzz_h5.c - the HDF5 reader (src/io/h5_read.c, snapshot.h): what
  * `info`, `run --restart`, `render` and `.h5` DEMs read.
  *

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * fuzz_mask.c - PNG masks of `mask = PNG` shapes, read by
  * ss_shape_rasterize (src/model/shape.c, libpng's simplified API).
  *

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * fuzz_png.c - the 16-bit PNG heightmap reader, ss_dem_read on a .png
  * file (src/io/dem.c, src/io/dem_png.c).
  *

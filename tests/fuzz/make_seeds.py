@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """Write the hand-made seed inputs of the fuzz harnesses (tests/fuzz/) into
 tests/fuzz/corpus/<harness>/seed-*: small case files with overrides, ESRI
 ASCII grids, 16-bit PNG heightmaps and PNG masks of many kinds (bit depths,

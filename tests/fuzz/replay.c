@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * replay.c - runs a fuzz harness over files without libFuzzer, so any
  * compiler can replay the corpora and the regression inputs (`make
  * fuzz-replay`, part of `make test`).

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * batch_step.c - the test hook of the outflow batch (src/core/ledger.h:
  * on several ranks with open faces each rank keeps its faces' fluxes, and
  * the ranks fold them when ss_stepper_advance returns or the batch is

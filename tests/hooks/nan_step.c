@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * nan_step.c - the test hook of the non-finite guard (src/app/drive.h),
  * linked into a second sandslide, build/tests/sandslide-nan, and never
  * into the real one.

@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * pause_step.c - the test hook of the interrupt (SIGINT, SIGTERM: the stop
  * flag of src/cli/main.c), linked into a third sandslide,
  * build/tests/sandslide-pause, and never into the real one.

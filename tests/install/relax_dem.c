@@ -1,4 +1,6 @@
 /*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
  * relax_dem.c - a program a user writes against the installed library:
  * built by tests/cli/test_install.py with `pkg-config --cflags --libs
  * sandslide` from a DESTDIR tree, so that it sees only the installed

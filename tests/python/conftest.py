@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The Python module's tests import `sandslide` as a user does; when it
 is not on the path (no PYTHONPATH=python, no install), this checkout's
 python/ is put first, so `pytest tests/python` works from a checkout."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """sandslide.bmi.SandslideBmi, the Python BMI over the C BMI.
 
 Run from the top of the repository after `make`:

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """How the module's calls behave as calls (issue 27, items 5 and 6):
 Ctrl-C stops them, calls in two threads run at once and give the bits
 of a lone call, progress=True shows a line, messages name Python's

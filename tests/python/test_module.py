@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The Python module `sandslide` (python/sandslide) over libsandslide.so.0.
 
 Run from the top of the repository after `make`:

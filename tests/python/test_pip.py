@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """pip install . into a fresh virtual environment, and the module it installs.
 
 Issue 27, item 5: in a virtual environment made as doc/python.md says

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """No silent surprises from Python (issue 36 item 3): a raster too large for
 the machine's memory is refused before any work, as `run` and `bench` refuse
 such grids, by relax_raster and by the BMI's initialize; the BMI's elevation

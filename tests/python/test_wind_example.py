@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """python/examples/wind_deposition.py, the coupled example of doc/bmi.md:
 a wind model sets sandslide's deposition rate through the BMI every 2 s.
 

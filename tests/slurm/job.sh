@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: BSD-3-Clause
 # The Slurm job of doc/cluster.md#slurm as CI runs it on one node
 # (tests/slurm/run.sh submits it with sbatch --wait, twice: 2 tasks of 1
 # CPU, and 1 task of 2 CPUs, the options on sbatch's command line

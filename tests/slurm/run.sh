@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: BSD-3-Clause
 # tests/slurm/run.sh SANDSLIDE_MPI SANDSLIDE - a real Slurm on this one
 # machine (make MPI=1 test-slurm, CI): munged, slurmctld and slurmd started
 # from a slurm.conf written for this node, the job of doc/cluster.md#slurm
