@@ -46,20 +46,8 @@ int ss_rest_create(struct ss_rest **out, const struct ss_stepper *st)
 		r->m0 = st->rkl2->m0;
 		return SS_OK;
 	}
-	/* as after a super-step in which nothing moved (rkl2.h) */
-	const size_t n = ss_grid_storage_cells(g);
 	r->own = 1;
-	r->y0 = ss_alloc(n, sizeof(double), "the approach to rest: Y_0");
-	r->d1 = ss_alloc(n, sizeof(double), "the approach to rest: D_{j-1}");
-	r->d2 = ss_alloc(n, sizeof(double), "the approach to rest: D_{j-2}");
-	r->m0 = ss_alloc(n, sizeof(double), "the approach to rest: M(Y_0)");
-	if (!r->y0 || !r->d1 || !r->d2 || !r->m0)
-		return SS_ERR_FAIL;
-	memcpy(r->y0, st->height, n * sizeof(double));
-	memset(r->d1, 0, n * sizeof(double));
-	memset(r->d2, 0, n * sizeof(double));
-	memset(r->m0, 0, n * sizeof(double));
-	return SS_OK;
+	return ss_stages_arrays_create(st, "the approach to rest:", &r->y0, &r->d1, &r->d2, &r->m0);
 }
 
 void ss_rest_destroy(struct ss_rest *r)

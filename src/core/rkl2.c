@@ -87,17 +87,8 @@ int ss_rkl2_create(struct ss_rkl2 **out, const struct ss_stepper *st)
 	memset(r, 0, sizeof *r);
 	*out = r;
 	const struct ss_grid *g = &st->grid;
-	const size_t n = ss_grid_storage_cells(g);
-	r->y0 = ss_alloc(n, sizeof(double), "RKL2 Y_0");
-	r->d1 = ss_alloc(n, sizeof(double), "RKL2 D_{j-1}");
-	r->d2 = ss_alloc(n, sizeof(double), "RKL2 D_{j-2}");
-	r->m0 = ss_alloc(n, sizeof(double), "RKL2 M(Y_0)");
-	if (!r->y0 || !r->d1 || !r->d2 || !r->m0)
+	if (ss_stages_arrays_create(st, "RKL2", &r->y0, &r->d1, &r->d2, &r->m0))
 		return SS_ERR_FAIL;
-	memcpy(r->y0, st->height, n * sizeof(double));
-	memset(r->d1, 0, n * sizeof(double));
-	memset(r->d2, 0, n * sizeof(double));
-	memset(r->m0, 0, n * sizeof(double));
 	/* forward Euler's step for every slope the closure has (stepper.h) */
 	const double inv_d2 = 1.0 / (g->dx * g->dx) + 1.0 / (g->dy * g->dy);
 	r->dt_all = st->cfl / (2.0 * st->closure.nu *

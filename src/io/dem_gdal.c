@@ -443,58 +443,6 @@ int ss_dem_gdal_identify(const char *path)
 	return 0;
 }
 
-/*
- * What the file at path is, for a GDAL that opened none of it and said
- * nothing ("no reason given" told the user nothing): empty, text (its
- * first line), a format known by its first bytes, or bytes of no raster
- * format.  Virtual paths (/vsizip/...) that fopen cannot read get "".
- */
-static void describe_file(const char *path, char *out, size_t size)
-{
-	static const struct { const char *magic; size_t n; const char *what; } known[] = {
-		{"\x89HDF\r\n\x1a\n", 8, "an HDF5 file (name it .h5 to read it as a sandslide one)"},
-		{"\x89PNG\r\n\x1a\n", 8, "a PNG image (name it .png)"},
-		{"\x1f\x8b", 2, "a gzip archive (unpack it first)"},
-		{"PK\x03\x04", 4, "a zip archive (unpack it, or give /vsizip/FILE.zip/NAME)"},
-		{"%PDF", 4, "a PDF document"},
-	};
-	unsigned char head[64];
-	*out = '\0';
-	FILE *f = fopen(path, "rb");
-	if (!f)
-		return;
-	const size_t n = fread(head, 1, sizeof head, f);
-	long bytes = fseek(f, 0, SEEK_END) == 0 ? ftell(f) : -1;
-	fclose(f);
-	if (n == 0) {
-		snprintf(out, size, "it is an empty file");
-		return;
-	}
-	for (size_t k = 0; k < sizeof known / sizeof known[0]; k++)
-		if (n >= known[k].n && memcmp(head, known[k].magic, known[k].n) == 0) {
-			snprintf(out, size, "it is %s", known[k].what);
-			return;
-		}
-	int text = 1;
-	size_t line = n;   /* the first line's length within head */
-	for (size_t k = 0; k < n && text; k++) {
-		const unsigned char c = head[k];
-		text = c == '\n' || c == '\r' || c == '\t' || (c >= 0x20 && c != 0x7f);
-		if ((c == '\n' || c == '\r') && line == n)
-			line = k;
-	}
-	if (text && n >= 5 && strncasecmp((const char *)head, "ncols", 5) == 0) {
-		snprintf(out, size, "it is an ESRI ASCII grid (name it .asc)");
-	} else if (text) {
-		const int shown = line < 40 ? (int)line : 40;
-		snprintf(out, size, "it is a text file of %ld bytes, starting '%.*s'%s", bytes, shown,
-		         (const char *)head, (long)shown < bytes && line > (size_t)shown ? "..." : "");
-	} else {
-		snprintf(out, size, "it is %ld bytes of binary data in no raster format GDAL knows",
-		         bytes);
-	}
-}
-
 int ss_dem_read_gdal(const char *path, const char *context, const struct ss_dem_read_options *opt,
                      struct ss_raster *r)
 {

@@ -11,7 +11,7 @@ import subprocess
 
 import numpy as np
 
-from conftest import SANDSLIDE, h5open, run, wait_for
+from conftest import SANDSLIDE, SANDSLIDE_PAUSE, h5open, hook_binary, run, wait_for
 from test_reliability import snapshots, write_cliff
 from test_run import slow_case
 
@@ -19,9 +19,16 @@ EVERY = 0.02
 LONG = slow_case(1000, EVERY)      # a cone that slides for a long time
 
 
-def start(args, cwd):
-    return subprocess.Popen([SANDSLIDE] + args, cwd=cwd, stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)
+def start(args, cwd, pause_step=None):
+    """sandslide with args; with pause_step, sandslide-pause, which waits
+    after that substep for the stop signal: a run that lasts until it is
+    stopped, however fast the machine and the method."""
+    if pause_step is None:
+        return subprocess.Popen([SANDSLIDE] + args, cwd=cwd, stdout=subprocess.PIPE,
+                                stderr=subprocess.PIPE, text=True)
+    env = dict(os.environ, SANDSLIDE_TEST_PAUSE_STEP=str(pause_step))
+    return subprocess.Popen([hook_binary(SANDSLIDE_PAUSE)] + args, cwd=cwd,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
 
 
 def count(path):
@@ -122,7 +129,10 @@ def test_the_claim_of_a_killed_run_is_taken_over(tmp_path):
 
 def test_relax_claims_its_output_too(tmp_path):
     write_cliff(tmp_path / "cliff.asc", 160, 120)
-    a = start(["relax", "cliff.asc", "-o", "r.h5", "--output-every", "0.02", "-q"], tmp_path)
+    # relax comes to rest in seconds: paused after substep 60, a few
+    # snapshots in, until stopped
+    a = start(["relax", "cliff.asc", "-o", "r.h5", "--output-every", "0.02", "-q"], tmp_path,
+              pause_step=60)
     try:
         assert wait_for(lambda: count(tmp_path / "r.h5") >= 2 or a.poll() is not None, 60)
         assert a.poll() is None, a.communicate()
