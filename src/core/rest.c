@@ -47,7 +47,11 @@ int ss_rest_create(struct ss_rest **out, const struct ss_stepper *st)
 		return SS_OK;
 	}
 	r->own = 1;
-	return ss_stages_arrays_create(st, "the approach to rest:", &r->y0, &r->d1, &r->d2, &r->m0);
+	static const char *const names[4] = {
+		"the approach to rest: Y_0", "the approach to rest: D_{j-1}",
+		"the approach to rest: D_{j-2}", "the approach to rest: M(Y_0)",
+	};
+	return ss_stages_arrays_create(st, names, &r->y0, &r->d1, &r->d2, &r->m0);
 }
 
 void ss_rest_destroy(struct ss_rest *r)

@@ -87,7 +87,9 @@ int ss_rkl2_create(struct ss_rkl2 **out, const struct ss_stepper *st)
 	memset(r, 0, sizeof *r);
 	*out = r;
 	const struct ss_grid *g = &st->grid;
-	if (ss_stages_arrays_create(st, "RKL2", &r->y0, &r->d1, &r->d2, &r->m0))
+	static const char *const names[4] = {"RKL2 Y_0", "RKL2 D_{j-1}", "RKL2 D_{j-2}",
+	                                     "RKL2 M(Y_0)"};
+	if (ss_stages_arrays_create(st, names, &r->y0, &r->d1, &r->d2, &r->m0))
 		return SS_ERR_FAIL;
 	/* forward Euler's step for every slope the closure has (stepper.h) */
 	const double inv_d2 = 1.0 / (g->dx * g->dx) + 1.0 / (g->dy * g->dy);

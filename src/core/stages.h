@@ -27,10 +27,10 @@ void ss_stages_take_back(struct ss_stepper *st, const double *y0);
 
 /* The four arrays of a super-step's stages for st's grid, y0 .. m0 (Y_0,
  * D_{j-1}, D_{j-2} and M(Y_0), sweep.h), as after a super-step in which
- * nothing moved: Y_0 the heights, the others zero; `who` names them in
- * the message of a failed allocation (SS_ERR_FAIL; those made are the
- * caller's to free). */
-int ss_stages_arrays_create(const struct ss_stepper *st, const char *who, double **y0,
-                            double **d1, double **d2, double **m0);
+ * nothing moved: Y_0 the heights, the others zero; names[k] names the
+ * k-th in the message of a failed allocation (SS_ERR_FAIL; those made are
+ * the caller's to free). */
+int ss_stages_arrays_create(const struct ss_stepper *st, const char *const names[4],
+                            double **y0, double **d1, double **d2, double **m0);
 
 #endif

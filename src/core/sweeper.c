@@ -7,7 +7,6 @@
 #include "core/sweeper.h"
 
 #include <math.h>
-#include <stdio.h>
 #include <string.h>
 
 #include "core/ledger.h"
@@ -76,16 +75,13 @@ void ss_sweeper_wake_all(struct ss_stepper *st)
 		ss_sweep_fast_wake_all(&st->sweeper->fast, &st->grid, st->height, st->cell_types);
 }
 
-int ss_stages_arrays_create(const struct ss_stepper *st, const char *who, double **y0,
-                            double **d1, double **d2, double **m0)
+int ss_stages_arrays_create(const struct ss_stepper *st, const char *const names[4],
+                            double **y0, double **d1, double **d2, double **m0)
 {
 	double **arrays[4] = {y0, d1, d2, m0};
-	static const char *const names[4] = {"Y_0", "D_{j-1}", "D_{j-2}", "M(Y_0)"};
 	const size_t n = ss_grid_storage_cells(&st->grid);
 	for (int k = 0; k < 4; k++) {
-		char what[64];
-		snprintf(what, sizeof what, "%s %s", who, names[k]);
-		if (!(*arrays[k] = ss_alloc(n, sizeof(double), what)))
+		if (!(*arrays[k] = ss_alloc(n, sizeof(double), names[k])))
 			return SS_ERR_FAIL;
 		if (k == 0)
 			memcpy(*y0, st->height, n * sizeof(double));
