@@ -149,8 +149,8 @@ SHORTEN = [
      [(r"--video", "--frames ::20 --video")], "a video of 101 frames: of 6"),
     (r"^sandslide run cases/columns\.ini -o out/columns-live\.h5 --frames",
      [(r"$", " --set time.end=200")], "85 frames drawn as it runs: 21, to 200 s"),
-    (r"cases/fractal_dem\.py 4096",
-     [(r" 4096 ", " 256 ")], "a 4096^2 terrain, relaxed in a minute: 256^2"),
+    (r"cases/fractal_dem\.py (4096|8192)",
+     [(r" (4096|8192) ", " 256 ")], "a 4096^2 or 8192^2 terrain, relaxed in a minute: 256^2"),
     (r"^sandslide run cases/door\.ini -o out/door240\.h5 --threads 1",
      [(r"time\.end=300", "time.end=20")], "the door at 240 x 160 to 300 s: 20 s of wall time; to 20 s"),
 ]
