@@ -79,11 +79,12 @@ static int check_memory(const struct ss_relax_options *o)
 	} else {
 		struct ss_dem_read_options opt = o->read;
 		opt.rows = 0;   /* the header alone */
-		if ((err = ss_dem_read(o->dem, NULL, &opt, &header)))
-			return err;
+		err = ss_dem_read(o->dem, NULL, &opt, &header);
 		nx = header.nx;
 		ny = header.ny;
-		ss_raster_release(&header);
+		ss_raster_release(&header);   /* either way (dem.h) */
+		if (err)
+			return err;
 	}
 	/* the copy or the read, and the bedrock's */
 	return ss_setup_check_raster_memory(o->dem, nx, ny, o->bedrock ? 2 : 1, &o->model,
