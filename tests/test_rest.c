@@ -229,23 +229,30 @@ static void the_same_bits_everywhere(void)
 	release(&d);
 }
 
+/* One step at a time until the approach has taken n super-steps (fewer
+ * if the run ends first): the super-steps it took. */
+static long long into_the_approach(struct ss_stepper *st, long long n)
+{
+	struct ss_advance_options o = steady_options;
+	o.max_steps = 1;
+	long long rest_steps = 0, rest_evaluations = 0;
+	while (rest_steps < n && ss_stepper_advance(st, 1e6, &o) == SS_ADVANCE_STEPS)
+		ss_stepper_rest_counts(st, &rest_steps, &rest_evaluations);
+	return rest_steps;
+}
+
 /* The state after `steps` steps, saved as a snapshot saves it, put in a
  * fresh stepper, taken on to steady: the bits of the run never stopped. */
 static void a_restart_in_the_approach_gives_the_same_bits(void)
 {
 	struct run whole = relax(CONE, SS_INTEGRATOR_EULER, SS_REST_CHEBYSHEV, SS_KERNEL_FAST, 0, 0);
 	struct ss_stepper st, fresh;
-	long long rest_steps = 0, rest_evaluations = 0;
 	if (make(&st, CONE, SS_INTEGRATOR_EULER, SS_REST_CHEBYSHEV, SS_KERNEL_FAST, 0, 0)) {
 		CHECK(0, "set-up failed");
 		release(&whole);
 		return;
 	}
-	/* one step at a time until the approach has taken two super-steps */
-	struct ss_advance_options o = steady_options;
-	o.max_steps = 1;
-	while (rest_steps < 2 && ss_stepper_advance(&st, 1e6, &o) == SS_ADVANCE_STEPS)
-		ss_stepper_rest_counts(&st, &rest_steps, &rest_evaluations);
+	const long long rest_steps = into_the_approach(&st, 2);
 	CHECK(rest_steps == 2, "test set-up: the approach took %lld super-steps, not 2",
 	      rest_steps);
 	struct ss_restart_state s;
@@ -287,12 +294,7 @@ static void a_stop_between_stages_takes_the_super_step_back(void)
 		release(&whole);
 		return;
 	}
-	/* into the approach, one step at a time */
-	struct ss_advance_options o = steady_options;
-	o.max_steps = 1;
-	long long rest_steps = 0, rest_evaluations = 0;
-	while (rest_steps < 1 && ss_stepper_advance(&st, 1e6, &o) == SS_ADVANCE_STEPS)
-		ss_stepper_rest_counts(&st, &rest_steps, &rest_evaluations);
+	CHECK(into_the_approach(&st, 1) == 1, "test set-up: the approach did not begin");
 	double *before = interior(&st);
 	const double t = st.time;
 	const long long steps = st.steps, evaluations = st.evaluations;

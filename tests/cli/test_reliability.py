@@ -5,6 +5,7 @@ restarts bit for bit, write failures, the non-finite guard.
 The interrupts are sent to sandslide-pause (tests/hooks/pause_step.c),
 paused after a chosen substep: they arrive there whatever the speed of the
 machine, and the run stops after the next substep."""
+import contextlib
 import os
 import re
 import resource
@@ -235,9 +236,10 @@ def test_file_size_limit_gives_exit_1_and_keeps_earlier_snapshots(tmp_path):
         assert np.isfinite(h).all()
 
 
-def test_full_disk_gives_exit_1_and_keeps_earlier_snapshots(tmp_path):
-    """On a 3 MiB tmpfs (root only, with the right to mount; skipped
-    elsewhere, saying why)."""
+@contextlib.contextmanager
+def small_disk(tmp_path):
+    """A 3 MiB tmpfs (root only, with the right to mount; the test is
+    skipped elsewhere, saying why), unmounted after."""
     disk = tmp_path / "small"
     disk.mkdir()
     m = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=3m", "tmpfs", str(disk)],
@@ -246,6 +248,15 @@ def test_full_disk_gives_exit_1_and_keeps_earlier_snapshots(tmp_path):
         pytest.skip("cannot mount a 3 MiB tmpfs here (needs root and CAP_SYS_ADMIN): mount "
                     f"said {(m.stderr.strip().splitlines() or [''])[0]!r}")
     try:
+        yield disk
+    finally:
+        subprocess.run(["umount", str(disk)])
+
+
+def test_full_disk_gives_exit_1_and_keeps_earlier_snapshots(tmp_path):
+    """On a 3 MiB tmpfs (root only, with the right to mount; skipped
+    elsewhere, saying why)."""
+    with small_disk(tmp_path) as disk:
         # a steady run: its projected size is an upper bound, told but not
         # refused up front (doc/running.md#run), so the disk fills mid-run
         case = write_case(disk, edit(edit(edit(POUR, "nx = 40\n", "nx = 200\n"),
@@ -256,22 +267,13 @@ def test_full_disk_gives_exit_1_and_keeps_earlier_snapshots(tmp_path):
         assert p.returncode == 1, (p.returncode, p.stderr)
         assert "No space left" in p.stderr, p.stderr
         assert len(snapshots(disk / "big.h5")) >= 2
-    finally:
-        subprocess.run(["umount", str(disk)])
 
 
 def test_a_run_larger_than_the_disk_is_refused_up_front(tmp_path):
     """On a 3 MiB tmpfs (as above): 21 snapshots of 313 KiB do not fit, so
     the run is refused before it starts (exit 2, nothing written), naming
     the output_every that fits; with that output_every it runs and fits."""
-    disk = tmp_path / "small"
-    disk.mkdir()
-    m = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=3m", "tmpfs", str(disk)],
-                       capture_output=True, text=True)
-    if m.returncode != 0:
-        pytest.skip("cannot mount a 3 MiB tmpfs here (needs root and CAP_SYS_ADMIN): mount "
-                    f"said {(m.stderr.strip().splitlines() or [''])[0]!r}")
-    try:
+    with small_disk(tmp_path) as disk:
         case = write_case(disk, edit(edit(POUR, "nx = 40\n", "nx = 200\n"),
                                      "ny = 30\n", "ny = 200\n"))
         p = subprocess.run([SANDSLIDE, "run", case, "-o", "big.h5"], cwd=disk,
@@ -287,8 +289,6 @@ def test_a_run_larger_than_the_disk_is_refused_up_front(tmp_path):
                            capture_output=True, text=True, timeout=300)
         assert p.returncode == 0, (p.returncode, p.stderr)
         assert len(snapshots(disk / "big.h5")) >= 2
-    finally:
-        subprocess.run(["umount", str(disk)])
 
 
 # ---- the non-finite guard --------------------------------------------------------
