@@ -82,6 +82,14 @@ int ss_parse_numbers(const char *s, int commas, double *out, int max)
 	}
 }
 
+int ss_parse_name(const char *name, const char *const *names, int n)
+{
+	for (int k = 0; k < n; k++)
+		if (strcmp(name, names[k]) == 0)
+			return k;
+	return -1;
+}
+
 int ss_parse_tile(const char *s, int tile[2])
 {
 	const char *x = strchr(s, 'x');

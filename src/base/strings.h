@@ -26,6 +26,9 @@ int ss_parse_real(const char *s, double lo, double hi, double *out);
 int ss_parse_numbers(const char *s, int commas, double *out, int max);
 /* "NXxNY", each 1 to 2^20, into tile[0], tile[1] (--tile); 0 or -1. */
 int ss_parse_tile(const char *s, int tile[2]);
+/* The index of name among the n names (an enum's, in its order), or -1:
+ * the parsers of closures, sides, integrators and the approach to rest. */
+int ss_parse_name(const char *name, const char *const *names, int n);
 
 /* Text appended to a caller's buffer (the JSON of relax's report and run's
  * summary): always NUL-terminated, cut when full, and len counts what was

@@ -10,8 +10,7 @@
  */
 #include "sandslide/boundary.h"
 
-#include <string.h>
-
+#include "base/strings.h"
 #include "sandslide/comm.h"
 #include "sandslide/error.h"
 
@@ -20,13 +19,10 @@ static const char *const side_names[] = {"west", "east", "south", "north"};
 
 int ss_side_kind_parse(const char *name, enum ss_side_kind *kind)
 {
-	for (int k = 0; k < 3; k++) {
-		if (strcmp(name, side_kind_names[k]) == 0) {
-			*kind = (enum ss_side_kind)k;
-			return 0;
-		}
-	}
-	return -1;
+	const int k = ss_parse_name(name, side_kind_names, 3);
+	if (k >= 0)
+		*kind = (enum ss_side_kind)k;
+	return k < 0 ? -1 : 0;
 }
 
 const char *ss_side_kind_name(enum ss_side_kind kind)

@@ -7,8 +7,8 @@
 #include "sandslide/closure.h"
 
 #include <math.h>
-#include <string.h>
 
+#include "base/strings.h"
 #include "sandslide/error.h"
 
 static const char *const closure_names[] = {
@@ -27,13 +27,11 @@ const char *ss_closure_name(enum ss_closure_kind kind)
 
 int ss_closure_parse(const char *name, enum ss_closure_kind *kind)
 {
-	for (unsigned k = 0; k < sizeof closure_names / sizeof *closure_names; k++) {
-		if (strcmp(name, closure_names[k]) == 0) {
-			*kind = (enum ss_closure_kind)k;
-			return 0;
-		}
-	}
-	return -1;
+	const int k = ss_parse_name(name, closure_names,
+	                            (int)(sizeof closure_names / sizeof *closure_names));
+	if (k >= 0)
+		*kind = (enum ss_closure_kind)k;
+	return k < 0 ? -1 : 0;
 }
 
 int ss_closure_init(struct ss_closure *c, enum ss_closure_kind kind,

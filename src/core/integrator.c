@@ -5,7 +5,7 @@
  */
 #include "sandslide/integrator.h"
 
-#include <string.h>
+#include "base/strings.h"
 
 static const char *const integrator_names[] = {
 	[SS_INTEGRATOR_EULER] = "euler", [SS_INTEGRATOR_RKL2] = "rkl2",
@@ -19,13 +19,10 @@ const char *ss_integrator_name(enum ss_integrator integrator)
 
 int ss_integrator_parse(const char *name, enum ss_integrator *out)
 {
-	for (int k = 0; k < 3; k++) {
-		if (strcmp(name, integrator_names[k]) == 0) {
-			*out = (enum ss_integrator)k;
-			return 0;
-		}
-	}
-	return -1;
+	const int k = ss_parse_name(name, integrator_names, 3);
+	if (k >= 0)
+		*out = (enum ss_integrator)k;
+	return k < 0 ? -1 : 0;
 }
 
 enum ss_integrator ss_integrator_resolve(enum ss_integrator asked, int has_bedrock,
@@ -47,11 +44,8 @@ const char *ss_rest_mode_name(enum ss_rest_mode rest)
 
 int ss_rest_mode_parse(const char *name, enum ss_rest_mode *out)
 {
-	for (int k = 0; k < 2; k++) {
-		if (strcmp(name, rest_names[k]) == 0) {
-			*out = (enum ss_rest_mode)k;
-			return 0;
-		}
-	}
-	return -1;
+	const int k = ss_parse_name(name, rest_names, 2);
+	if (k >= 0)
+		*out = (enum ss_rest_mode)k;
+	return k < 0 ? -1 : 0;
 }
