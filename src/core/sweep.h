@@ -158,10 +158,17 @@ struct ss_sweep_stage {
 /* D_j of one cell: the one expression both kernels evaluate, so that they
  * give the same bits.  A cell with D_{j-1} = D_{j-2} = 0 and M = M_0 = 0
  * keeps its height exactly (Y_0 + 0). */
+static inline double ss_sweep_stage_weigh(double mu, double nu, double tau_mu,
+                                          double tau_gamma, double d1, double d2, double m,
+                                          double m0)
+{
+	return (mu * d1 + nu * d2) + (tau_mu * m + tau_gamma * m0);
+}
+
 static inline double ss_sweep_stage_delta(const struct ss_sweep_stage *s, double d1,
                                           double d2, double m, double m0)
 {
-	return (s->mu * d1 + s->nu * d2) + (s->tau_mu * m + s->tau_gamma * m0);
+	return ss_sweep_stage_weigh(s->mu, s->nu, s->tau_mu, s->tau_gamma, d1, d2, m, m0);
 }
 
 /*
