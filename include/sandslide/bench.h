@@ -8,10 +8,17 @@
  *   subcritical    a gentler plane inside walls: nothing slides after the
  *                  first sweep, so every tile is skipped
  *   patch          a flat floor with one 512 x 512 supercritical ramp
+ *   room           the door of cases/door.ini on 480 x 320 cells whatever
+ *                  --nx and --ny (the video of doc/rendering.md: a room
+ *                  with a wall, a door and open sides, a heap in the room
+ *                  and a source pouring on it), stepped by RKL2 super-steps
+ *                  of 32 stages as a pouring run is: what an evaluation
+ *                  costs on a room-sized grid
  *
  * A case is one surface, closure and thread count: one warm-up step, then
  * `repeats` timings of `steps` steps each (cell-updates/s = nx ny steps /
- * wall time, counting every cell of the grid, swept or skipped).  Bytes
+ * wall time, counting every cell of the grid, swept or skipped; for the
+ * room a step is a super-step, and the rate counts its 33 evaluations).  Bytes
  * per cell are those the sweep's design moves (heights read and written,
  * the ring rows, the type byte on tiles that need it); the roofline is the
  * probe's bandwidth over them.
@@ -30,6 +37,7 @@ enum ss_bench_surface {
 	SS_BENCH_SUPERCRITICAL,
 	SS_BENCH_SUBCRITICAL,
 	SS_BENCH_PATCH,
+	SS_BENCH_ROOM,          /* RKL2 stages in a room with a door (below) */
 	SS_BENCH_SURFACES
 };
 
@@ -81,7 +89,7 @@ struct ss_bench_options {
 	void *context;
 };
 
-/* The surface names "supercritical", "subcritical", "patch". */
+/* The surface names "supercritical", "subcritical", "patch", "room". */
 const char *ss_bench_surface_name(enum ss_bench_surface s);
 
 /* bench's options (option.h): the command line's parser and help read them. */

@@ -15,6 +15,8 @@
 
 #include "base/strings.h"
 #include "core/ledger.h"
+#include "core/rkl2.h"
+#include "core/sources.h"
 #include "core/sweeper.h"
 #include "sandslide/boundary.h"
 #include "sandslide/error.h"
@@ -25,8 +27,12 @@
 #define SPACING_M 0.01
 #define NU_M2_PER_S 0.1
 #define PATCH_CELLS 512
+#define ROOM_NX 480             /* the room's grid, whatever --nx, --ny: */
+#define ROOM_NY 320             /*   the video of doc/rendering.md */
+#define ROOM_STAGES 32          /* stages of the room's super-steps */
+#define ROOM_RATE_M_PER_S 1e-3  /* cases/door.ini's source */
 
-static const char *const surface_names[] = {"supercritical", "subcritical", "patch"};
+static const char *const surface_names[] = {"supercritical", "subcritical", "patch", "room"};
 
 const char *ss_bench_surface_name(enum ss_bench_surface s)
 {
@@ -97,12 +103,59 @@ static void set_surface(struct ss_stepper *st, enum ss_bench_surface surface)
 				if (i >= px0 && i < px0 + PATCH_CELLS && j >= py0 && j < py0 + PATCH_CELLS)
 					h = 1.5 * tc * (i - px0) * g->dx;
 				break;
+			case SS_BENCH_ROOM:
+				/* a heap against the west wall, steeper than the angle */
+				if (i < g->nx / 3)
+					h = 1.5 * tc * (g->nx / 3 - i) * g->dx;
+				break;
 			case SS_BENCH_SURFACES:
 				break;
 			}
 			st->height[ss_grid_index(g, i, j)] = h;
 		}
 	}
+}
+
+/*
+ * The room of cases/door.ini scaled to the grid (x 0 to 1.5 m, y -0.5 to
+ * 0.5 m): the room x < 0.5 with side walls 0.05 deep, the wall x = 0.5 to
+ * 0.55 with a door |y| <= 0.1, the source on the room; the west side is a
+ * wall (run_case), the others open.
+ */
+static int set_room(struct ss_stepper *st)
+{
+	const struct ss_grid *g = &st->grid;
+	const size_t n = (size_t)g->nx * (size_t)g->ny;
+	uint8_t *room = ss_alloc(n, 1, "bench room mask");
+	if (!room)
+		return SS_ERR_FAIL;
+	for (int j = 0; j < g->ny; j++) {
+		for (int i = 0; i < g->nx; i++) {
+			const double x = (i + 0.5) * 1.5 / g->nx, y = (j + 0.5) / g->ny - 0.5;
+			const int wall = (x < 0.55 && fabs(y) > 0.45) ||
+			                 (x >= 0.5 && x < 0.55 && fabs(y) > 0.1);
+			if (wall)
+				ss_cell_type_set(st->cell_types, ss_grid_index(g, i, j), SS_CELL_WALL);
+			room[(size_t)j * g->nx + i] = !wall && x < 0.5;
+		}
+	}
+	const int err = ss_stepper_add_source(st, room, ROOM_RATE_M_PER_S, 0.0, INFINITY);
+	ss_free(room);
+	return err;
+}
+
+/* One RKL2 super-step of ROOM_STAGES stages from the state as it is, with
+ * the source on: ROOM_STAGES + 1 stencil evaluations.  A height that is
+ * not finite sets *nonfinite. */
+static void bench_superstep(struct ss_stepper *st, int *nonfinite)
+{
+	static const struct ss_advance_options none;
+	int stopped;
+	ss_sweeper_measure(st);
+	const double change = ss_rkl2_superstep(st, st->rkl2->dt_all *
+	                                        ss_rkl2_stable_ratio(ROOM_STAGES), &none, &stopped);
+	st->sweeper->tile_slots += st->sweeper->tiles_all;
+	*nonfinite |= !isfinite(change);
 }
 
 /*
@@ -129,6 +182,7 @@ struct case_result {
 	double median, min, max;     /* cell-updates/s */
 	double active_fraction;      /* tiles swept / tiles, timed steps */
 	double plain_fraction;       /* tiles without cell-type work */
+	int tile_ny;                 /* rows per tile */
 	long long steps;             /* timed steps per repeat */
 };
 
@@ -141,10 +195,12 @@ static int run_case(const struct ss_bench_options *o, enum ss_bench_surface surf
 	struct ss_stepper st;
 	const enum ss_side_kind side = surface == SS_BENCH_SUPERCRITICAL ? SS_SIDE_PERIODIC
 	                                                                 : SS_SIDE_WALL;
+	const int room = surface == SS_BENCH_ROOM;
 	memset(&b, 0, sizeof b);
 	for (int k = 0; k < 4; k++)
-		b.side[k] = side;
-	int err = ss_grid_init(&g, o->nx, o->ny, SPACING_M, SPACING_M, 0.0, 0.0);
+		b.side[k] = room ? (k == SS_WEST ? SS_SIDE_WALL : SS_SIDE_OPEN) : side;
+	int err = ss_grid_init(&g, room ? ROOM_NX : o->nx, room ? ROOM_NY : o->ny, SPACING_M,
+	                       SPACING_M, 0.0, 0.0);
 	if (!err)
 		err = ss_closure_init(&c, bc->kind, REPOSE_DEG, bc->gamma, NU_M2_PER_S);
 	if (!err)
@@ -152,19 +208,38 @@ static int run_case(const struct ss_bench_options *o, enum ss_bench_surface surf
 	if (err)
 		return err;
 	set_surface(&st, surface);
-	if ((err = ss_stepper_prepare(&st))) {
+	if (room) {
+		/* RKL2 with no accuracy limit: every super-step ROOM_STAGES long */
+		st.integrator = SS_INTEGRATOR_RKL2;
+		st.rkl2_max_stages = ROOM_STAGES;
+		st.rkl2_tol = INFINITY;
+		err = set_room(&st);
+	}
+	if (err || (err = ss_stepper_prepare(&st))) {
 		ss_stepper_release(&st);
 		return err;
 	}
+	if (room && ss_sources_update(st.sources, &st.grid, 0.0))
+		ss_sweeper_mark_sources(&st);
 
 	struct ss_sweeper *w = st.sweeper;
 	const double lambda_idle = st.closure.nu * ss_cfl_bound_lookup(&w->cfl_bound, 2.0 * c.tan_cr);
-	bench_step(&st, lambda_idle);                 /* warm-up: every tile */
+	/* a step: a substep, or for the room a super-step of ROOM_STAGES + 1
+	 * evaluations, which the rate counts */
+	const int per_step = room ? ROOM_STAGES + 1 : 1;
+	int nonfinite = 0;
+	if (room)
+		bench_superstep(&st, &nonfinite);
+	else
+		bench_step(&st, lambda_idle);                 /* warm-up: every tile */
 	long long steps = o->steps;
 	if (steps <= 0) {
 		/* enough steps for about 0.3 s per timing */
 		const double t0 = ss_parallel_wall_seconds();
-		bench_step(&st, lambda_idle);
+		if (room)
+			bench_superstep(&st, &nonfinite);
+		else
+			bench_step(&st, lambda_idle);
 		const double one = ss_parallel_wall_seconds() - t0;
 		steps = (long long)ceil(0.3 / fmax(one, 1e-6));
 		steps = steps < 1 ? 1 : steps > 2000 ? 2000 : steps;
@@ -175,11 +250,15 @@ static int run_case(const struct ss_bench_options *o, enum ss_bench_surface surf
 	w->tile_sweeps = w->tile_slots = 0.0;
 	for (int r = 0; r < repeats; r++) {
 		const double t0 = ss_parallel_wall_seconds();
-		for (long long k = 0; k < steps; k++)
-			bench_step(&st, lambda_idle);
-		rates[r] = cells * (double)steps / (ss_parallel_wall_seconds() - t0);
+		for (long long k = 0; k < steps; k++) {
+			if (room)
+				bench_superstep(&st, &nonfinite);
+			else
+				bench_step(&st, lambda_idle);
+		}
+		rates[r] = cells * (double)(steps * per_step) / (ss_parallel_wall_seconds() - t0);
 	}
-	if (w->fast.nonfinite) {
+	if (w->fast.nonfinite || nonfinite) {
 		ss_stepper_release(&st);
 		return ss_error_fail("bench %s %s: a height became NaN or infinite",
 		                     surface_names[surface], bc->label);
@@ -189,6 +268,7 @@ static int run_case(const struct ss_bench_options *o, enum ss_bench_surface surf
 		plain += w->fast.plain[k];
 	res->active_fraction = w->tile_slots > 0.0 ? w->tile_sweeps / w->tile_slots : 0.0;
 	res->plain_fraction = plain / w->fast.tiles;
+	res->tile_ny = w->tiling.tile_ny;
 	res->steps = steps;
 	res->min = res->max = rates[0];
 	for (int r = 1; r < repeats; r++) {
@@ -203,10 +283,13 @@ static int run_case(const struct ss_bench_options *o, enum ss_bench_surface surf
 /* Bytes per cell update that the fast sweep's design moves: the height read
  * and written once (16 B), the two ring rows of each tile row saved and read
  * back (32 B per tile_ny cells of a column), the packed type (a quarter
- * byte, grid.h) on tiles with walls or open cells near them. */
-static double bytes_per_cell(int tile_ny, double plain_fraction)
+ * byte, grid.h) on tiles with walls or open cells near them; an RKL2 stage
+ * (the room) also reads and writes D_{j-1} and D_{j-2} and reads Y_0 and
+ * M(Y_0) (48 B, rkl2.h). */
+static double bytes_per_cell(enum ss_bench_surface surface, int tile_ny, double plain_fraction)
 {
-	return 16.0 + 32.0 / tile_ny + 0.25 * (1.0 - plain_fraction);
+	return 16.0 + 32.0 / tile_ny + 0.25 * (1.0 - plain_fraction) +
+	       (surface == SS_BENCH_ROOM ? 48.0 : 0.0);
 }
 
 /* The grid and memory the options ask for, checked. */
@@ -275,7 +358,8 @@ int ss_bench_run(const struct ss_bench_options *o)
 				ss_parallel_set_threads(o->threads[t]);
 				if ((err = run_case(o, (enum ss_bench_surface)s, &o->closures[c], &r)))
 					return err;
-				const double bytes = bytes_per_cell(tiling.tile_ny, r.plain_fraction);
+				const double bytes = bytes_per_cell((enum ss_bench_surface)s, r.tile_ny,
+				                                    r.plain_fraction);
 				const struct ss_bench_result res = {
 					.surface = (enum ss_bench_surface)s, .closure = o->closures[c].label,
 					.threads = o->threads[t], .median = r.median, .min = r.min,
@@ -385,9 +469,11 @@ static const struct ss_option options[] = {
 	 .help = "thread counts, comma-separated"},
 	{.name = "surface", .value_name = "NAME|all", .kind = SS_OPTION_WORD, .offset = 0,
 	 .default_value = "all", .parse = parse_surfaces,
-	 .expected = "all, supercritical, subcritical or patch",
+	 .expected = "all, supercritical, subcritical, patch or room",
 	 .help = "supercritical (every face slides), subcritical (none\n"
-	         "does), patch (a 512 x 512 ramp on a flat floor), all"},
+	         "does), patch (a 512 x 512 ramp on a flat floor), room\n"
+	         "(cases/door.ini at 480 x 320 whatever --nx, --ny;\n"
+	         "RKL2 super-steps of 32 stages), all"},
 	{.name = "repeats", .value_name = "N", .kind = SS_OPTION_INT, .offset = AT(repeats),
 	 .default_value = "5", .lo = 1, .hi = 64, .expected = "1 to 64",
 	 .help = "timings per case; median, min and max"},

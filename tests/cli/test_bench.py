@@ -22,7 +22,7 @@ def test_json_names_every_case(report):
     cases = {(c["surface"], c["closure"], c["threads"]) for c in report["cases"]}
     closures = ["coulomb", "bingham", "herschel-bulkley(0.5)", "herschel-bulkley(2)",
                 "casson"]
-    want = {(s, c, t) for s in ("supercritical", "subcritical", "patch")
+    want = {(s, c, t) for s in ("supercritical", "subcritical", "patch", "room")
             for c in closures for t in (1, 2)}
     assert cases == want, f"cases missing or extra: {sorted(want ^ cases)}"
     assert (report["nx"], report["ny"], report["tile_nx"], report["tile_ny"]) == (1100, 1000, 64, 16), \
@@ -57,6 +57,10 @@ def test_active_fraction_follows_the_surface(report):
             assert a == 1.0, f"{name}: every tile slides, yet active_fraction = {a}"
         elif c["surface"] == "subcritical":
             assert a == 0.0, f"{name}: nothing slides, yet active_fraction = {a}"
+        elif c["surface"] == "room":
+            # the heap and the source keep the room's tiles awake; the
+            # floor beyond the door stays bare for the few super-steps
+            assert 0.0 < a < 1.0, f"{name}: a room and a bare floor, active {a}"
         else:
             assert 0.0 < a < 0.5, f"{name}: a 512^2 patch in 1100x1000 cells, active {a}"
 
@@ -83,6 +87,19 @@ def test_bad_options_exit_2(args, what):
     p = run(["bench"] + args)
     assert p.returncode == 2, f"bench {args}: exit {p.returncode}, expected 2"
     assert what in p.stderr, f"bench {args}: the message must name {what}: {p.stderr}"
+
+
+def test_room_is_the_video_grid_with_rkl2_stages():
+    """The room runs at 480 x 320 whatever --nx and --ny (a grid smaller
+    than the patch needs is fine for it), counts the 33 evaluations of each
+    super-step, and moves the stage arrays besides the heights."""
+    out = run_ok(["bench", "--nx", "64", "--ny", "64", "--surface", "room", "--closure",
+                  "coulomb", "--threads", "1", "--repeats", "1", "--steps", "3", "--json"])
+    report = json.loads(out.stdout)
+    (case,) = report["cases"]
+    assert case["surface"] == "room" and case["steps_per_repeat"] == 3, case
+    assert case["bytes_per_cell"] >= 16 + 48, \
+        f"an RKL2 stage reads and writes 48 B more per cell: {case['bytes_per_cell']}"
 
 
 def test_patch_needs_room():
