@@ -568,8 +568,9 @@ out:
 #define ROOM_NX 48
 #define ROOM_NY 32
 
-static int door_room(struct ss_stepper *st, int tile_nx, int tile_ny,
-                     enum ss_integrator in, enum ss_kernel kernel)
+/* The room before ss_stepper_prepare, with its source when `pour`. */
+static int door_room_set(struct ss_stepper *st, int tile_nx, int tile_ny,
+                         enum ss_integrator in, enum ss_kernel kernel, int pour)
 {
 	const int nx = ROOM_NX, ny = ROOM_NY;
 	const enum ss_side_kind W = SS_SIDE_WALL, O = SS_SIDE_OPEN;
@@ -589,9 +590,16 @@ static int door_room(struct ss_stepper *st, int tile_nx, int tile_ny,
 			mask[(size_t)j * nx + i] = i < 20;
 		}
 	}
-	int err = ss_stepper_add_source(st, mask, 1e-3, 0.0, 25.0);
+	int err = pour ? ss_stepper_add_source(st, mask, 1e-3, 0.0, 25.0) : 0;
 	CHECK(err == 0, "door room: source refused");
 	free(mask);
+	return err;
+}
+
+static int door_room(struct ss_stepper *st, int tile_nx, int tile_ny,
+                     enum ss_integrator in, enum ss_kernel kernel)
+{
+	const int err = door_room_set(st, tile_nx, tile_ny, in, kernel, 1);
 	return err ? err : prepare(st);
 }
 
@@ -692,6 +700,108 @@ static void test_determinism(void)
 	for (int k = 0; k < N_RUNS; k++)
 		free(res[k].h);
 }
+
+/* ---- 4b. the pouring tolerance -------------------------------------------- */
+
+/* The door room (its source pours until 25 s) with rkl2_pouring_tol given,
+ * to t_end, optionally with the BMI's rate field instead of the source
+ * (a uniform 1e-3 m/s on the room: the field keeps rkl2_tol). */
+static struct det_result pouring_run(double pouring_tol, double t_mid, double t_end,
+                                     int rate_field, long long *evaluations_mid)
+{
+	struct det_result res = {NULL, 0, 0, 0, 0};
+	struct ss_stepper st;
+	if (door_room_set(&st, 0, 0, SS_INTEGRATOR_RKL2, SS_KERNEL_FAST, !rate_field) == 0) {
+		st.rkl2_pouring_tol = pouring_tol;
+		if (prepare(&st)) {
+			ss_stepper_release(&st);
+			return res;
+		}
+		if (rate_field) {
+			const size_t n = (size_t)ROOM_NX * ROOM_NY;
+			double *rate = calloc(n, sizeof *rate);
+			for (int j = 2; j < ROOM_NY - 2; j++)
+				for (int i = 0; i < 20; i++)
+					rate[(size_t)j * ROOM_NX + i] = 1e-3;
+			CHECK(ss_stepper_set_rate_field(&st, rate) == 0, "the rate field was refused");
+			free(rate);
+		}
+		const double v0 = diag(&st).volume;
+		advance_to(&st, t_mid);
+		*evaluations_mid = st.evaluations;
+		advance_to(&st, t_end);
+		res.h = interior_copy(&st);
+		res.inflow = ss_stepper_inflow(&st);
+		res.outflow = ss_stepper_outflow(&st);
+		res.steps = st.steps;
+		res.evaluations = st.evaluations;
+		const struct ss_diagnostics d = diag(&st);
+		const double balance = d.volume - v0 - d.inflow + d.outflow;
+		CHECK(fabs(balance) <= 1e-12 * d.inflow, "pouring tolerance %g: the volume balance "
+		      "is %.3g m^3 of %.3g poured", pouring_tol, balance, d.inflow);
+	}
+	ss_stepper_release(&st);
+	return res;
+}
+
+/*
+ * rkl2_pouring_tol (doc/model.md#accuracy-rule): 0 and rkl2_tol itself
+ * give the same bits; a looser one takes fewer evaluations while the
+ * source pours and stays near the tight run; the BMI's rate field keeps
+ * rkl2_tol whatever rkl2_pouring_tol says.
+ */
+static void test_pouring_tolerance(void)
+{
+	const size_t cells = (size_t)ROOM_NX * ROOM_NY;
+	struct ss_model_options m;
+	ss_model_options_init(&m);
+	long long mid_unset, mid_same, mid_loose, mid_field, mid_field_loose;
+	struct det_result unset = pouring_run(0.0, 25.0, 30.0, 0, &mid_unset);
+	struct det_result same = pouring_run(m.rkl2_tol, 25.0, 30.0, 0, &mid_same);
+	struct det_result loose = pouring_run(1.0, 25.0, 30.0, 0, &mid_loose);
+	struct det_result field = pouring_run(0.0, 10.0, 12.0, 1, &mid_field);
+	struct det_result field_loose = pouring_run(1.0, 10.0, 12.0, 1, &mid_field_loose);
+	if (unset.h && same.h)
+		CHECK(same_bits(unset.h, same.h, cells) && unset.evaluations == same.evaluations,
+		      "rkl2_pouring_tol %g (rkl2_tol's) and 0 (unset) differ: %lld against %lld "
+		      "evaluations, heights by %.3g m", m.rkl2_tol, same.evaluations,
+		      unset.evaluations, max_abs_diff(unset.h, same.h, cells));
+	/* forward Euler's state at 30 s: the room starts rough, so the state
+	 * depends on the path, and RKL2 at rkl2_tol itself is 0.75-1.13
+	 * tan(a_cr) dx from it (seeds 1-8 and the default); the loose pouring
+	 * added 0.01-0.23 to that, 0.4 allowed */
+	struct ss_stepper st;
+	double *euler = NULL;
+	if (door_room(&st, 0, 0, SS_INTEGRATOR_EULER, SS_KERNEL_FAST) == 0) {
+		advance_to(&st, 30.0);
+		euler = interior_copy(&st);
+	}
+	ss_stepper_release(&st);
+	if (unset.h && loose.h && euler) {
+		const double unit = tan(REPOSE * DEG) * 0.025;
+		const double tight_off = max_abs_diff(euler, unset.h, cells) / unit;
+		const double loose_off = max_abs_diff(euler, loose.h, cells) / unit;
+		CHECK(mid_loose < mid_unset, "pouring at rkl2_pouring_tol 1 took %lld evaluations "
+		      "to 25 s, not fewer than the %lld at %g", mid_loose, mid_unset, m.rkl2_tol);
+		CHECK(loose_off <= tight_off + 0.4, "at t = 30 s the loose pouring run is %.3g "
+		      "tan(a_cr) dx from Euler, the tight one %.3g", loose_off, tight_off);
+		printf("  pouring tolerance (door room %dx%d to 25 s): %lld evaluations at %g, %lld "
+		       "at 1; at 30 s %.3g and %.3g tan(a_cr) dx from Euler\n", ROOM_NX, ROOM_NY,
+		       mid_unset, m.rkl2_tol, mid_loose, tight_off, loose_off);
+	}
+	free(euler);
+	if (field.h && field_loose.h)
+		CHECK(same_bits(field.h, field_loose.h, cells) &&
+		      field.evaluations == field_loose.evaluations && field.inflow > 0.0,
+		      "the rate field (inflow %g m^3) took rkl2_pouring_tol: %lld against %lld "
+		      "evaluations", field.inflow, field_loose.evaluations, field.evaluations);
+	free(unset.h);
+	free(same.h);
+	free(loose.h);
+	free(field.h);
+	free(field_loose.h);
+}
+
 
 /* ---- 5. subcritical states keep their bits -------------------------------- */
 
@@ -1434,6 +1544,7 @@ int main(void)
 	RUN_TIMED(test_stability_polynomial);
 	RUN_TIMED(test_second_order);
 	RUN_TIMED(test_determinism);
+	RUN_TIMED(test_pouring_tolerance);
 	RUN_TIMED(test_subcritical_unchanged);
 	RUN_TIMED(test_conservation);
 	RUN_TIMED(test_periodic);

@@ -64,6 +64,9 @@ TIMING = {"wall_seconds", "read_seconds", "write_seconds", "seconds", "seconds_p
 #   and RKL2 no longer polishes near rest: the paths kept are compared, by
 #   running relax with --integrator euler in both builds and giving a NEW
 #   that has the approach `rest off` (Runner.sandslide)
+#   issue 39: RKL2's super-steps that pour have their own tolerance
+#   (rkl2_pouring_tol, doc/model.md#accuracy-rule): NEW gets the one the
+#   rest of the run has, which OLD used for both (Runner.rest_off)
 CHANGED_ON_PURPOSE = {
     "fit.json": re.compile(r"\.forward_runs|\.closures\[\d+\]\.(evaluations|"
                            r"uncertainty\.\w+\.(std|low|high))"),
@@ -143,19 +146,27 @@ class Runner:
         self.has_rest = {}          # build -> its relax takes --rest
 
     def rest_off(self, which, args):
-        """args, with the approach to rest off where the build has one."""
+        """args, with the approach to rest off where the build has one, and
+        the pouring tolerance that of the rest where it has its own."""
         build = self.builds[which]
         if build not in self.has_rest:
             h = subprocess.run([os.path.join(build, "sandslide"), "help", "relax"],
                                capture_output=True, text=True).stdout
-            self.has_rest[build] = "--rest " in h
-        if not self.has_rest[build] or "--restart" in args:
+            self.has_rest[build] = ("--rest " in h, "--rkl2-pouring-tol" in h)
+        rest, pouring = self.has_rest[build]
+        if "--restart" in args:
             return list(args)
+        out = list(args)
+        tol = next((a.split("=", 1)[1] for a in args if a.startswith("time.rkl2_tol=")), None)
         if args[0] == "relax":
-            return list(args) + ["--rest", "off"]
-        if args[0] == "run":
-            return list(args) + ["--set", "time.rest=off"]
-        return list(args)
+            if "--rkl2-tol" in args:
+                tol = args[args.index("--rkl2-tol") + 1]
+            out += ["--rest", "off"] if rest else []
+            out += ["--rkl2-pouring-tol", tol or "0.1"] if pouring else []
+        elif args[0] == "run":
+            out += ["--set", "time.rest=off"] if rest else []
+            out += ["--set", f"time.rkl2_pouring_tol={tol or 0.1}"] if pouring else []
+        return out
 
     def sandslide(self, which, args, env=None, mpi=0):
         build = self.builds[which]

@@ -47,6 +47,7 @@ struct ss_model_options {
 	int rkl2_max_stages;              /* RKL2: stages per super-step */
 	double rkl2_tol;                  /* RKL2: error estimate per super-step,
 	                                   * in tan(a_cr) min(dx, dy) */
+	double rkl2_pouring_tol;          /*   the same while a source pours */
 	struct ss_sliding_layer layer;    /* NaN where not given (a case's nu is
 	                                   * given or derived from it: case.h) */
 	int nu_from_layer;                /* nu was derived from the layer (a

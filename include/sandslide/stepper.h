@@ -29,8 +29,11 @@
  *              state), so no state a stage can reach is unstable;
  *   accuracy   s <= rkl2_max_stages, and the embedded error estimate of
  *              RKC and SUNDIALS at most rkl2_tol tan(a_cr) min(dx, dy) in
- *              the max norm.  One more evaluation after the last stage, at
- *              Y_s, writing nothing, makes the estimate of a super-step,
+ *              the max norm (rkl2_pouring_tol in its place for a
+ *              super-step in which a source of ss_stepper_add_source
+ *              pours, not the rate field).  One more evaluation
+ *              after the last stage, at Y_s, writing nothing, makes the
+ *              estimate of a super-step,
  *              which sets the limit of the next, tau 0.9 sqrt(tol / est),
  *              growing by at most 2x a super-step, from 4 stages at the
  *              start.  The limit is known when a super-step ends and is
@@ -46,19 +49,9 @@
  *              weights, as the heights are, so volume balances to
  *              round-off.
  *
- *   rest       once a super-step's mean rate |Y_s - Y_0| / tau is below
- *              steady_tol but a face is still above the steady rule's
- *              slope, RKL2 polishes: a burst of forward-Euler steps, as
- *              many as its last super-step had stages (the same cost),
- *              then one super-step, and so on until steady or the end of
- *              the call to ss_stepper_advance.  Near rest RKL2 damps the
- *              grid-scale remainder at the kink of f_sl only by about a_s
- *              ~ 1/2 a super-step, and super-steps that grow while the
- *              state barely changes crawl; on a long slope that still
- *              creeps, forward Euler crawls instead.  Bursts of the
- *              super-step's cost keep either from losing more than about
- *              2x to the other (measured: doc/model.md#accuracy-rule).
- *              Steps and evaluations count the polishing steps too.
+ *   rest       a run that asks for steady hands the last of its motion
+ *              to the approach to rest (rest, src/core/rest.h), with
+ *              either integrator.
  *
  * Bedrock is not supported by RKL2 (its stages have negative weights, so
  * the per-face limit of doc/model.md#bedrock cannot keep sand above the
@@ -122,6 +115,9 @@ struct ss_stepper {
 	                               * (both: the model options' table,
 	                               * model_options.h, has the defaults and
 	                               * checks the ranges) */
+	double rkl2_pouring_tol;      /* RKL2: the same while a source added by
+	                               * ss_stepper_add_source pours (not the
+	                               * rate field); 0: rkl2_tol */
 
 	/* the state */
 	double *height;               /* m, cells with halo (ss_grid_index) */

@@ -123,8 +123,12 @@ static int make_stepper(const struct fit *f, const struct closure_fit *cf, const
 			                      "at %s: expected a finite value > 0", c.path, c.model.nu, at);
 		}
 	}
-	if (f->integrator == SS_INTEGRATOR_RKL2)
+	if (f->integrator == SS_INTEGRATOR_RKL2) {
+		/* the forward runs' tolerance holds while a source pours too: a
+		 * cost that jitters with the super-steps misleads the optimiser */
 		c.model.rkl2_tol = stepping == STEP_REFERENCE ? fit_reference_rkl2_tol(f) : fit_rkl2_tol(f);
+		c.model.rkl2_pouring_tol = c.model.rkl2_tol;
+	}
 	else if (stepping == STEP_REFERENCE)
 		c.model.cfl *= 0.5;
 	return ss_setup_stepper(&c, f->o->job.tile[0], f->o->job.tile[1], SS_KERNEL_FAST, st);

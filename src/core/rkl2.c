@@ -97,6 +97,8 @@ int ss_rkl2_create(struct ss_rkl2 **out, const struct ss_stepper *st)
 	                       ss_cfl_bound_lookup(&st->sweeper->cfl_bound, HUGE_VAL) * inv_d2);
 	r->tau_stages = r->dt_all * ss_rkl2_stable_ratio(st->rkl2_max_stages);
 	r->tol = st->rkl2_tol * st->closure.tan_cr * fmin(g->dx, g->dy);
+	r->tol_pouring = st->rkl2_pouring_tol > 0.0
+		? st->rkl2_pouring_tol * st->closure.tan_cr * fmin(g->dx, g->dy) : r->tol;
 	r->tau_limit = r->dt_all * ss_rkl2_stable_ratio(START_STAGES);
 	return SS_OK;
 }
@@ -115,11 +117,14 @@ void ss_rkl2_destroy(struct ss_rkl2 *r)
 /*
  * The accuracy rule (stepper.h) after a super-step of tau with error
  * estimate est: the limit becomes tau 0.9 sqrt(tol / est), at most twice
- * the limit it had; a limit above the stage cap is none.
+ * the limit it had; a limit above the stage cap is none.  tol is the
+ * pouring one when a source of the case poured in the super-step
+ * (doc/model.md#accuracy-rule).
  */
-static void control(struct ss_rkl2 *r, double tau, double estimate)
+static void control(struct ss_rkl2 *r, double tau, double estimate, int pouring)
 {
-	const double factor = estimate > 0.0 ? fmin(0.9 * sqrt(r->tol / estimate), 2.0) : 2.0;
+	const double tol = pouring ? r->tol_pouring : r->tol;
+	const double factor = estimate > 0.0 ? fmin(0.9 * sqrt(tol / estimate), 2.0) : 2.0;
 	const double limit = isfinite(r->tau_limit) ? r->tau_limit : r->tau_stages;
 	r->tau_limit = fmin(tau * factor, 2.0 * limit);
 	if (r->tau_limit >= r->tau_stages)
@@ -186,7 +191,8 @@ double ss_rkl2_superstep(struct ss_stepper *st, double tau,
 	st->sweeper->tile_sweeps += awake / (s + 1);
 	st->sweeper->tiles_evaluated += awake;
 	st->sweeper->tile_evaluation_slots += (s + 1) * st->sweeper->tiles_all;
-	control(r, tau, max[1]);
+	/* a case's source, not the BMI's rate field (doc/model.md) */
+	control(r, tau, max[1], st->sources->on != 0);
 	r->last_stages = s;
 	return isfinite(max[0]) ? max[0] : INFINITY;
 }

@@ -74,6 +74,7 @@ struct ss_rkl2 {
 	double tau_stages;      /* the longest super-step the stage cap
 	                         * (rkl2_max_stages) allows, s */
 	double tol;             /* the error tolerance, m */
+	double tol_pouring;     /*   while a source of the case pours, m */
 	double tau_limit;       /* the accuracy rule's longest next super-step,
 	                         * s (INFINITY: no limit); restart state */
 	int last_stages;        /* s of the last super-step */

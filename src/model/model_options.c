@@ -101,6 +101,11 @@ static const struct ss_option options[] = {
 	 .expected = "a number > 0",
 	 .help = "rkl2: error estimate of a super-step at most\n"
 	         "E tan(angle) min(dx, dy)"},
+	{.name = "rkl2-pouring-tol", .case_key = "time.rkl2_pouring_tol", .value_name = "E",
+	 .kind = SS_OPTION_REAL, .offset = AT(rkl2_pouring_tol), .default_value = "1",
+	 SS_OPTION_POSITIVE, .expected = "a number > 0",
+	 .help = "rkl2: the same while a source of the case\n"
+	         "pours (doc/model.md#accuracy-rule)"},
 	{.name = "max-time", .case_key = "time.max_time", .value_name = "T", .kind = SS_OPTION_REAL,
 	 .offset = AT(max_time), SS_OPTION_POSITIVE, .expected = "s > 0",
 	 .help = "stop at T s even if not steady (default: no limit;\n"

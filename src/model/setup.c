@@ -117,6 +117,7 @@ static int start(const struct start *s, struct ss_stepper *st)
 	st->rest = rest;
 	st->rkl2_max_stages = m->rkl2_max_stages;
 	st->rkl2_tol = m->rkl2_tol;
+	st->rkl2_pouring_tol = m->rkl2_pouring_tol;
 	return SS_OK;
 }
 
