@@ -580,6 +580,10 @@ void SS_PATH_FN(ss_sweep_fast_wake_all)(struct ss_sweep_fast *f, const struct ss
 
 static int list_rows(struct ss_sweep_fast *f);
 
+/* ss_sweep_fast_save_rings copies in one thread up to this many cells per
+ * ring (2 x 8 B each; 16384: 256 kB) */
+#define SAVE_RINGS_SERIAL_CELLS 16384.0
+
 #if SS_PATH == SS_PATH_GENERIC
 void ss_sweep_fast_save_rings(struct ss_sweep_fast *f, const struct ss_grid *g,
                               const double *height)
@@ -587,8 +591,12 @@ void ss_sweep_fast_save_rings(struct ss_sweep_fast *f, const struct ss_grid *g,
 	const struct ss_tiling *t = &f->tiling;
 	const int rows = list_rows(f);
 	const ptrdiff_t stride = g->stride;
+	/* two rows of doubles per tile row: on a room-sized grid a few tens of
+	 * kB, copied faster than a sleeping thread wakes for a parallel
+	 * region (one per RKL2 stage) */
+	const int parallel = rows > 1 && (double)rows * g->nx > SAVE_RINGS_SERIAL_CELLS;
 
-	#pragma omp parallel for schedule(dynamic, 1) num_threads(f->threads) if(rows > 1)
+	#pragma omp parallel for schedule(dynamic, 1) num_threads(f->threads) if(parallel)
 	for (int r = 0; r < rows; r++) {
 		const int ty = f->row_list[r];
 		for (int tx = 0; tx < t->tiles_x; tx++) {
