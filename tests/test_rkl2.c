@@ -609,6 +609,15 @@ struct det_result {
 	long long steps, evaluations;
 };
 
+/* What the runs compare: the heights (the caller frees them), the ledger,
+ * the counters. */
+static struct det_result result_of(struct ss_stepper *st)
+{
+	const struct det_result res = {interior_copy(st), ss_stepper_inflow(st),
+	                               ss_stepper_outflow(st), st->steps, st->evaluations};
+	return res;
+}
+
 static struct det_result door_run(int threads, int tile_nx, int tile_ny, enum ss_kernel kernel,
                                   double t_end)
 {
@@ -618,11 +627,7 @@ static struct det_result door_run(int threads, int tile_nx, int tile_ny, enum ss
 	if (door_room(&st, tile_nx, tile_ny, SS_INTEGRATOR_RKL2, kernel) == 0) {
 		advance_to(&st, 0.4 * t_end);
 		advance_to(&st, t_end);
-		res.h = interior_copy(&st);
-		res.inflow = ss_stepper_inflow(&st);
-		res.outflow = ss_stepper_outflow(&st);
-		res.steps = st.steps;
-		res.evaluations = st.evaluations;
+		res = result_of(&st);
 	}
 	ss_stepper_release(&st);
 	ss_parallel_set_threads(1);
@@ -730,11 +735,7 @@ static struct det_result pouring_run(double pouring_tol, double t_mid, double t_
 		advance_to(&st, t_mid);
 		*evaluations_mid = st.evaluations;
 		advance_to(&st, t_end);
-		res.h = interior_copy(&st);
-		res.inflow = ss_stepper_inflow(&st);
-		res.outflow = ss_stepper_outflow(&st);
-		res.steps = st.steps;
-		res.evaluations = st.evaluations;
+		res = result_of(&st);
 		const struct ss_diagnostics d = diag(&st);
 		const double balance = d.volume - v0 - d.inflow + d.outflow;
 		CHECK(fabs(balance) <= 1e-12 * d.inflow, "pouring tolerance %g: the volume balance "

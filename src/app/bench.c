@@ -117,10 +117,10 @@ static void set_surface(struct ss_stepper *st, enum ss_bench_surface surface)
 }
 
 /*
- * The room of cases/door.ini scaled to the grid (x 0 to 1.5 m, y -0.5 to
- * 0.5 m): the room x < 0.5 with side walls 0.05 deep, the wall x = 0.5 to
- * 0.55 with a door |y| <= 0.1, the source on the room; the west side is a
- * wall (run_case), the others open.
+ * The room of cases/door.ini, its coordinates stretched over the grid (x
+ * from 0 to 1.5, y from -0.5 to 0.5): the room x < 0.5 with side walls
+ * 0.05 deep, the wall x = 0.5 to 0.55 with a door |y| <= 0.1, the source
+ * on the room; the west side is a wall (run_case), the others open.
  */
 static int set_room(struct ss_stepper *st)
 {
@@ -178,6 +178,15 @@ static void bench_step(struct ss_stepper *st, double lambda_idle)
 	                   NULL, NULL, st->cell_types, st->height, st->ledger->open_flux);
 }
 
+/* A step of the case: a substep, or the room's super-step. */
+static void bench_one(struct ss_stepper *st, int room, double lambda_idle, int *nonfinite)
+{
+	if (room)
+		bench_superstep(st, nonfinite);
+	else
+		bench_step(st, lambda_idle);
+}
+
 struct case_result {
 	double median, min, max;     /* cell-updates/s */
 	double active_fraction;      /* tiles swept / tiles, timed steps */
@@ -228,18 +237,12 @@ static int run_case(const struct ss_bench_options *o, enum ss_bench_surface surf
 	 * evaluations, which the rate counts */
 	const int per_step = room ? ROOM_STAGES + 1 : 1;
 	int nonfinite = 0;
-	if (room)
-		bench_superstep(&st, &nonfinite);
-	else
-		bench_step(&st, lambda_idle);                 /* warm-up: every tile */
+	bench_one(&st, room, lambda_idle, &nonfinite);   /* warm-up: every tile */
 	long long steps = o->steps;
 	if (steps <= 0) {
 		/* enough steps for about 0.3 s per timing */
 		const double t0 = ss_parallel_wall_seconds();
-		if (room)
-			bench_superstep(&st, &nonfinite);
-		else
-			bench_step(&st, lambda_idle);
+		bench_one(&st, room, lambda_idle, &nonfinite);
 		const double one = ss_parallel_wall_seconds() - t0;
 		steps = (long long)ceil(0.3 / fmax(one, 1e-6));
 		steps = steps < 1 ? 1 : steps > 2000 ? 2000 : steps;
@@ -250,12 +253,8 @@ static int run_case(const struct ss_bench_options *o, enum ss_bench_surface surf
 	w->tile_sweeps = w->tile_slots = 0.0;
 	for (int r = 0; r < repeats; r++) {
 		const double t0 = ss_parallel_wall_seconds();
-		for (long long k = 0; k < steps; k++) {
-			if (room)
-				bench_superstep(&st, &nonfinite);
-			else
-				bench_step(&st, lambda_idle);
-		}
+		for (long long k = 0; k < steps; k++)
+			bench_one(&st, room, lambda_idle, &nonfinite);
 		rates[r] = cells * (double)(steps * per_step) / (ss_parallel_wall_seconds() - t0);
 	}
 	if (w->fast.nonfinite || nonfinite) {
