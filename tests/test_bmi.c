@@ -55,6 +55,20 @@ static struct Bmi *started(void)
 	return m;
 }
 
+/* A model initialized from the test file `name`, or NULL after a failed
+ * check that gives the library's message. */
+static struct Bmi *initialized(const char *name)
+{
+	struct Bmi *m = ss_bmi_create();
+	CHECK(m && m->initialize(m, check_file(name)) == BMI_SUCCESS, "%s: %s", name,
+	      ss_error_last_message());
+	if (m && !m->data) {
+		ss_bmi_destroy(m);
+		m = NULL;
+	}
+	return m;
+}
+
 /* The heights of a stepper, [y][x], south row first. */
 static void stepper_heights(const struct ss_stepper *st, double *out)
 {
@@ -514,13 +528,9 @@ static void elevation_is_nan_without_data(const char *nodata)
 	snprintf(cfg, sizeof cfg, "[bmi]\ndem = holes.asc\ntime_step = 0.5\nend = 2\n"
 	         "nodata = %s\n", nodata);
 	check_write_file(check_file("holes.cfg"), cfg);
-	struct Bmi *m = ss_bmi_create();
-	CHECK(m && m->initialize(m, check_file("holes.cfg")) == BMI_SUCCESS, "%s",
-	      ss_error_last_message());
-	if (!m || !m->data) {
-		ss_bmi_destroy(m);
+	struct Bmi *m = initialized("holes.cfg");
+	if (!m)
 		return;
-	}
 	double got[DX * DY], at[DX * DY], want[DX * DY];
 	int inds[DX * DY];
 	for (int c = 0; c < DX * DY; c++)
@@ -599,13 +609,9 @@ static void rate_is_a_source(void)
 	const double inflow = ss_stepper_inflow(&st);
 	ss_stepper_release(&st);
 
-	struct Bmi *m = ss_bmi_create();
-	CHECK(m && m->initialize(m, check_file("flat.ini")) == BMI_SUCCESS, "%s",
-	      ss_error_last_message());
-	if (!m || !m->data) {
-		ss_bmi_destroy(m);
+	struct Bmi *m = initialized("flat.ini");
+	if (!m)
 		return;
-	}
 	const double v0 = scalar(m, VOLUME);
 	double back[NX * NY];
 	CHECK(m->set_value(m, RATE, rate) == BMI_SUCCESS, "%s", ss_error_last_message());
@@ -657,13 +663,9 @@ static void bedrock_and_erosion(void)
 	                 "[model]\nclosure = coulomb\nrepose_angle = 35\nnu = 0.1\n\n"
 	                 "[time]\nend = 10\noutput_every = 1\n\n"
 	                 "[initial]\ntype = flat\nheight = 0.3\nbedrock = rock.asc\n");
-	struct Bmi *m = ss_bmi_create();
-	CHECK(m && m->initialize(m, check_file("rock.ini")) == BMI_SUCCESS, "%s",
-	      ss_error_last_message());
-	if (!m || !m->data) {
-		ss_bmi_destroy(m);
+	struct Bmi *m = initialized("rock.ini");
+	if (!m)
 		return;
-	}
 	int n = 0, grid = -1;
 	CHECK(m->get_output_item_count(m, &n) == BMI_SUCCESS && n == NOUT + 1, "%d outputs", n);
 	CHECK(m->get_var_grid(m, BEDROCK, &grid) == BMI_SUCCESS && grid == 0, "bedrock grid");
@@ -703,13 +705,9 @@ static void config_names_a_case_or_a_dem(void)
 	fclose(f);
 	check_write_file(check_file("dem.cfg"), "; a DEM\n[bmi]\ndem = pile.asc\n"
 	                 "time_step = 0.5\nend = 3\nangle = 33\nnu = 0.1\nsides = open\n");
-	struct Bmi *m = ss_bmi_create();
-	CHECK(m && m->initialize(m, check_file("dem.cfg")) == BMI_SUCCESS, "%s",
-	      ss_error_last_message());
-	if (!m || !m->data) {
-		ss_bmi_destroy(m);
+	struct Bmi *m = initialized("dem.cfg");
+	if (!m)
 		return;
-	}
 	int shape[2] = {0, 0};
 	double spacing[2], origin[2], step = 0, end = 0;
 	CHECK(m->get_grid_shape(m, 0, shape) == BMI_SUCCESS && shape[0] == DY && shape[1] == DX,

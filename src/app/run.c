@@ -262,9 +262,10 @@ static int plan_output(struct run *r)
 	/* a grid too large for memory is the set-up's to refuse, naming its
 	 * [grid] line: the more basic complaint */
 	const int bedrock = r->c.bedrock_file != NULL;
-	const double memory = ss_stepper_memory_bytes(&g, ss_integrator_resolve(
-		r->c.model.integrator, bedrock, 0), r->c.steady && !bedrock ? r->c.model.rest :
-		SS_REST_OFF) / ss_comm_size() * ss_comm_node_ranks();
+	const double memory = ss_setup_node_bytes(&g, ss_integrator_resolve(r->c.model.integrator,
+	                                                                    bedrock, 0),
+	                                          ss_setup_rest_mode(&r->c.model, r->c.steady,
+	                                                             bedrock));
 	const double available = ss_memory_available_bytes();
 	if (available > 0.0 && memory > available)
 		return SS_OK;

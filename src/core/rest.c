@@ -138,9 +138,7 @@ double ss_rest_superstep(struct ss_stepper *st, double *tau,
 	double largest[2] = {change, start_rate};   /* max |Y_s - Y_0|, max |M(Y_0)| */
 	ss_comm_reduce(largest, 2, &awake, 1);
 	change = largest[0];
-	st->sweeper->tile_sweeps += awake / s;
-	st->sweeper->tiles_evaluated += awake;
-	st->sweeper->tile_evaluation_slots += s * st->sweeper->tiles_all;
+	ss_sweeper_count_superstep(st->sweeper, awake, s);
 	r->steps++;
 	*tau = ch.tau;
 	if (!isfinite(change))

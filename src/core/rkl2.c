@@ -188,9 +188,7 @@ double ss_rkl2_superstep(struct ss_stepper *st, double tau,
 	 * any rank count */
 	double max[2] = {change, estimate};
 	ss_comm_reduce(max, 2, &awake, 1);
-	st->sweeper->tile_sweeps += awake / (s + 1);
-	st->sweeper->tiles_evaluated += awake;
-	st->sweeper->tile_evaluation_slots += (s + 1) * st->sweeper->tiles_all;
+	ss_sweeper_count_superstep(st->sweeper, awake, s + 1);
 	/* a case's source, not the BMI's rate field (doc/model.md) */
 	control(r, tau, max[1], st->sources->on != 0);
 	r->last_stages = s;

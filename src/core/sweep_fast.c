@@ -1098,6 +1098,9 @@ static inline void row_stage(const struct tile_ctx *c, struct tile *t,
 			m0[x] = flows ? rate[x] : 0.0;
 		}
 	}
+	/* two loops, not one with `plain | (type == flow)`: gcc then splits
+	 * the one on `plain` itself and leaves the plain copy, the common one,
+	 * unvectorised (perf, 2026-12-05) */
 	if (plain) {
 		/* every cell flows */
 		#pragma omp simd reduction(max:row_max) reduction(|:changed)

@@ -75,6 +75,13 @@ void ss_sweeper_wake_all(struct ss_stepper *st)
 		ss_sweep_fast_wake_all(&st->sweeper->fast, &st->grid, st->height, st->cell_types);
 }
 
+void ss_sweeper_count_superstep(struct ss_sweeper *w, double awake, int evaluations)
+{
+	w->tile_sweeps += awake / evaluations;
+	w->tiles_evaluated += awake;
+	w->tile_evaluation_slots += evaluations * w->tiles_all;
+}
+
 int ss_stages_arrays_create(const struct ss_stepper *st, const char *const names[4],
                             double **y0, double **d1, double **d2, double **m0)
 {

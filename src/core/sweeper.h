@@ -88,6 +88,11 @@ double ss_sweeper_measure(struct ss_stepper *st);
  * cells of this rank, m/s (INFINITY on NaN). */
 double ss_sweeper_euler(struct ss_stepper *st, double dt);
 
+/* The tile counts of a super-step of `evaluations` passes that swept
+ * `awake` tiles in all (summed over the ranks): its share of the active
+ * fraction (the mean over its passes) and of the swept cells' rate. */
+void ss_sweeper_count_superstep(struct ss_sweeper *w, double awake, int evaluations);
+
 /* A pass of an RKL2 stage (or the estimate after the last: sweep.h), from
  * the halo and the ring rows it fills first unless `measured` (stage 1:
  * ss_sweeper_measure did).  Returns what the sweep returns on this rank;

@@ -37,10 +37,14 @@ struct start {
 	const char *memory_advice;            /* " (reduce nx and ny)", or "" */
 };
 
-/* The bytes a stepper of nx x ny cells of this rank's share and the ranks
- * on its node need (dx, dy and the origin do not matter). */
-static double stepper_node_bytes(const struct ss_grid *g, enum ss_integrator integrator,
-                                 enum ss_rest_mode rest)
+enum ss_rest_mode ss_setup_rest_mode(const struct ss_model_options *m, int steady,
+                                     int has_bedrock)
+{
+	return steady && !has_bedrock ? m->rest : SS_REST_OFF;
+}
+
+double ss_setup_node_bytes(const struct ss_grid *g, enum ss_integrator integrator,
+                           enum ss_rest_mode rest)
 {
 	return ss_stepper_memory_bytes(g, integrator, rest) / ss_comm_size() *
 	       ss_comm_node_ranks();
@@ -59,10 +63,10 @@ int ss_setup_check_raster_memory(const char *name, int nx, int ny, int rasters,
 	const double raster = rasters * cells * (sizeof(double) + 1.0) / ss_comm_size() *
 	                      ss_comm_node_ranks();
 	/* auto as a run (fit) or a relax resolves it, whichever needs more */
-	const enum ss_rest_mode rest = has_bedrock ? SS_REST_OFF : m->rest;
-	const double run = stepper_node_bytes(&g, ss_integrator_resolve(m->integrator, has_bedrock,
+	const enum ss_rest_mode rest = ss_setup_rest_mode(m, 1, has_bedrock);   /* at most */
+	const double run = ss_setup_node_bytes(&g, ss_integrator_resolve(m->integrator, has_bedrock,
 	                                                                0), rest);
-	const double relax = stepper_node_bytes(&g, ss_integrator_resolve(m->integrator,
+	const double relax = ss_setup_node_bytes(&g, ss_integrator_resolve(m->integrator,
 	                                                                  has_bedrock, 1), rest);
 	const double need = raster + fmax(run, relax);
 	const double have = ss_memory_available_bytes();
@@ -93,11 +97,9 @@ static int start(const struct start *s, struct ss_stepper *st)
 		return ss_error_input("%s cannot be used with %s: its stages cannot keep the sand "
 		                      "above the rock (use euler or auto)", s->integrator_what,
 		                      s->bedrock_what);
-	/* the approach to rest: for a run until steady, and not with a
-	 * bedrock (its stages have negative weights, as RKL2's) */
-	const enum ss_rest_mode rest = s->steady && !s->has_bedrock ? m->rest : SS_REST_OFF;
+	const enum ss_rest_mode rest = ss_setup_rest_mode(m, s->steady, s->has_bedrock);
 	/* the memory of one rank's slab, times the ranks on this node */
-	const double need = stepper_node_bytes(&g, integrator, rest);
+	const double need = ss_setup_node_bytes(&g, integrator, rest);
 	const double have = ss_memory_available_bytes();
 	if (have > 0.0 && need > have) {
 		char nb[32], hb[32];

@@ -70,6 +70,17 @@ int ss_setup_read_window(const char *spec, const char *context,
                          struct ss_dem_read_options opt, int tile_nx, int tile_ny,
                          struct ss_raster *r);
 
+/* The approach to rest a stepper of model m takes: for a run until steady,
+ * not with a bedrock (its stages have negative weights, as RKL2's). */
+enum ss_rest_mode ss_setup_rest_mode(const struct ss_model_options *m, int steady,
+                                     int has_bedrock);
+
+/* The bytes a stepper of g's size with this integrator and approach needs
+ * on this node: this rank's share of the grid times the ranks on the node
+ * (dx, dy and the origin do not matter). */
+double ss_setup_node_bytes(const struct ss_grid *g, enum ss_integrator integrator,
+                           enum ss_rest_mode rest);
+
 /* SS_ERR_INPUT "NAME: NX x NY cells need X of memory; this machine has Y
  * available" when `rasters` whole rasters of nx x ny cells (values and
  * nodata flags) and the stepper of model m (with a bedrock or not) need
