@@ -103,6 +103,9 @@ struct scenario {
 	int sources;
 	uint8_t *mask[2];
 	double rate[2], start[2], stop[2];
+	int materials;       /* > 0: ss_stepper_set_materials with these */
+	struct ss_closure material[3];
+	uint16_t *material_of_cell;   /* nx * ny */
 };
 
 static void scenario_alloc(struct scenario *sc, int nx, int ny)
@@ -121,6 +124,7 @@ static void scenario_free(struct scenario *sc)
 	free(sc->h0);
 	free(sc->type);
 	free(sc->bedrock);
+	free(sc->material_of_cell);
 	for (int k = 0; k < 2; k++)
 		free(sc->mask[k]);
 }
@@ -162,6 +166,13 @@ static int build(struct ss_stepper *st, const struct scenario *sc, enum ss_kerne
 			st->height[k] = sc->h0[(size_t)j * sc->nx + i];
 			ss_cell_type_set(st->cell_types, k, sc->type[(size_t)j * sc->nx + i]);
 		}
+	}
+	if (sc->materials &&
+	    (err = ss_stepper_set_materials(st, sc->material, sc->materials,
+	                                    sc->material_of_cell))) {
+		CHECK(0, "%s: materials refused", sc->name);
+		ss_stepper_release(st);
+		return err;
 	}
 	if (sc->bedrock && (err = ss_stepper_set_bedrock(st, sc->bedrock))) {
 		CHECK(0, "%s: bedrock refused", sc->name);
@@ -509,6 +520,82 @@ static void test_identity_bedrock(void)
 }
 
 /* ---- 2. active tiles: a pile slides, spreads and stops -------------------- */
+
+/* Materials (doc/model.md#materials) in random rectangles: angles 25,
+ * REPOSE and 40 deg with different nu; the fast kernel gives the
+ * reference's bits, and each face the rule of the larger angle of its two
+ * cells.  Also Coulomb beside Bingham (faces of two forms in one row).
+ * One material, or three equal ones, give the bits of a run without
+ * materials. */
+static void test_identity_materials(void)
+{
+	const double T = 0.12;
+	const struct ss_boundary sides[2] = {sides4(SS_SIDE_OPEN, SS_SIDE_WALL, SS_SIDE_WALL,
+	                                            SS_SIDE_OPEN, 0.002),
+	                                     sides4(SS_SIDE_PERIODIC, SS_SIDE_PERIODIC,
+	                                            SS_SIDE_WALL, SS_SIDE_WALL, 0.0)};
+	static const int some[3] = {0, 1, 3};
+	for (int c = 0; c <= N_CLOSURES; c++) {
+		struct rng r = {seed * 37u + (uint64_t)c};
+		struct scenario sc;
+		char name[160];
+		/* c == N_CLOSURES: coulomb and bingham side by side */
+		const struct closure_case cl = closures[c < N_CLOSURES ? c : 0];
+		random_scenario(&sc, &r, cl, sides[c % 2], c % 2, T);
+		sc.materials = 3;
+		const double angles[3] = {25.0, REPOSE, 40.0};
+		for (int m = 0; m < 3; m++) {
+			const struct closure_case mc = c < N_CLOSURES || m != 1 ? cl : closures[1];
+			ss_closure_init(&sc.material[m], mc.kind, angles[m], mc.gamma,
+			                cl.nu * (1.0 + 0.5 * m));
+		}
+		sc.material_of_cell = calloc((size_t)sc.nx * sc.ny, sizeof *sc.material_of_cell);
+		uint8_t *mask = calloc((size_t)sc.nx * sc.ny, 1);
+		for (int m = 1; m < 3; m++) {
+			memset(mask, 0, (size_t)sc.nx * sc.ny);
+			for (int k = 0; k < 3; k++)
+				random_rect(&r, sc.nx, sc.ny, 40, 30, mask, 1);
+			for (size_t q = 0; q < (size_t)sc.nx * sc.ny; q++)
+				if (mask[q])
+					sc.material_of_cell[q] = (uint16_t)(m == 1 ? 2 : 1);
+		}
+		free(mask);
+		snprintf(name, sizeof name, "%s, three materials%s", cl.name,
+		         c < N_CLOSURES ? "" : " (coulomb and bingham)");
+		sc.name = name;
+		identity_case(&sc, T, some, 3);
+
+		/* one material, then three equal ones: the run without */
+		struct ss_stepper plain, one;
+		sc.name = "materials test: one material";
+		sc.materials = 0;
+		if (build(&plain, &sc, SS_KERNEL_FAST, 16, 8, 2) == 0) {
+			advance_to(&plain, T, sc.name);
+			for (int variant = 0; variant < 2; variant++) {
+				ss_closure_init(&sc.material[0], cl.kind, REPOSE, cl.gamma, cl.nu);
+				sc.material[1] = sc.material[2] = sc.material[0];
+				sc.materials = variant == 0 ? 1 : 3;
+				if (variant == 0)
+					memset(sc.material_of_cell, 0,
+					       (size_t)sc.nx * sc.ny * sizeof *sc.material_of_cell);
+				if (build(&one, &sc, SS_KERNEL_FAST, 16, 8, 2) == 0) {
+					CHECK(one.material == NULL, "%s: %d equal materials kept a field of "
+					      "materials", cl.name, sc.materials);
+					advance_to(&one, T, sc.name);
+					compare_states(&one, &plain, variant == 0 ? "one material"
+					                                          : "three equal materials");
+					ss_stepper_release(&one);
+				}
+			}
+			ss_stepper_release(&plain);
+		}
+		sc.materials = 0;
+		scenario_free(&sc);
+	}
+	printf("  bit identity with materials: %d closures and coulomb beside bingham, "
+	       "three tile sizes x 1, 2 threads; one or equal materials as none\n",
+	       N_CLOSURES);
+}
 
 static void test_active_tiles(void)
 {
@@ -1355,6 +1442,7 @@ int main(void)
 	{
 		const double t_ = check_now();
 		RUN(test_identity_bedrock);
+		RUN(test_identity_materials);
 		printf("    (%.2f s)\n", check_now() - t_);
 	}
 	{

@@ -57,6 +57,7 @@ struct ss_bench_header {
 	int thread_count;
 	const int *threads;                /* thread_count entries */
 	const double *bandwidth;           /* bytes/s, read+write, per entry */
+	int angles;                        /* repose angles (materials) */
 };
 
 /* One case: a surface, closure and thread count. */
@@ -83,6 +84,9 @@ struct ss_bench_options {
 	int steps;                                         /* per timing; 0: auto */
 	int tile[2];                                       /* cells per tile, nx
 	                                                    * and ny; < 1: defaults */
+	int angles;                                        /* repose angles over
+	                                                    * the grid (materials,
+	                                                    * doc/model.md); 1: one */
 	/* the figures, as they come (the caller prints them) */
 	void (*on_header)(void *context, const struct ss_bench_header *h);
 	void (*on_result)(void *context, const struct ss_bench_result *r);

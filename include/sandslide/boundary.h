@@ -59,6 +59,11 @@ void ss_boundary_fill_heights(const struct ss_grid *g, const struct ss_boundary 
 void ss_boundary_fill_field(const struct ss_grid *g, const struct ss_boundary *b,
                             double *field, double wall_value, double open_value);
 
+/* The same for each cell's material (stepper.h): a ghost beyond a wall or
+ * an open side takes the material of the cell beside it. */
+void ss_boundary_fill_materials(const struct ss_grid *g, const struct ss_boundary *b,
+                                uint16_t *material);
+
 /* For a slab of a distributed grid (grid.h, comm.h) both fills take the
  * ghost rows that face a neighbour rank from it, whole, after the x sides
  * (collective: every rank calls them together).  Those neighbours, or -1

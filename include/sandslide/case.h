@@ -94,6 +94,10 @@ struct ss_case {
 	char *bedrock_file;     /* non-erodible base (raster), or NULL */
 	char bedrock_where[SS_CASE_WHERE_SIZE];
 
+	/* [model] repose_angle = FILE: resolved, owned; model.angle_file is it */
+	char *angle_file;
+	char angle_where[SS_CASE_WHERE_SIZE];
+
 	struct ss_region *regions; /* in file order */
 	int region_count;
 

@@ -179,5 +179,9 @@ struct ss_cfl_bound {
 void ss_cfl_bound_init(struct ss_cfl_bound *t, const struct ss_closure *c);
 /* Lambda(S)/nu for the largest face slope S >= 0 (0 when S <= tan a_cr). */
 double ss_cfl_bound_lookup(const struct ss_cfl_bound *t, double s_max);
+/* Widen t to bound closure c too, whose nu is c->nu where t's is nu_t:
+ * Lambda_t(S) >= (c->nu / nu_t) Lambda_c(S) for every S (several materials,
+ * doc/model.md#materials). */
+void ss_cfl_bound_widen(struct ss_cfl_bound *t, const struct ss_closure *c, double nu_t);
 
 #endif

@@ -32,6 +32,12 @@ struct ss_sliding_layer {
 struct ss_model_options {
 	enum ss_closure_kind closure;     /* f_sl of doc/model.md */
 	double angle_deg;                 /* repose angle a_cr, degrees in (0, 90) */
+	const char *angle_file;           /* a raster of each cell's a_cr, degrees
+	                                   * (doc/model.md#materials); NULL:
+	                                   * angle_deg everywhere */
+	double static_angle_deg;          /* a_s >= a_cr, where sand at rest
+	                                   * starts to slide (hysteresis,
+	                                   * doc/model.md); NaN: a_cr, none */
 	double gamma;                     /* herschel-bulkley exponent, > 0 */
 	double nu;                        /* m^2/s, > 0 (a case may derive it
 	                                   * from the sliding layer: case.h) */

@@ -49,6 +49,11 @@ enum {
 	SS_OPTION_FITTABLE = 32,   /* `sandslide fit` may free it (--param
 	                            * NAME=LO:HI, NAME its case key's); the
 	                            * model's table */
+	SS_OPTION_OR_FILE = 64,    /* REAL: a value that does not start as a
+	                            * number is a file name, kept (const
+	                            * char *) at value_offset; a number
+	                            * clears it ("30x" is refused: ./30x is
+	                            * the file) */
 };
 
 struct ss_option {
@@ -70,7 +75,8 @@ struct ss_option {
 	const char *help;          /* lines separated by '\n', without the
 	                            * default (the help adds it) */
 	int (*parse)(const char *value, void *field); /* WORD: 0 when valid */
-	size_t value_offset;       /* OPTIONAL_INT: where its value goes */
+	size_t value_offset;       /* OPTIONAL_INT: where its value goes;
+	                            * REAL with SS_OPTION_OR_FILE: its file */
 	unsigned applies_to;       /* bit k: it means something for variant k
 	                            * of its table's model (the model's: closure
 	                            * k, closure.h); 0: for every variant */

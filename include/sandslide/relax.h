@@ -105,6 +105,10 @@ struct ss_relax_report {
 	                                     x max, y min, y max, m */
 	double max_slope_before_deg;      /* steepest face that can move sand */
 	double max_slope_after_deg;
+	int materials;                    /* distinct repose angles (--angle
+	                                   * FILE: doc/model.md#materials), 1
+	                                   * without */
+	double repose_min_deg, repose_max_deg;  /*   their range */
 	long long steps;                  /* substeps (RKL2: super-steps) */
 	long long evaluations;            /* stencil evaluations */
 	long long rest_steps;             /* of the steps: super-steps of the

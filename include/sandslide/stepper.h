@@ -126,6 +126,17 @@ struct ss_stepper {
 	double *bedrock;              /* m, with halo; NULL without bedrock
 	                               * (-infinity where no sand lies: walls,
 	                               * open cells, open and wall ghosts) */
+	/* several materials (doc/model.md#materials), set by
+	 * ss_stepper_set_materials; NULL: `closure` everywhere */
+	struct ss_closure *materials; /* material_count closures; `closure` is
+	                               * then the one of the smallest angle */
+	int material_count;
+	uint16_t *material;           /* each cell's material, with halo */
+	int hysteresis;               /* ss_stepper_set_hysteresis: materials
+	                               * 0 (sand at rest, a_s) and 1 (moving
+	                               * sand, a_d); `material` is then each
+	                               * cell's state (doc/model.md#hysteresis) */
+	long long flowing_cells;      /*   flow cells moving, all ranks */
 	double time;                  /* s */
 	long long steps;              /* substeps (RKL2: super-steps) taken */
 	long long evaluations;        /* stencil evaluations: Euler one a step,
@@ -184,6 +195,12 @@ void ss_stepper_tile_size(const struct ss_stepper *st, int *tile_nx, int *tile_n
  * integrator and approach to rest (for the memory check). */
 double ss_stepper_memory_bytes(const struct ss_grid *g, enum ss_integrator integrator,
                                enum ss_rest_mode rest);
+/* The bytes of st's arrays on this rank: ss_stepper_memory_bytes and each
+ * cell's material (2 B, with several materials). */
+double ss_stepper_bytes(const struct ss_stepper *st);
+/* The smallest and largest repose angle of st's materials (degrees): the
+ * closure's twice without materials. */
+void ss_stepper_repose_range(const struct ss_stepper *st, double *min_deg, double *max_deg);
 
 /* Add a source of rate m/s on the cells where mask (nx * ny, row-major,
  * south row first) is non-zero; call after the cell types are final.
@@ -232,6 +249,32 @@ double ss_stepper_swept_fraction(const struct ss_stepper *st);
 /* The kernel's wall time since ss_stepper_init, s: measuring the slopes
  * (and the reference sweep's fluxes) and sweeping. */
 void ss_stepper_kernel_seconds(const struct ss_stepper *st, double *measure, double *sweep);
+
+/*
+ * Several materials (doc/model.md#materials): closures[m] holds in the
+ * cells with material_of_cell[j nx + i] == m (this rank's rows, nx x ny).
+ * A face takes the closure of the larger angle of its two cells.  The
+ * CFL bound is the largest of the materials'; `closure` becomes the one of
+ * the smallest angle (the accuracy and source rules' scale).  One material,
+ * or several equal ones, is `closure` everywhere: the bits of a run without
+ * materials.  Before ss_stepper_prepare; SS_ERR_INPUT names a material
+ * number out of range.
+ */
+int ss_stepper_set_materials(struct ss_stepper *st, const struct ss_closure *closures,
+                             int count, const uint16_t *material_of_cell);
+
+/*
+ * Hysteresis (doc/model.md#hysteresis): sand at rest starts to slide only
+ * where a face of its cell is steeper than tan a_s (static_deg, the angle
+ * of maximum stability), and moving sand stops once every face of its cell
+ * is at most tan a_d (the closure's repose angle).  Each flow cell carries
+ * its state (`material`: 1 at rest, 0 moving), updated between steps (and
+ * RKL2's super-steps) from the heights; a face takes the larger angle of
+ * its two cells' states (materials, face.h).  static_deg must be at least
+ * the repose angle; equal, it is the model without hysteresis, the same
+ * bits.  Before ss_stepper_prepare; not with ss_stepper_set_materials.
+ */
+int ss_stepper_set_hysteresis(struct ss_stepper *st, double static_deg);
 
 /* A non-erodible bedrock (nx * ny values, m, row-major, south row first):
  * only the sand above it moves, each face limited by the thickness of the

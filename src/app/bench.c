@@ -117,6 +117,35 @@ static void set_surface(struct ss_stepper *st, enum ss_bench_surface surface)
 }
 
 /*
+ * `angles` repose angles from REPOSE_DEG - 5 to REPOSE_DEG + 5 degrees
+ * (doc/model.md#materials) in diagonal stripes 16 cells wide, so that rows
+ * of faces mix them: the cost of a field of materials.  The supercritical
+ * surface (s = 1.41 tan 35 deg) slides on every face at all of them.
+ */
+static int set_angles(struct ss_stepper *st, int angles)
+{
+	const struct ss_grid *g = &st->grid;
+	struct ss_closure c[64];
+	for (int m = 0; m < angles; m++) {
+		const double a = REPOSE_DEG - 5.0 + 10.0 * m / (angles - 1);
+		int err = ss_closure_init(&c[m], st->closure.kind, a, st->closure.gamma,
+		                          st->closure.nu);
+		if (err)
+			return err;
+	}
+	uint16_t *material = ss_alloc((size_t)g->nx * (size_t)g->ny, sizeof *material,
+	                              "bench materials");
+	if (!material)
+		return SS_ERR_FAIL;
+	for (int j = 0; j < g->ny; j++)
+		for (int i = 0; i < g->nx; i++)
+			material[(size_t)j * g->nx + i] = (uint16_t)(((i + j) / 16) % angles);
+	int err = ss_stepper_set_materials(st, c, angles, material);
+	ss_free(material);
+	return err;
+}
+
+/*
  * The room of cases/door.ini, its coordinates stretched over the grid (x
  * from 0 to 1.5, y from -0.5 to 0.5): the room x < 0.5 with side walls
  * 0.05 deep, the wall x = 0.5 to 0.55 with a door |y| <= 0.1, the source
@@ -224,6 +253,8 @@ static int run_case(const struct ss_bench_options *o, enum ss_bench_surface surf
 		st.rkl2_tol = INFINITY;
 		err = set_room(&st);
 	}
+	if (!err && o->angles > 1)
+		err = set_angles(&st, o->angles);
 	if (err || (err = ss_stepper_prepare(&st))) {
 		ss_stepper_release(&st);
 		return err;
@@ -285,10 +316,12 @@ static int run_case(const struct ss_bench_options *o, enum ss_bench_surface surf
  * byte, grid.h) on tiles with walls or open cells near them; an RKL2 stage
  * (the room) also reads and writes D_{j-1} and D_{j-2} and reads Y_0 and
  * M(Y_0) (48 B, rkl2.h). */
-static double bytes_per_cell(enum ss_bench_surface surface, int tile_ny, double plain_fraction)
+static double bytes_per_cell(enum ss_bench_surface surface, int tile_ny, double plain_fraction,
+                             int angles)
 {
+	/* with materials, each cell's number (2 B) read where its row is */
 	return 16.0 + 32.0 / tile_ny + 0.25 * (1.0 - plain_fraction) +
-	       (surface == SS_BENCH_ROOM ? 48.0 : 0.0);
+	       (surface == SS_BENCH_ROOM ? 48.0 : 0.0) + (angles > 1 ? 2.0 : 0.0);
 }
 
 /* The grid and memory the options ask for, checked. */
@@ -347,6 +380,7 @@ int ss_bench_run(const struct ss_bench_options *o)
 		.nx = o->nx, .ny = o->ny, .tile_nx = tiling.tile_nx, .tile_ny = tiling.tile_ny,
 		.repeats = o->repeats, .rsqrt = ss_face_rsqrt_method(), .probe_doubles = probe_n,
 		.thread_count = o->thread_count, .threads = o->threads, .bandwidth = bandwidth,
+		.angles = o->angles,
 	};
 	if (o->on_header)
 		o->on_header(o->context, &h);
@@ -358,7 +392,7 @@ int ss_bench_run(const struct ss_bench_options *o)
 				if ((err = run_case(o, (enum ss_bench_surface)s, &o->closures[c], &r)))
 					return err;
 				const double bytes = bytes_per_cell((enum ss_bench_surface)s, r.tile_ny,
-				                                    r.plain_fraction);
+				                                    r.plain_fraction, o->angles);
 				const struct ss_bench_result res = {
 					.surface = (enum ss_bench_surface)s, .closure = o->closures[c].label,
 					.threads = o->threads[t], .median = r.median, .min = r.min,
@@ -482,6 +516,10 @@ static const struct ss_option options[] = {
 	{.name = "tile", .value_name = "NXxNY", .kind = SS_OPTION_WORD, .offset = AT(tile),
 	 .parse = parse_tile, .expected = "NXxNY, e.g. 256x64",
 	 .help = "tile size of the sweep (default 256x128)"},
+	{.name = "angles", .value_name = "N", .kind = SS_OPTION_INT, .offset = AT(angles),
+	 .default_value = "1", .lo = 1, .hi = 64, .expected = "1 to 64",
+	 .help = "repose angles from 30 to 40 deg in stripes 16 cells\n"
+	         "wide (materials, doc/model.md#materials); 1: 35 deg"},
 };
 
 const struct ss_option_table ss_bench_option_table = {

@@ -278,6 +278,9 @@ static void measure_after(struct relax *x, enum ss_drive_end end, struct ss_rela
 	rep->outflow = ss_stepper_outflow(st);
 	rep->volume_after = flow_volume(st);
 	rep->max_slope_after_deg = steepest_sand_face_deg(st);
+	rep->materials = st->material ? st->material_count : 1;
+	ss_stepper_repose_range(st, &rep->repose_min_deg, &rep->repose_max_deg);
+	rep->model.angle_deg = rep->repose_min_deg;   /* an angle raster's smallest */
 	/* in row order, carried from rank to rank (comm.h) */
 	double moved = 0.0, cells_moved = 0.0, none = 0.0;
 	const double *h0 = x->in.dem.values + (size_t)(g->offset_j - x->in.dem.row_first) * g->nx;
@@ -368,8 +371,7 @@ int ss_relax_run(const struct ss_relax_options *o, struct ss_relax_report *rep)
 	if (!err) {   /* the output is written: the peak is the run's */
 		const struct ss_grid *g = &x.st.grid;
 		rep->ranks = ss_comm_size();
-		rep->bytes_per_cell = ss_stepper_memory_bytes(g, x.st.integrator, x.st.rest) /
-		                      fmax((double)g->nx * g->ny, 1.0);
+		rep->bytes_per_cell = ss_stepper_bytes(&x.st) / fmax((double)g->nx * g->ny, 1.0);
 		/* the largest rank's: the job waits for it */
 		double most[3] = {ss_memory_peak_bytes(), rep->read_seconds, rep->write_seconds};
 		ss_comm_reduce(most, 3, NULL, 0);

@@ -18,6 +18,7 @@ struct ss_relax_inputs {
 	struct ss_raster dem;       /* this rank's rows (a window, dem.h): the
 	                             * initial surface, later the output's */
 	struct ss_raster bedrock;   /* the same rows, when o->bedrock */
+	struct ss_raster angles;    /* the same rows, when o->model.angle_file */
 };
 
 /* The DEM (o->dem, or a copy of o->input_raster) and the bedrock, this

@@ -159,6 +159,12 @@ static int start_stepper(struct run *r)
 	int err = r->o->restart ? restart_files_reachable(r) : SS_OK;
 	if (err || (err = rebuild(r, &r->st)) || !r->o->restart)
 		return err;
+	if (r->st.hysteresis)
+		/* the snapshots hold the heights, not which cells move */
+		return ss_error_input("--restart %s: its case has hysteresis ([model] static_angle "
+		                      "%g above repose_angle %g), and a restart of such a run is not "
+		                      "supported yet: run it again from the start", r->o->restart,
+		                      r->c.model.static_angle_deg, r->c.model.angle_deg);
 	const struct ss_grid *g = &r->st.grid;
 	if (rs->nx != g->global_nx || rs->ny != g->global_ny)
 		return ss_error_input("--restart %s: its snapshots are %d x %d cells, its case "
@@ -351,8 +357,7 @@ static void summarise(const struct run *r, enum ss_drive_end end, struct ss_run_
 	s->cells = (double)st->grid.global_nx * st->grid.global_ny;
 	s->cell_updates_here = (double)s->evaluations_here * s->cells *
 	                       ss_stepper_swept_fraction(st);
-	s->bytes_per_cell = ss_stepper_memory_bytes(&st->grid, st->integrator, st->rest) /
-	                    ((double)st->grid.nx * st->grid.ny);
+	s->bytes_per_cell = ss_stepper_bytes(st) / ((double)st->grid.nx * st->grid.ny);
 	s->ranks = ss_comm_size();
 	s->wall_seconds = ss_parallel_wall_seconds() - r->drive.started;
 	ss_stepper_kernel_seconds(st, &s->measure_seconds, &s->sweep_seconds);

@@ -102,13 +102,28 @@ int ss_option_parse(const struct ss_option *o, const char *value, void *field)
 	switch (o->kind) {
 	case SS_OPTION_INT:
 		return ss_parse_int(value, (long)o->lo, (long)o->hi, field);
-	case SS_OPTION_REAL:
+	case SS_OPTION_REAL: {
+		/* OR_FILE: a value that does not start as a number does is a file
+		 * (one that does, "30x", is a mistyped number: ./30x is the file) */
+		const char **file = (o->flags & SS_OPTION_OR_FILE)
+			? (const char **)((char *)field - o->offset + o->value_offset) : NULL;
+		char *end;
+		(void)strtod(value, &end);
+		if (file && end == value) {
+			if (!*value)
+				return -1;
+			*file = value;
+			return 0;
+		}
 		if (ss_parse_real(value, o->lo, o->hi, &x) ||
 		    ((o->flags & SS_OPTION_LO_OPEN) && x == o->lo) ||
 		    ((o->flags & SS_OPTION_HI_OPEN) && x == o->hi))
 			return -1;
 		*(double *)field = x;
+		if (file)
+			*file = NULL;
 		return 0;
+	}
 	case SS_OPTION_FLAG:
 		if (strcmp(value, "0") && strcmp(value, "1"))
 			return -1;

@@ -164,9 +164,15 @@ void cli_print_relax_end(const struct ss_relax_report *r, int quiet)
 	char ranks[48] = "", peak[32];
 	if (r->ranks > 1)
 		snprintf(ranks, sizeof ranks, "%d ranks x ", r->ranks);
+	char repose[96];
+	if (r->materials > 1)
+		snprintf(repose, sizeof repose, "repose %g to %g in %d materials", r->repose_min_deg,
+		         r->repose_max_deg, r->materials);
+	else
+		snprintf(repose, sizeof repose, "repose %g", r->repose_min_deg);
 	printf("cells moved %lld, volume moved %.6g m^3, steepest sand face %.4f -> "
-	       "%.4f deg (repose %g), wall %.3f s on %s%d thread%s\n", r->cells_moved,
-	       r->volume_moved, r->max_slope_before_deg, r->max_slope_after_deg, r->model.angle_deg,
+	       "%.4f deg (%s), wall %.3f s on %s%d thread%s\n", r->cells_moved,
+	       r->volume_moved, r->max_slope_before_deg, r->max_slope_after_deg, repose,
 	       r->wall_seconds, ranks, ss_parallel_max_threads(),
 	       ss_parallel_max_threads() == 1 ? "" : "s");
 	printf("read %.3f s, write %.3f s; memory: %.0f B per cell, peak %s%s\n",
@@ -191,15 +197,19 @@ void cli_bench_header(void *context, const struct ss_bench_header *h)
 	const struct cli_bench *b = context;
 	if (b->json) {
 		printf("{\n  \"nx\": %d, \"ny\": %d, \"tile_nx\": %d, \"tile_ny\": %d,\n"
-		       "  \"repeats\": %d, \"rsqrt\": \"%s\",\n  \"bandwidth_bytes_per_s\": {",
-		       h->nx, h->ny, h->tile_nx, h->tile_ny, h->repeats, h->rsqrt);
+		       "  \"repeats\": %d, \"rsqrt\": \"%s\", \"angles\": %d,\n"
+		       "  \"bandwidth_bytes_per_s\": {",
+		       h->nx, h->ny, h->tile_nx, h->tile_ny, h->repeats, h->rsqrt, h->angles);
 		for (int t = 0; t < h->thread_count; t++)
 			printf("%s\"%d\": %.6g", t ? ", " : "", h->threads[t], h->bandwidth[t]);
 		printf("},\n  \"cases\": [");
 	} else {
+		char angles[64] = "";
+		if (h->angles > 1)
+			snprintf(angles, sizeof angles, ", %d repose angles (materials)", h->angles);
 		printf("sandslide bench: %d x %d cells, tiles %dx%d, %d repeats per case, "
-		       "reciprocal sqrt: %s\n", h->nx, h->ny, h->tile_nx, h->tile_ny, h->repeats,
-		       h->rsqrt);
+		       "reciprocal sqrt: %s%s\n", h->nx, h->ny, h->tile_nx, h->tile_ny, h->repeats,
+		       h->rsqrt, angles);
 		printf("memory bandwidth (read+write one array of %zu doubles):", h->probe_doubles);
 		for (int t = 0; t < h->thread_count; t++)
 			printf(" %d thread%s %.1f GB/s%s", h->threads[t], h->threads[t] > 1 ? "s" : "",

@@ -146,3 +146,29 @@ void ss_boundary_fill_field(const struct ss_grid *g, const struct ss_boundary *b
 	exchange_rows(south, north, field, row, 0, row, (size_t)ny * row,
 	              (size_t)(ny + 1) * row);
 }
+
+void ss_boundary_fill_materials(const struct ss_grid *g, const struct ss_boundary *b,
+                                uint16_t *material)
+{
+	const int nx = g->nx, ny = g->ny;
+	int south, north;
+	ss_boundary_neighbours(g, b, &south, &north);
+	/* periodic: the cell it wraps to; else the cell beside */
+	const int wrap_x = b->side[SS_WEST] == SS_SIDE_PERIODIC;
+	const int wrap_y = b->side[SS_SOUTH] == SS_SIDE_PERIODIC;
+	for (int j = 0; j < ny; j++) {
+		material[ss_grid_index(g, -1, j)] = material[ss_grid_index(g, wrap_x ? nx - 1 : 0, j)];
+		material[ss_grid_index(g, nx, j)] = material[ss_grid_index(g, wrap_x ? 0 : nx - 1, j)];
+	}
+	for (int i = -1; i <= nx; i++) {
+		if (south < 0)
+			material[ss_grid_index(g, i, -1)] =
+				material[ss_grid_index(g, i, wrap_y ? ny - 1 : 0)];
+		if (north < 0)
+			material[ss_grid_index(g, i, ny)] =
+				material[ss_grid_index(g, i, wrap_y ? 0 : ny - 1)];
+	}
+	const size_t row = (size_t)g->stride * sizeof *material;
+	exchange_rows(south, north, material, row, 0, row, (size_t)ny * row,
+	              (size_t)(ny + 1) * row);
+}

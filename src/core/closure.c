@@ -94,3 +94,13 @@ double ss_cfl_bound_lookup(const struct ss_cfl_bound *t, double s_max)
 		k = SS_CFL_TABLE_SIZE;
 	return t->lambda_max[(int)k];
 }
+
+void ss_cfl_bound_widen(struct ss_cfl_bound *t, const struct ss_closure *c, double nu_t)
+{
+	struct ss_cfl_bound u;
+	ss_cfl_bound_init(&u, c);
+	const double scale = c->nu / nu_t;
+	t->tan_cr = fmin(t->tan_cr, u.tan_cr);
+	for (int k = 0; k <= SS_CFL_TABLE_SIZE; k++)
+		t->lambda_max[k] = fmax(t->lambda_max[k], scale * u.lambda_max[k]);
+}

@@ -66,6 +66,10 @@
 	int ss_face_fluxes##sfx(const struct ss_face_rule *r, int n,                         \
 	                        const double *restrict g_n, const double *restrict g_t,      \
 	                        double *restrict flux);                                      \
+	int ss_face_fluxes_mixed##sfx(const struct ss_face_table *t, int n,                  \
+	                              const uint16_t *restrict rule,                         \
+	                              const double *restrict g_n, const double *restrict g_t, \
+	                              double *restrict flux);                                \
 	void ss_face_rsqrt##sfx(int n, const double *restrict x, double *restrict y);        \
 	double ss_sweep_max_slope##sfx(const struct ss_grid *g, const double *restrict height, \
 	                               const uint8_t *restrict cell_types);                  \

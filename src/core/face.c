@@ -19,14 +19,21 @@
 
 #include <math.h>
 #include <stdint.h>
+#include <string.h>
 
 #include "core/cpu_paths.h"
+#include "sandslide/error.h"
 
 #if SS_PATH == SS_PATH_AVX512
 #include <immintrin.h>
 #endif
 
 enum { CHUNK = 128 };
+
+/* The loops below take the rule's numbers as constants (step 0) or per
+ * face (step 1): inlined into each caller so that step and the form are
+ * constants there, and the uniform copy keeps its numbers in registers. */
+#define FACE_INLINE static inline __attribute__((always_inline))
 
 /* max(x, 0) as a select: fmax() is a library call unless -ffast-math, and
  * stops vectorisation.  A NaN gives 0, as fmax(NaN, 0) does. */
@@ -53,6 +60,8 @@ void ss_face_rule_init(struct ss_face_rule *r, const struct ss_closure *c)
 	r->inv_sin_cr = 1.0 / c->sin_cr;
 	r->gamma = c->gamma;
 	r->power = c->power;
+	r->table = NULL;
+	r->material = NULL;
 	switch (c->kind) {
 	case SS_CLOSURE_COULOMB:
 		r->form = SS_FACE_COULOMB;
@@ -102,16 +111,19 @@ void SS_PATH_FN(ss_face_rsqrt)(int n, const double *restrict x, double *restrict
 }
 
 /* Pass 1 of a chunk: s^2 where a face slides (1 elsewhere), 1/s, 1/w, the
- * sliding flag; returns whether any face slides. */
-static int slopes_and_rsqrt(int m, double tan_cr2, const double *restrict gn,
-                            const double *restrict gt, double *restrict s2,
-                            double *restrict inv_s, double *restrict inv_w,
-                            double *restrict slides)
+ * sliding flag; returns whether any face slides.  The threshold of face k
+ * is tan_cr2[k] (step 1: a rule per face) or tan_cr2[0] (step 0: one rule). */
+FACE_INLINE int slopes_and_rsqrt(int m, const double *restrict tan_cr2, int step,
+                                   const double *restrict gn,
+                                   const double *restrict gt, double *restrict s2,
+                                   double *restrict inv_s, double *restrict inv_w,
+                                   double *restrict slides)
 {
-	const __m512d one = _mm512_set1_pd(1.0), tc2 = _mm512_set1_pd(tan_cr2);
+	const __m512d one = _mm512_set1_pd(1.0), tc2_one = _mm512_set1_pd(tan_cr2[0]);
 	__mmask8 any = 0;
 	for (int k = 0; k < m; k += 8) {
 		const __mmask8 lanes = tail_mask(m - k);
+		const __m512d tc2 = step ? _mm512_maskz_loadu_pd(lanes, tan_cr2 + k) : tc2_one;
 		const __m512d a = _mm512_maskz_loadu_pd(lanes, gn + k);
 		const __m512d b = _mm512_maskz_loadu_pd(lanes, gt + k);
 		const __m512d q = _mm512_add_pd(_mm512_mul_pd(a, a), _mm512_mul_pd(b, b));
@@ -132,15 +144,17 @@ void SS_PATH_FN(ss_face_rsqrt)(int n, const double *restrict x, double *restrict
 		y[k] = 1.0 / sqrt(x[k]);
 }
 
-static int slopes_and_rsqrt(int m, double tan_cr2, const double *restrict gn,
-                            const double *restrict gt, double *restrict s2,
-                            double *restrict inv_s, double *restrict inv_w,
-                            double *restrict slides)
+FACE_INLINE int slopes_and_rsqrt(int m, const double *restrict tan_cr2, int step,
+                                   const double *restrict gn,
+                                   const double *restrict gt, double *restrict s2,
+                                   double *restrict inv_s, double *restrict inv_w,
+                                   double *restrict slides)
 {
+	const double tan_cr2_one = tan_cr2[0];
 	int any = 0;
 	for (int k = 0; k < m; k++) {
 		const double q = gn[k] * gn[k] + gt[k] * gt[k];
-		const int sl = q > tan_cr2;
+		const int sl = q > (step ? tan_cr2[k] : tan_cr2_one);
 		s2[k] = sl ? q : 1.0;
 		slides[k] = sl ? 1.0 : 0.0;
 		any |= sl;
@@ -153,25 +167,39 @@ static int slopes_and_rsqrt(int m, double tan_cr2, const double *restrict gn,
 }
 #endif
 
+/* A closure's numbers for the faces of a chunk: face k's at [k * step]
+ * (step 0: one rule's, step 1: a rule per face). */
+struct numbers {
+	const double *tan_cr, *sin_cr, *inv_sin_cr, *gamma, *power;
+};
+
 /* f_sl(s)/s for the m faces of a chunk from s^2 (s2), 1/s and 1/w. */
-static inline void f_over_s(enum ss_face_form form, const struct ss_face_rule *r,
+FACE_INLINE void f_over_s(enum ss_face_form form, const struct numbers *p, int step,
                             int m, const double *restrict s2,
                             const double *restrict inv_s,
                             const double *restrict inv_w, double *restrict out)
 {
-	const double tan_cr = r->tan_cr, sin_cr = r->sin_cr, inv_sin_cr = r->inv_sin_cr;
-	const double gamma = r->gamma, one_gamma = 1.0 + r->gamma;
+	const double *restrict tan_crs = p->tan_cr, *restrict sin_crs = p->sin_cr;
+	const double *restrict inv_sin_crs = p->inv_sin_cr, *restrict gammas = p->gamma;
+	const double *restrict powers = p->power;
+	/* one rule: its numbers in registers, as constants of the loops */
+	const double tan_cr = tan_crs[0], sin_cr = sin_crs[0], inv_sin_cr = inv_sin_crs[0];
+	const double gamma = gammas[0];
+#define TAN_CR (step ? tan_crs[k] : tan_cr)
+#define SIN_CR (step ? sin_crs[k] : sin_cr)
+#define INV_SIN_CR (step ? inv_sin_crs[k] : inv_sin_cr)
+#define GAMMA (step ? gammas[k] : gamma)
 	switch (form) {
 	case SS_FACE_COULOMB:
 		for (int k = 0; k < m; k++) {
 			const double s = s2[k] * inv_s[k];
-			out[k] = positive_part(s - tan_cr) * inv_w[k] * inv_s[k];
+			out[k] = positive_part(s - TAN_CR) * inv_w[k] * inv_s[k];
 		}
 		break;
 	case SS_FACE_BINGHAM:
 		for (int k = 0; k < m; k++) {
 			const double s = s2[k] * inv_s[k], w = (1.0 + s2[k]) * inv_w[k];
-			const double b = s * inv_w[k] * inv_sin_cr, rb = w * inv_s[k] * sin_cr;
+			const double b = s * inv_w[k] * INV_SIN_CR, rb = w * inv_s[k] * SIN_CR;
 			const double e = positive_part(b - 1.0);
 			out[k] = rb * (2.0 + rb) * (e * e) * inv_s[k];
 		}
@@ -181,34 +209,57 @@ static inline void f_over_s(enum ss_face_form form, const struct ss_face_rule *r
 	case SS_FACE_HB_POW:
 		for (int k = 0; k < m; k++) {
 			const double s = s2[k] * inv_s[k], w = (1.0 + s2[k]) * inv_w[k];
-			const double b = s * inv_w[k] * inv_sin_cr, rb = w * inv_s[k] * sin_cr;
+			const double b = s * inv_w[k] * INV_SIN_CR, rb = w * inv_s[k] * SIN_CR;
 			const double e = positive_part(b - 1.0);
 			const double ep = form == SS_FACE_HB_CUBE ? e * e * e
 			                : form == SS_FACE_HB_THREE_HALVES ? e * sqrt(e)
 			                : e;   /* raised to the power below */
-			out[k] = rb * (one_gamma + gamma * rb) * ep * inv_s[k];
+			out[k] = rb * (1.0 + GAMMA + GAMMA * rb) * ep * inv_s[k];
 		}
 		if (form == SS_FACE_HB_POW) {
 			/* out = coefficient * e: divide e back out only where it is
 			 * positive, i.e. apply e^(p-1) to the sliding faces */
 			for (int k = 0; k < m; k++) {
 				const double s = s2[k] * inv_s[k];
-				const double e = positive_part(s * inv_w[k] * inv_sin_cr - 1.0);
+				const double e = positive_part(s * inv_w[k] * INV_SIN_CR - 1.0);
 				if (e > 0.0)
-					out[k] *= pow(e, r->power - 1.0);
+					out[k] *= pow(e, (step ? powers[k] : powers[0]) - 1.0);
 			}
 		}
 		break;
 	case SS_FACE_CASSON:
 		for (int k = 0; k < m; k++) {
 			const double s = s2[k] * inv_s[k], w = (1.0 + s2[k]) * inv_w[k];
-			const double b = s * inv_w[k] * inv_sin_cr, rb = w * inv_s[k] * sin_cr;
+			const double b = s * inv_w[k] * INV_SIN_CR, rb = w * inv_s[k] * SIN_CR;
 			const double q = sqrt(b), e = positive_part(q - 1.0);
 			out[k] = rb * rb * (10.0 * b * q + 6.0 * b + 3.0 * q + 1.0) *
 			         (e * e * e) * inv_s[k];
 		}
 		break;
 	}
+#undef TAN_CR
+#undef SIN_CR
+#undef INV_SIN_CR
+#undef GAMMA
+}
+
+/* f_sl/s of a chunk's faces in form `form`: each form a call with a
+ * constant `form`, so that the inlined f_over_s keeps only that form's
+ * loop (no switch per face). */
+FACE_INLINE void f_over_s_of(enum ss_face_form form, const struct numbers *p, int step,
+                               int m, const double *restrict s2, const double *restrict inv_s,
+                               const double *restrict inv_w, double *restrict out)
+{
+#define FORM(f) case f: f_over_s(f, p, step, m, s2, inv_s, inv_w, out); break
+	switch (form) {
+	FORM(SS_FACE_COULOMB);
+	FORM(SS_FACE_BINGHAM);
+	FORM(SS_FACE_HB_POW);
+	FORM(SS_FACE_HB_CUBE);
+	FORM(SS_FACE_HB_THREE_HALVES);
+	FORM(SS_FACE_CASSON);
+	}
+#undef FORM
 }
 
 int SS_PATH_FN(ss_face_fluxes)(const struct ss_face_rule *r, int n,
@@ -217,25 +268,72 @@ int SS_PATH_FN(ss_face_fluxes)(const struct ss_face_rule *r, int n,
 {
 	double s2[CHUNK], inv_s[CHUNK], inv_w[CHUNK], fos[CHUNK], slides[CHUNK];
 	const double nu = r->nu;
+	const struct numbers one = {&r->tan_cr, &r->sin_cr, &r->inv_sin_cr, &r->gamma, &r->power};
 	int any = 0;
 	for (int base = 0; base < n; base += CHUNK) {
 		const int m = n - base < CHUNK ? n - base : CHUNK;
 		const double *restrict gn = g_n + base;
-		any |= slopes_and_rsqrt(m, r->tan_cr2, gn, g_t + base, s2, inv_s, inv_w, slides);
-		/* each form a call with a constant `form`, so that the inlined
-		 * f_over_s keeps only that form's loop (no switch per face) */
-#define FORM(form) case form: f_over_s(form, r, m, s2, inv_s, inv_w, fos); break
-		switch (r->form) {
-		FORM(SS_FACE_COULOMB);
-		FORM(SS_FACE_BINGHAM);
-		FORM(SS_FACE_HB_POW);
-		FORM(SS_FACE_HB_CUBE);
-		FORM(SS_FACE_HB_THREE_HALVES);
-		FORM(SS_FACE_CASSON);
-		}
-#undef FORM
+		any |= slopes_and_rsqrt(m, &r->tan_cr2, 0, gn, g_t + base, s2, inv_s, inv_w, slides);
+		f_over_s_of(r->form, &one, 0, m, s2, inv_s, inv_w, fos);
 		for (int k = 0; k < m; k++)
 			flux[base + k] = slides[k] != 0.0 ? -(nu * gn[k]) * fos[k] : 0.0;
+	}
+	return any;
+}
+
+/* The same, the rule of face k gathered from the table: the same
+ * expressions with each face's numbers, so the bits of a face are those of
+ * ss_face_fluxes with its rule.  Faces of different forms evaluate each
+ * form present and keep their own. */
+int SS_PATH_FN(ss_face_fluxes_mixed)(const struct ss_face_table *t, int n,
+                                     const uint16_t *restrict rule,
+                                     const double *restrict g_n, const double *restrict g_t,
+                                     double *restrict flux)
+{
+	double s2[CHUNK], inv_s[CHUNK], inv_w[CHUNK], fos[CHUNK], slides[CHUNK];
+	double nu[CHUNK], tan_cr2[CHUNK], tan_cr[CHUNK], sin_cr[CHUNK], inv_sin_cr[CHUNK];
+	double gamma[CHUNK], power[CHUNK], other[CHUNK];
+	const struct numbers each = {tan_cr, sin_cr, inv_sin_cr, gamma, power};
+	const unsigned forms = t->forms;
+	const int single = (forms & (forms - 1)) == 0;
+	const int angles = forms != 1u << SS_FACE_COULOMB;   /* sin a_cr needed */
+	const int hb = (forms & (1u << SS_FACE_HB_POW | 1u << SS_FACE_HB_CUBE |
+	                         1u << SS_FACE_HB_THREE_HALVES)) != 0;
+	int any = 0;
+	for (int base = 0; base < n; base += CHUNK) {
+		const int m = n - base < CHUNK ? n - base : CHUNK;
+		const double *restrict gn = g_n + base;
+		const uint16_t *restrict rk = rule + base;
+		for (int k = 0; k < m; k++) {
+			nu[k] = t->nu[rk[k]];
+			tan_cr2[k] = t->tan_cr2[rk[k]];
+			tan_cr[k] = t->tan_cr[rk[k]];
+		}
+		if (angles)
+			for (int k = 0; k < m; k++) {
+				sin_cr[k] = t->sin_cr[rk[k]];
+				inv_sin_cr[k] = t->inv_sin_cr[rk[k]];
+			}
+		if (hb)
+			for (int k = 0; k < m; k++) {
+				gamma[k] = t->gamma[rk[k]];
+				power[k] = t->power[rk[k]];
+			}
+		any |= slopes_and_rsqrt(m, tan_cr2, 1, gn, g_t + base, s2, inv_s, inv_w, slides);
+		if (single) {
+			f_over_s_of((enum ss_face_form)t->form[0], &each, 1, m, s2, inv_s, inv_w, fos);
+		} else {
+			memset(fos, 0, sizeof fos);
+			for (int f = 0; f <= SS_FACE_CASSON; f++) {
+				if (!(forms & 1u << f))
+					continue;
+				f_over_s_of((enum ss_face_form)f, &each, 1, m, s2, inv_s, inv_w, other);
+				for (int k = 0; k < m; k++)
+					fos[k] = t->form[rk[k]] == f ? other[k] : fos[k];
+			}
+		}
+		for (int k = 0; k < m; k++)
+			flux[base + k] = slides[k] != 0.0 ? -(nu[k] * gn[k]) * fos[k] : 0.0;
 	}
 	return any;
 }
@@ -250,6 +348,54 @@ int ss_face_fluxes(const struct ss_face_rule *r, int n,
 {
 	const enum ss_cpu_path p = ss_cpu_path();
 	return SS_PATH_CALL(p, ss_face_fluxes, r, n, g_n, g_t, flux);
+}
+
+int ss_face_fluxes_mixed(const struct ss_face_table *t, int n, const uint16_t *restrict rule,
+                         const double *restrict g_n, const double *restrict g_t,
+                         double *restrict flux)
+{
+	const enum ss_cpu_path p = ss_cpu_path();
+	return SS_PATH_CALL(p, ss_face_fluxes_mixed, t, n, rule, g_n, g_t, flux);
+}
+
+int ss_face_table_create(struct ss_face_table *t, const struct ss_closure *c, int count)
+{
+	memset(t, 0, sizeof *t);
+	double **arrays[] = {&t->nu, &t->tan_cr, &t->tan_cr2, &t->sin_cr, &t->inv_sin_cr,
+	                     &t->gamma, &t->power};
+	for (size_t a = 0; a < sizeof arrays / sizeof *arrays; a++)
+		if (!(*arrays[a] = ss_alloc((size_t)count, sizeof(double), "material rules")))
+			return SS_ERR_FAIL;
+	if (!(t->form = ss_alloc((size_t)count, 1, "material rules")))
+		return SS_ERR_FAIL;
+	t->count = count;
+	for (int k = 0; k < count; k++) {
+		struct ss_face_rule r;
+		ss_face_rule_init(&r, &c[k]);
+		t->nu[k] = r.nu;
+		t->tan_cr[k] = r.tan_cr;
+		t->tan_cr2[k] = r.tan_cr2;
+		t->sin_cr[k] = r.sin_cr;
+		t->inv_sin_cr[k] = r.inv_sin_cr;
+		t->gamma[k] = r.gamma;
+		t->power[k] = r.power;
+		t->form[k] = (uint8_t)r.form;
+		t->forms |= 1u << r.form;
+	}
+	return SS_OK;
+}
+
+void ss_face_table_release(struct ss_face_table *t)
+{
+	ss_free(t->nu);
+	ss_free(t->tan_cr);
+	ss_free(t->tan_cr2);
+	ss_free(t->sin_cr);
+	ss_free(t->inv_sin_cr);
+	ss_free(t->gamma);
+	ss_free(t->power);
+	ss_free(t->form);
+	memset(t, 0, sizeof *t);
 }
 
 void ss_face_rsqrt(int n, const double *restrict x, double *restrict y)

@@ -31,6 +31,9 @@
 #ifndef SANDSLIDE_CORE_FACE_H
 #define SANDSLIDE_CORE_FACE_H
 
+#include <stddef.h>
+#include <stdint.h>
+
 #include "sandslide/closure.h"
 
 /* The formula a sweep instantiates; a Herschel-Bulkley power with a short
@@ -44,6 +47,18 @@ enum ss_face_form {
 	SS_FACE_CASSON,
 };
 
+/*
+ * The rules of a grid of several materials (doc/model.md#materials), by
+ * rule number, as arrays a row of faces gathers from: each face takes the
+ * rule of the larger angle of its two cells (ss_face_material).
+ */
+struct ss_face_table {
+	int count;
+	unsigned forms;            /* bit 1 << form of each rule's form */
+	double *nu, *tan_cr, *tan_cr2, *sin_cr, *inv_sin_cr, *gamma, *power;
+	uint8_t *form;             /* enum ss_face_form */
+};
+
 struct ss_face_rule {
 	enum ss_face_form form;
 	double nu;                 /* m^2/s */
@@ -51,9 +66,28 @@ struct ss_face_rule {
 	double tan_cr2;            /* largest s^2 with sqrt(s^2) <= tan a_cr */
 	double sin_cr, inv_sin_cr;
 	double gamma, power;       /* Herschel-Bulkley */
+	/* several materials: the rules, and each cell's rule number by storage
+	 * index (halo included); NULL: this one rule everywhere */
+	const struct ss_face_table *table;
+	const uint16_t *material;
 };
 
 void ss_face_rule_init(struct ss_face_rule *r, const struct ss_closure *c);
+
+/* The table of count closures; SS_ERR_FAIL if out of memory. */
+int ss_face_table_create(struct ss_face_table *t, const struct ss_closure *c, int count);
+void ss_face_table_release(struct ss_face_table *t);
+
+/* The rule number of the face between cells a and b (storage indices):
+ * the larger of the two.  Materials are numbered by angle, smallest first
+ * (stepper.h), so a face holds up to the larger angle of its two cells;
+ * hysteresis numbers moving sand above sand at rest, so a face beside
+ * moving sand slides at the dynamic angle (doc/model.md#materials,
+ * #hysteresis). */
+static inline uint16_t ss_face_material(const uint16_t *material, ptrdiff_t a, ptrdiff_t b)
+{
+	return material[b] > material[a] ? material[b] : material[a];
+}
 
 /* flux[k] = F of the face with normal gradient g_n[k] and tangential
  * gradient g_t[k], k < n (m^2/s; g dimensionless).  Exactly 0 where
@@ -62,6 +96,12 @@ void ss_face_rule_init(struct ss_face_rule *r, const struct ss_closure *c);
 int ss_face_fluxes(const struct ss_face_rule *r, int n,
                     const double *restrict g_n, const double *restrict g_t,
                     double *restrict flux);
+
+/* The same with the table's rule rule[k] for face k (ss_face_material): the arithmetic of ss_face_fluxes with that rule's
+ * numbers, so one rule everywhere gives ss_face_fluxes' bits. */
+int ss_face_fluxes_mixed(const struct ss_face_table *t, int n, const uint16_t *restrict rule,
+                         const double *restrict g_n, const double *restrict g_t,
+                         double *restrict flux);
 
 /*
  * Non-erodible bedrock: a face takes from the cell it leaves at most a

@@ -10,9 +10,11 @@
 #include "sandslide/stepper.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "base/strings.h"
+#include "core/hysteresis.h"
 #include "core/ledger.h"
 #include "core/rest.h"
 #include "core/rkl2.h"
@@ -35,6 +37,22 @@ double ss_stepper_memory_bytes(const struct ss_grid *g, enum ss_integrator integ
 	const int stages = integrator == SS_INTEGRATOR_RKL2 || rest == SS_REST_CHEBYSHEV;
 	const double doubles = stages ? 6.0 : 2.0;
 	return (double)ss_grid_storage_cells(g) * (doubles * sizeof(double) + 0.25);
+}
+
+double ss_stepper_bytes(const struct ss_stepper *st)
+{
+	const double materials = st->material
+		? (double)ss_grid_storage_cells(&st->grid) * sizeof *st->material : 0.0;
+	return ss_stepper_memory_bytes(&st->grid, st->integrator, st->rest) + materials;
+}
+
+void ss_stepper_repose_range(const struct ss_stepper *st, double *min_deg, double *max_deg)
+{
+	*min_deg = *max_deg = st->closure.repose_angle_deg;
+	for (int m = 0; m < st->material_count; m++) {
+		*min_deg = fmin(*min_deg, st->materials[m].repose_angle_deg);
+		*max_deg = fmax(*max_deg, st->materials[m].repose_angle_deg);
+	}
 }
 
 void ss_stepper_slab_rows(const struct ss_grid *g, int tile_nx, int tile_ny, int rank,
@@ -118,6 +136,8 @@ void ss_stepper_release(struct ss_stepper *st)
 	ss_sources_destroy(st->sources);
 	ss_sweeper_destroy(st->sweeper);
 	ss_free(st->bedrock);
+	ss_free(st->material);
+	ss_free(st->materials);
 	ss_free(st->cell_types);
 	ss_free(st->height);
 	memset(st, 0, sizeof *st);
@@ -153,6 +173,102 @@ int ss_stepper_set_bedrock(struct ss_stepper *st, const double *bedrock)
 	return SS_OK;
 }
 
+/* A material while they are numbered: its closure and its number given. */
+struct material_entry {
+	const struct ss_closure *c;
+	int given;
+};
+
+/* By angle, then kind, gamma and nu (equal closures side by side), then
+ * as given: the order of the materials' numbers. */
+static int compare_materials(const void *pa, const void *pb)
+{
+	const struct material_entry *a = pa, *b = pb;
+	const double ka[4] = {a->c->tan_cr, a->c->kind, a->c->gamma, a->c->nu};
+	const double kb[4] = {b->c->tan_cr, b->c->kind, b->c->gamma, b->c->nu};
+	for (int k = 0; k < 4; k++)
+		if (ka[k] != kb[k])
+			return ka[k] < kb[k] ? -1 : 1;
+	return (a->given > b->given) - (a->given < b->given);
+}
+
+static int same_closure(const struct ss_closure *a, const struct ss_closure *b)
+{
+	return a->kind == b->kind && a->tan_cr == b->tan_cr && a->gamma == b->gamma &&
+	       a->nu == b->nu;
+}
+
+int ss_stepper_set_materials(struct ss_stepper *st, const struct ss_closure *closures,
+                             int count, const uint16_t *material_of_cell)
+{
+	const struct ss_grid *g = &st->grid;
+	if (count < 1 || count > UINT16_MAX)
+		return ss_error_input("%d materials: between 1 and %d are accepted", count,
+		                      UINT16_MAX);
+	if (st->hysteresis)
+		return ss_error_input("materials with a static angle are not supported: hysteresis "
+		                      "takes one repose angle");
+	/* the given materials by angle; each given number's place among the
+	 * distinct closures; those in use (on any rank: all decide alike) */
+	struct material_entry *order = ss_alloc((size_t)count, sizeof *order, "materials");
+	uint16_t *number = ss_alloc((size_t)count, sizeof *number, "materials");
+	double *used = ss_alloc((size_t)count, sizeof *used, "materials");
+	int err = order && number && used ? SS_OK : SS_ERR_FAIL;
+	for (int m = 0; !err && m < count; m++)
+		order[m] = (struct material_entry){&closures[m], m};
+	if (!err)
+		qsort(order, (size_t)count, sizeof *order, compare_materials);
+	int places = 0;
+	for (int k = 0; !err && k < count; k++) {
+		if (k > 0 && !same_closure(order[k - 1].c, order[k].c))
+			places++;
+		number[order[k].given] = (uint16_t)places;
+		used[k] = 0.0;
+	}
+	for (int j = 0; !err && j < g->ny; j++)
+		for (int i = 0; !err && i < g->nx; i++) {
+			const int m = material_of_cell[(size_t)j * g->nx + i];
+			if (m >= count)
+				err = ss_error_input("material %d of %s: the materials are numbered 0 "
+				                     "to %d", m, SS_GRID_CELL(g, i, j), count - 1);
+			else
+				used[number[m]] = 1.0;
+		}
+	if (!(err = ss_comm_agree(err)))
+		ss_comm_reduce(used, count, NULL, 0);
+	/* the places in use, renumbered from 0: a face takes the larger
+	 * number of its two cells (face.h) */
+	int distinct = 0;
+	for (int k = 0; !err && k < count; k++)
+		used[k] = used[k] != 0.0 ? (double)distinct++ : -1.0;
+	if (!err && distinct > 1) {
+		st->materials = ss_alloc((size_t)distinct, sizeof *st->materials, "materials");
+		st->material = ss_alloc(ss_grid_storage_cells(g), sizeof *st->material, "materials");
+		err = st->materials && st->material ? SS_OK : SS_ERR_FAIL;
+	}
+	if (!err) {
+		for (int k = 0; k < count; k++) {
+			const int n = (int)used[number[order[k].given]];
+			if (n >= 0 && distinct > 1)
+				st->materials[n] = *order[k].c;
+			if (n == 0)   /* the smallest angle: the rules' scale */
+				st->closure = *order[k].c;
+		}
+		st->material_count = distinct > 1 ? distinct : 0;
+	}
+	if (!err && distinct > 1) {
+		memset(st->material, 0, ss_grid_storage_cells(g) * sizeof *st->material);
+		for (int j = 0; j < g->ny; j++)
+			for (int i = 0; i < g->nx; i++)
+				st->material[ss_grid_index(g, i, j)] = (uint16_t)
+					used[number[material_of_cell[(size_t)j * g->nx + i]]];
+	}
+	ss_free(used);
+	ss_free(number);
+	ss_free(order);
+	return err;
+}
+
 /* The checks of ss_stepper_prepare on this rank's cells (the messages name
  * a cell by its index in the whole grid). */
 static int check_cells(struct ss_stepper *st)
@@ -185,7 +301,9 @@ static int check_cells(struct ss_stepper *st)
  * ledger's open faces, RKL2's state, the kernel's arrays. */
 static int prepare_parts(struct ss_stepper *st)
 {
-	int err = ss_sources_prepare(st->sources, &st->grid);
+	int err = ss_sweeper_rules(st);
+	if (!err)
+		err = ss_sources_prepare(st->sources, &st->grid);
 	if (!err)
 		err = ss_ledger_list_open_faces(st->ledger, &st->grid, st->cell_types);
 	if (!err && st->integrator == SS_INTEGRATOR_RKL2)
@@ -209,12 +327,18 @@ int ss_stepper_prepare(struct ss_stepper *st)
 		/* bedrock ghosts: a periodic side copies the cell it wraps to;
 		 * elsewhere no sand lies outside the grid (-infinity: no limit) */
 		ss_boundary_fill_field(g, &st->boundary, st->bedrock, -INFINITY, -INFINITY);
+	if (st->hysteresis)
+		ss_hysteresis_start(st);   /* every flow cell at rest */
+	else if (st->material)
+		ss_boundary_fill_materials(g, &st->boundary, st->material);
 	if ((err = ss_comm_agree(prepare_parts(st))))
 		return err;
 	if ((err = ss_comm_agree(ss_ledger_prepare_batch(st->ledger))))
 		return err;
 	ss_ledger_agree_batch(st->ledger);
 	ss_sweeper_wake_all(st);
+	if (st->hysteresis)
+		ss_hysteresis_update(st);   /* what is steeper than tan a_s moves */
 	return SS_OK;
 }
 
@@ -307,10 +431,19 @@ static int slopes_settled(struct ss_stepper *st, double s_max, double slope_tol)
 	const struct ss_closure *c = &st->closure;
 	const double t = c->tan_cr + slope_tol;
 	const double flux_tol = slope_tol / sqrt(1.0 + t * t);   /* f_coulomb(t) */
+	const struct ss_grid *g = &st->grid;
+	/* a film of sand thinner than round-off of the heights is rock */
+	const double bare = 1e-9 * fmax(g->dx, g->dy);
+	if (st->hysteresis && st->flowing_cells > 0)
+		return 0;   /* sand still moving is not at rest */
+	if (st->material) {
+		/* each face against its own material's rule */
+		double excess = ss_sweep_material_excess(g, st->height, st->cell_types, st->material,
+		                                         st->materials, st->bedrock, bare, slope_tol);
+		ss_comm_reduce(&excess, 1, NULL, 0);
+		return excess <= 1.0;
+	}
 	if (st->bedrock) {
-		const struct ss_grid *g = &st->grid;
-		/* a film of sand thinner than round-off of the heights is rock */
-		const double bare = 1e-9 * fmax(g->dx, g->dy);
 		s_max = ss_sweep_max_sand_slope(g, st->height, st->cell_types, st->bedrock, bare);
 		ss_comm_reduce(&s_max, 1, NULL, 0);
 	}
@@ -443,6 +576,8 @@ static enum ss_advance_end advance(struct ss_stepper *st, double t_target,
 		}
 		st->steps++;
 		steps_left--;
+		if (st->hysteresis)
+			ss_hysteresis_update(st);   /* between steps: hysteresis.c */
 		const int end = step_end(st, o, &b, &steady_candidate);
 		if (end >= 0)
 			return (enum ss_advance_end)end;

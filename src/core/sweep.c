@@ -93,7 +93,12 @@ static inline double face_flux(const struct ss_face_rule *rule,
 	if (s2 > *s2_max || s2 != s2)
 		*s2_max = s2 != s2 ? INFINITY : s2;
 	double flux;
-	ss_face_fluxes(rule, 1, &g_n, &g_t, &flux);
+	if (rule->material) {
+		const uint16_t face_rule = ss_face_material(rule->material, a, b);
+		ss_face_fluxes_mixed(rule->table, 1, &face_rule, &g_n, &g_t, &flux);
+	} else {
+		ss_face_fluxes(rule, 1, &g_n, &g_t, &flux);
+	}
 	return flux;
 }
 

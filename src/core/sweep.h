@@ -206,6 +206,23 @@ double ss_sweep_max_sand_slope(const struct ss_grid *g, const double *restrict h
                                const double *restrict bedrock, double bare);
 
 /*
+ * Several materials (doc/model.md#materials): the largest over the faces
+ * that carry flux (with a bedrock, those whose stencil lies in sand, as
+ * above) of f_d(s) |g_n| / s / f_tol_d, the sliding flux across the face
+ * over nu, d its material (ss_face_material), f_tol_d the Coulomb flux of a face
+ * steeper than d's angle by slope_tol: the steady rule of stepper.h holds
+ * where it is at most 1.  NaN if a slope is.  A face beside a steeper
+ * material may stay steeper than its own angle along itself (g_t) while
+ * nothing crosses it.
+ */
+double ss_sweep_material_excess(const struct ss_grid *g, const double *restrict height,
+                                const uint8_t *restrict cell_types,
+                                const uint16_t *restrict material,
+                                const struct ss_closure *materials,
+                                const double *restrict bedrock, double bare,
+                                double slope_tol);
+
+/*
  * The fast sweep (sweep_fast.c): one in-place pass per step over the tiles
  * that can move, with the same face function and update as the reference.
  *

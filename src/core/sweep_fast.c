@@ -391,6 +391,60 @@ double SS_PATH_FN(ss_sweep_max_sand_slope)(const struct ss_grid *g,
 	return bad ? NAN : sqrt(m2);
 }
 
+#if SS_PATH == SS_PATH_GENERIC
+/* f_d(s) / f_tol_d of one face (ss_sweep_material_excess); 0 where it
+ * carries nothing or lies on rock. */
+static double face_excess(const double *h, const uint8_t *t, const uint16_t *material,
+                          const struct ss_closure *materials, double slope_tol,
+                          const double *bedrock, double bare, ptrdiff_t a, ptrdiff_t normal,
+                          ptrdiff_t along, double inv_spacing, double inv_2along)
+{
+	if (bedrock && !stencil_in_sand(h, bedrock, t, a, normal, along, bare))
+		return 0.0;
+	const double s = sqrt(double_of(face_slope2_bits(h, t, a, normal, along, inv_spacing,
+	                                                 inv_2along)));
+	const double g_n = (h[a + normal] - h[a]) * inv_spacing;
+	const uint16_t d = ss_face_material(material, a, a + normal);
+	const double tol_slope = materials[d].tan_cr + slope_tol;
+	const double f_tol = slope_tol / sqrt(1.0 + tol_slope * tol_slope);   /* f_coulomb */
+	/* the sliding flux across the face, |F| / nu = f(s) |g_n| / s: a face
+	 * beside a steeper material may be steeper than its own angle along
+	 * the face (g_t) and still carry nothing across it */
+	const double e = s > 0.0 ? ss_closure_eval(&materials[d], s) * fabs(g_n) / s / f_tol : 0.0;
+	return s != s ? NAN : e;
+}
+
+double ss_sweep_material_excess(const struct ss_grid *g, const double *restrict height,
+                                const uint8_t *restrict cell_types,
+                                const uint16_t *restrict material,
+                                const struct ss_closure *materials,
+                                const double *restrict bedrock, double bare,
+                                double slope_tol)
+{
+	const ptrdiff_t s = g->stride;
+	const double inv_dx = 1.0 / g->dx, inv_dy = 1.0 / g->dy;
+	const double inv_2dx = 0.5 / g->dx, inv_2dy = 0.5 / g->dy;
+	double worst = 0.0;
+	int bad = 0;
+	#pragma omp parallel for schedule(static) reduction(max:worst) reduction(|:bad)
+	for (int j = 0; j <= g->ny; j++) {
+		for (int i = 0; i <= g->nx; i++) {
+			const ptrdiff_t k = ss_grid_index(g, i, j);
+			double e = 0.0, y = 0.0;
+			if (j < g->ny)
+				e = face_excess(height, cell_types, material, materials, slope_tol, bedrock,
+				                bare, k - 1, 1, s, inv_dx, inv_2dy);
+			if (i < g->nx)
+				y = face_excess(height, cell_types, material, materials, slope_tol, bedrock,
+				                bare, k - s, s, 1, inv_dy, inv_2dx);
+			bad |= e != e || y != y;
+			worst = fmax(worst, fmax(e, y));
+		}
+	}
+	return bad ? NAN : worst;
+}
+#endif
+
 /* ---- set-up ---------------------------------------------------------- */
 
 static size_t row_doubles(const struct ss_tiling *t)
@@ -407,7 +461,7 @@ static int alloc_tables(struct ss_sweep_fast *f, const struct ss_grid *g,
 	const struct ss_tiling *t = &f->tiling;
 	const size_t tiles = (size_t)f->tiles;
 
-	f->scratch_doubles = 16 * row_doubles(t) + 2 * (((size_t)t->tile_ny + 7) / 8 * 8);
+	f->scratch_doubles = 17 * row_doubles(t) + 2 * (((size_t)t->tile_ny + 7) / 8 * 8);
 	f->sweep = ss_alloc(tiles, 1, "tile flags");
 	f->sweep_next = ss_alloc(tiles, 1, "tile flags");
 	f->moving = ss_alloc(tiles, 1, "tile flags");
@@ -767,6 +821,7 @@ struct row_buffers {
 	double *cdy;               /* dh/dy, central, of row j, positions 0 .. W + 1 */
 	double *gn, *gt;           /* g_n, g_t of a row of faces; then gn + 1 the rates */
 	double *fx;                /* F of the x-faces of row j, positions 0 .. W */
+	uint16_t *face_rule;       /* several materials: each face's rule (face.h) */
 	double *west_old;          /* old column i0 - 1 of the tile, by j - j0 */
 	double *east_save;         /* old column i1 - 1, the next tile's west_old */
 };
@@ -792,7 +847,8 @@ static struct row_buffers buffers_of(const struct ss_sweep_fast *f, int thread)
 	b.ring.type_cur = (int64_t *)(p + 13 * w);
 	b.ring.type_next = (int64_t *)(p + 14 * w);
 	b.ring.type_back = (int64_t *)(p + 15 * w);
-	b.west_old = p + 16 * w;
+	b.face_rule = (uint16_t *)(p + 16 * w);
+	b.west_old = p + 17 * w;
 	b.east_save = b.west_old + ((size_t)f->tiling.tile_ny + 7) / 8 * 8;
 	return b;
 }
@@ -829,19 +885,30 @@ static inline void central_x(int plain, int W, double inv_2dx,
 }
 
 /* Fluxes of n faces from (g_n, g_t); faces that cannot carry flux get 0.
- * ta, tb: types of the cells on either side (NULL in a plain tile).
- * Returns whether a face that can carry flux is above the critical slope. */
+ * ta, tb: types of the cells on either side (NULL in a plain tile);
+ * face_rule: each face's rule in rule->table (NULL: one rule).  Returns whether a
+ * face that can carry flux is above its critical slope. */
 static inline int face_row(const struct ss_face_rule *rule, int n,
                            const double *restrict gn, const double *restrict gt,
                            const int64_t *restrict ta, const int64_t *restrict tb,
-                           double *restrict flux)
+                           const uint16_t *restrict face_rule, double *restrict flux)
 {
 	const double tan_cr2 = rule->tan_cr2;
-	const int any = SS_PATH_FN(ss_face_fluxes)(rule, n, gn, gt, flux);
+	const int any = face_rule
+		? SS_PATH_FN(ss_face_fluxes_mixed)(rule->table, n, face_rule, gn, gt, flux)
+		: SS_PATH_FN(ss_face_fluxes)(rule, n, gn, gt, flux);
 	int sliding = 0;
 	if (!ta)
 		return any;
-	if (any) {
+	if (any && face_rule) {
+		/* the same with each face's threshold */
+		const double *restrict tan_cr2s = rule->table->tan_cr2;
+		for (int k = 0; k < n; k++) {
+			const int64_t carries = wide_carries(ta[k], tb[k]);
+			flux[k] = carries ? flux[k] : 0.0;
+			sliding |= carries & (gn[k] * gn[k] + gt[k] * gt[k] > tan_cr2s[face_rule[k]]);
+		}
+	} else if (any) {
 		/* F = 0 where the face cannot carry flux; sliding: s^2 > tan^2 a_cr */
 		for (int k = 0; k < n; k++) {
 			const int64_t carries = wide_carries(ta[k], tb[k]);
@@ -857,7 +924,8 @@ static inline int y_faces(const struct ss_face_rule *rule, int plain, int W,
                           double inv_dy, const double *restrict a,
                           const double *restrict b, const double *restrict cdx_a,
                           const double *restrict cdx_b, const int64_t *ta,
-                          const int64_t *tb, struct row_buffers *w,
+                          const int64_t *tb, const uint16_t *restrict mat_a,
+                          const uint16_t *restrict mat_b, struct row_buffers *w,
                           double *restrict fy)
 {
 	/* g_n = (b[x] - a[x]) / dy, g_t = (cdx_a[x] + cdx_b[x]) / 2 */
@@ -865,8 +933,13 @@ static inline int y_faces(const struct ss_face_rule *rule, int plain, int W,
 		w->gn[x] = (b[x] - a[x]) * inv_dy;
 		w->gt[x] = 0.5 * (cdx_a[x] + cdx_b[x]);
 	}
+	if (mat_a) {
+		/* the rule of the larger angle (ss_face_material) */
+		for (int x = 1; x <= W; x++)
+			w->face_rule[x] = mat_b[x] > mat_a[x] ? mat_b[x] : mat_a[x];
+	}
 	return face_row(rule, W, w->gn + 1, w->gt + 1, plain ? NULL : ta + 1,
-	                plain ? NULL : tb + 1, fy + 1);
+	                plain ? NULL : tb + 1, mat_a ? w->face_rule + 1 : NULL, fy + 1);
 }
 
 /* Bedrock limits (ss_face_limit) on the faces between buffer rows a and b
@@ -917,9 +990,11 @@ static inline int north_y_faces(const struct tile_ctx *c, const struct tile *t,
                                 struct row_buffers *w, const struct ring *r, int j)
 {
 	central_x(t->plain, t->W, c->inv_2dx, r->next, r->type_next, r->cdx_next);
+	const uint16_t *mat = c->rule->material
+		? c->rule->material + ss_grid_index(c->g, t->i0 - 1, j) : NULL;
 	const int moving = y_faces(c->rule, t->plain, t->W, c->inv_dy, r->cur, r->next,
-	                           r->cdx_cur, r->cdx_next, r->type_cur, r->type_next, w,
-	                           r->fy_north);
+	                           r->cdx_cur, r->cdx_next, r->type_cur, r->type_next, mat,
+	                           mat ? mat + c->stride : NULL, w, r->fy_north);
 	if (c->bed) {
 		const double *bed_cur = c->bed + ss_grid_index(c->g, t->i0 - 1, j);
 		limit_y_faces(t->W, c->limit_y, r->cur, r->next, bed_cur, bed_cur + c->stride,
@@ -1015,8 +1090,15 @@ static inline int row_fluxes(const struct tile_ctx *c, const struct tile *t,
 		w->gn[x] = (cur[x + 1] - cur[x]) * inv_dx;
 		w->gt[x] = 0.5 * (w->cdy[x] + w->cdy[x + 1]);
 	}
+	const uint16_t *restrict mat = c->rule->material;
+	if (mat) {
+		/* the rule of the larger angle (ss_face_material) */
+		mat += ss_grid_index(c->g, t->i0 - 1, j);
+		for (int x = 0; x <= W; x++)
+			w->face_rule[x] = mat[x + 1] > mat[x] ? mat[x + 1] : mat[x];
+	}
 	int moving = face_row(c->rule, W + 1, w->gn, w->gt, t->plain ? NULL : r->type_cur,
-	                      t->plain ? NULL : r->type_cur + 1, w->fx);
+	                      t->plain ? NULL : r->type_cur + 1, mat ? w->face_rule : NULL, w->fx);
 	if (c->bed) {
 		const double *bed_cur = c->bed + ss_grid_index(c->g, t->i0 - 1, j);
 		const double limit_x = c->limit_x;

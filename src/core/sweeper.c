@@ -42,7 +42,23 @@ void ss_sweeper_destroy(struct ss_sweeper *w)
 	ss_free(w->flux_y);
 	ss_free(w->flux_x);
 	ss_free(w->cell_type_bytes);
+	ss_face_table_release(&w->materials);
 	ss_free(w);
+}
+
+int ss_sweeper_rules(struct ss_stepper *st)
+{
+	struct ss_sweeper *w = st->sweeper;
+	ss_cfl_bound_init(&w->cfl_bound, &st->closure);
+	ss_face_rule_init(&w->face_rule, &st->closure);
+	if (!st->material)
+		return SS_OK;
+	for (int m = 0; m < st->material_count; m++)
+		ss_cfl_bound_widen(&w->cfl_bound, &st->materials[m], st->closure.nu);
+	int err = ss_face_table_create(&w->materials, st->materials, st->material_count);
+	w->face_rule.table = &w->materials;
+	w->face_rule.material = st->material;
+	return err;
 }
 
 int ss_sweeper_prepare(struct ss_stepper *st)

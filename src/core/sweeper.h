@@ -31,7 +31,10 @@
 struct ss_sweeper {
 	struct ss_tiling tiling;        /* this rank's tiles */
 	struct ss_face_rule face_rule;
-	struct ss_cfl_bound cfl_bound;  /* Lambda(S) of the closure */
+	struct ss_face_table materials; /* several materials: their rules */
+	struct ss_cfl_bound cfl_bound;  /* Lambda(S) of the closure (of
+	                                 * materials: their largest, per nu of
+	                                 * st->closure) */
 	struct ss_sweep_fast fast;      /* fast kernel */
 	uint8_t *cell_type_bytes;       /* reference kernel: the cell types,
 	                                 * one byte per cell */
@@ -63,6 +66,13 @@ struct ss_sweeper {
 int ss_sweeper_create(struct ss_sweeper **out, const struct ss_stepper *st,
                       const struct ss_tiling *tiling, double tiles_all);
 void ss_sweeper_destroy(struct ss_sweeper *w);
+
+/* The face rule and the CFL table of st->closure, or of st's materials
+ * (their rules for the face loops, each cell's material, a CFL table that
+ * bounds every one): set by ss_stepper_set_materials after the sweeper was
+ * created.  Before anything reads the CFL table (RKL2's and the approach
+ * to rest's set-up). */
+int ss_sweeper_rules(struct ss_stepper *st);
 
 /* The arrays of the kernel st->kernel, once the cell types are final and
  * the ledger lists the open faces (each rank's failure: the caller agrees

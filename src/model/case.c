@@ -243,7 +243,8 @@ static int store_path(struct parse *p, char **field, const char *value)
 		return ss_error_fail("out of memory reading '%s'", p->path);
 	free(*field);
 	*field = s;
-	char *where = field == &p->c->bedrock_file ? p->c->bedrock_where : p->c->initial_where;
+	char *where = field == &p->c->bedrock_file ? p->c->bedrock_where
+	            : field == &p->c->angle_file ? p->c->angle_where : p->c->initial_where;
 	snprintf(where, SS_CASE_WHERE_SIZE, "%s", p->where);
 	return SS_OK;
 }
@@ -258,6 +259,20 @@ static int store_value(struct parse *p, const char *section, const char *name,
 	if (o->kind != SS_OPTION_TEXT && ss_option_parse(o, value, field) == 0) {
 		if (field == &p->c->end)
 			p->c->steady = isinf(p->c->end);
+		if (o->flags & SS_OPTION_OR_FILE) {
+			/* [model] repose_angle: a number, or a raster the case owns */
+			const char **file = (const char **)((char *)field - o->offset +
+			                                    o->value_offset);
+			int err = SS_OK;
+			if (*file)
+				err = store_path(p, &p->c->angle_file, *file);
+			else {
+				free(p->c->angle_file);
+				p->c->angle_file = NULL;
+			}
+			*file = p->c->angle_file;
+			return err;
+		}
 		return SS_OK;
 	}
 	return fail_at(p, "[%s] %s = '%s' is not valid: expected %s", section, name, value,
@@ -272,6 +287,10 @@ static void reset_value(struct parse *p, const struct ss_option *o, size_t offse
 		free(*(char **)field);
 		*(char **)field = NULL;
 		return;
+	}
+	if (o->flags & SS_OPTION_OR_FILE) {
+		free(p->c->angle_file);
+		p->c->angle_file = NULL;
 	}
 	if (o->default_value)
 		ss_option_parse(o, o->default_value, field);
@@ -1155,6 +1174,7 @@ void ss_case_release(struct ss_case *c)
 	free(c->regions);
 	free(c->initial_file);
 	free(c->bedrock_file);
+	free(c->angle_file);
 	free(c->text);
 	free(c->path);
 	memset(c, 0, sizeof *c);

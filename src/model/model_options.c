@@ -56,11 +56,20 @@ static const struct ss_option options[] = {
 	 .parse = parse_closure, .expected = SS_CLOSURE_NAMES,
 	 .help = "the sliding law f_sl: coulomb, bingham,\n"
 	         "herschel-bulkley or casson"},
-	{.name = "angle", .case_key = "model.repose_angle", .value_name = "DEG",
+	{.name = "angle", .case_key = "model.repose_angle", .value_name = "DEG|FILE",
 	 .kind = SS_OPTION_REAL, .offset = AT(angle_deg), .default_value = "35", .lo = 0.0,
 	 .hi = 90.0, .flags = SS_OPTION_LO_OPEN | SS_OPTION_HI_OPEN | SS_OPTION_CASE_REQUIRED |
-	                      SS_OPTION_FITTABLE,
-	 .expected = "degrees in (0, 90)", .help = "repose angle a_cr"},
+	                      SS_OPTION_FITTABLE | SS_OPTION_OR_FILE,
+	 .value_offset = AT(angle_file),
+	 .expected = "degrees in (0, 90), or a raster of them",
+	 .help = "repose angle a_cr, or a raster of each cell's"},
+	{.name = "static-angle", .case_key = "model.static_angle", .value_name = "DEG",
+	 .kind = SS_OPTION_REAL, .offset = AT(static_angle_deg), .lo = 0.0, .hi = 90.0,
+	 .flags = SS_OPTION_LO_OPEN | SS_OPTION_HI_OPEN, .expected = "degrees in (0, 90)",
+	 .help = "hysteresis: the angle where sand at rest starts\n"
+	         "to slide, at least the repose angle, where moving\n"
+	         "sand stops (default: the repose angle, no\n"
+	         "hysteresis; doc/model.md#hysteresis)"},
 	{.name = "gamma", .case_key = "model.gamma", .value_name = "G", .kind = SS_OPTION_REAL,
 	 .offset = AT(gamma), .default_value = "1", .lo = 0.0, .hi = INFINITY,
 	 .flags = SS_OPTION_LO_OPEN | SS_OPTION_FITTABLE, .applies_to = FOR(HERSCHEL_BULKLEY),

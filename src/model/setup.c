@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "base/strings.h"
+#include "model/materials.h"
 #include "sandslide/comm.h"
 #include "sandslide/dem.h"
 #include "sandslide/error.h"
@@ -33,6 +34,8 @@ struct start {
 	enum ss_kernel kernel;
 	const char *integrator_what;          /* "--integrator rkl2" */
 	const char *bedrock_what;             /* "--bedrock" */
+	const char *static_what;              /* "--static-angle" */
+	const char *angle_what;               /* "--angle FILE" */
 	const char *grid_what;                /* "dem.asc: 60 x 40 cells need" */
 	const char *memory_advice;            /* " (reduce nx and ny)", or "" */
 };
@@ -108,8 +111,19 @@ static int start(const struct start *s, struct ss_stepper *st)
 		                      ss_format_bytes(have, hb), s->memory_advice);
 	}
 	err = ss_model_closure(m, &closure);
+	const double a_s = m->static_angle_deg;
+	if (!err && !isnan(a_s) && m->angle_file)
+		err = ss_error_input("%s %g with %s: hysteresis takes one repose angle (an angle "
+		                     "raster with it is not supported yet)", s->static_what, a_s,
+		                     s->angle_what);
+	if (!err && !isnan(a_s) && a_s < m->angle_deg)
+		err = ss_error_input("%s %g is below the repose angle %g: sand at rest starts to "
+		                     "slide at an angle at least the one where moving sand stops "
+		                     "(doc/model.md#hysteresis)", s->static_what, a_s, m->angle_deg);
 	if (!err)
 		err = ss_stepper_init(st, &g, &closure, s->boundary, m->cfl, s->tile_nx, s->tile_ny);
+	if (!err && !isnan(a_s))
+		err = ss_stepper_set_hysteresis(st, a_s);
 	if ((err = ss_comm_agree(err))) {
 		ss_stepper_release(st);   /* another rank's failure: ours is whole */
 		return err;
@@ -255,6 +269,22 @@ static int load_bedrock(const struct ss_case *c, struct ss_stepper *st)
 	return err;
 }
 
+/* [model] repose_angle = FILE: each cell's angle, the grid's size
+ * (collective). */
+static int load_angles(const struct ss_case *c, struct ss_stepper *st)
+{
+	struct ss_raster r;
+	memset(&r, 0, sizeof r);
+	char what[SS_CASE_WHERE_SIZE + 4200], where[SS_CASE_WHERE_SIZE + 32];
+	snprintf(what, sizeof what, "%s: repose_angle '%s'", c->angle_where, c->angle_file);
+	snprintf(where, sizeof where, "%s: [model] repose_angle", c->angle_where);
+	int err = ss_comm_agree(read_slab(c->angle_file, where, "repose angle raster", st, &r));
+	if (!err)
+		err = ss_materials_from_angles(st, &c->model, &r, what);
+	ss_raster_release(&r);
+	return err;
+}
+
 int ss_setup_stepper(const struct ss_case *c, int tile_nx, int tile_ny,
                      enum ss_kernel kernel, struct ss_stepper *st)
 {
@@ -269,6 +299,7 @@ int ss_setup_stepper(const struct ss_case *c, int tile_nx, int tile_ny,
 		.has_bedrock = c->bedrock_file != NULL, .steady = c->steady, .tile_nx = tile_nx,
 		.tile_ny = tile_ny, .kernel = kernel, .integrator_what = integrator_what,
 		.bedrock_what = "a bedrock", .grid_what = grid_what,
+		.static_what = "[model] static_angle =", .angle_what = "repose_angle = FILE",
 		.memory_advice = " (reduce nx and ny)",
 	};
 	int err = start(&s, st);
@@ -315,6 +346,8 @@ int ss_setup_stepper(const struct ss_case *c, int tile_nx, int tile_ny,
 	/* failures of one rank (a file, an allocation) before the collective
 	 * calls of prepare */
 	err = ss_comm_agree(err);
+	if (!err && c->angle_file)
+		err = load_angles(c, st);
 	if (!err)
 		err = ss_stepper_prepare(st);
 	if (err)
@@ -406,6 +439,8 @@ static int fill_from_raster(const struct ss_raster_setup *s, struct ss_stepper *
 	int err = ss_comm_agree(rock ? ss_stepper_set_bedrock(st, rock->values + (size_t)(g.offset_j -
 	                                                      rock->row_first) * g.nx)
 	                             : SS_OK);
+	if (!err && s->angles)
+		err = ss_materials_from_angles(st, s->model, s->angles, s->angles_what);
 	if (err || !s->pour)
 		return err;
 	uint8_t *mask = ss_alloc((size_t)g.nx * g.ny, 1, "sand source mask");
@@ -443,6 +478,7 @@ int ss_setup_stepper_from_raster(const struct ss_raster_setup *s, struct ss_step
 		.tile_nx = s->tile_nx, .tile_ny = s->tile_ny,
 		.kernel = SS_KERNEL_FAST, .integrator_what = "--integrator rkl2",
 		.bedrock_what = "--bedrock", .grid_what = grid_what, .memory_advice = "",
+		.static_what = "--static-angle", .angle_what = "--angle FILE",
 	};
 	if ((err = start(&start_with, st)))
 		return err;

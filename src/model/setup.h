@@ -48,6 +48,10 @@ struct ss_raster_setup {
 	                                   * raster (where an open side or cell
 	                                   * lets sand leave) */
 	const struct ss_raster *bedrock;  /* the same size and rows, or NULL */
+	const struct ss_raster *angles;   /* each cell's repose angle, degrees
+	                                   * (model/materials.h), the same size
+	                                   * and rows, or NULL: the model's */
+	const char *angles_what;          /*   the file, for messages */
 	int steady;                       /* the run goes on until steady (relax;
 	                                   * not the BMI, which drives it): the
 	                                   * approach to rest (stepper.h) */

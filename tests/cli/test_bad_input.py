@@ -238,8 +238,11 @@ def bad_inputs():
                 ["repose_angle", "(0, 90)"]),
         b_value("angle-95", "repose_angle = 35\n", "repose_angle = 95\n",
                 ["repose_angle", "(0, 90)"]),
+        # not a number: a raster of angles (doc/model.md#materials)
         b_value("angle-abc", "repose_angle = 35\n", "repose_angle = abc\n",
-                ["repose_angle", "abc", "(0, 90)"]),
+                ["repose_angle", "abc", "cannot open"]),
+        b_value("angle-junk", "repose_angle = 35\n", "repose_angle = 35x\n",
+                ["repose_angle", "35x", "(0, 90)"]),
         b_value("angle-nan", "repose_angle = 35\n", "repose_angle = nan\n",
                 ["repose_angle", "(0, 90)"]),
         b_added("cfl-0", "output_every = 0.5\n", "cfl = 0\n", ["cfl", "(0, 1]"]),

@@ -1,0 +1,163 @@
+/*
+ * SPDX-License-Identifier: BSD-3-Clause
+ *
+ * materials.c - a raster of repose angles as the stepper's materials (see
+ * materials.h).
+ *
+ * The materials are numbered by angle, smallest first, over the whole grid:
+ * each rank sorts its own distinct angles, rank 0 merges the ranks' lists
+ * and every rank takes the merged one, so that the numbers in the halo rows
+ * traded between ranks mean the same on both sides.
+ */
+#include "model/materials.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "base/strings.h"
+#include "sandslide/comm.h"
+#include "sandslide/error.h"
+
+enum { MAX_MATERIALS = UINT16_MAX };
+
+static int compare_doubles(const void *a, const void *b)
+{
+	const double x = *(const double *)a, y = *(const double *)b;
+	return (x > y) - (x < y);
+}
+
+/* values[0 .. n) sorted, each once; returns how many. */
+static size_t sort_distinct(double *values, size_t n)
+{
+	qsort(values, n, sizeof *values, compare_doubles);
+	size_t d = 0;
+	for (size_t k = 0; k < n; k++)
+		if (d == 0 || values[k] != values[d - 1])
+			values[d++] = values[k];
+	return d;
+}
+
+/* The distinct angles of the whole grid into *all (sorted, owned), from
+ * this rank's `mine` (sorted, distinct, NaN-free); collective. */
+static int merge_ranks(const double *mine, size_t n, double **all, size_t *count)
+{
+	const int ranks = ss_comm_size();
+	double longest = (double)n;
+	ss_comm_reduce(&longest, 1, NULL, 0);
+	const size_t k = (size_t)longest;
+	/* every rank sends k values, its own then NaN */
+	double *padded = ss_alloc(k ? k : 1, sizeof *padded, "repose angles");
+	double *gathered = ss_alloc((k ? k : 1) * (size_t)ranks, sizeof *gathered,
+	                            "repose angles");
+	int err = padded && gathered ? SS_OK : SS_ERR_FAIL;
+	if ((err = ss_comm_agree(err))) {
+		ss_free(padded);
+		ss_free(gathered);
+		return err;
+	}
+	for (size_t m = 0; m < k; m++)
+		padded[m] = m < n ? mine[m] : NAN;
+	ss_comm_gather_rows(padded, k * sizeof *padded, gathered);
+	double total = 0.0;
+	if (ss_comm_rank() == 0) {
+		size_t kept = 0;
+		for (size_t m = 0; m < k * (size_t)ranks; m++)
+			if (gathered[m] == gathered[m])
+				gathered[kept++] = gathered[m];
+		total = (double)sort_distinct(gathered, kept);
+	}
+	ss_comm_broadcast(&total, sizeof total, 0);
+	ss_comm_broadcast(gathered, (size_t)total * sizeof *gathered, 0);
+	ss_free(padded);
+	*all = gathered;
+	*count = (size_t)total;
+	return SS_OK;
+}
+
+/* The first cell of this rank that lacks data and flows, or an angle out
+ * of range: its message.  Also this rank's distinct angles. */
+static int check_angles(const struct ss_stepper *st, const struct ss_raster *r,
+                        const char *what, double *distinct, size_t *n)
+{
+	const struct ss_grid *g = &st->grid;
+	const size_t first = (size_t)(g->offset_j - r->row_first) * g->nx;
+	size_t count = 0;
+	for (int j = 0; j < g->ny; j++) {
+		for (int i = 0; i < g->nx; i++) {
+			const size_t m = first + (size_t)j * g->nx + i;
+			const double a = r->values[m];
+			const int flows = ss_cell_type_get(st->cell_types, ss_grid_index(g, i, j)) ==
+			                  SS_CELL_FLOW;
+			if (r->nodata && r->nodata[m]) {
+				if (flows)
+					return ss_error_input("%s has no data at %s: every cell that holds "
+					                      "sand needs an angle", what,
+					                      SS_GRID_CELL(g, i, j));
+				continue;
+			}
+			if (!(a > 0.0 && a < 90.0))
+				return ss_error_input("%s: the angle of %s is %g: expected degrees in "
+				                      "(0, 90)", what, SS_GRID_CELL(g, i, j), a);
+			distinct[count++] = a;
+		}
+	}
+	*n = sort_distinct(distinct, count);
+	return SS_OK;
+}
+
+static size_t find_angle(const double *angles, size_t n, double a)
+{
+	size_t lo = 0, hi = n;
+	while (hi - lo > 1) {
+		const size_t mid = lo + (hi - lo) / 2;
+		if (angles[mid] <= a)
+			lo = mid;
+		else
+			hi = mid;
+	}
+	return lo;
+}
+
+int ss_materials_from_angles(struct ss_stepper *st, const struct ss_model_options *m,
+                             const struct ss_raster *r, const char *what)
+{
+	const struct ss_grid *g = &st->grid;
+	const size_t cells = (size_t)g->nx * (size_t)g->ny;
+	if (g->offset_j < r->row_first || g->offset_j + g->ny > r->row_first + r->rows)
+		SS_BUG("the angles hold rows %d + %d: not the slab's", r->row_first, r->rows);
+	double *mine = ss_alloc(cells ? cells : 1, sizeof *mine, "repose angles");
+	size_t n = 0, count = 0;
+	int err = mine ? check_angles(st, r, what, mine, &n) : SS_ERR_FAIL;
+	double *angles = NULL;
+	if (!(err = ss_comm_agree(err)))
+		err = merge_ranks(mine, n, &angles, &count);
+	ss_free(mine);
+	if (!err && count > MAX_MATERIALS)
+		err = ss_error_input("%s holds %zu distinct angles: at most %d are accepted (round "
+		                     "them, to 0.01 degree for example)", what, count, MAX_MATERIALS);
+	if (!err && count == 0)
+		err = ss_error_input("%s has no angle in a cell with data", what);
+	struct ss_closure *closures = NULL;
+	uint16_t *material = NULL;
+	if (!err) {
+		closures = ss_alloc(count, sizeof *closures, "materials");
+		material = ss_alloc(cells ? cells : 1, sizeof *material, "materials");
+		err = ss_comm_agree(closures && material ? SS_OK : SS_ERR_FAIL);
+	}
+	for (size_t k = 0; !err && k < count; k++)
+		err = ss_closure_init(&closures[k], m->closure, angles[k], m->gamma, m->nu);
+	if (!err) {
+		const size_t first = (size_t)(g->offset_j - r->row_first) * g->nx;
+		for (size_t c = 0; c < cells; c++) {
+			const size_t q = first + c;
+			material[c] = r->nodata && r->nodata[q]
+				? 0 : (uint16_t)find_angle(angles, count, r->values[q]);
+		}
+		err = ss_stepper_set_materials(st, closures, (int)count, material);
+	}
+	ss_free(material);
+	ss_free(closures);
+	ss_free(angles);
+	return ss_comm_agree(err);
+}

@@ -1,0 +1,267 @@
+# SPDX-License-Identifier: BSD-3-Clause
+"""Materials (issue 37, doc/model.md#materials): a repose angle per cell.
+
+Two half-planes at 30 and 40 degrees relax each to its own angle, with the
+boundary between them as the face law says (the larger angle of a face's
+two cells); one angle in a raster gives the bits of that angle given as a
+number; bad rasters are refused with the file, the cell and the value.
+"""
+import json
+import math
+
+import numpy as np
+
+from conftest import h5open, run, same_bits
+from test_relax import read_asc, write_asc
+
+DX = 1.0
+
+
+def ridge(nx=48, ny=40, height=15.0):
+    """A ridge along x: 60 degree flanks on a flat floor, crest at mid y."""
+    y = np.arange(ny) - (ny - 1) / 2.0
+    profile = np.maximum(0.0, height - math.tan(math.radians(60.0)) * np.abs(y) * DX)
+    return np.tile(profile[:, None], (1, nx))
+
+
+def half_planes(nx=48, ny=40, west=30.0, east=40.0):
+    a = np.full((ny, nx), east)
+    a[:, : nx // 2] = west
+    return a
+
+
+def relax_ok(args, tmp_path):
+    r = run(["relax"] + [str(a) for a in args], cwd=tmp_path, timeout=300)
+    assert r.returncode == 0, f"relax {args} exited {r.returncode}:\n{r.stderr}"
+    return r
+
+
+def normal_slopes_deg(h):
+    """|g_n| of the x-faces and of the y-faces, in degrees."""
+    gx = np.degrees(np.arctan(np.abs(np.diff(h, axis=1)) / DX))
+    gy = np.degrees(np.arctan(np.abs(np.diff(h, axis=0)) / DX))
+    return gx, gy
+
+
+def test_half_planes_relax_each_to_its_angle(tmp_path):
+    h0, angles = ridge(), half_planes()
+    ny, nx = h0.shape
+    write_asc(tmp_path / "ridge.asc", h0, cellsize=DX)
+    write_asc(tmp_path / "angles.asc", angles, cellsize=DX)
+    relax_ok(["ridge.asc", "-o", "out.asc", "--angle", "angles.asc",
+              "--report", "report.json"], tmp_path)
+    report = json.loads((tmp_path / "report.json").read_text())
+    assert report["steady"], f"not steady: {report}"
+    _, h = read_asc(tmp_path / "out.asc")
+    assert abs(h.sum() - h0.sum()) <= 1e-9 * h0.sum(), (
+        f"volume {h0.sum()!r} -> {h.sum()!r} m^3 (x dx dy)")
+    gx, gy = normal_slopes_deg(h)
+    b = nx // 2        # first column of the 40 degree half
+    tol = 1e-3         # degrees: the steady rule's slope tolerance, and more
+    # away from the boundary each half lies at its own angle
+    west, east = gy[:, : b - 3].max(), gy[:, b + 3:].max()
+    assert 29.9 <= west <= 30.0 + tol, f"the 30 degree half's steepest face: {west:.4f} deg"
+    assert 39.9 <= east <= 40.0 + tol, f"the 40 degree half's steepest face: {east:.4f} deg"
+    # the steep half keeps its angle up to its edge: the column beside the
+    # loose half holds at 40 degrees (a face takes the larger angle)
+    edge = gy[:, b].max()
+    assert 39.9 <= edge <= 40.0 + tol, (
+        f"the 40 degree column at the boundary has its steepest face at {edge:.4f} deg")
+    # no face is steeper than the larger angle of its two cells
+    limit_x = np.maximum(angles[:, 1:], angles[:, :-1])
+    limit_y = np.maximum(angles[1:, :], angles[:-1, :])
+    over_x, over_y = (gx - limit_x).max(), (gy - limit_y).max()
+    assert max(over_x, over_y) <= tol, (
+        f"a face steeper than the larger angle of its cells by {max(over_x, over_y):.4g} deg")
+    # and the loose half's faces that do not touch the steep one hold at 30
+    assert gy[:, : b - 1].max() <= 30.0 + tol and gx[:, : b - 2].max() <= 30.0 + tol, (
+        "a face inside the 30 degree half is steeper than 30 degrees")
+
+
+def test_one_angle_in_a_raster_is_that_angle(tmp_path):
+    h0 = ridge(24, 20, 8.0)
+    write_asc(tmp_path / "ridge.asc", h0, cellsize=DX)
+    write_asc(tmp_path / "angles.asc", np.full(h0.shape, 33.0), cellsize=DX)
+    relax_ok(["ridge.asc", "-o", "raster.asc", "--angle", "angles.asc"], tmp_path)
+    relax_ok(["ridge.asc", "-o", "number.asc", "--angle", "33"], tmp_path)
+    assert (tmp_path / "raster.asc").read_bytes() == (tmp_path / "number.asc").read_bytes(), (
+        "an angle raster of one value did not give the bits of --angle 33")
+
+
+CASE = """[grid]
+nx = 24
+ny = 20
+dx = 1
+dy = 1
+[model]
+closure = coulomb
+repose_angle = {angle}
+nu = 1
+[time]
+end = steady
+output_every = 50
+[initial]
+type = file
+file = ridge.asc
+"""
+
+
+def test_case_angle_file(tmp_path):
+    """[model] repose_angle = FILE, resolved beside the case: one angle gives
+    the bits of the number; two halves the half-planes' angles."""
+    h0 = ridge(24, 20, 8.0)
+    write_asc(tmp_path / "ridge.asc", h0, cellsize=DX)
+    write_asc(tmp_path / "one.asc", np.full(h0.shape, 33.0), cellsize=DX)
+    write_asc(tmp_path / "two.asc", half_planes(24, 20), cellsize=DX)
+    for name, angle in (("number", "33"), ("one", "one.asc"), ("two", "two.asc")):
+        (tmp_path / f"{name}.ini").write_text(CASE.format(angle=angle))
+        r = run(["run", f"{name}.ini", "-o", f"{name}.h5"], cwd=tmp_path, timeout=300)
+        assert r.returncode == 0, f"run {name}.ini exited {r.returncode}:\n{r.stderr}"
+    with h5open(tmp_path / "number.h5") as a, h5open(tmp_path / "one.h5") as b:
+        ha, hb = a["height"][-1], b["height"][-1]
+        assert same_bits(ha, hb), "repose_angle = one.asc (all 33) differs from 33"
+    with h5open(tmp_path / "two.h5") as f:
+        h = f["height"][-1]
+    gx, gy = normal_slopes_deg(h)
+    assert gy[:, 12:].max() > 39.0, (
+        f"the 40 degree half lies at {gy[:, 12:].max():.3f} deg at most")
+    assert gy[:, :10].max() <= 30.001, (
+        f"the 30 degree half lies at {gy[:, :10].max():.3f} deg at most")
+
+
+def test_bad_angle_rasters(tmp_path):
+    h0 = ridge(24, 20, 8.0)
+    write_asc(tmp_path / "ridge.asc", h0, cellsize=DX)
+    write_asc(tmp_path / "small.asc", np.full((10, 24), 33.0), cellsize=DX)
+    steep = np.full(h0.shape, 33.0)
+    steep[3, 5] = 95.0
+    write_asc(tmp_path / "steep.asc", steep, cellsize=DX)
+    holes = np.full(h0.shape, 33.0)
+    holes[4, 6] = -9999.0
+    write_asc(tmp_path / "holes.asc", holes, cellsize=DX, nodata=-9999.0)
+    for angle, words in (("small.asc", ["small.asc", "24 x 10", "24 x 20"]),
+                         ("steep.asc", ["steep.asc", "95", "(5, 3)", "(0, 90)"]),
+                         ("holes.asc", ["holes.asc", "no data", "(6, 4)"]),
+                         ("missing.asc", ["missing.asc"])):
+        r = run(["relax", "ridge.asc", "-o", "out.asc", "--angle", angle], cwd=tmp_path)
+        assert r.returncode == 2, f"--angle {angle}: exit {r.returncode}\n{r.stderr}"
+        line = r.stderr.strip()
+        assert len(line.splitlines()) == 1, f"--angle {angle}: not one line:\n{r.stderr}"
+        for w in words:
+            assert w in line, f"--angle {angle}: '{w}' not in the message: {line}"
+    # a number out of range is still a number
+    r = run(["relax", "ridge.asc", "-o", "out.asc", "--angle", "95"], cwd=tmp_path)
+    assert r.returncode == 2 and "(0, 90)" in r.stderr, r.stderr
+
+
+# ---- hysteresis (doc/model.md#hysteresis) ----------------------------------
+
+POUR = """[grid]
+nx = 41
+ny = 41
+dx = 0.05
+origin = -1.025 -1.025
+
+[model]
+closure = coulomb
+repose_angle = 30
+{static}
+nu = 0.1
+
+[time]
+end = steady
+max_time = 120
+output_every = 0.25
+
+[boundary]
+west = open
+east = open
+south = open
+north = open
+
+[source pour]
+disk = 0 0 0.06
+rate = 0.02
+stop = 45
+"""
+
+
+def steepest_deg(h, dx=0.05):
+    g = max((np.abs(np.diff(h, axis=1)) / dx).max(), (np.abs(np.diff(h, axis=0)) / dx).max())
+    return math.degrees(math.atan(g))
+
+
+def pour(tmp_path, name, static, *args):
+    (tmp_path / f"{name}.ini").write_text(POUR.format(static=static))
+    r = run(["run", f"{name}.ini", "-o", f"{name}.h5"] + list(args), cwd=tmp_path,
+            timeout=300)
+    assert r.returncode == 0, f"run {name}.ini exited {r.returncode}:\n{r.stderr}"
+    with h5open(tmp_path / f"{name}.h5") as f:
+        return f["height"][:], f["time"][:], r.stdout
+
+
+def test_slow_pour_avalanches_between_the_two_angles(tmp_path):
+    """Poured slowly at 30 and 36 degrees, the flank steepens to the static
+    angle, an avalanche runs it down to the dynamic one, again and again; it
+    stays between the two, and the pile ends at rest."""
+    a_d, a_s, tol = 30.0, 36.0, 0.2
+    heights, times, out = pour(tmp_path, "pour", "static_angle = 36")
+    assert "(steady)" in out, f"the pile did not come to rest:\n{out}"
+    steepest = [steepest_deg(h) for h in heights]
+    # an avalanche: the steepest face from near a_s down to near a_d
+    avalanches, high = 0, False
+    for s in steepest:
+        if s >= a_s - 1.0:
+            high = True
+        elif high and s <= a_d + 1.5:
+            avalanches, high = avalanches + 1, False
+    assert avalanches >= 3, f"{avalanches} avalanches: steepest faces {steepest}"
+    first = next(k for k, s in enumerate(steepest) if s >= a_s - 1.0)
+    after = steepest[first:]
+    assert a_d - tol <= min(after) and max(after) <= a_s + tol, (
+        f"after the first avalanche the steepest face ran from {min(after):.3f} to "
+        f"{max(after):.3f} deg, outside [{a_d}, {a_s}] + {tol}")
+    # at rest anywhere between the two: a pile poured no more stays as it is
+    assert a_d - tol <= steepest[-1] <= a_s + tol, f"at rest at {steepest[-1]:.4f} deg"
+    # the same bits on 1 and 2 threads and another tile size
+    other, _, _ = pour(tmp_path, "pour1", "static_angle = 36", "--threads", "1",
+                       "--tile", "16x8")
+    assert same_bits(heights, other), "hysteresis: another thread count or tile size " \
+        "gave other bits"
+
+
+def test_static_angle_equal_to_repose_is_no_hysteresis(tmp_path):
+    plain, _, _ = pour(tmp_path, "plain", "")
+    equal, _, _ = pour(tmp_path, "equal", "static_angle = 30")
+    assert same_bits(plain, equal), "static_angle = repose_angle differs from no static_angle"
+
+
+def test_bad_static_angles(tmp_path):
+    (tmp_path / "low.ini").write_text(POUR.format(static="static_angle = 25"))
+    r = run(["run", "low.ini", "-o", "low.h5"], cwd=tmp_path)
+    assert r.returncode == 2 and len(r.stderr.splitlines()) == 1, r.stderr
+    for w in ("static_angle", "25", "30"):
+        assert w in r.stderr, f"'{w}' not in: {r.stderr}"
+    h0 = ridge(24, 20, 8.0)
+    write_asc(tmp_path / "ridge.asc", h0, cellsize=DX)
+    write_asc(tmp_path / "angles.asc", half_planes(24, 20), cellsize=DX)
+    for args, words in ((["--angle", "35", "--static-angle", "30"],
+                         ["--static-angle", "30", "35"]),
+                        (["--angle", "angles.asc", "--static-angle", "45"],
+                         ["--static-angle", "--angle", "not supported"])):
+        r = run(["relax", "ridge.asc", "-o", "out.asc"] + args, cwd=tmp_path)
+        assert r.returncode == 2 and len(r.stderr.splitlines()) == 1, (args, r.stderr)
+        for w in words:
+            assert w in r.stderr, f"{args}: '{w}' not in: {r.stderr}"
+
+
+def test_restart_with_hysteresis_is_refused(tmp_path):
+    """The snapshots do not hold which cells move (yet): a restart says so
+    rather than continue with other bits."""
+    (tmp_path / "p.ini").write_text(POUR.format(static="static_angle = 36")
+                                    .replace("end = steady\nmax_time = 120", "end = 2"))
+    r = run(["run", "p.ini", "-o", "p.h5"], cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    r = run(["run", "--restart", "p.h5", "p.ini"], cwd=tmp_path)
+    assert r.returncode == 2 and "hysteresis" in r.stderr and "static_angle" in r.stderr, (
+        r.stderr)
