@@ -9,9 +9,15 @@
  * The states change between steps, from the heights the step left:
  *
  *   at rest -> moving   where a face of the cell is steeper than tan a_s
- *   moving  -> at rest  where no face of the cell is steeper than tan a_d
+ *   moving  -> at rest  where no face of the cell carries more sliding
+ *                       flux at a_d, f_d(s) |g_n| / s, than a Coulomb
+ *                       face steeper than a_d by the steady rule's
+ *                       slope tolerance
  *
- * (the faces that carry flux, s of doc/model.md#face-flux).  A cell's new
+ * (the faces that carry flux, s and g_n of doc/model.md#face-flux).  A
+ * face at a_d comes down to tan a_d only in the limit, and one steep
+ * along itself (g_t) but level across it carries nothing: both would keep
+ * a cell moving for ever by its slope alone.  A cell's new
  * state depends on its heights' stencil and its own old state only, so it
  * is the same for any thread count, tile size and rank count.  Cells that
  * do not flow are "at rest" (0): a face between a flow cell and an open
@@ -61,11 +67,12 @@ int ss_stepper_set_hysteresis(struct ss_stepper *st, double static_deg)
 	return SS_OK;
 }
 
-/* The largest s^2 of the faces of cell k that carry flux (the kernel's
- * expressions: g_n across, g_t the mean of the central differences along,
- * a wall neighbour mirrored). */
-static double cell_slope2(const struct ss_grid *g, const double *h, const uint8_t *t,
-                          ptrdiff_t k)
+/* Of the faces of cell k that carry flux (the kernel's expressions: g_n
+ * across, g_t the mean of the central differences along, a wall neighbour
+ * mirrored): the largest s^2 into *s2_max, and the largest sliding flux
+ * over nu at a_d, f_d(s) |g_n| / s, returned. */
+static double cell_faces(const struct ss_grid *g, const double *h, const uint8_t *t,
+                         ptrdiff_t k, const struct ss_closure *moving, double *s2_max)
 {
 	const ptrdiff_t s = g->stride;
 	const double inv_dx = 1.0 / g->dx, inv_dy = 1.0 / g->dy;
@@ -75,7 +82,7 @@ static double cell_slope2(const struct ss_grid *g, const double *h, const uint8_
 	const ptrdiff_t normal[4] = {1, 1, s, s}, along[4] = {s, s, 1, 1};
 	const double inv_n[4] = {inv_dx, inv_dx, inv_dy, inv_dy};
 	const double inv_2a[4] = {inv_2dy, inv_2dy, inv_2dx, inv_2dx};
-	double q_max = 0.0;
+	double q_max = 0.0, flux_max = 0.0;
 	for (int f = 0; f < 4; f++) {
 		const ptrdiff_t p = a[f], q = p + normal[f], l = along[f];
 		if (!ss_face_carries(ss_cell_type_get(t, p), ss_cell_type_get(t, q)))
@@ -85,17 +92,26 @@ static double cell_slope2(const struct ss_grid *g, const double *h, const uint8_
 		const double cdq = (H_ALONG(q, l) - H_ALONG(q, -l)) * inv_2a[f];
 #undef H_ALONG
 		const double gn = (h[q] - h[p]) * inv_n[f], gt = 0.5 * (cdp + cdq);
-		const double s2 = gn * gn + gt * gt;
+		const double s2 = gn * gn + gt * gt, slope = sqrt(s2);
+		const double flux = slope > 0.0 ? ss_closure_eval(moving, slope) * fabs(gn) / slope
+		                                : 0.0;
 		q_max = s2 > q_max || s2 != s2 ? s2 : q_max;
+		flux_max = flux > flux_max || flux != flux ? flux : flux_max;
 	}
-	return q_max;
+	*s2_max = q_max;
+	return flux_max;
 }
 
-long long ss_hysteresis_update(struct ss_stepper *st)
+long long ss_hysteresis_update(struct ss_stepper *st, double slope_tol)
 {
 	const struct ss_grid *g = &st->grid;
 	const struct ss_face_table *rules = &st->sweeper->materials;
-	const double start2 = rules->tan_cr2[AT_REST], stop2 = rules->tan_cr2[MOVING];
+	const struct ss_closure *moving_law = &st->materials[MOVING];
+	const double start2 = rules->tan_cr2[AT_REST];
+	/* the steady rule's tolerance (stepper.h): the flux of a Coulomb face
+	 * steeper than a_d by slope_tol */
+	const double e = slope_tol, te = moving_law->tan_cr + e;
+	const double flux_tol = e / sqrt(1.0 + te * te);
 	const uint8_t *t = st->cell_types;
 	const double *h = st->height;
 	uint16_t *state = st->material;
@@ -108,11 +124,12 @@ long long ss_hysteresis_update(struct ss_stepper *st)
 			const ptrdiff_t k = ss_grid_index(g, i, j);
 			if (ss_cell_type_get(t, k) != SS_CELL_FLOW)
 				continue;
-			const double q = cell_slope2(g, h, t, k);
+			double s2;
+			const double flux = cell_faces(g, h, t, k, moving_law, &s2);
 			const uint16_t old = state[k];
 			/* a NaN slope leaves the state: the guard stops the run */
-			const uint16_t now = old == AT_REST ? (q > start2 ? MOVING : AT_REST)
-			                                    : (q > stop2 ? MOVING : AT_REST);
+			const uint16_t now = old == AT_REST ? (s2 > start2 ? MOVING : AT_REST)
+			                                    : (flux > flux_tol ? MOVING : AT_REST);
 			state[k] = now;
 			changed += now != old;
 			moving += now == MOVING;

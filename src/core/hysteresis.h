@@ -14,9 +14,10 @@
  * tan a_s. */
 void ss_hysteresis_start(struct ss_stepper *st);
 
-/* The states from the heights (stepper.h), the halo's too, and
- * st->flowing_cells; every tile woken when a state changed.  Returns the
- * cells that changed, all ranks.  Collective. */
-long long ss_hysteresis_update(struct ss_stepper *st);
+/* The states from the heights (hysteresis.c), the halo's too, and
+ * st->flowing_cells; every tile woken when a state changed.  slope_tol:
+ * the steady rule's (stepper.h), below which moving sand stops.  Returns
+ * the cells that changed, all ranks.  Collective. */
+long long ss_hysteresis_update(struct ss_stepper *st, double slope_tol);
 
 #endif

@@ -338,7 +338,7 @@ int ss_stepper_prepare(struct ss_stepper *st)
 	ss_ledger_agree_batch(st->ledger);
 	ss_sweeper_wake_all(st);
 	if (st->hysteresis)
-		ss_hysteresis_update(st);   /* what is steeper than tan a_s moves */
+		ss_hysteresis_update(st, 1e-6);   /* what is steeper than tan a_s moves */
 	return SS_OK;
 }
 
@@ -577,7 +577,7 @@ static enum ss_advance_end advance(struct ss_stepper *st, double t_target,
 		st->steps++;
 		steps_left--;
 		if (st->hysteresis)
-			ss_hysteresis_update(st);   /* between steps: hysteresis.c */
+			ss_hysteresis_update(st, slope_tol);   /* between steps: hysteresis.c */
 		const int end = step_end(st, o, &b, &steady_candidate);
 		if (end >= 0)
 			return (enum ss_advance_end)end;

@@ -591,6 +591,71 @@ def test_relax_h5_under_3_ranks_is_the_serial_series(tmp_path, serial_relax):
                        "relax (.h5, open sides, rkl2) under np = 3")
 
 
+def write_angles(path):
+    """Repose angles of 30 and 40 degrees in bands of 5 rows, which the
+    ranks' edges cut, and a column of 35: materials (doc/model.md#materials)
+    whose faces cross the ranks' edges."""
+    y, _ = np.mgrid[0:26, 0:32]
+    a = np.where((y // 5) % 2 == 0, 30.0, 40.0)
+    a[:, 20:24] = 35.0
+    path.write_text(asc_text(a, dx=0.1))
+
+
+def test_relax_with_an_angle_raster_under_3_ranks_is_the_serial_raster(tmp_path):
+    """Each rank numbers the whole grid's angles alike, and the halo rows of
+    the materials come from the ranks beside."""
+    serial, mpi = tmp_path / "serial", tmp_path / "mpi"
+    for d in (serial, mpi):
+        d.mkdir()
+        write_cliff(d / "cliff.asc")
+        write_angles(d / "angles.asc")
+    args = ["relax", "cliff.asc", "-o", "relaxed.asc", "-q", "--angle", "angles.asc",
+            *RELAX_FAST]
+    serial_run_ok(args, serial)
+    mpi_run_ok(3, args, mpi)
+    assert (mpi / "relaxed.asc").read_bytes() == (serial / "relaxed.asc").read_bytes(), \
+        "relax --angle FILE under np = 3: the .asc differs from the serial one"
+
+
+HYSTERESIS_CASE = """[grid]
+nx = 41
+ny = 41
+dx = 0.05
+origin = -1.025 -1.025
+[model]
+closure = coulomb
+repose_angle = 30
+static_angle = 36
+nu = 0.1
+[time]
+end = 12
+output_every = 1
+[boundary]
+west = open
+east = open
+south = open
+north = open
+[source pour]
+disk = 0 0 0.06
+rate = 0.02
+"""
+
+
+def test_hysteresis_under_3_ranks_has_the_serial_bits(tmp_path):
+    """Each cell at rest or moving (doc/model.md#hysteresis): the states of
+    the halo rows from the ranks beside, the same avalanches."""
+    serial, mpi = tmp_path / "serial", tmp_path / "mpi"
+    for d in (serial, mpi):
+        d.mkdir()
+        (d / "pour.ini").write_text(HYSTERESIS_CASE)
+    args = ["run", "pour.ini", "-o", "pour.h5", "-q", "--tile", "16x8"]
+    serial_run_ok(args, serial)
+    mpi_run_ok(3, args, mpi)
+    with h5open(serial / "pour.h5") as a, h5open(mpi / "pour.h5") as b:
+        assert same_bits(a["height"][:], b["height"][:]), \
+            "hysteresis under np = 3: the heights differ from the serial run's"
+
+
 def write_clipped_cliff(path):
     """The cliff with nodata (-9999) round a disk that crosses every rank's
     rows, and a hole: the cells relax writes as /cell_type 3."""
