@@ -1279,6 +1279,82 @@ static double *path_heights(const struct scenario *sc, double T, size_t *n_out)
 	return h;
 }
 
+/*
+ * The faces of several rules (materials, doc/model.md#materials) on every
+ * path: a row whose faces all take rule r gives the bits of the one-rule
+ * function with r; a row of mixed rules the bits of single calls, with up
+ * to 8 rules (a register permutation on AVX-512) and with 12 (gathers);
+ * coulomb beside bingham beside casson in one row too.
+ */
+static void test_face_mixed(void)
+{
+	enum { N = 300, PAD = 4 };
+	double gn[N + PAD], gt[N + PAD], row[N], plain[N];
+	uint16_t rules[N + PAD];
+	for (int pi = 0; pi < N_PATHS; pi++) {
+		const enum ss_cpu_path path = all_paths[pi];
+		if (!use_path(path, "face mixed"))
+			continue;
+		struct rng r = {seed + 11};
+		long total = 0, differ = 0;
+		for (int variant = 0; variant < 3; variant++) {
+			/* 0: 8 angles of one closure; 1: 12; 2: three closures */
+			const int count = variant == 1 ? 12 : 8;
+			struct ss_closure c[12];
+			for (int m = 0; m < count; m++) {
+				const int ci = variant == 2 ? (m % 3 == 0 ? 0 : m % 3 == 1 ? 1 : N_CLOSURES - 1)
+				                            : 0;
+				ss_closure_init(&c[m], closures[ci].kind, 20.0 + 2.5 * m, closures[ci].gamma,
+				                0.02 * (1.0 + 0.1 * m));
+			}
+			struct ss_face_table table;
+			if (ss_face_table_create(&table, c, count)) {
+				CHECK(0, "test set-up: face table");
+				continue;
+			}
+			lane_faces(&r, &c[count - 1], N + PAD, gn, gt);
+			for (int k = 0; k < N + PAD; k++)
+				rules[k] = (uint16_t)rng_int(&r, count);
+			for (int off = 0; off <= PAD; off += 3) {
+				const int n = off ? 129 : N;
+				ss_face_fluxes_mixed(&table, n, rules + off, gn + off, gt + off, row);
+				long d = 0;
+				for (int k = 0; k < n; k++) {
+					double one;
+					ss_face_fluxes_mixed(&table, 1, rules + off + k, gn + off + k,
+					                     gt + off + k, &one);
+					d += !same_bits(one, row[k]);
+				}
+				CHECK(d == 0, "%s path, %d rules: a mixed row of %d faces differs from single "
+				      "calls in %ld faces", ss_cpu_path_name(path), count, n, d);
+				total += n;
+				differ += d;
+			}
+			/* every face of rule m: the one-rule function's bits */
+			for (int m = 0; m < count; m += 3) {
+				uint16_t same[N];
+				for (int k = 0; k < N; k++)
+					same[k] = (uint16_t)m;
+				struct ss_face_rule one;
+				ss_face_rule_init(&one, &c[m]);
+				ss_face_fluxes_mixed(&table, N, same, gn, gt, row);
+				ss_face_fluxes(&one, N, gn, gt, plain);
+				long d = 0;
+				for (int k = 0; k < N; k++)
+					d += !same_bits(row[k], plain[k]);
+				CHECK(d == 0, "%s path: rule %d of %d in a table differs from it alone in %ld "
+				      "faces", ss_cpu_path_name(path), m, count, d);
+				total += N;
+				differ += d;
+			}
+			ss_face_table_release(&table);
+		}
+		printf("  face rules of a table, %s path: %ld faces, %ld differ\n",
+		       ss_cpu_path_name(path), total, differ);
+	}
+	restore_path();
+}
+
 static void test_paths(void)
 {
 	const double T = 0.12;
@@ -1402,6 +1478,7 @@ int main(void)
 	{
 		const double t_ = check_now();
 		RUN(test_face_lanes);
+		RUN(test_face_mixed);
 		printf("    (%.2f s)\n", check_now() - t_);
 	}
 	{

@@ -167,6 +167,30 @@ FACE_INLINE int slopes_and_rsqrt(int m, const double *restrict tan_cr2, int step
 }
 #endif
 
+/* out[k] = table[rule[k]], k < m: a face's number of its rule.  With at
+ * most 8 rules on the AVX-512 path, a permutation of one register (the
+ * gathers it replaces cost a face about as much as its arithmetic). */
+static inline void gather_rules(int m, const uint16_t *restrict rule, const double *restrict table,
+                                int count, double *restrict out)
+{
+#if SS_PATH == SS_PATH_AVX512
+	if (count <= 8) {
+		const __m512d numbers = _mm512_maskz_loadu_pd(tail_mask(count), table);
+		for (int k = 0; k < m; k += 8) {
+			const __mmask8 lanes = tail_mask(m - k);
+			const __m512i r = _mm512_cvtepu16_epi64(_mm_maskz_loadu_epi16(lanes, rule + k));
+			_mm512_mask_storeu_pd(out + k, lanes, _mm512_permutexvar_pd(r, numbers));
+		}
+		return;
+	}
+#else
+	(void)count;
+#endif
+	#pragma omp simd
+	for (int k = 0; k < m; k++)
+		out[k] = table[rule[k]];
+}
+
 /* A closure's numbers for the faces of a chunk: face k's at [k * step]
  * (step 0: one rule's, step 1: a rule per face). */
 struct numbers {
@@ -299,26 +323,31 @@ int SS_PATH_FN(ss_face_fluxes_mixed)(const struct ss_face_table *t, int n,
 	const int angles = forms != 1u << SS_FACE_COULOMB;   /* sin a_cr needed */
 	const int hb = (forms & (1u << SS_FACE_HB_POW | 1u << SS_FACE_HB_CUBE |
 	                         1u << SS_FACE_HB_THREE_HALVES)) != 0;
+	/* the table's arrays as locals: loads through t in the loops would be
+	 * reloaded after every store, and the gathers not vectorised */
+	const double *restrict nus = t->nu, *restrict tan_cr2s = t->tan_cr2;
+	const double *restrict tan_crs = t->tan_cr, *restrict sin_crs = t->sin_cr;
+	const double *restrict inv_sin_crs = t->inv_sin_cr, *restrict gammas = t->gamma;
+	const double *restrict powers = t->power;
+	const double nu_one = nus[0];
+	const int count = t->count;
 	int any = 0;
 	for (int base = 0; base < n; base += CHUNK) {
 		const int m = n - base < CHUNK ? n - base : CHUNK;
 		const double *restrict gn = g_n + base;
 		const uint16_t *restrict rk = rule + base;
-		for (int k = 0; k < m; k++) {
-			nu[k] = t->nu[rk[k]];
-			tan_cr2[k] = t->tan_cr2[rk[k]];
-			tan_cr[k] = t->tan_cr[rk[k]];
+		if (!t->one_nu)
+			gather_rules(m, rk, nus, count, nu);
+		gather_rules(m, rk, tan_cr2s, count, tan_cr2);
+		gather_rules(m, rk, tan_crs, count, tan_cr);
+		if (angles) {
+			gather_rules(m, rk, sin_crs, count, sin_cr);
+			gather_rules(m, rk, inv_sin_crs, count, inv_sin_cr);
 		}
-		if (angles)
-			for (int k = 0; k < m; k++) {
-				sin_cr[k] = t->sin_cr[rk[k]];
-				inv_sin_cr[k] = t->inv_sin_cr[rk[k]];
-			}
-		if (hb)
-			for (int k = 0; k < m; k++) {
-				gamma[k] = t->gamma[rk[k]];
-				power[k] = t->power[rk[k]];
-			}
+		if (hb) {
+			gather_rules(m, rk, gammas, count, gamma);
+			gather_rules(m, rk, powers, count, power);
+		}
 		any |= slopes_and_rsqrt(m, tan_cr2, 1, gn, g_t + base, s2, inv_s, inv_w, slides);
 		if (single) {
 			f_over_s_of((enum ss_face_form)t->form[0], &each, 1, m, s2, inv_s, inv_w, fos);
@@ -332,8 +361,12 @@ int SS_PATH_FN(ss_face_fluxes_mixed)(const struct ss_face_table *t, int n,
 					fos[k] = t->form[rk[k]] == f ? other[k] : fos[k];
 			}
 		}
-		for (int k = 0; k < m; k++)
-			flux[base + k] = slides[k] != 0.0 ? -(nu[k] * gn[k]) * fos[k] : 0.0;
+		if (t->one_nu)
+			for (int k = 0; k < m; k++)
+				flux[base + k] = slides[k] != 0.0 ? -(nu_one * gn[k]) * fos[k] : 0.0;
+		else
+			for (int k = 0; k < m; k++)
+				flux[base + k] = slides[k] != 0.0 ? -(nu[k] * gn[k]) * fos[k] : 0.0;
 	}
 	return any;
 }
@@ -381,6 +414,7 @@ int ss_face_table_create(struct ss_face_table *t, const struct ss_closure *c, in
 		t->power[k] = r.power;
 		t->form[k] = (uint8_t)r.form;
 		t->forms |= 1u << r.form;
+		t->one_nu = k == 0 || (t->one_nu && r.nu == t->nu[0]);
 	}
 	return SS_OK;
 }

@@ -55,6 +55,7 @@ enum ss_face_form {
 struct ss_face_table {
 	int count;
 	unsigned forms;            /* bit 1 << form of each rule's form */
+	int one_nu;                /* every rule has nu[0] */
 	double *nu, *tan_cr, *tan_cr2, *sin_cr, *inv_sin_cr, *gamma, *power;
 	uint8_t *form;             /* enum ss_face_form */
 };
