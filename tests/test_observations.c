@@ -106,7 +106,7 @@ static int write_series(const char *path, const double *times, int count, int al
 			h[ss_grid_index(&g, 2, 1)] = INFINITY;
 		struct ss_diagnostics d;
 		memset(&d, 0, sizeof d);
-		err = ss_snapshot_append(s, times[k], h, types, &d, NULL);
+		err = ss_snapshot_append(s, times[k], h, types, NULL, &d, NULL);
 	}
 	if (s && ss_snapshot_destroy(s))
 		err = -1;

@@ -261,7 +261,7 @@ static void a_restart_in_the_approach_gives_the_same_bits(void)
 	const double t = st.time;
 	ss_stepper_release(&st);
 	if (make(&fresh, CONE, SS_INTEGRATOR_EULER, SS_REST_CHEBYSHEV, SS_KERNEL_FAST, 0, 0) == 0) {
-		ss_stepper_restore(&fresh, t, h, &s);
+		ss_stepper_restore(&fresh, t, h, NULL, &s);
 		struct run r;
 		memset(&r, 0, sizeof r);
 		finish(&fresh, &r);

@@ -1480,7 +1480,7 @@ static void restart_case(enum ss_kernel kernel, double t1, long long cut, double
 	advance_to(&a, t2);
 
 	if (door_room(&b, 0, 0, SS_INTEGRATOR_RKL2, kernel) == 0) {
-		ss_stepper_restore(&b, t1, h1, &saved);
+		ss_stepper_restore(&b, t1, h1, NULL, &saved);
 		CHECK(memcmp(&b.rkl2->tau_limit, &tau1, sizeof tau1) == 0, "restore did not carry "
 		      "the next super-step limit: %.17g, saved %.17g", b.rkl2->tau_limit, tau1);
 		advance_to(&b, t2);

@@ -63,6 +63,9 @@ struct ss_snapshot_meta {
 	                          * CF grid mapping variable /crs */
 	const struct ss_boundary *boundary; /* the grid's sides (root attribute
 	                          * boundary), or NULL: not written */
+	int moving;              /* 1: each snapshot has /moving, the cells'
+	                          * states of hysteresis (stepper.h), which
+	                          * a restart continues */
 	const uint8_t *nodata;   /* this rank's rows of the cells without data
 	                          * (nx x ny of its slab, south row first,
 	                          * nonzero: no data, as a window of struct
@@ -98,13 +101,15 @@ double ss_snapshot_bytes(const struct ss_grid *g);
 
 /* Append one snapshot (height with the grid's halo layout; walls and
  * cells without data are written as NaN, the _FillValue, so cell_types in
- * the same layout) and, when state is not NULL, the restart state (root
+ * the same layout; moving, in the same layout, nonzero where sand moves:
+ * /moving of a file created with meta->moving, else not used) and, when
+ * state is not NULL, the restart state (root
  * attribute restart_state_even or _odd by the snapshot's index), flushed
  * so that a run killed at any moment leaves every earlier snapshot whole
  * (doc/output.md#written-as-the-run-goes); then rewrite the XDMF sidecar. */
 int ss_snapshot_append(struct ss_snapshot *s, double time_s, const double *height,
-                       const uint8_t *cell_types, const struct ss_diagnostics *d,
-                       const struct ss_restart_state *state);
+                       const uint8_t *cell_types, const uint16_t *moving,
+                       const struct ss_diagnostics *d, const struct ss_restart_state *state);
 
 /* Reopen an output of grid g to append snapshots to it (a restart, or the
  * guard of drive.h), with the cells without data it has.  SS_ERR_INPUT if
@@ -120,6 +125,8 @@ struct ss_restart_info {
 	double time;             /* of the last one, s */
 	double *height;          /* nx * rows, south row first (ss_free); NULL
 	                          * when no row was asked for */
+	uint8_t *moving;         /* the same rows of /moving (hysteresis), 1
+	                          * where sand moves; NULL: the file has none */
 	long long first_row;     /* the rows height holds: first_row .. */
 	int rows;                /*   first_row + rows - 1 of the grid */
 	struct ss_restart_state state;
@@ -286,6 +293,13 @@ int ss_snapshot_file_open_image(struct ss_snapshot_file *f, const char *name,
 
 /* Close the file and free what it holds; a zeroed or closed f is a no-op. */
 void ss_snapshot_file_close(struct ss_snapshot_file *f);
+
+/* Whether the file has /moving (a run with hysteresis), and its rows j0 ..
+ * j0 + rows - 1 of snapshot t into out (rows * nx bytes, 1 where sand
+ * moves), as ss_snapshot_file_read_rows reads /height. */
+int ss_snapshot_file_has_moving(const struct ss_snapshot_file *f);
+int ss_snapshot_file_read_moving(struct ss_snapshot_file *f, long long t, int j0, int rows,
+                                 uint8_t *out);
 
 /* Rows j0 .. j0 + rows - 1 of snapshot t of /height into out (rows * nx
  * values, south row first).  May be called from several OpenMP threads at

@@ -351,10 +351,12 @@ void ss_stepper_restart_state(const struct ss_stepper *st, struct ss_restart_sta
 
 /* Put a prepared stepper in a saved state: time t (s), the heights of
  * every cell of st->grid as a snapshot stores them (nx * ny, row-major,
- * south row first) and the state s that ss_stepper_restart_state gave.
- * Stepping on from it gives the same bits as the run that saved it. */
+ * south row first), with hysteresis which cells move (the same layout,
+ * nonzero: moving; NULL: none), and the state s that
+ * ss_stepper_restart_state gave.  Stepping on from it gives the same bits
+ * as the run that saved it.  Collective. */
 void ss_stepper_restore(struct ss_stepper *st, double t, const double *height,
-                        const struct ss_restart_state *s);
+                        const uint8_t *moving, const struct ss_restart_state *s);
 
 /* The first cell (in row order, of every rank) whose height is not
  * finite: 1 and its global (i, j), or 0 when every height is finite. */

@@ -70,7 +70,7 @@ static int keep_state(struct ss_drive *d)
 		return SS_OK;
 	ss_stepper_restart_state(st, &state);
 	const int err = ss_snapshot_append(d->snapshot, st->time, st->height, st->cell_types,
-	                                   &diag, &state);
+	                                   st->hysteresis ? st->material : NULL, &diag, &state);
 	d->seconds_output += ss_parallel_wall_seconds() - t0;
 	return err;
 }
@@ -161,7 +161,7 @@ static int restart_point(struct ss_drive *d, struct ss_stepper *fresh)
 	err = ss_comm_agree(ss_snapshot_read_last_rows(d->output, fresh->grid.offset_j,
 	                                               fresh->grid.ny, &r));
 	if (!err)
-		ss_stepper_restore(fresh, r.time, r.height, &r.state);   /* this rank's rows */
+		ss_stepper_restore(fresh, r.time, r.height, r.moving, &r.state);   /* this rank's rows */
 	ss_restart_info_release(&r);
 	if (!err)
 		err = ss_snapshot_open_append(&d->snapshot, d->output, &fresh->grid);

@@ -256,7 +256,7 @@ static int open_output(struct relax *x, const struct ss_relax_report *rep)
 		.case_text = "", .model = &o->model,
 		.integrator = ss_integrator_name(x->st.integrator),
 		.bedrock = x->st.bedrock, .crs_wkt = x->in.dem.crs_wkt, .boundary = &x->st.boundary,
-		.nodata = x->in.dem.nodata,
+		.nodata = x->in.dem.nodata, .moving = x->st.hysteresis,
 	};
 	return ss_drive_create(d, &meta);
 }

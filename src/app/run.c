@@ -159,12 +159,6 @@ static int start_stepper(struct run *r)
 	int err = r->o->restart ? restart_files_reachable(r) : SS_OK;
 	if (err || (err = rebuild(r, &r->st)) || !r->o->restart)
 		return err;
-	if (r->st.hysteresis)
-		/* the snapshots hold the heights, not which cells move */
-		return ss_error_input("--restart %s: its case has hysteresis ([model] static_angle "
-		                      "%g above repose_angle %g), and a restart of such a run is not "
-		                      "supported yet: run it again from the start", r->o->restart,
-		                      r->c.model.static_angle_deg, r->c.model.angle_deg);
 	const struct ss_grid *g = &r->st.grid;
 	if (rs->nx != g->global_nx || rs->ny != g->global_ny)
 		return ss_error_input("--restart %s: its snapshots are %d x %d cells, its case "
@@ -178,8 +172,14 @@ static int start_stepper(struct run *r)
 	if (rows.time != rs->time || rows.count != rs->count)
 		err = ss_error_input("--restart %s: the file changed while it was read",
 		                     r->o->restart);
+	else if (r->st.hysteresis && !rows.moving)
+		/* written before /moving was: which cells move is not known */
+		err = ss_error_input("--restart %s: its case has hysteresis ([model] static_angle "
+		                     "%g above repose_angle %g), but the file does not say which "
+		                     "cells move (no /moving): run it again from the start",
+		                     r->o->restart, r->c.model.static_angle_deg, r->c.model.angle_deg);
 	else
-		ss_stepper_restore(&r->st, rows.time, rows.height, &rows.state);
+		ss_stepper_restore(&r->st, rows.time, rows.height, rows.moving, &rows.state);
 	ss_restart_info_release(&rows);
 	return err;
 }
@@ -331,7 +331,7 @@ static int open_output(struct run *r)
 		.case_text = r->c.text, .model = &r->c.model,
 		.integrator = ss_integrator_name(r->st.integrator),
 		.deflate = o->deflate, .bedrock = r->st.bedrock, .case_overrides = overrides,
-		.boundary = &r->st.boundary,
+		.boundary = &r->st.boundary, .moving = r->st.hysteresis,
 	};
 	err = ss_drive_create(d, &meta);
 	free(overrides);

@@ -152,3 +152,21 @@ void ss_hysteresis_start(struct ss_stepper *st)
 	const struct ss_grid *g = &st->grid;
 	memset(st->material, AT_REST, ss_grid_storage_cells(g) * sizeof *st->material);
 }
+
+void ss_hysteresis_restore(struct ss_stepper *st, const uint8_t *moving)
+{
+	const struct ss_grid *g = &st->grid;
+	double count = 0.0;
+	ss_hysteresis_start(st);
+	for (int j = 0; j < g->ny && moving; j++)
+		for (int i = 0; i < g->nx; i++) {
+			const ptrdiff_t k = ss_grid_index(g, i, j);
+			const int flows = ss_cell_type_get(st->cell_types, k) == SS_CELL_FLOW;
+			const int now = flows && moving[(size_t)j * g->nx + i];
+			st->material[k] = now ? MOVING : AT_REST;
+			count += now;
+		}
+	ss_comm_reduce(NULL, 0, &count, 1);
+	st->flowing_cells = (long long)count;
+	ss_boundary_fill_materials(g, &st->boundary, st->material);
+}

@@ -20,4 +20,9 @@ void ss_hysteresis_start(struct ss_stepper *st);
  * the cells that changed, all ranks.  Collective. */
 long long ss_hysteresis_update(struct ss_stepper *st, double slope_tol);
 
+/* The states of a snapshot (ss_stepper_restore): moving, this rank's
+ * cells (nx x ny, south row first), nonzero where sand moves; NULL: every
+ * cell at rest.  Collective. */
+void ss_hysteresis_restore(struct ss_stepper *st, const uint8_t *moving);
+
 #endif

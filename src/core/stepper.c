@@ -684,12 +684,14 @@ void ss_stepper_restart_state(const struct ss_stepper *st, struct ss_restart_sta
 }
 
 void ss_stepper_restore(struct ss_stepper *st, double t, const double *height,
-                        const struct ss_restart_state *s)
+                        const uint8_t *moving, const struct ss_restart_state *s)
 {
 	const struct ss_grid *g = &st->grid;
 	for (int j = 0; j < g->ny; j++)
 		memcpy(st->height + ss_grid_index(g, 0, j), height + (size_t)j * g->nx,
 		       (size_t)g->nx * sizeof(double));
+	if (st->hysteresis)
+		ss_hysteresis_restore(st, moving);
 	st->time = t;
 	st->steps = s->steps;
 	st->evaluations = s->evaluations;

@@ -93,6 +93,20 @@ static int check_grid(struct ss_snapshot_file *f)
 	const hsize_t *cd = h->cell_type.dims;
 	if (err > 0 || (!err && (h->cell_type.rank != 2 || cd[0] != hd[1] || cd[1] != hd[2])))
 		return not_sandslide(&h->in, "/cell_type (y, x) does not match /height");
+	if (err)
+		return err;
+	/* /moving of a run with hysteresis: the shape of /height */
+	err = ss_h5_var_open(&h->in, "moving", &h->moving);
+	const hsize_t *md = h->moving.dims;
+	if (err == SS_H5_VAR_MISSING) {
+		ss_h5_var_close(&h->moving);
+		h->moving.d = -1;
+		return SS_OK;
+	}
+	/* (a run killed between the two extents leaves /height one longer) */
+	if (err > 0 || (!err && (h->moving.rank != 3 || md[0] > hd[0] || md[0] + 1 < hd[0] ||
+	                         md[1] != hd[1] || md[2] != hd[2])))
+		return not_sandslide(&h->in, "/moving (time, y, x) does not match /height");
 	return err;
 }
 
@@ -211,6 +225,7 @@ void ss_snapshot_file_close(struct ss_snapshot_file *f)
 	if (f->h5) {
 		ss_h5_var_close(&f->h5->height);
 		ss_h5_var_close(&f->h5->cell_type);
+		ss_h5_var_close(&f->h5->moving);
 		ss_h5_file_close(&f->h5->in);
 		free(f->h5);
 	}
@@ -231,7 +246,7 @@ static int file_open(struct ss_snapshot_file *f, const char *name, const void *d
 		ss_snapshot_file_close(f);
 		return ss_error_fail("out of memory");
 	}
-	f->h5->height.d = f->h5->cell_type.d = f->h5->in.file = -1;
+	f->h5->height.d = f->h5->cell_type.d = f->h5->moving.d = f->h5->in.file = -1;
 	int err = ss_h5_file_open(&f->h5->in, f->name, data, size);
 	if (!err)
 		err = check_definition(f);
@@ -311,6 +326,37 @@ int ss_snapshot_file_read_rows(struct ss_snapshot_file *f, long long t, int j0, 
 		                     out, what);
 	}
 	return err ? err : walls_to_zero(f, j0, rows, out);
+}
+
+int ss_snapshot_file_has_moving(const struct ss_snapshot_file *f)
+{
+	return f->h5 && f->h5->moving.d >= 0;
+}
+
+int ss_snapshot_file_read_moving(struct ss_snapshot_file *f, long long t, int j0, int rows,
+                                 uint8_t *out)
+{
+	check_rows(f, j0, rows);
+	if (t < 0 || t >= f->count || !ss_snapshot_file_has_moving(f))
+		SS_BUG("/moving of snapshot %lld of %lld", t, f->count);
+	const hsize_t start[3] = {(hsize_t)t, (hsize_t)j0, 0};
+	const hsize_t count[3] = {1, (hsize_t)rows, (hsize_t)f->nx};
+	char what[96];
+	snprintf(what, sizeof what, "snapshot %lld of /moving, rows %d .. %d", t, j0,
+	         j0 + rows - 1);
+	int err;
+	#pragma omp critical(ss_snapshot_hdf5)
+	{
+		ss_h5_quiet();
+		err = ss_h5_var_read(&f->h5->in, &f->h5->moving, start, count, H5T_NATIVE_UINT8,
+		                     out, what);
+	}
+	const size_t n = (size_t)rows * (size_t)f->nx;
+	for (size_t k = 0; k < n && !err; k++)
+		if (out[k] > 1)
+			err = ss_h5_damaged(&f->h5->in, "%s holds %d: expected 0 (at rest) or 1 "
+			                    "(moving)", what, out[k]);
+	return err;
 }
 
 int ss_snapshot_file_read_cell_flags(struct ss_snapshot_file *f, int j0, int rows,

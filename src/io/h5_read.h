@@ -16,6 +16,7 @@ struct ss_snapshot_file_h5 {
 	struct ss_h5_file in;
 	struct ss_h5_var height;    /* (time, y, x) */
 	struct ss_h5_var cell_type; /* (y, x) */
+	struct ss_h5_var moving;    /* (time, y, x) of hysteresis; d < 0: none */
 };
 
 /* The first n values of the 1-D series name into out; SS_ERR_INPUT naming

@@ -155,6 +155,7 @@ void ss_restart_info_release(struct ss_restart_info *r)
 	free(r->case_path);
 	free(r->case_overrides);
 	ss_free(r->height);
+	ss_free(r->moving);
 	memset(r, 0, sizeof *r);
 }
 
@@ -251,6 +252,12 @@ static int read_last(struct ss_snapshot_file *f, struct ss_restart_info *r, int 
 		err = read_state(f, r);
 	if (!err)
 		err = read_snapshot_rows(f, f->count - 1, first_row, rows, &r->height);
+	if (!err && r->height && ss_snapshot_file_has_moving(f)) {
+		/* which cells move, for a run with hysteresis */
+		r->moving = ss_alloc((size_t)f->nx * (size_t)r->rows, 1, "snapshot states");
+		err = r->moving ? ss_snapshot_file_read_moving(f, f->count - 1, (int)r->first_row,
+		                                               r->rows, r->moving) : SS_ERR_FAIL;
+	}
 	if (err)
 		ss_restart_info_release(r);
 	return err;

@@ -60,6 +60,7 @@ struct ss_snapshot {
 	char *xmf_path;
 	hid_t file;
 	hid_t height, time, diag[SS_SNAPSHOT_DIAG_COUNT];
+	hid_t moving;           /* /moving (hysteresis), or -1: none */
 	struct ss_grid grid;
 	long long count;
 	int failed;             /* a write failed (and said so): the close that
@@ -328,6 +329,31 @@ static int write_static(struct ss_snapshot *s, const uint8_t *cell_types,
 	      H5DSattach_scale(s->height, s->time, 0) < 0 ||
 	      H5DSattach_scale(s->height, y, 1) < 0 || H5DSattach_scale(s->height, x, 2) < 0;
 
+	/* moving (time, y, x), hysteresis: each flow cell at rest (0) or moving
+	 * (1), what a restart needs besides the heights (doc/output.md) */
+	if (meta->moving && !bad) {
+		space = H5Screate_simple(3, dims, maxdims);
+		dcpl = H5Pcreate(H5P_DATASET_CREATE);
+		H5Pset_chunk(dcpl, 3, chunk);
+		if (meta->deflate > 0) {
+			H5Pset_shuffle(dcpl);
+			H5Pset_deflate(dcpl, (unsigned)meta->deflate);
+		}
+		H5Pset_fletcher32(dcpl);
+		const int8_t rest = 0;
+		H5Pset_fill_value(dcpl, H5T_NATIVE_INT8, &rest);
+		s->moving = H5Dcreate2(f, "moving", H5T_STD_I8LE, space, H5P_DEFAULT, dcpl,
+		                       H5P_DEFAULT);
+		H5Pclose(dcpl);
+		H5Sclose(space);
+		bad = s->moving < 0 ||
+		      attr_units(s->moving, "1", "sand moving (1) or at rest (0): hysteresis") ||
+		      ss_h5_attr_write_string(s->moving, "flag_meanings", "at_rest moving") ||
+		      (crs && ss_h5_attr_write_string(s->moving, "grid_mapping", "crs")) ||
+		      H5DSattach_scale(s->moving, s->time, 0) < 0 ||
+		      H5DSattach_scale(s->moving, y, 1) < 0 || H5DSattach_scale(s->moving, x, 2) < 0;
+	}
+
 	/* cell_type (y, x): signed bytes, NC_BYTE to netCDF, which every netCDF
 	 * reader takes (VTK's netCDF-CF reader, ParaView's, rejects NC_UBYTE) */
 	hsize_t dims2[2] = {ny, (hsize_t)g->nx};
@@ -420,6 +446,8 @@ static void close_handles(struct ss_snapshot *s)
 		H5Dclose(s->time);
 	if (s->height >= 0)
 		H5Dclose(s->height);
+	if (s->moving >= 0)
+		H5Dclose(s->moving);
 }
 
 int ss_snapshot_destroy(struct ss_snapshot *s)
@@ -482,7 +510,7 @@ static struct ss_snapshot *snapshot_alloc(const char *path, const struct ss_grid
 	struct ss_snapshot *s = calloc(1, sizeof *s);
 	if (!s)
 		return NULL;
-	s->file = s->height = s->time = -1;
+	s->file = s->height = s->time = s->moving = -1;
 	for (int k = 0; k < SS_SNAPSHOT_DIAG_COUNT; k++)
 		s->diag[k] = -1;
 	s->grid = *g;
@@ -637,11 +665,14 @@ static int check_snapshot_space(struct ss_snapshot *s)
  * collective write, as parallel HDF5 requires of filtered data.
  */
 static int write_heights(struct ss_snapshot *s, long long k, const double *height,
-                         const uint8_t *cell_types)
+                         const uint8_t *cell_types, const uint16_t *moving)
 {
 	const struct ss_grid *g = &s->grid;
 	const long long first = g->offset_j, end = g->offset_j + g->ny;
-	hid_t fs = H5Dget_space(s->height);
+	/* the heights, or (moving given) /moving as bytes in the same band */
+	const hid_t dataset = moving ? s->moving : s->height;
+	uint8_t *bytes = (uint8_t *)s->band;
+	hid_t fs = H5Dget_space(dataset);
 	hid_t dxpl = transfer();
 	int bad = fs < 0 || dxpl < 0;
 	for (long long b0 = 0; b0 < g->global_ny && !bad; b0 += s->band_rows) {
@@ -655,7 +686,13 @@ static int write_heights(struct ss_snapshot *s, long long k, const double *heigh
 		const hsize_t mdims[3] = {1, hi > lo ? (hsize_t)(hi - lo) : 1, (hsize_t)g->nx};
 		hid_t ms = H5Screate_simple(3, mdims, NULL);
 		if (hi > lo) {
-			for (long long j = lo; j < hi; j++) {
+			for (long long j = lo; j < hi && moving; j++) {
+				const ptrdiff_t row = ss_grid_index(g, 0, (int)(j - first));
+				uint8_t *out = bytes + (size_t)(j - lo) * (size_t)g->nx;
+				for (int i = 0; i < g->nx; i++)
+					out[i] = moving[row + i] != 0;
+			}
+			for (long long j = lo; j < hi && !moving; j++) {
 				const ptrdiff_t row = ss_grid_index(g, 0, (int)(j - first));
 				double *out = s->band + (size_t)(j - lo) * (size_t)g->nx;
 				ss_cell_types_unpack(cell_types, row, (size_t)g->nx, s->band_types);
@@ -671,8 +708,11 @@ static int write_heights(struct ss_snapshot *s, long long k, const double *heigh
 		} else {
 			bad = H5Sselect_none(fs) < 0 || H5Sselect_none(ms) < 0;
 		}
+		/* the file's own types in memory: parallel HDF5 writes filtered
+		 * data only collectively, and a conversion would take that away */
 		bad = bad || ms < 0 ||
-		      H5Dwrite(s->height, H5T_NATIVE_DOUBLE, ms, fs, dxpl, s->band) < 0;
+		      H5Dwrite(dataset, moving ? H5T_NATIVE_INT8 : H5T_NATIVE_DOUBLE, ms, fs, dxpl,
+		               s->band) < 0;
 		if (ms >= 0)
 			H5Sclose(ms);
 	}
@@ -684,8 +724,8 @@ static int write_heights(struct ss_snapshot *s, long long k, const double *heigh
 }
 
 static int append(struct ss_snapshot *s, double time_s, const double *height,
-                  const uint8_t *cell_types, const struct ss_diagnostics *d,
-                  const struct ss_restart_state *state)
+                  const uint8_t *cell_types, const uint16_t *moving,
+                  const struct ss_diagnostics *d, const struct ss_restart_state *state)
 {
 	const struct ss_grid *g = &s->grid;
 	const long long k = s->count;
@@ -706,7 +746,10 @@ static int append(struct ss_snapshot *s, double time_s, const double *height,
 	 * two attributes by k's parity, so the last complete snapshot's stays
 	 * whole whenever the run dies. */
 	hsize_t dims[3] = {(hsize_t)k + 1, (hsize_t)g->global_ny, (hsize_t)g->nx};
-	if (H5Dset_extent(s->height, dims) < 0 || write_heights(s, k, height, cell_types))
+	if (H5Dset_extent(s->height, dims) < 0 || write_heights(s, k, height, cell_types, NULL))
+		goto fail;
+	if (s->moving >= 0 && (!moving || H5Dset_extent(s->moving, dims) < 0 ||
+	                       write_heights(s, k, NULL, cell_types, moving)))
 		goto fail;
 	for (int m = 0; m < SS_SNAPSHOT_DIAG_COUNT; m++)
 		if (append_value(s->diag[m], k, diag_get(d, m)))
@@ -754,10 +797,10 @@ fail:
 /* A failure of one rank's write is every rank's, before the next
  * collective call (comm.h). */
 int ss_snapshot_append(struct ss_snapshot *s, double time_s, const double *height,
-                       const uint8_t *cell_types, const struct ss_diagnostics *d,
-                       const struct ss_restart_state *state)
+                       const uint8_t *cell_types, const uint16_t *moving,
+                       const struct ss_diagnostics *d, const struct ss_restart_state *state)
 {
-	const int err = ss_comm_agree(append(s, time_s, height, cell_types, d, state));
+	const int err = ss_comm_agree(append(s, time_s, height, cell_types, moving, d, state));
 	if (err)
 		s->failed = 1;
 	return err;
@@ -841,6 +884,8 @@ int ss_snapshot_open_append(struct ss_snapshot **out, const char *path,
 		s->height = H5Dopen2(s->file, "height", H5P_DEFAULT);
 		s->time = H5Dopen2(s->file, "time", H5P_DEFAULT);
 		bad = s->height < 0 || s->time < 0;
+		if (!bad && H5Lexists(s->file, "moving", H5P_DEFAULT) > 0)
+			bad = (s->moving = H5Dopen2(s->file, "moving", H5P_DEFAULT)) < 0;
 		for (int k = 0; k < SS_SNAPSHOT_DIAG_COUNT && !bad; k++)
 			bad = (s->diag[k] = H5Dopen2(s->file, ss_snapshot_diag_name(k), H5P_DEFAULT)) < 0;
 	}

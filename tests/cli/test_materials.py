@@ -8,10 +8,12 @@ number; bad rasters are refused with the file, the cell and the value.
 """
 import json
 import math
+import signal
+import subprocess
 
 import numpy as np
 
-from conftest import h5open, run, same_bits
+from conftest import SANDSLIDE_PAUSE, h5open, hook_binary, pause_env, run, same_bits, wait_paused
 from test_relax import read_asc, write_asc
 
 DX = 1.0
@@ -186,6 +188,20 @@ stop = 45
 """
 
 
+def start_paused(args, cwd, step):
+    """sandslide-pause with args, paused after substep `step` (conftest)."""
+    marker = cwd / "paused"
+    p = subprocess.Popen([hook_binary(SANDSLIDE_PAUSE)] + args, cwd=cwd, stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True, env=pause_env(step, marker))
+    try:
+        wait_paused(p, marker, step)
+    except BaseException:
+        p.kill()
+        p.communicate()
+        raise
+    return p
+
+
 def steepest_deg(h, dx=0.05):
     g = max((np.abs(np.diff(h, axis=1)) / dx).max(), (np.abs(np.diff(h, axis=0)) / dx).max())
     return math.degrees(math.atan(g))
@@ -255,13 +271,36 @@ def test_bad_static_angles(tmp_path):
             assert w in r.stderr, f"{args}: '{w}' not in: {r.stderr}"
 
 
-def test_restart_with_hysteresis_is_refused(tmp_path):
-    """The snapshots do not hold which cells move (yet): a restart says so
-    rather than continue with other bits."""
-    (tmp_path / "p.ini").write_text(POUR.format(static="static_angle = 36")
-                                    .replace("end = steady\nmax_time = 120", "end = 2"))
-    r = run(["run", "p.ini", "-o", "p.h5"], cwd=tmp_path)
+def test_restart_mid_avalanche_gives_the_uninterrupted_bits(tmp_path):
+    """The snapshots hold which cells move (/moving): a run signalled in the
+    middle of an avalanche and continued by run --restart has every
+    snapshot of the run never cut."""
+    case = POUR.format(static="static_angle = 36").replace(
+        "end = steady\nmax_time = 120", "end = 6\nintegrator = euler")
+    (tmp_path / "p.ini").write_text(case)
+    r = run(["run", "p.ini", "-o", "whole.h5", "-q"], cwd=tmp_path)
     assert r.returncode == 0, r.stderr
-    r = run(["run", "--restart", "p.h5", "p.ini"], cwd=tmp_path)
-    assert r.returncode == 2 and "hysteresis" in r.stderr and "static_angle" in r.stderr, (
-        r.stderr)
+    with h5open(tmp_path / "whole.h5") as f:
+        steps, slope, moving = f["steps"][:], f["max_slope_deg"][:], f["moving"][:]
+    # the first avalanche: the steepest face falls between snapshots k - 1 and k
+    k = next(k for k in range(1, len(slope)) if slope[k - 1] >= 33.0 and slope[k] < slope[k - 1] - 1.0)
+    assert moving[k].sum() > 0, "test set-up: nothing moves during the avalanche"
+    pause = int(steps[k - 1] + steps[k]) // 2
+    assert steps[k - 1] < pause < steps[k], f"test set-up: steps {list(steps)}"
+    p = start_paused(["run", "p.ini", "-o", "cut.h5", "-q"], tmp_path, pause)
+    p.send_signal(signal.SIGTERM)
+    _, err = p.communicate(timeout=60)
+    assert p.returncode == 143, (p.returncode, err)
+    with h5open(tmp_path / "cut.h5") as f:
+        assert f["moving"][-1].sum() > 0, "the cut is not in the middle of an avalanche"
+    r = run(["run", "--restart", "cut.h5", "-q"], cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    with h5open(tmp_path / "whole.h5") as a, h5open(tmp_path / "cut.h5") as b:
+        ta, tb = a["time"][:], b["time"][:]
+        for name in ("height", "moving"):
+            for t in ta:
+                ia, ib = np.flatnonzero(ta == t)[0], np.flatnonzero(tb == t)
+                assert len(ib) == 1, f"t = {t} s missing from the continued run"
+                assert same_bits(a[name][ia].astype(np.float64),
+                                 b[name][ib[0]].astype(np.float64)), (
+                    f"/{name} at t = {t} s differs from the uninterrupted run")

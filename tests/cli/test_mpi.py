@@ -654,6 +654,8 @@ def test_hysteresis_under_3_ranks_has_the_serial_bits(tmp_path):
     with h5open(serial / "pour.h5") as a, h5open(mpi / "pour.h5") as b:
         assert same_bits(a["height"][:], b["height"][:]), \
             "hysteresis under np = 3: the heights differ from the serial run's"
+        assert np.array_equal(a["moving"][:], b["moving"][:]) and a["moving"][:].any(), \
+            "hysteresis under np = 3: /moving differs from the serial run's (or is empty)"
 
 
 def write_clipped_cliff(path):
