@@ -36,6 +36,7 @@
 
 #include "sandslide/boundary.h"
 #include "sandslide/closure.h"
+#include "sandslide/material_table.h"
 #include "sandslide/model_options.h"
 #include "sandslide/shape.h"
 #include "sandslide/stepper.h"
@@ -97,6 +98,10 @@ struct ss_case {
 	/* [model] repose_angle = FILE: resolved, owned; model.angle_file is it */
 	char *angle_file;
 	char angle_where[SS_CASE_WHERE_SIZE];
+	/* [model] materials = FILE (model.materials_file, resolved, owned) and
+	 * its [material NAME] sections (NULL: none) */
+	char materials_where[SS_CASE_WHERE_SIZE];
+	struct ss_material_table *material_table;
 
 	struct ss_region *regions; /* in file order */
 	int region_count;

@@ -35,6 +35,8 @@ struct ss_model_options {
 	const char *angle_file;           /* a raster of each cell's a_cr, degrees
 	                                   * (doc/model.md#materials); NULL:
 	                                   * angle_deg everywhere */
+	const char *materials_file;       /* a raster of material classes
+	                                   * (doc/model.md#materials), or NULL */
 	double static_angle_deg;          /* a_s >= a_cr, where sand at rest
 	                                   * starts to slide (hysteresis,
 	                                   * doc/model.md); NaN: a_cr, none */

@@ -53,6 +53,8 @@ struct ss_relax_options {
 	                                     SS_CELL_OPEN */
 	double open_level;                /* m; NAN: the lowest height of the DEM */
 	const char *bedrock;              /* raster of the fixed base, or NULL */
+	const char *material_table;       /* [material NAME] sections of
+	                                   * model.materials_file's classes */
 	struct ss_shape sand_shape;       /* pour sand on it (rect or disk, m;
 	                                   * SS_SHAPE_NONE: none): */
 	double sand_rate;                 /*   m/s */

@@ -31,6 +31,7 @@
 #include "sandslide/diagnostics.h"
 #include "sandslide/integrator.h"
 #include "sandslide/stepper.h"
+#include "sandslide/material_table.h"
 #include "sandslide/model_options.h"
 
 #include "sandslide/dem.h"

@@ -31,7 +31,7 @@
  * grid 1 (a scalar), from ss_stepper_diagnostics.  The bedrock is there
  * only when the case has one. */
 enum var_id {
-	VAR_ELEVATION, VAR_RATE, VAR_BEDROCK, VAR_VOLUME, VAR_INFLOW, VAR_OUTFLOW,
+	VAR_ELEVATION, VAR_RATE, VAR_BEDROCK, VAR_MOVING, VAR_VOLUME, VAR_INFLOW, VAR_OUTFLOW,
 	VAR_EXTERNAL, VAR_SLOPE, VAR_COUNT
 };
 
@@ -43,6 +43,7 @@ static const struct var {
 	[VAR_ELEVATION] = {ELEVATION, "m", 0, 1, 1},
 	[VAR_RATE] = {RATE, "m s-1", 0, 1, 0},
 	[VAR_BEDROCK] = {"bedrock_surface__elevation", "m", 0, 0, 1},
+	[VAR_MOVING] = {"sand__flowing_state", "1", 0, 0, 1},
 	[VAR_VOLUME] = {"sand__volume", "m3", 1, 0, 1},
 	[VAR_INFLOW] = {"sand__time_integral_of_source_volume_flux", "m3", 1, 0, 1},
 	[VAR_OUTFLOW] = {"sand__time_integral_of_outflow_volume_flux", "m3", 1, 0, 1},
@@ -72,7 +73,8 @@ static struct bmi_state *state(struct Bmi *self)
 
 static int present(const struct bmi_state *s, int v)
 {
-	return v != VAR_BEDROCK || (s && s->st.bedrock);
+	return (v != VAR_BEDROCK || (s && s->st.bedrock)) &&
+	       (v != VAR_MOVING || (s && s->st.hysteresis));
 }
 
 /* The variable called name that this model has, or NULL. */
@@ -539,6 +541,12 @@ static double grid_value(const struct bmi_state *s, const struct var *v, int c)
 {
 	switch (v - vars) {
 	case VAR_RATE: return s->rate[c];
+	case VAR_MOVING: {   /* hysteresis: 1 where sand moves (stepper.h) */
+		const ptrdiff_t at = at_of(&s->st, c);
+		if (ss_cell_type_get(s->st.cell_types, at) != SS_CELL_FLOW)
+			return NAN;
+		return s->st.material[at] != 0 ? 1.0 : 0.0;
+	}
 	case VAR_BEDROCK: {
 		const double b = s->st.bedrock[at_of(&s->st, c)];
 		return isinf(b) ? NAN : b;

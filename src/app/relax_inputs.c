@@ -89,7 +89,8 @@ static int check_memory(const struct ss_relax_options *o)
 	}
 	/* the copy or the read, and the bedrock's */
 	return ss_setup_check_raster_memory(o->dem, nx, ny, 1 + (o->bedrock != NULL) +
-	                                    (o->model.angle_file != NULL), &o->model,
+	                                    (o->model.angle_file || o->model.materials_file),
+	                                    &o->model,
 	                                    o->bedrock != NULL);
 }
 
@@ -105,16 +106,31 @@ static int read_here(const struct ss_relax_options *o, struct ss_relax_inputs *i
 	const int tx = o->job.tile[0], ty = o->job.tile[1];
 	err = o->input_raster ? raster_copy(o->input_raster, &in->dem)
 	                      : ss_setup_read_window(o->dem, NULL, o->read, tx, ty, &in->dem);
-	if (!err && o->model.angle_file) {
-		/* the angles as they are: a DEM's read options (z scale) are its own */
+	if (!err && o->model.angle_file && o->model.materials_file)
+		err = ss_error_input("--angle %s and --materials %s: give the angles one way",
+		                     o->model.angle_file, o->model.materials_file);
+	if (!err && !o->model.materials_file != !o->material_table)
+		err = ss_error_input("--materials and --material-table go together (only %s %s "
+		                     "was given)", o->model.materials_file ? "--materials"
+		                     : "--material-table", o->model.materials_file
+		                     ? o->model.materials_file : o->material_table);
+	if (!err && o->material_table) {
+		in->table = ss_alloc(1, sizeof *in->table, "material table");
+		err = in->table ? ss_material_table_read(in->table, o->material_table) : SS_ERR_FAIL;
+		if (!err)
+			err = ss_material_table_check(in->table, o->material_table);
+	}
+	const char *field = o->model.angle_file ? o->model.angle_file : o->model.materials_file;
+	const char *option = o->model.angle_file ? "--angle" : "--materials";
+	if (!err && field) {
+		/* the values as they are: a DEM's read options (z scale) are its own */
 		struct ss_dem_read_options plain;
 		ss_dem_read_options_init(&plain);
-		err = ss_setup_read_window(o->model.angle_file, "--angle", plain, tx, ty,
-		                           &in->angles);
+		err = ss_setup_read_window(field, option, plain, tx, ty, &in->angles);
 		if (!err && (in->angles.nx != in->dem.nx || in->angles.ny != in->dem.ny))
-			err = ss_error_input("--angle %s is %d x %d cells: expected the DEM's %d x %d",
-			                     o->model.angle_file, in->angles.nx, in->angles.ny,
-			                     in->dem.nx, in->dem.ny);
+			err = ss_error_input("%s %s is %d x %d cells: expected the DEM's %d x %d",
+			                     option, field, in->angles.nx, in->angles.ny, in->dem.nx,
+			                     in->dem.ny);
 	}
 	if (err || !o->bedrock)
 		return err;
@@ -141,6 +157,7 @@ int ss_relax_inputs_read(const struct ss_relax_options *o, struct ss_relax_input
 void ss_relax_inputs_release(struct ss_relax_inputs *in)
 {
 	ss_raster_release(&in->angles);
+	ss_free(in->table);
 	ss_raster_release(&in->bedrock);
 	ss_raster_release(&in->dem);
 }
@@ -149,12 +166,15 @@ int ss_relax_setup_stepper(const struct ss_relax_options *o, const struct ss_rel
                            int steady, struct ss_stepper *st, struct ss_pour_cover *cover)
 {
 	char what[4200];
-	snprintf(what, sizeof what, "--angle %s", o->model.angle_file ? o->model.angle_file : "");
+	snprintf(what, sizeof what, "%s %s", o->model.angle_file ? "--angle" : "--materials",
+	         o->model.angle_file ? o->model.angle_file
+	         : o->model.materials_file ? o->model.materials_file : "");
 	const struct ss_raster_setup s = {
 		.model = &o->model, .name = o->dem, .heights = &in->dem, .dx = o->read.cellsize,
 		.sides = o->sides, .nodata_type = o->nodata_type, .open_level = o->open_level,
 		.bedrock = o->bedrock ? &in->bedrock : NULL, .steady = steady,
-		.angles = o->model.angle_file ? &in->angles : NULL, .angles_what = what,
+		.angles = o->model.angle_file || o->model.materials_file ? &in->angles : NULL,
+		.classes = in->table, .angles_what = what,
 		.tile_nx = o->job.tile[0], .tile_ny = o->job.tile[1],
 		.pour = o->sand_shape.kind != SS_SHAPE_NONE ? &o->sand_shape : NULL,
 		.pour_rate = o->sand_rate, .pour_duration = o->sand_duration,

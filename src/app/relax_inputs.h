@@ -9,6 +9,7 @@
 #define SANDSLIDE_APP_RELAX_INPUTS_H
 
 #include "sandslide/dem.h"
+#include "sandslide/material_table.h"
 #include "sandslide/relax.h"
 #include "sandslide/stepper.h"
 
@@ -18,7 +19,9 @@ struct ss_relax_inputs {
 	struct ss_raster dem;       /* this rank's rows (a window, dem.h): the
 	                             * initial surface, later the output's */
 	struct ss_raster bedrock;   /* the same rows, when o->bedrock */
-	struct ss_raster angles;    /* the same rows, when o->model.angle_file */
+	struct ss_raster angles;    /* the same rows, when o->model.angle_file,
+	                             * or the classes of o->model.materials_file */
+	struct ss_material_table *table;  /* o->material_table, or NULL */
 };
 
 /* The DEM (o->dem, or a copy of o->input_raster) and the bedrock, this

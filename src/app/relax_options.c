@@ -82,6 +82,10 @@ static const struct ss_option options[] = {
 	 .expected = "a path",
 	 .help = "non-erodible base, a raster of the DEM's size: only\n"
 	         "the sand above it moves"},
+	{.name = "material-table", .value_name = "FILE", .kind = SS_OPTION_TEXT,
+	 .offset = AT(material_table), .expected = "a path",
+	 .help = "the [material NAME] sections of --materials'\n"
+	         "classes (doc/model.md#materials)"},
 	{.name = "add-sand", .value_name = "SHAPE", .kind = SS_OPTION_WORD,
 	 .offset = AT(sand_shape), .parse = parse_sand_shape,
 	 .expected = "rect=X0,Y0,X1,Y1 (X0 < X1, Y0 < Y1) or disk=X,Y,R (R > 0), in m",

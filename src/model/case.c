@@ -145,7 +145,8 @@ static const char *const fixed_sections[] = {"grid", "model", "time", "boundary"
 static const char *const region_prefix[] = {
 	[SS_REGION_WALL] = "wall", [SS_REGION_OPEN] = "open", [SS_REGION_SOURCE] = "source",
 };
-#define SECTIONS_ACCEPTED "grid, model, time, boundary, initial, wall NAME, open NAME, source NAME"
+#define SECTIONS_ACCEPTED "grid, model, time, boundary, initial, wall NAME, open NAME, " \
+                          "source NAME, material NAME"
 #define MAX_REGIONS 256
 
 /* Where a key's value came from: the file (file:line) or an override. */
@@ -244,7 +245,9 @@ static int store_path(struct parse *p, char **field, const char *value)
 	free(*field);
 	*field = s;
 	char *where = field == &p->c->bedrock_file ? p->c->bedrock_where
-	            : field == &p->c->angle_file ? p->c->angle_where : p->c->initial_where;
+	            : field == &p->c->angle_file ? p->c->angle_where
+	            : field == (char **)&p->c->model.materials_file ? p->c->materials_where
+	            : p->c->initial_where;
 	snprintf(where, SS_CASE_WHERE_SIZE, "%s", p->where);
 	return SS_OK;
 }
@@ -555,9 +558,32 @@ static const struct ss_option *fixed_key(struct parse *p, const char *section,
 	return o;
 }
 
+/* key = value of [material NAME] (material_table.h); an override changes
+ * a section of the case, it does not make one up. */
+static int apply_material_key(struct parse *p, const char *name, const char *key,
+                              const char *value)
+{
+	struct ss_case *c = p->c;
+	int known = 0;
+	for (int k = 0; c->material_table && k < c->material_table->count; k++)
+		known |= !strcmp(c->material_table->item[k].name, name);
+	if (p->overriding && !known)
+		return fail_at(p, "the case has no [material %s]", name);
+	if (!c->material_table && !(c->material_table = calloc(1, sizeof *c->material_table)))
+		return ss_error_fail("out of memory reading '%s'", p->path);
+	return ss_material_table_set(c->material_table, name, key, value, p->where);
+}
+
 static int apply(struct parse *p, const char *section, const char *key,
                  const char *value)
 {
+	const char *material = ss_material_section(section);
+	if (material) {
+		if (p->continuation)
+			return fail_at(p, "[%s] %s continues on an indented line: only polygon "
+			               "values may", section, key);
+		return apply_material_key(p, material, key, value);
+	}
 	if (!is_fixed(section)) {
 		if (p->continuation && strcmp(key, "polygon") != 0)
 			return fail_at(p, "only polygon values may continue on an indented line");
@@ -718,7 +744,8 @@ static int prescan(struct parse *p)
 			const char *name = t + 1;
 			enum ss_region_role role;
 			const char *rname;
-			if (!is_fixed(name) && region_section(name, &role, &rname) != 0) {
+			if (!is_fixed(name) && region_section(name, &role, &rname) != 0 &&
+			    !ss_material_section(name)) {
 				err = fail_at(p, "unknown section [%s]: expected " SECTIONS_ACCEPTED
 				              " (NAME of letters, digits, _ or -)", name);
 				break;
@@ -774,6 +801,8 @@ static int require_flagged(struct parse *p)
 		const struct ss_option *o = option[k];
 		if (!(o->flags & SS_OPTION_CASE_REQUIRED) || is_set(p, o->case_key))
 			continue;
+		if (!strcmp(o->case_key, "model.repose_angle") && is_set(p, "model.materials"))
+			continue;   /* the materials give the angles */
 		const char *dot = strchr(o->case_key, '.');
 		return ss_error_input("%s: [%.*s] is missing '%s' (%s, %s)", p->path,
 		                      (int)(dot - o->case_key), o->case_key, dot + 1, o->help,
@@ -1011,6 +1040,25 @@ static int finish_regions(struct parse *p)
 	return SS_OK;
 }
 
+/* [model] materials = FILE and [material NAME] sections go together; the
+ * angles come one way. */
+static int finish_materials(struct parse *p)
+{
+	struct ss_case *c = p->c;
+	if (c->model.materials_file && !c->material_table)
+		return ss_error_input("%s: [model] materials = %s needs a [material NAME] section "
+		                      "for each class", c->materials_where, c->model.materials_file);
+	if (c->material_table && !c->model.materials_file)
+		return ss_error_input("%s: [material %s] needs [model] materials = FILE, the raster "
+		                      "of classes", c->material_table->item[0].where,
+		                      c->material_table->item[0].name);
+	if (c->material_table && is_set(p, "model.repose_angle"))
+		return ss_error_input("%s: [model] repose_angle with materials = %s: each [material "
+		                      "NAME] gives its own", where_of(p, "model.repose_angle"),
+		                      c->model.materials_file);
+	return c->material_table ? ss_material_table_check(c->material_table, p->path) : SS_OK;
+}
+
 static int finish(struct parse *p)
 {
 	struct ss_case *c = p->c;
@@ -1027,6 +1075,8 @@ static int finish(struct parse *p)
 		                      c->grid_where, c->origin_x, c->origin_y, c->nx, c->ny, c->dx,
 		                      c->dy);
 	if ((err = finish_model(p)))
+		return err;
+	if ((err = finish_materials(p)))
 		return err;
 	/* max_time limits a steady run; an override that gives the run an end
 	 * makes the file's max_time redundant */
@@ -1175,6 +1225,8 @@ void ss_case_release(struct ss_case *c)
 	free(c->initial_file);
 	free(c->bedrock_file);
 	free(c->angle_file);
+	free((char *)c->model.materials_file);
+	free(c->material_table);
 	free(c->text);
 	free(c->path);
 	memset(c, 0, sizeof *c);

@@ -12,6 +12,7 @@
 #include "model/materials.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -159,5 +160,75 @@ int ss_materials_from_angles(struct ss_stepper *st, const struct ss_model_option
 	ss_free(material);
 	ss_free(closures);
 	ss_free(angles);
+	return ss_comm_agree(err);
+}
+
+/* The table's entry of this rank's cell m of r, or -1 after the message. */
+static int class_of(const struct ss_stepper *st, const struct ss_material_table *t,
+                    const struct ss_raster *r, size_t m, int i, int j, const char *what)
+{
+	const struct ss_grid *g = &st->grid;
+	const int flows = ss_cell_type_get(st->cell_types, ss_grid_index(g, i, j)) == SS_CELL_FLOW;
+	if (r->nodata && r->nodata[m]) {
+		if (flows)
+			ss_error_input("%s has no data at %s: every cell that holds sand needs a "
+			               "class", what, SS_GRID_CELL(g, i, j));
+		return flows ? -1 : 0;
+	}
+	const double v = r->values[m];
+	if (!(v >= 0.0 && v == floor(v) && v < 2147483648.0)) {
+		ss_error_input("%s: the class of %s is %g: expected an integer >= 0", what,
+		               SS_GRID_CELL(g, i, j), v);
+		return -1;
+	}
+	for (int k = 0; k < t->count; k++)
+		if ((double)t->item[k].class_value == v)
+			return k;
+	char classes[256] = "";
+	for (int k = 0; k < t->count && strlen(classes) < sizeof classes - 24; k++)
+		snprintf(classes + strlen(classes), sizeof classes - strlen(classes), "%s%lld",
+		         k ? ", " : "", t->item[k].class_value);
+	ss_error_input("%s: class %g of %s is not in the material table (its classes: %s)",
+	               what, v, SS_GRID_CELL(g, i, j), classes);
+	return -1;
+}
+
+int ss_materials_from_classes(struct ss_stepper *st, const struct ss_model_options *m,
+                              const struct ss_material_table *t, const struct ss_raster *r,
+                              const char *what)
+{
+	const struct ss_grid *g = &st->grid;
+	const size_t cells = (size_t)g->nx * (size_t)g->ny;
+	if (g->offset_j < r->row_first || g->offset_j + g->ny > r->row_first + r->rows)
+		SS_BUG("the classes hold rows %d + %d: not the slab's", r->row_first, r->rows);
+	struct ss_closure closures[SS_MATERIAL_MAX];
+	int err = SS_OK;
+	for (int k = 0; k < t->count && !err; k++) {
+		const struct ss_material_spec *s = &t->item[k];
+		err = ss_closure_init(&closures[k], s->has_closure ? s->closure : m->closure,
+		                      s->angle_deg, isnan(s->gamma) ? m->gamma : s->gamma,
+		                      isnan(s->nu) ? m->nu : s->nu);
+		if (err) {
+			char why[512];
+			snprintf(why, sizeof why, "%s", ss_error_last_message());
+			err = ss_error_input("%s: [material %s]: %s", s->where, s->name, why);
+		}
+	}
+	uint16_t *material = err ? NULL : ss_alloc(cells ? cells : 1, sizeof *material,
+	                                           "materials");
+	if (!err && !material)
+		err = SS_ERR_FAIL;
+	const size_t first = err ? 0 : (size_t)(g->offset_j - r->row_first) * g->nx;
+	for (int j = 0; j < g->ny && !err; j++)
+		for (int i = 0; i < g->nx && !err; i++) {
+			const int k = class_of(st, t, r, first + (size_t)j * g->nx + i, i, j, what);
+			if (k < 0)
+				err = SS_ERR_INPUT;
+			else
+				material[(size_t)j * g->nx + i] = (uint16_t)k;
+		}
+	if (!(err = ss_comm_agree(err)))
+		err = ss_stepper_set_materials(st, closures, t->count, material);
+	ss_free(material);
 	return ss_comm_agree(err);
 }

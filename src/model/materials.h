@@ -3,14 +3,17 @@
  *
  * materials.h - a grid of materials for the stepper (ss_stepper_set_materials,
  * doc/model.md#materials) from what a user gives: a raster of repose angles
- * (relax --angle FILE, a case's [model] repose_angle = FILE).  The model's
- * closure, gamma and nu hold in every cell; each distinct angle is a
- * material.
+ * (relax --angle FILE, a case's [model] repose_angle = FILE: the model's
+ * closure, gamma and nu in every cell, each distinct angle a material), or
+ * a raster of classes and their table (relax --materials FILE
+ * --material-table FILE, a case's [model] materials = FILE with its
+ * [material NAME] sections).
  */
 #ifndef SANDSLIDE_MODEL_MATERIALS_H
 #define SANDSLIDE_MODEL_MATERIALS_H
 
 #include "sandslide/dem.h"
+#include "sandslide/material_table.h"
 #include "sandslide/model_options.h"
 #include "sandslide/stepper.h"
 
@@ -24,5 +27,17 @@
  */
 int ss_materials_from_angles(struct ss_stepper *st, const struct ss_model_options *m,
                              const struct ss_raster *r, const char *what);
+
+/*
+ * The classes of r (integers >= 0; this rank's rows at least, the grid's
+ * size) as st's materials, each class the law of its [material NAME] of t
+ * (material_table.h; what it leaves out, the model's).  A flow cell
+ * without data, a value that is not an integer, or a class that t does
+ * not have, is refused naming `what`, the cell and the value.
+ * Collective.
+ */
+int ss_materials_from_classes(struct ss_stepper *st, const struct ss_model_options *m,
+                              const struct ss_material_table *t, const struct ss_raster *r,
+                              const char *what);
 
 #endif

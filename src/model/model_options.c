@@ -63,6 +63,11 @@ static const struct ss_option options[] = {
 	 .value_offset = AT(angle_file),
 	 .expected = "degrees in (0, 90), or a raster of them",
 	 .help = "repose angle a_cr, or a raster of each cell's"},
+	{.name = "materials", .case_key = "model.materials", .value_name = "FILE",
+	 .kind = SS_OPTION_TEXT, .offset = AT(materials_file), .expected = "a file name",
+	 .help = "a raster of material classes, each the law of\n"
+	         "its [material NAME] (relax: of --material-table;\n"
+	         "doc/model.md#materials)"},
 	{.name = "static-angle", .case_key = "model.static_angle", .value_name = "DEG",
 	 .kind = SS_OPTION_REAL, .offset = AT(static_angle_deg), .lo = 0.0, .hi = 90.0,
 	 .flags = SS_OPTION_LO_OPEN | SS_OPTION_HI_OPEN, .expected = "degrees in (0, 90)",

@@ -112,7 +112,7 @@ static int start(const struct start *s, struct ss_stepper *st)
 	}
 	err = ss_model_closure(m, &closure);
 	const double a_s = m->static_angle_deg;
-	if (!err && !isnan(a_s) && m->angle_file)
+	if (!err && !isnan(a_s) && (m->angle_file || m->materials_file))
 		err = ss_error_input("%s %g with %s: hysteresis takes one repose angle (an angle "
 		                     "raster with it is not supported yet)", s->static_what, a_s,
 		                     s->angle_what);
@@ -285,6 +285,24 @@ static int load_angles(const struct ss_case *c, struct ss_stepper *st)
 	return err;
 }
 
+/* [model] materials = FILE: each cell's class, the law of its [material
+ * NAME] (collective). */
+static int load_classes(const struct ss_case *c, struct ss_stepper *st)
+{
+	struct ss_raster r;
+	memset(&r, 0, sizeof r);
+	char what[SS_CASE_WHERE_SIZE + 4200], where[SS_CASE_WHERE_SIZE + 32];
+	snprintf(what, sizeof what, "%s: materials '%s'", c->materials_where,
+	         c->model.materials_file);
+	snprintf(where, sizeof where, "%s: [model] materials", c->materials_where);
+	int err = ss_comm_agree(read_slab(c->model.materials_file, where, "class raster", st,
+	                                  &r));
+	if (!err)
+		err = ss_materials_from_classes(st, &c->model, c->material_table, &r, what);
+	ss_raster_release(&r);
+	return err;
+}
+
 int ss_setup_stepper(const struct ss_case *c, int tile_nx, int tile_ny,
                      enum ss_kernel kernel, struct ss_stepper *st)
 {
@@ -348,6 +366,8 @@ int ss_setup_stepper(const struct ss_case *c, int tile_nx, int tile_ny,
 	err = ss_comm_agree(err);
 	if (!err && c->angle_file)
 		err = load_angles(c, st);
+	if (!err && c->model.materials_file)
+		err = load_classes(c, st);
 	if (!err)
 		err = ss_stepper_prepare(st);
 	if (err)
@@ -440,7 +460,9 @@ static int fill_from_raster(const struct ss_raster_setup *s, struct ss_stepper *
 	                                                      rock->row_first) * g.nx)
 	                             : SS_OK);
 	if (!err && s->angles)
-		err = ss_materials_from_angles(st, s->model, s->angles, s->angles_what);
+		err = s->classes
+			? ss_materials_from_classes(st, s->model, s->classes, s->angles, s->angles_what)
+			: ss_materials_from_angles(st, s->model, s->angles, s->angles_what);
 	if (err || !s->pour)
 		return err;
 	uint8_t *mask = ss_alloc((size_t)g.nx * g.ny, 1, "sand source mask");

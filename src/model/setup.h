@@ -11,6 +11,7 @@
 
 #include "sandslide/case.h"
 #include "sandslide/dem.h"
+#include "sandslide/material_table.h"
 #include "sandslide/model_options.h"
 #include "sandslide/shape.h"
 #include "sandslide/stepper.h"
@@ -51,6 +52,9 @@ struct ss_raster_setup {
 	const struct ss_raster *angles;   /* each cell's repose angle, degrees
 	                                   * (model/materials.h), the same size
 	                                   * and rows, or NULL: the model's */
+	const struct ss_material_table *classes;  /* not NULL: `angles` holds
+	                                   * classes, each the law of its
+	                                   * material here */
 	const char *angles_what;          /*   the file, for messages */
 	int steady;                       /* the run goes on until steady (relax;
 	                                   * not the BMI, which drives it): the

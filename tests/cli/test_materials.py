@@ -304,3 +304,120 @@ def test_restart_mid_avalanche_gives_the_uninterrupted_bits(tmp_path):
                 assert same_bits(a[name][ia].astype(np.float64),
                                  b[name][ib[0]].astype(np.float64)), (
                     f"/{name} at t = {t} s differs from the uninterrupted run")
+
+
+# ---- classes and a material table (doc/model.md#materials) -----------------
+
+TABLE = """[material sand]
+class = 3
+repose_angle = 30
+
+[material gravel]
+class = 7
+repose_angle = 40
+"""
+
+
+def classes(nx=48, ny=40):
+    c = np.full((ny, nx), 7.0)
+    c[:, : nx // 2] = 3.0
+    return c
+
+
+def test_classes_and_table_are_the_angle_raster(tmp_path):
+    """Two classes of 30 and 40 degrees give the bits of the raster of those
+    angles; one class the bits of its angle as a number."""
+    write_asc(tmp_path / "ridge.asc", ridge(), cellsize=DX)
+    write_asc(tmp_path / "classes.asc", classes(), cellsize=DX)
+    write_asc(tmp_path / "angles.asc", half_planes(), cellsize=DX)
+    (tmp_path / "table.ini").write_text(TABLE)
+    relax_ok(["ridge.asc", "-o", "classes.out.asc", "--materials", "classes.asc",
+              "--material-table", "table.ini"], tmp_path)
+    relax_ok(["ridge.asc", "-o", "angles.out.asc", "--angle", "angles.asc"], tmp_path)
+    assert (tmp_path / "classes.out.asc").read_bytes() == \
+        (tmp_path / "angles.out.asc").read_bytes(), \
+        "classes 3 and 7 at 30 and 40 degrees differ from the raster of those angles"
+    write_asc(tmp_path / "one.asc", np.full((40, 48), 7.0), cellsize=DX)
+    relax_ok(["ridge.asc", "-o", "one.out.asc", "--materials", "one.asc",
+              "--material-table", "table.ini"], tmp_path)
+    relax_ok(["ridge.asc", "-o", "forty.out.asc", "--angle", "40"], tmp_path)
+    assert (tmp_path / "one.out.asc").read_bytes() == \
+        (tmp_path / "forty.out.asc").read_bytes(), \
+        "a class raster of one class (40 degrees) differs from --angle 40"
+
+
+CLASS_CASE = """[grid]
+nx = 48
+ny = 40
+dx = 1
+[model]
+closure = coulomb
+materials = classes.asc
+nu = 1
+[time]
+end = steady
+output_every = 200
+[initial]
+type = file
+file = ridge.asc
+""" + TABLE
+
+
+def test_case_material_sections(tmp_path):
+    """[model] materials = FILE with [material NAME] sections; --set changes
+    one; the halves lie at their angles."""
+    write_asc(tmp_path / "ridge.asc", ridge(), cellsize=DX)
+    write_asc(tmp_path / "classes.asc", classes(), cellsize=DX)
+    (tmp_path / "case.ini").write_text(CLASS_CASE)
+    for name, extra in (("table", []), ("set", ["--set", "material gravel.repose_angle=38"])):
+        r = run(["run", "case.ini", "-o", f"{name}.h5", "-q"] + extra, cwd=tmp_path,
+                timeout=300)
+        assert r.returncode == 0, r.stderr
+    for name, steep in (("table", 40.0), ("set", 38.0)):
+        with h5open(tmp_path / f"{name}.h5") as f:
+            gx, gy = normal_slopes_deg(f["height"][-1])
+        assert gy[:, :21].max() <= 30.001 and steep - 0.1 <= gy[:, 27:].max() <= steep + 0.001, (
+            f"{name}: the halves lie at {gy[:, :21].max():.3f} and {gy[:, 27:].max():.3f} deg")
+
+
+def test_bad_classes_and_tables(tmp_path):
+    write_asc(tmp_path / "ridge.asc", ridge(), cellsize=DX)
+    write_asc(tmp_path / "classes.asc", classes(), cellsize=DX)
+    c = classes()
+    c[5, 30] = 2.5
+    write_asc(tmp_path / "half.asc", c, cellsize=DX)
+    (tmp_path / "table.ini").write_text(TABLE)
+    (tmp_path / "sand.ini").write_text(TABLE.split("\n\n")[0] + "\n")
+    (tmp_path / "twice.ini").write_text(TABLE.replace("class = 7", "class = 3"))
+    (tmp_path / "noangle.ini").write_text(TABLE.replace("repose_angle = 40\n", ""))
+    (tmp_path / "steep.ini").write_text(TABLE.replace("repose_angle = 40", "repose_angle = 95"))
+    bad = [
+        (["--materials", "classes.asc", "--material-table", "sand.ini"],
+         ["classes.asc", "class 7", "not in the material table", "3"]),
+        (["--materials", "half.asc", "--material-table", "table.ini"],
+         ["half.asc", "2.5", "(30, 5)", "integer"]),
+        (["--materials", "classes.asc", "--material-table", "twice.ini"],
+         ["twice.ini", "class 3", "gravel", "sand"]),
+        (["--materials", "classes.asc", "--material-table", "noangle.ini"],
+         ["gravel", "repose_angle"]),
+        (["--materials", "classes.asc", "--material-table", "steep.ini"],
+         ["steep.ini", "gravel", "95", "(0, 90)"]),
+        (["--materials", "classes.asc"], ["--materials", "--material-table"]),
+        (["--materials", "classes.asc", "--material-table", "table.ini", "--angle", "a.asc"],
+         ["--angle", "--materials"]),
+    ]
+    for args, words in bad:
+        r = run(["relax", "ridge.asc", "-o", "out.asc"] + args, cwd=tmp_path)
+        assert r.returncode == 2 and len(r.stderr.splitlines()) == 1, (args, r.stderr)
+        for w in words:
+            assert w in r.stderr, f"{args}: '{w}' not in: {r.stderr}"
+    # a case: sections without the raster, the raster without sections
+    base = CLASS_CASE.replace("materials = classes.asc\n", "repose_angle = 35\n")
+    (tmp_path / "a.ini").write_text(base)
+    (tmp_path / "b.ini").write_text(CLASS_CASE.split("[material sand]")[0])
+    for case, words in (("a.ini", ["[material sand]", "materials = FILE"]),
+                        ("b.ini", ["materials = classes.asc", "[material NAME]"])):
+        r = run(["run", case, "-o", "out.h5"], cwd=tmp_path)
+        assert r.returncode == 2 and len(r.stderr.splitlines()) == 1, (case, r.stderr)
+        for w in words:
+            assert w in r.stderr, f"{case}: '{w}' not in: {r.stderr}"
