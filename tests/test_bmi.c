@@ -682,6 +682,39 @@ static void bedrock_and_erosion(void)
 	remove(check_file("rock.ini"));
 }
 
+/* A case with hysteresis (doc/model.md#hysteresis): which cells move is
+ * an output, 1 where sand moves and 0 where it rests, NaN on walls. */
+static void flowing_state(void)
+{
+	check_write_file(check_file("pour.ini"), "[grid]\nnx = 12\nny = 10\ndx = 0.05\n\n"
+	                 "[model]\nclosure = coulomb\nrepose_angle = 30\nstatic_angle = 36\n"
+	                 "nu = 0.1\n\n[time]\nend = 10\noutput_every = 0.5\n\n"
+	                 "[boundary]\neast = open\n\n"
+	                 "[initial]\ntype = flat\nheight = 0\n\n"
+	                 "[wall post]\nrect = 0 0 0.05 0.05\n\n"
+	                 "[source pour]\nrect = 0.2 0.2 0.3 0.3\nrate = 0.05\n");
+	struct Bmi *m = initialized("pour.ini");
+	if (!m)
+		return;
+	int n = 0, grid = -1;
+	CHECK(m->get_output_item_count(m, &n) == BMI_SUCCESS && n == NOUT + 1, "%d outputs", n);
+	CHECK(m->get_var_grid(m, "sand__flowing_state", &grid) == BMI_SUCCESS && grid == 0,
+	      "flowing state's grid");
+	double moving[120];
+	int ones = 0, bad = 0;
+	for (int k = 0; k < 8 && m->update(m) == BMI_SUCCESS; k++) {
+		CHECK(m->get_value(m, "sand__flowing_state", moving) == BMI_SUCCESS, "get");
+		for (int c = 0; c < 120; c++) {
+			ones += moving[c] == 1.0;
+			bad += !(moving[c] == 0.0 || moving[c] == 1.0 || (c == 0 && isnan(moving[c])));
+		}
+	}
+	CHECK(ones > 0 && bad == 0, "flowing state: %d ones over 8 updates, %d values not 0, 1 "
+	      "or NaN on the wall", ones, bad);
+	ss_bmi_destroy(m);
+	remove(check_file("pour.ini"));
+}
+
 /* A BMI config naming a case is that case; one naming a DEM is set up as
  * relax sets it up: update_until(T) gives the bits of relax with
  * max_time T on the same heights.  Bad configs fail and keep nothing. */
@@ -792,6 +825,7 @@ int main(void)
 	RUN(elevation_is_nan_on_walls_and_nodata);
 	RUN(rate_is_a_source);
 	RUN(bedrock_and_erosion);
+	RUN(flowing_state);
 	RUN(config_names_a_case_or_a_dem);
 	remove(check_file("cone.ini"));
 	rmdir(check_scratch());
