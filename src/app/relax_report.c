@@ -37,6 +37,9 @@ static const struct ss_field fields[] = {
 	 .name_of = closure_name},
 	FIELD("repose_angle_deg", SS_FIELD_REAL, model.angle_deg),
 	FIELD("nu", SS_FIELD_REAL, model.nu),
+	LINE("materials", SS_FIELD_INT, materials),
+	FIELD("repose_angle_min_deg", SS_FIELD_REAL, repose_min_deg),
+	FIELD("repose_angle_max_deg", SS_FIELD_REAL, repose_max_deg),
 	LINE("steady", SS_FIELD_BOOL, steady),
 	FIELD("end", SS_FIELD_TEXT, end),
 	FIELD("tol", SS_FIELD_REAL, model.steady_tol),
@@ -63,9 +66,6 @@ static const struct ss_field fields[] = {
 	FIELD("pour_cells_nodata", SS_FIELD_COUNT, pour_cells_nodata),
 	LINE("max_slope_before_deg", SS_FIELD_REAL, max_slope_before_deg),
 	FIELD("max_slope_after_deg", SS_FIELD_REAL, max_slope_after_deg),
-	FIELD("materials", SS_FIELD_INT, materials),
-	FIELD("repose_angle_min_deg", SS_FIELD_REAL, repose_min_deg),
-	FIELD("repose_angle_max_deg", SS_FIELD_REAL, repose_max_deg),
 };
 
 int ss_relax_report_json(const struct ss_relax_report *r, char *buf, size_t size)

@@ -53,6 +53,17 @@ double ss_setup_node_bytes(const struct ss_grid *g, enum ss_integrator integrato
 	       ss_comm_node_ranks();
 }
 
+/* Each cell's material number (2 B, stepper.h) when the model gives the
+ * angles per cell or has hysteresis, this node's share as
+ * ss_setup_node_bytes counts. */
+static double material_node_bytes(const struct ss_model_options *m, const struct ss_grid *g)
+{
+	const int per_cell = m->angle_file || m->materials_file || !isnan(m->static_angle_deg);
+	return per_cell ? (double)ss_grid_storage_cells(g) * sizeof(uint16_t) / ss_comm_size() *
+	                  ss_comm_node_ranks()
+	                : 0.0;
+}
+
 int ss_setup_check_raster_memory(const char *name, int nx, int ny, int rasters,
                                  const struct ss_model_options *m, int has_bedrock)
 {
@@ -71,7 +82,7 @@ int ss_setup_check_raster_memory(const char *name, int nx, int ny, int rasters,
 	                                                                0), rest);
 	const double relax = ss_setup_node_bytes(&g, ss_integrator_resolve(m->integrator,
 	                                                                  has_bedrock, 1), rest);
-	const double need = raster + fmax(run, relax);
+	const double need = raster + fmax(run, relax) + material_node_bytes(m, &g);
 	const double have = ss_memory_available_bytes();
 	if (have > 0.0 && need > have) {
 		char nb[32], hb[32];
@@ -102,7 +113,7 @@ static int start(const struct start *s, struct ss_stepper *st)
 		                      s->bedrock_what);
 	const enum ss_rest_mode rest = ss_setup_rest_mode(m, s->steady, s->has_bedrock);
 	/* the memory of one rank's slab, times the ranks on this node */
-	const double need = ss_setup_node_bytes(&g, integrator, rest);
+	const double need = ss_setup_node_bytes(&g, integrator, rest) + material_node_bytes(m, &g);
 	const double have = ss_memory_available_bytes();
 	if (have > 0.0 && need > have) {
 		char nb[32], hb[32];
