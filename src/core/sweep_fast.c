@@ -847,9 +847,10 @@ static struct row_buffers buffers_of(const struct ss_sweep_fast *f, int thread)
 	b.ring.type_cur = (int64_t *)(p + 13 * w);
 	b.ring.type_next = (int64_t *)(p + 14 * w);
 	b.ring.type_back = (int64_t *)(p + 15 * w);
-	b.face_rule = (uint16_t *)(p + 16 * w);
-	b.west_old = p + 17 * w;
+	b.west_old = p + 16 * w;
 	b.east_save = b.west_old + ((size_t)f->tiling.tile_ny + 7) / 8 * 8;
+	/* last: the buffers of one material keep the places they had */
+	b.face_rule = (uint16_t *)(b.east_save + ((size_t)f->tiling.tile_ny + 7) / 8 * 8);
 	return b;
 }
 
