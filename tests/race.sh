@@ -142,6 +142,26 @@ check "render oblique" "$bin" render fast.h5 -o oblique --frames -1 --style obli
 check "relax" "$bin" relax cliff.asc -o cliff-relaxed.asc --max-time 2
 # until steady: forward Euler, then the approach to rest's super-steps
 check "relax to rest, tiles 8x4" "$bin" relax cliff.asc -o cliff-rest.asc --tile 8x4
+# materials: 30 and 40 degrees in bands of rows (doc/model.md#materials);
+# hysteresis: the states updated between steps, a reduction of the threads
+{
+	printf 'ncols 40\nnrows 24\nxllcorner 0\nyllcorner 0\ncellsize 0.05\n'
+	j=0
+	while [ $j -lt 24 ]; do
+		i=0
+		row=""
+		while [ $i -lt 40 ]; do
+			if [ $((j / 6 % 2)) -eq 0 ]; then row="$row 30"; else row="$row 40"; fi
+			i=$((i + 1))
+		done
+		echo "$row"
+		j=$((j + 1))
+	done
+} >angles.asc
+check "relax, two materials, tiles 8x4" "$bin" relax cliff.asc -o cliff-angles.asc \
+	--angle angles.asc --tile 8x4
+check "relax, hysteresis, tiles 8x4" "$bin" relax cliff.asc -o cliff-hysteresis.asc \
+	--angle 30 --static-angle 36 --tile 8x4
 check "bench" "$bin" bench --nx 300 --ny 200 --tile 32x16 --closure bingham \
 	--surface supercritical --repeats 1 --steps 2 --threads 2
 
