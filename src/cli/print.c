@@ -168,6 +168,9 @@ void cli_print_relax_end(const struct ss_relax_report *r, int quiet)
 	if (r->materials > 1)
 		snprintf(repose, sizeof repose, "repose %g to %g in %d materials", r->repose_min_deg,
 		         r->repose_max_deg, r->materials);
+	else if (r->model.static_angle_deg > r->repose_min_deg)
+		snprintf(repose, sizeof repose, "repose %g, static %g", r->repose_min_deg,
+		         r->model.static_angle_deg);
 	else
 		snprintf(repose, sizeof repose, "repose %g", r->repose_min_deg);
 	printf("cells moved %lld, volume moved %.6g m^3, steepest sand face %.4f -> "
