@@ -70,7 +70,8 @@ static const struct ss_option options[] = {
 	         "doc/model.md#materials)"},
 	{.name = "static-angle", .case_key = "model.static_angle", .value_name = "DEG",
 	 .kind = SS_OPTION_REAL, .offset = AT(static_angle_deg), .lo = 0.0, .hi = 90.0,
-	 .flags = SS_OPTION_LO_OPEN | SS_OPTION_HI_OPEN, .expected = "degrees in (0, 90)",
+	 .flags = SS_OPTION_LO_OPEN | SS_OPTION_HI_OPEN | SS_OPTION_FITTABLE,
+	 .expected = "degrees in (0, 90)",
 	 .help = "hysteresis: the angle where sand at rest starts\n"
 	         "to slide, at least the repose angle, where moving\n"
 	         "sand stops (default: the repose angle, no\n"

@@ -395,3 +395,45 @@ def test_interrupt_writes_the_best_so_far(tmp_path):
     report = json.loads((tmp_path / "f.json").read_text())
     assert report["interrupted"] is True
     assert report["forward_runs"] > 0 and report["best"]["closure"] == "coulomb", report
+
+
+HYSTERESIS_TWIN = """[grid]
+nx = 60
+ny = 8
+dx = 0.025
+origin = 0 0
+[model]
+closure = coulomb
+repose_angle = 30
+static_angle = 36
+nu = 0.1
+[time]
+end = 12
+output_every = 0.5
+[boundary]
+west = wall
+east = open
+south = periodic
+north = periodic
+[initial]
+type = flat
+height = 0
+[source pour]
+rect = 0 0 0.05 0.2
+rate = 0.01
+"""
+
+
+def test_a_poured_twin_gives_both_angles_of_hysteresis(tmp_path):
+    """A pour against a wall under hysteresis (30 and 36 degrees): fit frees
+    repose_angle and static_angle and finds each within 0.5 degree
+    (doc/fit.md#parameters)."""
+    (tmp_path / "twin.ini").write_text(HYSTERESIS_TWIN)
+    run_ok(["run", "twin.ini", "-o", "twin.h5", "-q"], cwd=tmp_path)
+    run_ok(["fit", "twin.ini", "twin.h5", "--param", "repose_angle=27:33",
+            "--param", "static_angle=33.5:39", "-o", "fit.json", "-q"], cwd=tmp_path,
+           timeout=300)
+    best = json.loads((tmp_path / "fit.json").read_text())["best"]["params"]
+    assert abs(best["repose_angle"] - 30.0) <= 0.5 and abs(best["static_angle"] - 36.0) <= 0.5, (
+        f"fit found repose_angle {best['repose_angle']:.3f}, static_angle "
+        f"{best['static_angle']:.3f}: the twin's are 30 and 36")
