@@ -392,7 +392,7 @@ double SS_PATH_FN(ss_sweep_max_sand_slope)(const struct ss_grid *g,
 }
 
 #if SS_PATH == SS_PATH_GENERIC
-/* f_d(s) / f_tol_d of one face (ss_sweep_material_excess); 0 where it
+/* f_d(s) |g_n| / s / f_tol_d of one face (ss_sweep_material_excess); 0 where it
  * carries nothing or lies on rock. */
 static double face_excess(const double *h, const uint8_t *t, const uint16_t *material,
                           const struct ss_closure *materials, double slope_tol,
