@@ -30,6 +30,7 @@
 #include "render/plot.h"
 #include "sandslide/case.h"
 #include "sandslide/closure.h"
+#include "sandslide/material_table.h"
 #include "sandslide/comm.h"
 #include "sandslide/error.h"
 #include "sandslide/parallel.h"
@@ -49,9 +50,34 @@ static const struct ss_option *param_row(const struct ss_fit_param *p, size_t *o
 	return o;
 }
 
-/* Whether closure kind takes parameter p: the closures of its row. */
+/* Whether p is a class's parameter, "material NAME.KEY" (fit_options.c). */
+static int is_material_param(const struct ss_fit_param *p)
+{
+	return !strncmp(p->name, "material ", strlen("material "));
+}
+
+/* Parameter p, a class's, set to value in table t (the case's [material
+ * NAME]: the case parser made sure that it has one). */
+static void set_material_param(const struct ss_fit_param *p, struct ss_material_table *t,
+                               double value)
+{
+	const char *name = p->name + strlen("material "), *dot = strchr(name, '.');
+	for (int k = 0; t && k < t->count; k++) {
+		struct ss_material_spec *m = &t->item[k];
+		if (strlen(m->name) == (size_t)(dot - name) && !strncmp(m->name, name, dot - name)) {
+			*(!strcmp(dot + 1, "nu") ? &m->nu : &m->angle_deg) = value;
+			return;
+		}
+	}
+	SS_BUG("fit: no [material %.*s] in the case", (int)(dot - name), name);
+}
+
+/* Whether closure kind takes parameter p: the closures of its row (a
+ * class's parameter: every closure). */
 static int param_applies(const struct ss_fit_param *p, enum ss_closure_kind kind)
 {
+	if (is_material_param(p))
+		return 1;
 	size_t offset;
 	const struct ss_option *o = param_row(p, &offset);
 	return !o->applies_to || (o->applies_to >> kind & 1);
@@ -82,7 +108,8 @@ static int parse_closure_case(const struct fit *f, struct closure_fit *cf)
 	n++;
 	for (int k = 0; k < cf->p; k++) {
 		const struct ss_fit_param *p = &f->params[cf->param[k]];
-		snprintf(text[n], 96, "model.%s=%s", p->name, SS_REAL(fit_value_of(p, 0.5)));
+		snprintf(text[n], 96, "%s%s=%s", is_material_param(p) ? "" : "model.", p->name,
+		         SS_REAL(fit_value_of(p, 0.5)));
 		ov[n] = text[n];
 		n++;
 	}
@@ -110,6 +137,11 @@ static int make_stepper(const struct fit *f, const struct closure_fit *cf, const
 	struct ss_case c = cf->c;   /* a copy of the values: the set-up only reads */
 	for (int k = 0; k < cf->p; k++) {
 		const struct ss_fit_param *p = &f->params[cf->param[k]];
+		if (is_material_param(p)) {
+			/* the table is the closure's case's, set before each run */
+			set_material_param(p, c.material_table, fit_value_of(p, u[k]));
+			continue;
+		}
 		size_t offset;
 		const struct ss_option *o = param_row(p, &offset);
 		*(double *)((char *)&c + offset + o->offset) = fit_value_of(p, u[k]);
@@ -743,7 +775,8 @@ static int assign_params(struct fit *f)
 				return ss_error_input("--param %s is given twice", f->params[k].name);
 		size_t offset;
 		nu |= !strcmp(f->params[k].name, "nu");
-		derived |= ss_model_option_is_layer(param_row(&f->params[k], &offset));
+		derived |= !is_material_param(&f->params[k]) &&
+		           ss_model_option_is_layer(param_row(&f->params[k], &offset));
 	}
 	if (nu && derived)
 		return ss_error_input("--param nu and the sliding layer's parameters (delta, "

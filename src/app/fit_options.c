@@ -16,6 +16,7 @@
 #include "base/strings.h"
 #include "sandslide/model_options.h"
 #include "sandslide/error.h"
+#include "sandslide/material_table.h"
 
 static int parse_cost(const char *value, void *field)
 {
@@ -126,9 +127,26 @@ static void fittable_names(char *buf, size_t size)
 	}
 }
 
+/* Whether name (len bytes) is "material NAME.repose_angle" or
+ * "material NAME.nu": a class's angle or nu (doc/fit.md#parameters). */
+static int fittable_material(const char *name, size_t len)
+{
+	char section[96];
+	const char *dot = memchr(name, '.', len);
+	if (!dot || (size_t)(dot - name) >= sizeof section)
+		return 0;
+	snprintf(section, sizeof section, "%.*s", (int)(dot - name), name);
+	const size_t key = len - (size_t)(dot + 1 - name);
+	return ss_material_section(section) &&
+	       ((key == strlen("repose_angle") && !strncmp(dot + 1, "repose_angle", key)) ||
+	        (key == 2 && !strncmp(dot + 1, "nu", 2)));
+}
+
 /* Whether name (len bytes) is a key --param takes. */
 static int fittable(const char *name, size_t len)
 {
+	if (fittable_material(name, len))
+		return 1;
 	for (int k = 0; k < ss_model_option_table.count; k++) {
 		const struct ss_option *o = &ss_model_option_table.options[k];
 		const char *key = o->case_key ? strchr(o->case_key, '.') + 1 : NULL;
@@ -142,8 +160,9 @@ int ss_fit_param_parse(const char *text, struct ss_fit_param *p)
 {
 	char names[256], expected[512];
 	fittable_names(names, sizeof names);
-	snprintf(expected, sizeof expected, "NAME=LO:HI or NAME=LO:HI:log with NAME one of %s and "
-	         "LO < HI, e.g. nu=0.01:1:log", names);
+	snprintf(expected, sizeof expected, "NAME=LO:HI or NAME=LO:HI:log with NAME one of %s, or "
+	         "'material NAME.repose_angle' or 'material NAME.nu', and LO < HI, e.g. "
+	         "nu=0.01:1:log", names);
 	memset(p, 0, sizeof *p);
 	const char *eq = strchr(text, '=');
 	const size_t len = eq ? (size_t)(eq - text) : 0;

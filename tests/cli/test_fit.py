@@ -437,3 +437,57 @@ def test_a_poured_twin_gives_both_angles_of_hysteresis(tmp_path):
     assert abs(best["repose_angle"] - 30.0) <= 0.5 and abs(best["static_angle"] - 36.0) <= 0.5, (
         f"fit found repose_angle {best['repose_angle']:.3f}, static_angle "
         f"{best['static_angle']:.3f}: the twin's are 30 and 36")
+
+
+def asc(values):
+    ny, nx = values.shape
+    rows = "\n".join(" ".join(repr(float(v)) for v in values[j]) for j in range(ny - 1, -1, -1))
+    return f"ncols {nx}\nnrows {ny}\nxllcorner 0\nyllcorner 0\ncellsize 1.0\n{rows}\n"
+
+
+CLASS_TWIN = """[grid]
+nx = 32
+ny = 24
+dx = 1
+[model]
+closure = coulomb
+materials = classes.asc
+nu = 1
+[time]
+end = 300
+output_every = 50
+[initial]
+type = file
+file = ridge.asc
+[material sand]
+class = 3
+repose_angle = 30
+[material gravel]
+class = 7
+repose_angle = 40
+"""
+
+
+def test_one_angle_per_class_of_a_twin(tmp_path):
+    """A ridge half sand (30 degrees), half gravel (40): fit frees each
+    class's angle ('material NAME.repose_angle') and finds both within 0.5
+    degree (doc/fit.md#parameters)."""
+    y = np.arange(24) - 11.5
+    ridge = np.tile(np.maximum(0.0, 10.0 - np.tan(np.radians(60.0)) * np.abs(y))[:, None],
+                    (1, 32))
+    classes = np.full((24, 32), 7.0)
+    classes[:, :16] = 3.0
+    (tmp_path / "ridge.asc").write_text(asc(ridge))
+    (tmp_path / "classes.asc").write_text(asc(classes))
+    (tmp_path / "twin.ini").write_text(CLASS_TWIN)
+    run_ok(["run", "twin.ini", "-o", "twin.h5", "-q"], cwd=tmp_path)
+    run_ok(["fit", "twin.ini", "twin.h5", "--param", "material sand.repose_angle=27:33",
+            "--param", "material gravel.repose_angle=37:43", "-o", "fit.json", "-q"],
+           cwd=tmp_path, timeout=300)
+    best = json.loads((tmp_path / "fit.json").read_text())["best"]["params"]
+    sand, gravel = best["material sand.repose_angle"], best["material gravel.repose_angle"]
+    assert abs(sand - 30.0) <= 0.5 and abs(gravel - 40.0) <= 0.5, (
+        f"fit found sand {sand:.3f}, gravel {gravel:.3f} degrees: the twin's are 30 and 40")
+    r = run(["fit", "twin.ini", "twin.h5", "--param", "material rock.repose_angle=27:33"],
+            cwd=tmp_path)
+    assert r.returncode == 2 and "[material rock]" in r.stderr, r.stderr
