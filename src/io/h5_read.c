@@ -307,24 +307,33 @@ static int walls_to_zero(struct ss_snapshot_file *f, int j0, int rows, double *o
 	return err;
 }
 
-int ss_snapshot_file_read_rows(struct ss_snapshot_file *f, long long t, int j0, int rows,
-                               double *out)
+/* Rows j0 .. j0 + rows - 1 of snapshot t of the (time, y, x) variable v
+ * (/name) into out as mem_type; `what` (its size) gets its description. */
+static int read_snapshot_block(struct ss_snapshot_file *f, struct ss_h5_var *v,
+                               const char *name, long long t, int j0, int rows,
+                               hid_t mem_type, void *out, char *what, size_t size)
 {
 	check_rows(f, j0, rows);
 	if (t < 0 || t >= f->count)
 		SS_BUG("snapshot %lld of %lld", t, f->count);
 	const hsize_t start[3] = {(hsize_t)t, (hsize_t)j0, 0};
 	const hsize_t count[3] = {1, (hsize_t)rows, (hsize_t)f->nx};
-	char what[96];
-	snprintf(what, sizeof what, "snapshot %lld of /height, rows %d .. %d", t, j0,
-	         j0 + rows - 1);
+	snprintf(what, size, "snapshot %lld of /%s, rows %d .. %d", t, name, j0, j0 + rows - 1);
 	int err;
 	#pragma omp critical(ss_snapshot_hdf5)
 	{
 		ss_h5_quiet();
-		err = ss_h5_var_read(&f->h5->in, &f->h5->height, start, count, H5T_NATIVE_DOUBLE,
-		                     out, what);
+		err = ss_h5_var_read(&f->h5->in, v, start, count, mem_type, out, what);
 	}
+	return err;
+}
+
+int ss_snapshot_file_read_rows(struct ss_snapshot_file *f, long long t, int j0, int rows,
+                               double *out)
+{
+	char what[96];
+	const int err = read_snapshot_block(f, &f->h5->height, "height", t, j0, rows,
+	                                    H5T_NATIVE_DOUBLE, out, what, sizeof what);
 	return err ? err : walls_to_zero(f, j0, rows, out);
 }
 
@@ -336,21 +345,11 @@ int ss_snapshot_file_has_moving(const struct ss_snapshot_file *f)
 int ss_snapshot_file_read_moving(struct ss_snapshot_file *f, long long t, int j0, int rows,
                                  uint8_t *out)
 {
-	check_rows(f, j0, rows);
-	if (t < 0 || t >= f->count || !ss_snapshot_file_has_moving(f))
-		SS_BUG("/moving of snapshot %lld of %lld", t, f->count);
-	const hsize_t start[3] = {(hsize_t)t, (hsize_t)j0, 0};
-	const hsize_t count[3] = {1, (hsize_t)rows, (hsize_t)f->nx};
+	if (!ss_snapshot_file_has_moving(f))
+		SS_BUG("/moving of '%s', which has none", f->name);
 	char what[96];
-	snprintf(what, sizeof what, "snapshot %lld of /moving, rows %d .. %d", t, j0,
-	         j0 + rows - 1);
-	int err;
-	#pragma omp critical(ss_snapshot_hdf5)
-	{
-		ss_h5_quiet();
-		err = ss_h5_var_read(&f->h5->in, &f->h5->moving, start, count, H5T_NATIVE_UINT8,
-		                     out, what);
-	}
+	int err = read_snapshot_block(f, &f->h5->moving, "moving", t, j0, rows,
+	                              H5T_NATIVE_UINT8, out, what, sizeof what);
 	const size_t n = (size_t)rows * (size_t)f->nx;
 	for (size_t k = 0; k < n && !err; k++)
 		if (out[k] > 1)
