@@ -34,8 +34,9 @@
 #define EXTERNAL "sand__external_volume_change"
 #define RATE "land_surface__net_deposition_rate"
 #define BEDROCK "bedrock_surface__elevation"
-#define NOUT 6
-static const char *const outputs[NOUT] = {ELEV, VOLUME, INFLOW, OUTFLOW, EXTERNAL, SLOPE};
+#define ANGLE "sand__angle_of_repose"
+#define NOUT 7   /* without a bedrock or hysteresis */
+static const char *const outputs[NOUT] = {ELEV, ANGLE, VOLUME, INFLOW, OUTFLOW, EXTERNAL, SLOPE};
 
 /* A cone slumping towards an open east side: heights change every step. */
 static const char *case_text =
@@ -129,10 +130,11 @@ static void info(void)
 		names[v] = var[v];
 	int in = 0, out = 0;
 	CHECK(m->get_component_name(m, name) == BMI_SUCCESS && !strcmp(name, "sandslide"), "name");
-	CHECK(m->get_input_item_count(m, &in) == BMI_SUCCESS && in == 2, "%d inputs", in);
+	CHECK(m->get_input_item_count(m, &in) == BMI_SUCCESS && in == 3, "%d inputs", in);
 	CHECK(m->get_output_item_count(m, &out) == BMI_SUCCESS && out == NOUT, "%d outputs", out);
 	CHECK(m->get_input_var_names(m, names) == BMI_SUCCESS && !strcmp(var[0], ELEV) &&
-	      !strcmp(var[1], RATE), "%s, %s", var[0], var[1]);
+	      !strcmp(var[1], RATE) && !strcmp(var[2], ANGLE), "%s, %s, %s", var[0], var[1],
+	      var[2]);
 	var[0][0] = 0;
 	CHECK(m->get_output_var_names(m, names) == BMI_SUCCESS, "output names");
 	for (int v = 0; v < NOUT; v++)
@@ -180,8 +182,8 @@ static void vars(void)
 	CHECK(m->get_var_nbytes(m, ELEV, &v) == BMI_SUCCESS && v == NX * NY * 8, "nbytes %d", v);
 	CHECK(m->get_var_grid(m, ELEV, &v) == BMI_SUCCESS && v == 0, "grid %d", v);
 	/* the read-only diagnostics: scalars on grid 1 */
-	const char *units[NOUT] = {"m", "m3", "m3", "m3", "m3", "deg"};
-	for (int k = 1; k < NOUT; k++) {
+	const char *units[NOUT] = {"m", "deg", "m3", "m3", "m3", "m3", "deg"};
+	for (int k = 2; k < NOUT; k++) {
 		CHECK(m->get_var_grid(m, outputs[k], &v) == BMI_SUCCESS && v == 1, "%s: grid %d",
 		      outputs[k], v);
 		CHECK(m->get_var_units(m, outputs[k], s) == BMI_SUCCESS && !strcmp(s, units[k]),
@@ -697,9 +699,11 @@ static void flowing_state(void)
 	if (!m)
 		return;
 	int n = 0, grid = -1;
-	CHECK(m->get_output_item_count(m, &n) == BMI_SUCCESS && n == NOUT + 1, "%d outputs", n);
+	/* the flowing state for the angle: hysteresis takes one */
+	CHECK(m->get_output_item_count(m, &n) == BMI_SUCCESS && n == NOUT, "%d outputs", n);
 	CHECK(m->get_var_grid(m, "sand__flowing_state", &grid) == BMI_SUCCESS && grid == 0,
 	      "flowing state's grid");
+	CHECK(m->get_var_grid(m, ANGLE, &grid) == BMI_FAILURE, "an angle field with hysteresis");
 	double moving[120];
 	int ones = 0, bad = 0;
 	for (int k = 0; k < 8 && m->update(m) == BMI_SUCCESS; k++) {
@@ -713,6 +717,130 @@ static void flowing_state(void)
 	      "or NaN on the wall", ones, bad);
 	ss_bmi_destroy(m);
 	remove(check_file("pour.ini"));
+}
+
+/* pile.asc (DX x DY cells of 0.5 m, 50-degree flanks) into the scratch
+ * folder, and its heights into dem ([y][x], south row first). */
+enum { PILE_NX = 12, PILE_NY = 9 };
+static int write_pile(double *dem)
+{
+	for (int j = 0; j < PILE_NY; j++)
+		for (int i = 0; i < PILE_NX; i++) {
+			const double r = hypot(i - 5.5, j - 4.0);
+			dem[j * PILE_NX + i] = 0.1 + fmax(0.0, 1.2 * (3.0 - r)) * 0.5;
+		}
+	FILE *f = fopen(check_file("pile.asc"), "w");
+	CHECK(f != NULL, "pile.asc");
+	if (!f)
+		return -1;
+	fprintf(f, "ncols %d\nnrows %d\nxllcorner 100\nyllcorner 200\ncellsize 0.5\n", PILE_NX,
+	        PILE_NY);
+	for (int j = PILE_NY - 1; j >= 0; j--)           /* north row first */
+		for (int i = 0; i < PILE_NX; i++)
+			fprintf(f, "%.17g%s", dem[j * PILE_NX + i], i == PILE_NX - 1 ? "\n" : " ");
+	return fclose(f);
+}
+
+/* The repose angle as an input (doc/bmi.md, doc/model.md#materials): set
+ * at the start it is the run with that angle raster; a pile steeper than
+ * its angle slides, one below it holds to the bit; setting the angles the
+ * model has changes nothing; a bad angle is refused and changes nothing. */
+static void angle_field(void)
+{
+	enum { DX = PILE_NX, DY = PILE_NY, N = PILE_NX * PILE_NY };
+	double dem[N], half[N], got[N], want[N], angles[N];
+	if (write_pile(dem))
+		return;
+	FILE *f = fopen(check_file("half.asc"), "w");   /* west 30, east 40 degrees */
+	CHECK(f != NULL, "half.asc");
+	if (!f)
+		return;
+	fprintf(f, "ncols %d\nnrows %d\nxllcorner 100\nyllcorner 200\ncellsize 0.5\n", DX, DY);
+	for (int j = DY - 1; j >= 0; j--)
+		for (int i = 0; i < DX; i++)
+			fprintf(f, "%d%s", i < DX / 2 ? 30 : 40, i == DX - 1 ? "\n" : " ");
+	fclose(f);
+	for (int c = 0; c < N; c++)
+		half[c] = c % DX < DX / 2 ? 30.0 : 40.0;
+	const char *common = "time_step = 0.5\nend = 3\nnu = 0.1\nsides = open\ntile = 4x3\n"
+	                     "integrator = rkl2\n";
+	char text[512];
+	snprintf(text, sizeof text, "[bmi]\ndem = pile.asc\nangle = half.asc\n%s", common);
+	check_write_file(check_file("half.cfg"), text);
+	snprintf(text, sizeof text, "[bmi]\ndem = pile.asc\nangle = 33\n%s", common);
+	check_write_file(check_file("uniform.cfg"), text);
+
+	/* the raster given at initialize (its name relative to the config),
+	 * and the same angles set at t = 0 */
+	struct Bmi *a = initialized("half.cfg"), *b = initialized("uniform.cfg");
+	if (a && b) {
+		CHECK(b->get_value(b, ANGLE, angles) == BMI_SUCCESS && angles[0] == 33.0 &&
+		      angles[N - 1] == 33.0, "uniform angles %g %g", angles[0], angles[N - 1]);
+		CHECK(b->set_value(b, ANGLE, half) == BMI_SUCCESS, "%s", ss_error_last_message());
+		CHECK(b->get_value(b, ANGLE, angles) == BMI_SUCCESS && same_bits(angles, half, N),
+		      "the angles set are not read back");
+		CHECK(a->update_until(a, 1.5) == BMI_SUCCESS && b->update_until(b, 1.5) == BMI_SUCCESS,
+		      "update_until");
+		CHECK(a->get_value(a, ELEV, want) == BMI_SUCCESS &&
+		      b->get_value(b, ELEV, got) == BMI_SUCCESS && same_bits(got, want, N),
+		      "angles set at t = 0 are not the run with that angle raster");
+		CHECK(!same_bits(got, dem, N), "the pile slid");
+		/* the angles it has, set again: not a bit changes */
+		CHECK(b->get_value(b, ANGLE, angles) == BMI_SUCCESS &&
+		      b->set_value(b, ANGLE, angles) == BMI_SUCCESS, "%s", ss_error_last_message());
+		CHECK(a->update_until(a, 3.0) == BMI_SUCCESS && b->update_until(b, 3.0) == BMI_SUCCESS,
+		      "update_until");
+		CHECK(a->get_value(a, ELEV, want) == BMI_SUCCESS &&
+		      b->get_value(b, ELEV, got) == BMI_SUCCESS && same_bits(got, want, N),
+		      "setting the angles the model has changed the heights");
+	}
+	ss_bmi_destroy(a);
+	ss_bmi_destroy(b);
+
+	/* 55 degrees holds the 50-degree pile to the bit; 33 then lets it
+	 * slide, conserving the sand (no open side: sides = open is only
+	 * the outer ring's, the pile stays inside) */
+	b = initialized("uniform.cfg");
+	if (!b)
+		return;
+	for (int c = 0; c < N; c++)
+		angles[c] = 55.0;
+	const double volume = scalar(b, VOLUME);
+	CHECK(b->set_value(b, ANGLE, angles) == BMI_SUCCESS && b->update(b) == BMI_SUCCESS &&
+	      b->update(b) == BMI_SUCCESS, "%s", ss_error_last_message());
+	CHECK(b->get_value(b, ELEV, got) == BMI_SUCCESS && same_bits(got, dem, N),
+	      "a 50-degree pile moved under a 55-degree angle");
+	for (int c = 0; c < N; c++)
+		angles[c] = 33.0;
+	CHECK(b->set_value(b, ANGLE, angles) == BMI_SUCCESS && b->update(b) == BMI_SUCCESS,
+	      "%s", ss_error_last_message());
+	CHECK(b->get_value(b, ELEV, got) == BMI_SUCCESS && !same_bits(got, dem, N),
+	      "the pile did not slide at 33 degrees");
+	CHECK(fabs(scalar(b, VOLUME) + scalar(b, OUTFLOW) - volume) <= 1e-12 * volume,
+	      "volume %.17g + outflow %.17g, was %.17g", scalar(b, VOLUME), scalar(b, OUTFLOW),
+	      volume);
+	/* one cell's angle */
+	int at = 3 * DX + 4;
+	double one = 45.0;
+	CHECK(b->set_value_at_indices(b, ANGLE, &at, 1, &one) == BMI_SUCCESS &&
+	      b->get_value(b, ANGLE, angles) == BMI_SUCCESS && angles[at] == 45.0 &&
+	      angles[at + 1] == 33.0, "one cell's angle: %g, beside %g", angles[at],
+	      angles[at + 1]);
+	/* refused, the angles as they were */
+	const double bad[] = {95.0, 0.0, -30.0, NAN, INFINITY};
+	for (size_t k = 0; k < sizeof bad / sizeof *bad; k++) {
+		CHECK(b->set_value_at_indices(b, ANGLE, &at, 1, (double *)&bad[k]) == BMI_FAILURE &&
+		      strstr(ss_error_last_message(), ANGLE), "angle %g accepted: %s", bad[k],
+		      ss_error_last_message());
+		CHECK(b->get_value(b, ANGLE, angles) == BMI_SUCCESS && angles[at] == 45.0,
+		      "a refused angle changed the field: %g", angles[at]);
+	}
+	CHECK(b->update(b) == BMI_SUCCESS, "update after a refused set");
+	ss_bmi_destroy(b);
+	remove(check_file("half.cfg"));
+	remove(check_file("uniform.cfg"));
+	remove(check_file("half.asc"));
+	remove(check_file("pile.asc"));
 }
 
 /* A BMI config naming a case is that case; one naming a DEM is set up as
@@ -826,6 +954,7 @@ int main(void)
 	RUN(rate_is_a_source);
 	RUN(bedrock_and_erosion);
 	RUN(flowing_state);
+	RUN(angle_field);
 	RUN(config_names_a_case_or_a_dem);
 	remove(check_file("cone.ini"));
 	rmdir(check_scratch());

@@ -264,11 +264,21 @@ int ss_stepper_set_materials(struct ss_stepper *st, const struct ss_closure *clo
                              int count, const uint16_t *material_of_cell);
 
 /*
+ * The same after ss_stepper_prepare, between steps (the BMI's angle
+ * field): the kernel's rules and CFL table follow the new materials, RKL2
+ * and the approach to rest size their steps from them as at the start,
+ * and every tile is swept again.  Materials equal to st's change nothing,
+ * not a bit.  On an error st is as it was.  Not with hysteresis.
+ */
+int ss_stepper_change_materials(struct ss_stepper *st, const struct ss_closure *closures,
+                                int count, const uint16_t *material_of_cell);
+
+/*
  * Hysteresis (doc/model.md#hysteresis): sand at rest starts to slide only
  * where a face of its cell is steeper than tan a_s (static_deg, the angle
  * of maximum stability), and moving sand stops once every face of its cell
  * is at most tan a_d (the closure's repose angle).  Each flow cell carries
- * its state (`material`: 1 at rest, 0 moving), updated between steps (and
+ * its state (`material`: 0 at rest, 1 moving), updated between steps (and
  * RKL2's super-steps) from the heights; a face takes the larger angle of
  * its two cells' states (materials, face.h).  static_deg must be at least
  * the repose angle; equal, it is the model without hysteresis, the same

@@ -16,6 +16,7 @@
 
 #include "app/relax_inputs.h"
 #include "base/strings.h"
+#include "model/materials.h"
 #include "model/setup.h"
 #include "sandslide/case.h"
 #include "sandslide/dem.h"
@@ -25,13 +26,14 @@
 
 #define ELEVATION "land_surface__elevation"
 #define RATE "land_surface__net_deposition_rate"
+#define ANGLE "sand__angle_of_repose"
 
-/* The variables: the elevation and the deposition rate (the inputs) and
- * the bedrock on grid 0, and read-only diagnostics of the whole model on
+/* The variables: the elevation, the deposition rate and the repose angle
+ * (the inputs) and the bedrock on grid 0, and read-only diagnostics of the whole model on
  * grid 1 (a scalar), from ss_stepper_diagnostics.  The bedrock is there
  * only when the case has one. */
 enum var_id {
-	VAR_ELEVATION, VAR_RATE, VAR_BEDROCK, VAR_MOVING, VAR_VOLUME, VAR_INFLOW, VAR_OUTFLOW,
+	VAR_ELEVATION, VAR_RATE, VAR_ANGLE, VAR_BEDROCK, VAR_MOVING, VAR_VOLUME, VAR_INFLOW, VAR_OUTFLOW,
 	VAR_EXTERNAL, VAR_SLOPE, VAR_COUNT
 };
 
@@ -42,6 +44,7 @@ static const struct var {
 } vars[VAR_COUNT] = {
 	[VAR_ELEVATION] = {ELEVATION, "m", 0, 1, 1},
 	[VAR_RATE] = {RATE, "m s-1", 0, 1, 0},
+	[VAR_ANGLE] = {ANGLE, "deg", 0, 1, 1},
 	[VAR_BEDROCK] = {"bedrock_surface__elevation", "m", 0, 0, 1},
 	[VAR_MOVING] = {"sand__flowing_state", "1", 0, 0, 1},
 	[VAR_VOLUME] = {"sand__volume", "m3", 1, 0, 1},
@@ -73,8 +76,10 @@ static struct bmi_state *state(struct Bmi *self)
 
 static int present(const struct bmi_state *s, int v)
 {
+	/* with hysteresis the materials are the states: one repose angle */
 	return (v != VAR_BEDROCK || (s && s->st.bedrock)) &&
-	       (v != VAR_MOVING || (s && s->st.hysteresis));
+	       (v != VAR_MOVING || (s && s->st.hysteresis)) &&
+	       (v != VAR_ANGLE || (s && !s->st.hysteresis));
 }
 
 /* The variable called name that this model has, or NULL. */
@@ -185,6 +190,21 @@ static int setup_case(struct bmi_state *s, const char *path)
 	return err;
 }
 
+/* Whether relax's option key with this value names a file, which the
+ * config names relative to its folder: the rasters, the material table, an
+ * angle that is not a number (model_options.h). */
+static int names_file(const char *key, const char *value)
+{
+	static const char *const files[] = {"dem", "bedrock", "materials", "material-table",
+	                                    "material_table"};
+	for (size_t k = 0; k < sizeof files / sizeof *files; k++)
+		if (!strcmp(key, files[k]))
+			return 1;
+	char *end;
+	(void)strtod(value, &end);
+	return !strcmp(key, "angle") && end == value;
+}
+
 /* A DEM and relax's options by name into s (as `sandslide relax` sets
  * it up: its CRS check, nodata, sides, bedrock). */
 static int setup_dem(struct bmi_state *s, const struct config *cf)
@@ -214,7 +234,7 @@ static int setup_dem(struct bmi_state *s, const struct config *cf)
 		         !strcmp(key, "output_every") || !strcmp(key, "output-every"))
 			err = ss_error_input("%s: [bmi] %s: not a BMI setting (the BMI writes no "
 			                     "files; threads: OMP_NUM_THREADS)", cf->path, key);
-		else if (!strcmp(key, "dem") || !strcmp(key, "bedrock")) {
+		else if (names_file(key, value)) {
 			if (!(err = config_path(cf, value, path, sizeof path)))
 				err = ss_option_object_set(o, key, path);
 		} else {
@@ -541,6 +561,13 @@ static double grid_value(const struct bmi_state *s, const struct var *v, int c)
 {
 	switch (v - vars) {
 	case VAR_RATE: return s->rate[c];
+	case VAR_ANGLE: {   /* the angle its faces take; none on a wall */
+		const ptrdiff_t at = at_of(&s->st, c);
+		if (ss_cell_type_get(s->st.cell_types, at) == SS_CELL_WALL)
+			return NAN;
+		return s->st.material ? s->st.materials[s->st.material[at]].repose_angle_deg
+		                      : s->st.closure.repose_angle_deg;
+	}
 	case VAR_MOVING: {   /* hysteresis: 1 where sand moves (stepper.h) */
 		const ptrdiff_t at = at_of(&s->st, c);
 		if (ss_cell_type_get(s->st.cell_types, at) != SS_CELL_FLOW)
@@ -673,7 +700,35 @@ static int set_rate(struct bmi_state *s, const int *inds, int count, const doubl
 	return BMI_SUCCESS;
 }
 
-/* The input variable called name: elevation or rate, else NULL. */
+/* The repose angle at inds (NULL: every cell) becomes src
+ * (ss_materials_change_angles checks it: degrees in (0, 90) where sand
+ * lies).  Refused: the angles are as they were. */
+static int set_angles(struct bmi_state *s, const int *inds, int count, const double *src)
+{
+	double *angle = ss_alloc((size_t)s->cells, sizeof *angle, "the BMI's repose angles");
+	if (!angle)
+		return BMI_FAILURE;
+	for (int c = 0; c < s->cells; c++)
+		angle[c] = grid_value(s, &vars[VAR_ANGLE], c);
+	for (int k = 0; k < count; k++)
+		angle[inds ? inds[k] : k] = src[k];
+	const int err = ss_materials_change_angles(&s->st, angle, "BMI set_value: " ANGLE);
+	ss_free(angle);
+	return err ? BMI_FAILURE : BMI_SUCCESS;
+}
+
+/* Set input variable v at inds (NULL: every cell) to src. */
+static int set_input(struct bmi_state *s, const struct var *v, const int *inds, int count,
+                     const double *src)
+{
+	switch (v - vars) {
+	case VAR_RATE: return set_rate(s, inds, count, src);
+	case VAR_ANGLE: return set_angles(s, inds, count, src);
+	default: return set_heights(s, inds, count, src);
+	}
+}
+
+/* The input variable called name: elevation, rate or angle, else NULL. */
 static const struct var *find_input(const struct bmi_state *s, const char *name)
 {
 	const struct var *v = find_var_of(s, name);
@@ -690,8 +745,7 @@ static int bmi_set_value(struct Bmi *self, const char *name, void *src)
 	const struct var *v = find_input(s, name);
 	if (!s || !v || !src)
 		return BMI_FAILURE;
-	return v == &vars[VAR_RATE] ? set_rate(s, NULL, s->cells, src)
-	                            : set_heights(s, NULL, s->cells, src);
+	return set_input(s, v, NULL, s->cells, src);
 }
 
 static int bmi_set_value_at_indices(struct Bmi *self, const char *name, int *inds, int count,
@@ -701,8 +755,7 @@ static int bmi_set_value_at_indices(struct Bmi *self, const char *name, int *ind
 	const struct var *v = find_input(s, name);
 	if (!s || !v || (count > 0 && !src) || !indices_ok(s, inds, count))
 		return BMI_FAILURE;
-	return v == &vars[VAR_RATE] ? set_rate(s, inds, count, src)
-	                            : set_heights(s, inds, count, src);
+	return set_input(s, v, inds, count, src);
 }
 
 /* ---- grid ----------------------------------------------------------------- */

@@ -294,6 +294,12 @@ int ss_option_object_set(void *options, const char *key, const char *value)
 	if (o->kind == SS_OPTION_LIST ? o->parse && o->parse(value, NULL)
 	                              : o->kind != SS_OPTION_TEXT && ss_option_parse(o, value, field))
 		return ss_error_input("%s '%s': expected %s", key, value, o->expected);
+	if (o->flags & SS_OPTION_OR_FILE) {   /* a file name: the object's copy */
+		const char **file = (const char **)((char *)options + offset + o->value_offset);
+		if (*file == value && !(*file = keep_copy(head, value)))
+			return SS_ERR_FAIL;
+		return SS_OK;
+	}
 	if (o->kind != SS_OPTION_TEXT && o->kind != SS_OPTION_LIST)
 		return SS_OK;
 	const char *copy = keep_copy(head, value);

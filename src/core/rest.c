@@ -27,18 +27,7 @@ int ss_rest_create(struct ss_rest **out, const struct ss_stepper *st)
 		return SS_ERR_FAIL;
 	memset(r, 0, sizeof *r);
 	*out = r;
-	const struct ss_grid *g = &st->grid;
-	const double lambda = st->closure.nu * ss_cfl_bound_lookup(&st->sweeper->cfl_bound,
-	                                                           HUGE_VAL);
-	/* the rate of a face steeper than the repose angle by the excess:
-	 * f_sl' <= Lambda, so its flux is at most nu Lambda excess */
-	const double excess = st->rkl2 ? SS_REST_EXCESS_RKL2 : SS_REST_EXCESS;
-	r->entry_rate = excess * lambda / fmin(g->dx, g->dy);
-	/* forward Euler is stable for dt <= 2 / b: at cfl = 1 its step for
-	 * every slope, 1 / (2 nu Lambda (1/dx^2 + 1/dy^2)); cfl < 1 keeps a
-	 * margin as it does for forward Euler */
-	const double inv_d2 = 1.0 / (g->dx * g->dx) + 1.0 / (g->dy * g->dy);
-	r->b = 4.0 * lambda * inv_d2 / st->cfl;
+	ss_rest_scale(r, st);
 	if (st->rkl2) {   /* the same arrays: never in use at once */
 		r->y0 = st->rkl2->y0;
 		r->d1 = st->rkl2->d1;
@@ -52,6 +41,23 @@ int ss_rest_create(struct ss_rest **out, const struct ss_stepper *st)
 		"the approach to rest: D_{j-2}", "the approach to rest: M(Y_0)",
 	};
 	return ss_stages_arrays_create(st, names, &r->y0, &r->d1, &r->d2, &r->m0);
+}
+
+void ss_rest_scale(struct ss_rest *r, const struct ss_stepper *st)
+{
+	const struct ss_grid *g = &st->grid;
+	const double lambda = st->closure.nu * ss_cfl_bound_lookup(&st->sweeper->cfl_bound,
+	                                                           HUGE_VAL);
+	/* the rate of a face steeper than the repose angle by the excess:
+	 * f_sl' <= Lambda, so its flux is at most nu Lambda excess */
+	const double excess = st->rkl2 ? SS_REST_EXCESS_RKL2 : SS_REST_EXCESS;
+	r->entry_rate = excess * lambda / fmin(g->dx, g->dy);
+	/* forward Euler is stable for dt <= 2 / b: at cfl = 1 its step for
+	 * every slope, 1 / (2 nu Lambda (1/dx^2 + 1/dy^2)); cfl < 1 keeps a
+	 * margin as it does for forward Euler */
+	const double inv_d2 = 1.0 / (g->dx * g->dx) + 1.0 / (g->dy * g->dy);
+	r->b = 4.0 * lambda * inv_d2 / st->cfl;
+	r->stages = 0;
 }
 
 void ss_rest_destroy(struct ss_rest *r)

@@ -78,6 +78,11 @@ struct ss_rest {
 int ss_rest_create(struct ss_rest **out, const struct ss_stepper *st);
 void ss_rest_destroy(struct ss_rest *r);
 
+/* The entry rate and the stencil's largest rate from st's CFL table and
+ * closure, the approach not begun: at create, and again when the
+ * materials change (ss_stepper_change_materials). */
+void ss_rest_scale(struct ss_rest *r, const struct ss_stepper *st);
+
 /* Whether the approach begins after a step of rate `rate` (m/s) that
  * ended with no source on and none to come; if so it has begun. */
 int ss_rest_begins(struct ss_rest *r, double rate);

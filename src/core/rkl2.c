@@ -86,11 +86,17 @@ int ss_rkl2_create(struct ss_rkl2 **out, const struct ss_stepper *st)
 		return SS_ERR_FAIL;
 	memset(r, 0, sizeof *r);
 	*out = r;
-	const struct ss_grid *g = &st->grid;
 	static const char *const names[4] = {"RKL2 Y_0", "RKL2 D_{j-1}", "RKL2 D_{j-2}",
 	                                     "RKL2 M(Y_0)"};
 	if (ss_stages_arrays_create(st, names, &r->y0, &r->d1, &r->d2, &r->m0))
 		return SS_ERR_FAIL;
+	ss_rkl2_scale(r, st);
+	return SS_OK;
+}
+
+void ss_rkl2_scale(struct ss_rkl2 *r, const struct ss_stepper *st)
+{
+	const struct ss_grid *g = &st->grid;
 	/* forward Euler's step for every slope the closure has (stepper.h) */
 	const double inv_d2 = 1.0 / (g->dx * g->dx) + 1.0 / (g->dy * g->dy);
 	r->dt_all = st->cfl / (2.0 * st->closure.nu *
@@ -100,7 +106,6 @@ int ss_rkl2_create(struct ss_rkl2 **out, const struct ss_stepper *st)
 	r->tol_pouring = st->rkl2_pouring_tol > 0.0
 		? st->rkl2_pouring_tol * st->closure.tan_cr * fmin(g->dx, g->dy) : r->tol;
 	r->tau_limit = r->dt_all * ss_rkl2_stable_ratio(START_STAGES);
-	return SS_OK;
 }
 
 void ss_rkl2_destroy(struct ss_rkl2 *r)

@@ -87,6 +87,11 @@ struct ss_rkl2 {
 int ss_rkl2_create(struct ss_rkl2 **out, const struct ss_stepper *st);
 void ss_rkl2_destroy(struct ss_rkl2 *r);
 
+/* The step sizes and tolerances from st's CFL table and closure, and the
+ * accuracy rule's limit as at the start: at create, and again when the
+ * materials change (ss_stepper_change_materials). */
+void ss_rkl2_scale(struct ss_rkl2 *r, const struct ss_stepper *st);
+
 /* The longest super-step the rules allow now, s. */
 static inline double ss_rkl2_longest(const struct ss_rkl2 *r)
 {

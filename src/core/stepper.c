@@ -198,16 +198,18 @@ static int same_closure(const struct ss_closure *a, const struct ss_closure *b)
 	       a->nu == b->nu;
 }
 
-int ss_stepper_set_materials(struct ss_stepper *st, const struct ss_closure *closures,
-                             int count, const uint16_t *material_of_cell)
+/* The materials of set_materials into *out_materials, *out_count and
+ * *out_material (NULL and 0 when they are one closure, which goes to
+ * *smallest); st is not changed.  Collective. */
+static int build_materials(const struct ss_stepper *st, const struct ss_closure *closures,
+                           int count, const uint16_t *material_of_cell,
+                           struct ss_closure **out_materials, int *out_count,
+                           uint16_t **out_material, struct ss_closure *smallest)
 {
 	const struct ss_grid *g = &st->grid;
-	if (count < 1 || count > UINT16_MAX)
-		return ss_error_input("%d materials: between 1 and %d are accepted", count,
-		                      UINT16_MAX);
-	if (st->hysteresis)
-		return ss_error_input("materials with a static angle are not supported: hysteresis "
-		                      "takes one repose angle");
+	*out_materials = NULL;
+	*out_material = NULL;
+	*out_count = 0;
 	/* the given materials by angle; each given number's place among the
 	 * distinct closures; those in use (on any rank: all decide alike) */
 	struct material_entry *order = ss_alloc((size_t)count, sizeof *order, "materials");
@@ -241,32 +243,140 @@ int ss_stepper_set_materials(struct ss_stepper *st, const struct ss_closure *clo
 	int distinct = 0;
 	for (int k = 0; !err && k < count; k++)
 		used[k] = used[k] != 0.0 ? (double)distinct++ : -1.0;
+	struct ss_closure *materials = NULL;
+	uint16_t *material = NULL;
 	if (!err && distinct > 1) {
-		st->materials = ss_alloc((size_t)distinct, sizeof *st->materials, "materials");
-		st->material = ss_alloc(ss_grid_storage_cells(g), sizeof *st->material, "materials");
-		err = st->materials && st->material ? SS_OK : SS_ERR_FAIL;
+		materials = ss_alloc((size_t)distinct, sizeof *materials, "materials");
+		material = ss_alloc(ss_grid_storage_cells(g), sizeof *material, "materials");
+		err = ss_comm_agree(materials && material ? SS_OK : SS_ERR_FAIL);
 	}
 	if (!err) {
 		for (int k = 0; k < count; k++) {
 			const int n = (int)used[number[order[k].given]];
 			if (n >= 0 && distinct > 1)
-				st->materials[n] = *order[k].c;
+				materials[n] = *order[k].c;
 			if (n == 0)   /* the smallest angle: the rules' scale */
-				st->closure = *order[k].c;
+				*smallest = *order[k].c;
 		}
-		st->material_count = distinct > 1 ? distinct : 0;
 	}
 	if (!err && distinct > 1) {
-		memset(st->material, 0, ss_grid_storage_cells(g) * sizeof *st->material);
+		memset(material, 0, ss_grid_storage_cells(g) * sizeof *material);
 		for (int j = 0; j < g->ny; j++)
 			for (int i = 0; i < g->nx; i++)
-				st->material[ss_grid_index(g, i, j)] = (uint16_t)
+				material[ss_grid_index(g, i, j)] = (uint16_t)
 					used[number[material_of_cell[(size_t)j * g->nx + i]]];
+		*out_materials = materials;
+		*out_material = material;
+		*out_count = distinct;
+	} else {
+		ss_free(material);
+		ss_free(materials);
 	}
 	ss_free(used);
 	ss_free(number);
 	ss_free(order);
 	return err;
+}
+
+/* Whether the materials built are st's own: a change that changes nothing. */
+static int same_materials(const struct ss_stepper *st, const struct ss_closure *materials,
+                          int count, const uint16_t *material, const struct ss_closure *smallest)
+{
+	if (count != st->material_count || !same_closure(smallest, &st->closure) ||
+	    smallest->repose_angle_deg != st->closure.repose_angle_deg)
+		return 0;
+	for (int m = 0; m < count; m++)
+		if (!same_closure(&materials[m], &st->materials[m]))
+			return 0;
+	const struct ss_grid *g = &st->grid;
+	int same = 1;
+	for (int j = 0; same && j < g->ny; j++)
+		for (int i = 0; same && i < g->nx; i++) {
+			const ptrdiff_t k = ss_grid_index(g, i, j);
+			same = !count || material[k] == st->material[k];
+		}
+	double differs = !same;
+	ss_comm_reduce(&differs, 1, NULL, 0);   /* any rank's */
+	return differs == 0.0;
+}
+
+static int check_count(const struct ss_stepper *st, int count)
+{
+	if (count < 1 || count > UINT16_MAX)
+		return ss_error_input("%d materials: between 1 and %d are accepted", count,
+		                      UINT16_MAX);
+	if (st->hysteresis)
+		return ss_error_input("materials with a static angle are not supported: hysteresis "
+		                      "takes one repose angle");
+	return SS_OK;
+}
+
+int ss_stepper_set_materials(struct ss_stepper *st, const struct ss_closure *closures,
+                             int count, const uint16_t *material_of_cell)
+{
+	int err = check_count(st, count);
+	if (err)
+		return err;
+	struct ss_closure *materials, smallest = st->closure;
+	uint16_t *material;
+	int distinct;
+	if ((err = build_materials(st, closures, count, material_of_cell, &materials, &distinct,
+	                           &material, &smallest)))
+		return err;
+	ss_free(st->material);
+	ss_free(st->materials);
+	st->materials = materials;
+	st->material = material;
+	st->material_count = distinct;
+	st->closure = smallest;
+	return SS_OK;
+}
+
+int ss_stepper_change_materials(struct ss_stepper *st, const struct ss_closure *closures,
+                                int count, const uint16_t *material_of_cell)
+{
+	int err = check_count(st, count);
+	if (err)
+		return err;
+	struct ss_closure *materials, smallest = st->closure;
+	uint16_t *material;
+	int distinct;
+	if ((err = build_materials(st, closures, count, material_of_cell, &materials, &distinct,
+	                           &material, &smallest)))
+		return err;
+	if (same_materials(st, materials, distinct, material, &smallest)) {
+		ss_free(material);
+		ss_free(materials);
+		return SS_OK;
+	}
+	/* the kernel's rules are built before the old materials go: a
+	 * failure leaves st as it was */
+	struct ss_stepper next = *st;
+	next.materials = materials;
+	next.material = material;
+	next.material_count = distinct;
+	next.closure = smallest;
+	if ((err = ss_comm_agree(ss_sweeper_change_rules(&next)))) {
+		ss_free(material);
+		ss_free(materials);
+		return err;
+	}
+	ss_free(st->material);
+	ss_free(st->materials);
+	st->materials = materials;
+	st->material = material;
+	st->material_count = distinct;
+	st->closure = smallest;
+	if (st->material)
+		ss_boundary_fill_materials(&st->grid, &st->boundary, st->material);
+	/* what the CFL table sizes starts over: RKL2's super-steps and the
+	 * approach to rest (rkl2.h, rest.h); every tile may slide now */
+	if (st->rkl2)
+		ss_rkl2_scale(st->rkl2, st);
+	if (st->rest_state)
+		ss_rest_scale(st->rest_state, st);
+	ss_sweeper_wake_all(st);
+	return SS_OK;
 }
 
 /* The checks of ss_stepper_prepare on this rank's cells (the messages name

@@ -74,6 +74,11 @@ void ss_sweeper_destroy(struct ss_sweeper *w);
  * to rest's set-up). */
 int ss_sweeper_rules(struct ss_stepper *st);
 
+/* ss_sweeper_rules again for st's new materials, after the sweeper was
+ * prepared (ss_stepper_change_materials): on failure (SS_ERR_FAIL) the
+ * rules are as they were. */
+int ss_sweeper_change_rules(struct ss_stepper *st);
+
 /* The arrays of the kernel st->kernel, once the cell types are final and
  * the ledger lists the open faces (each rank's failure: the caller agrees
  * on it).  The fast sweep starts with every tile awake. */

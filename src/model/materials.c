@@ -232,3 +232,116 @@ int ss_materials_from_classes(struct ss_stepper *st, const struct ss_model_optio
 	ss_free(material);
 	return ss_comm_agree(err);
 }
+
+/* Cell (i, j)'s angle now: its material's, or the closure's. */
+static double angle_now(const struct ss_stepper *st, int i, int j)
+{
+	return st->material
+		? st->materials[st->material[ss_grid_index(&st->grid, i, j)]].repose_angle_deg
+		: st->closure.repose_angle_deg;
+}
+
+/* Each cell's law (closure, gamma and nu: all but the angle) into law[]
+ * (this rank's cells, [y][x]) and the distinct laws into laws[] (at most
+ * st's material count): st's materials are the same on every rank. */
+static int cell_laws(const struct ss_stepper *st, uint16_t *law, struct ss_closure *laws)
+{
+	const struct ss_grid *g = &st->grid;
+	const int count = st->material ? st->material_count : 1;
+	const struct ss_closure *given = st->material ? st->materials : &st->closure;
+	uint16_t law_of[UINT16_MAX];   /* 128 KiB: count <= UINT16_MAX */
+	int n = 0;
+	for (int m = 0; m < count; m++) {
+		const struct ss_closure *c = &given[m];
+		int l = 0;
+		while (l < n && !(laws[l].kind == c->kind && laws[l].gamma == c->gamma &&
+		                  laws[l].nu == c->nu))
+			l++;
+		if (l == n)
+			laws[n++] = *c;
+		law_of[m] = (uint16_t)l;
+	}
+	for (int j = 0; j < g->ny; j++)
+		for (int i = 0; i < g->nx; i++)
+			law[(size_t)j * g->nx + i] =
+				law_of[st->material ? st->material[ss_grid_index(g, i, j)] : 0];
+	return n;
+}
+
+int ss_materials_change_angles(struct ss_stepper *st, const double *angle_deg, const char *what)
+{
+	const struct ss_grid *g = &st->grid;
+	const size_t cells = (size_t)g->nx * (size_t)g->ny;
+	if (st->hysteresis)
+		return ss_comm_agree(ss_error_input("%s: not with a static angle (hysteresis takes "
+		                                    "one repose angle)", what));
+	double *angle = ss_alloc(cells ? cells : 1, sizeof *angle, "repose angles");
+	double *mine = ss_alloc(cells ? cells : 1, sizeof *mine, "repose angles");
+	uint16_t *law = ss_alloc(cells ? cells : 1, sizeof *law, "materials");
+	uint16_t *material = ss_alloc(cells ? cells : 1, sizeof *material, "materials");
+	const int most = st->material ? st->material_count : 1;
+	struct ss_closure *laws = ss_alloc((size_t)most, sizeof *laws, "materials");
+	int err = angle && mine && law && material && laws ? SS_OK : SS_ERR_FAIL;
+	/* the angle each cell takes: a flow cell's is checked; a wall's stays
+	 * (no face of it slides); an open cell's, which its faces take, is
+	 * the one given when it is an angle, else it stays */
+	for (int j = 0; !err && j < g->ny; j++)
+		for (int i = 0; !err && i < g->nx; i++) {
+			const size_t c = (size_t)j * g->nx + i;
+			const double a = angle_deg[c];
+			const enum ss_cell_type type =
+				ss_cell_type_get(st->cell_types, ss_grid_index(g, i, j));
+			const int valid = a > 0.0 && a < 90.0;
+			if (type == SS_CELL_FLOW && !valid)
+				err = ss_error_input("%s: item %zu, the angle of %s, is %g: expected "
+				                     "degrees in (0, 90)", what, c, SS_GRID_CELL(g, i, j),
+				                     a);
+			angle[c] = type != SS_CELL_WALL && valid ? a : angle_now(st, i, j);
+		}
+	err = ss_comm_agree(err);
+	const int laws_count = err ? 0 : cell_laws(st, law, laws);
+	/* each law's distinct angles over the whole grid, laws one after the
+	 * other: every rank numbers them alike (merge_ranks) */
+	double **angles = err ? NULL : ss_alloc((size_t)laws_count, sizeof *angles, "materials");
+	size_t *count = err ? NULL : ss_alloc((size_t)laws_count, sizeof *count, "materials");
+	if (!err)
+		err = ss_comm_agree(angles && count ? SS_OK : SS_ERR_FAIL);
+	for (int l = 0; !err && l < laws_count; l++)
+		angles[l] = NULL;
+	size_t total = 0;
+	for (int l = 0; !err && l < laws_count; l++) {
+		size_t n = 0;
+		for (size_t c = 0; c < cells; c++)
+			if (law[c] == l)
+				mine[n++] = angle[c];
+		if (!(err = merge_ranks(mine, sort_distinct(mine, n), &angles[l], &count[l])))
+			total += count[l];
+	}
+	if (!err && total > MAX_MATERIALS)
+		err = ss_error_input("%s holds %zu distinct angles: at most %d are accepted (round "
+		                     "them, to 0.01 degree for example)", what, total, MAX_MATERIALS);
+	struct ss_closure *closures = err ? NULL : ss_alloc(total, sizeof *closures, "materials");
+	if (!err)
+		err = ss_comm_agree(closures ? SS_OK : SS_ERR_FAIL);
+	for (size_t l = 0, first = 0; !err && l < (size_t)laws_count; first += count[l++]) {
+		for (size_t k = 0; !err && k < count[l]; k++)
+			err = ss_closure_init(&closures[first + k], laws[l].kind, angles[l][k],
+			                      laws[l].gamma, laws[l].nu);
+		for (size_t c = 0; !err && c < cells; c++)
+			if (law[c] == l)
+				material[c] = (uint16_t)(first + find_angle(angles[l], count[l], angle[c]));
+	}
+	if (!err)
+		err = ss_stepper_change_materials(st, closures, (int)total, material);
+	for (int l = 0; angles && l < laws_count; l++)
+		ss_free(angles[l]);
+	ss_free(angles);
+	ss_free(count);
+	ss_free(closures);
+	ss_free(laws);
+	ss_free(material);
+	ss_free(law);
+	ss_free(mine);
+	ss_free(angle);
+	return ss_comm_agree(err);
+}

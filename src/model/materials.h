@@ -40,4 +40,17 @@ int ss_materials_from_classes(struct ss_stepper *st, const struct ss_model_optio
                               const struct ss_material_table *t, const struct ss_raster *r,
                               const char *what);
 
+/*
+ * The angles of st's cells become angle_deg (degrees, this rank's cells,
+ * nx x ny, [y][x] south row first), after ss_stepper_prepare and between
+ * steps (the BMI's angle field): each cell keeps its closure, gamma and nu
+ * (its material's law) with the new angle (ss_stepper_change_materials).
+ * A flow cell's angle outside (0, 90) is refused naming `what`, the item
+ * (j nx + i), the cell and the value; a wall keeps its angle, and so does
+ * an open cell given one outside (0, 90).  Not with hysteresis.
+ * Collective.
+ */
+int ss_materials_change_angles(struct ss_stepper *st, const double *angle_deg,
+                               const char *what);
+
 #endif

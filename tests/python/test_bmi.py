@@ -440,7 +440,7 @@ def scalars(m):
 
 
 def test_the_rate_input_and_the_ledger(bmi):
-    assert bmi.get_input_var_names() == (ELEV, RATE)
+    assert bmi.get_input_var_names() == (ELEV, RATE, ANGLE)
     assert RATE not in bmi.get_output_var_names()
     assert bmi.get_var_units(RATE) == "m s-1" and bmi.get_var_grid(RATE) == 0
     assert bmi.get_var_location(RATE) == "node"
@@ -470,6 +470,32 @@ def test_the_rate_input_and_the_ledger(bmi):
     assert volume - v0 == pytest.approx(inflow - outflow + external, rel=1e-12, abs=1e-15)
 
 
+ANGLE = "sand__angle_of_repose"
+
+
+def test_the_angle_input_changes_the_law(bmi):
+    """The cone's 50-degree flanks at 35 degrees slide; at 60 they hold to
+    the bit, and the angles read back are those set (row 0 south)."""
+    assert bmi.get_var_units(ANGLE) == "deg" and ANGLE in bmi.get_output_var_names()
+    angles = bmi.get_value(ANGLE, np.empty((NY, NX)))
+    assert np.all(angles == 35.0)
+    steep = np.full((NY, NX), 60.0)
+    steep[0, :] = 61.0                               # the south row: read back there
+    bmi.set_value(ANGLE, steep)
+    assert same_bits(bmi.get_value(ANGLE, np.empty((NY, NX))), steep)
+    before = heights(bmi)
+    bmi.update()
+    assert same_bits(heights(bmi), before), "the cone moved under a 60-degree angle"
+    bad = steep.copy()
+    bad[3, 4] = 90.0
+    with pytest.raises(sandslide.InputError, match=ANGLE + ".*item 46"):
+        bmi.set_value(ANGLE, bad)
+    assert same_bits(bmi.get_value(ANGLE, np.empty((NY, NX))), steep), "refused: unchanged"
+    bmi.set_value(ANGLE, np.full((NY, NX), 35.0))
+    bmi.update()
+    assert not same_bits(heights(bmi), before), "the cone did not slide at 35 degrees"
+
+
 def test_a_bedrock_is_an_output(tmp_path):
     (tmp_path / "rock.asc").write_text("ncols 4\nnrows 3\nxllcorner 0\nyllcorner 0\n"
                                        "cellsize 1\n0 0 0 0\n0 0.1 0.1 0\n0 0 0 0\n")
@@ -479,7 +505,7 @@ def test_a_bedrock_is_an_output(tmp_path):
         "[initial]\ntype = flat\nheight = 0.3\nbedrock = rock.asc\n")
     with SandslideBmi() as m:
         m.initialize(str(tmp_path / "rock.ini"))
-        assert m.get_output_var_names()[:2] == (ELEV, "bedrock_surface__elevation")
+        assert m.get_output_var_names()[:3] == (ELEV, ANGLE, "bedrock_surface__elevation")
         rock = m.get_value("bedrock_surface__elevation", np.empty((3, 4)))
         assert rock[1, 1] == 0.1 and rock[1, 2] == 0.1 and rock[0, 0] == 0.0
         rate = np.zeros(12)
