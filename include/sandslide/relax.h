@@ -70,10 +70,12 @@ struct ss_relax_options {
 	 * report, and must be set), and the relaxed heights go to the values
 	 * of output_raster, which must have the input's size, instead of a
 	 * file (0 where the input has no data, as rasters store it): nothing
-	 * is claimed or written, job.output and job.force are unused.  The
-	 * caller owns all three. */
+	 * is claimed or written, job.output and job.force are unused.
+	 * angle_raster, the repose angles, replaces reading
+	 * model.angle_file, which names it.  The caller owns all four. */
 	const struct ss_raster *input_raster;
 	const struct ss_raster *bedrock_raster;
+	const struct ss_raster *angle_raster;
 	struct ss_raster *output_raster;
 };
 
@@ -160,6 +162,15 @@ int ss_relax_report_json(const struct ss_relax_report *r, char *buf, size_t size
 int ss_relax_heights(const struct ss_relax_options *o, int nx, int ny, double dx, double dy,
                      const double *heights, const double *bedrock, double *relaxed,
                      char *report_json, size_t report_size);
+
+/* ss_relax_heights with each cell's repose angle (degrees, the heights'
+ * layout; NaN only where heights is NaN), as --angle FILE gives them; the
+ * options' model.angle_file names them in messages ("(array)" when NULL).
+ * angles NULL: ss_relax_heights. */
+int ss_relax_heights_angles(const struct ss_relax_options *o, int nx, int ny, double dx,
+                            double dy, const double *heights, const double *bedrock,
+                            const double *angles, double *relaxed, char *report_json,
+                            size_t report_size);
 
 /* ss_relax_run with the report as JSON (ss_relax_report_json) into
  * report_json (report_size bytes): `sandslide relax DEM -o OUT` for

@@ -195,10 +195,10 @@ def _word(value):
     return str(value)
 
 
-def _grid(name, values):
+def _grid(name, values, expected="a finite height"):
     """values as a new float64 array [row, column] with row 0 the SOUTH
     edge, C-contiguous (the library's order); InputError if it is not a
-    2-D array of real numbers."""
+    2-D array of real numbers (an infinite one: not what was expected)."""
     try:
         if isinstance(values, np.ma.MaskedArray):   # rasterio's masked=True
             values = values.astype(np.float64).filled(np.nan)
@@ -219,7 +219,7 @@ def _grid(name, values):
     inf = np.isinf(a)
     if inf.any():
         r, c = np.argwhere(inf)[0]
-        raise InputError(f"{name}[{r}, {c}] is {a[r, c]}: expected a finite height, or NaN "
+        raise InputError(f"{name}[{r}, {c}] is {a[r, c]}: expected {expected}, or NaN "
                          f"for no data")
     # a copy always: relax writes its result over it (a one-row view is
     # contiguous, and ascontiguousarray would hand back the caller's memory)
@@ -234,7 +234,8 @@ def _tile_word(tile):
 
 
 def relax(heights: np.typing.ArrayLike, dx: float, dy: Optional[float] = None,
-          angle: Optional[float] = None, closure: Optional[str] = None,
+          angle: Union[float, str, np.typing.ArrayLike, None] = None,
+          closure: Optional[str] = None,
           nu: Optional[float] = None, sides: Optional[str] = None,
           bedrock: Optional[np.typing.ArrayLike] = None, tol: Optional[float] = None,
           threads: Optional[int] = None, *, gamma: Optional[float] = None,
@@ -263,6 +264,11 @@ def relax(heights: np.typing.ArrayLike, dx: float, dy: Optional[float] = None,
     bedrock : array_like, optional
         The non-erodible base, shaped like heights: only the sand above it
         moves.  NaN only where heights is NaN.
+    angle : float, str or array_like, optional
+        The repose angle, degrees: one for every cell, a raster file, or
+        an array shaped like heights (row 0 north; NaN only where heights
+        is NaN), each cell's angle as ``--angle FILE`` gives them
+        (doc/model.md#materials) (library default: {angle_default}).
     {threads}
     {progress}
 
@@ -320,6 +326,13 @@ def relax(heights: np.typing.ArrayLike, dx: float, dy: Optional[float] = None,
     (True, 33)
     """
     h = _grid("heights", heights)
+    angles = None
+    if angle is not None and np.ndim(angle) > 0:
+        angles = _grid("angle", angle, "degrees in (0, 90)")
+        if angles.shape != h.shape:
+            raise InputError(f"angle: shape {angles.shape} differs from the heights' "
+                             f"{h.shape}")
+        angle = None   # the library names the array "(array)"
     rock = None
     if bedrock is not None:
         rock = _grid("bedrock", bedrock)
@@ -348,16 +361,18 @@ def relax(heights: np.typing.ArrayLike, dx: float, dy: Optional[float] = None,
             if value is not None:
                 o.set(key, _word(value))
         # h is this call's copy: the library may write the result over it
-        _native.call(o, _native.lib.ss_relax_heights,
+        _native.call(o, _native.lib.ss_relax_heights_angles,
                      (o.ptr, nx, ny, dx, dy, h.ctypes.data,
-                      rock.ctypes.data if rock is not None else None, h.ctypes.data, report,
-                      len(report)),
+                      rock.ctypes.data if rock is not None else None,
+                      angles.ctypes.data if angles is not None else None, h.ctypes.data,
+                      report, len(report)),
                      progress="relax" if progress else None, keywords=keywords)
     return np.ascontiguousarray(h[::-1]), json.loads(report.value.decode())
 
 
 relax.__doc__ = relax.__doc__.format(
-    options=_options_doc("relax", skip=_RELAX_SKIP + ("threads",)),
+    options=_options_doc("relax", skip=_RELAX_SKIP + ("threads", "angle")),
+    angle_default=next(o["default"] for o in options("relax") if o["name"] == "angle"),
     threads=_THREADS_DOC, progress=_PROGRESS_DOC,
     interrupt=_interrupt_note("the surface of that moment is dropped"))
 

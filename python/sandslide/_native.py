@@ -125,6 +125,7 @@ _PROTOTYPES = {
     "ss_job_of": (_P, [_P, _P]),
     "ss_job_set_watch": (None, [_P, _P]),
     "ss_relax_heights": (_I, [_P, _I, _I, _D, _D, _P, _P, _P, _P, _Z]),
+    "ss_relax_heights_angles": (_I, [_P, _I, _I, _D, _D, _P, _P, _P, _P, _P, _Z]),
     "ss_run_case_json": (_I, [_P, _P, _Z]),
     "ss_fit_run_json": (_I, [_P, _P, _Z]),
     "ss_relax_file_json": (_I, [_P, _P, _Z]),

@@ -126,7 +126,9 @@ static int read_here(const struct ss_relax_options *o, struct ss_relax_inputs *i
 		/* the values as they are: a DEM's read options (z scale) are its own */
 		struct ss_dem_read_options plain;
 		ss_dem_read_options_init(&plain);
-		err = ss_setup_read_window(field, option, plain, tx, ty, &in->angles);
+		err = o->angle_raster && o->model.angle_file
+			? raster_copy(o->angle_raster, &in->angles)
+			: ss_setup_read_window(field, option, plain, tx, ty, &in->angles);
 		if (!err && (in->angles.nx != in->dem.nx || in->angles.ny != in->dem.ny))
 			err = ss_error_input("%s %s is %d x %d cells: expected the DEM's %d x %d",
 			                     option, field, in->angles.nx, in->angles.ny, in->dem.nx,

@@ -75,9 +75,10 @@ int ss_relax_report_json(const struct ss_relax_report *r, char *buf, size_t size
 }
 
 /* nx x ny values into r (initialised here): NaN is no data (flagged, 0 as
- * rasters store it), an infinite value refused naming `what` and the cell. */
-static int raster_from(const char *what, int nx, int ny, double dx, double dy,
-                       const double *values, struct ss_raster *r)
+ * rasters store it), an infinite value refused naming `what`, the cell and
+ * the `expected` value. */
+static int raster_from(const char *what, const char *expected, int nx, int ny, double dx,
+                       double dy, const double *values, struct ss_raster *r)
 {
 	const size_t cells = (size_t)nx * (size_t)ny;
 	int err = ss_raster_init(r, nx, ny);
@@ -87,11 +88,10 @@ static int raster_from(const char *what, int nx, int ny, double dx, double dy,
 	r->cellsize_y = dy;
 	for (size_t m = 0; m < cells; m++) {
 		if (isinf(values[m]))
-			return ss_error_input("%s: %s is %g: expected a finite height, or NaN for no "
-			                      "data", what,
+			return ss_error_input("%s: %s is %g: expected %s, or NaN for no data", what,
 			                      SS_CELL((long long)(m % (size_t)nx), (long long)(m / (size_t)nx),
 			                              (m % (size_t)nx + 0.5) * dx,
-			                              (m / (size_t)nx + 0.5) * dy), values[m]);
+			                              (m / (size_t)nx + 0.5) * dy), values[m], expected);
 		if (!isnan(values[m])) {
 			r->values[m] = values[m];
 			continue;
@@ -107,9 +107,20 @@ int ss_relax_heights(const struct ss_relax_options *o, int nx, int ny, double dx
                      const double *heights, const double *bedrock, double *relaxed,
                      char *report_json, size_t report_size)
 {
+	return ss_relax_heights_angles(o, nx, ny, dx, dy, heights, bedrock, NULL, relaxed,
+	                               report_json, report_size);
+}
+
+int ss_relax_heights_angles(const struct ss_relax_options *o, int nx, int ny, double dx,
+                            double dy, const double *heights, const double *bedrock,
+                            const double *angles, double *relaxed, char *report_json,
+                            size_t report_size)
+{
 	struct ss_relax_options local = *o;
 	if (!local.dem)
 		local.dem = "(array)";
+	if (angles && !local.model.angle_file)
+		local.model.angle_file = "(array)";
 	if (bedrock && !local.bedrock)
 		local.bedrock = "(array)";
 	if (!bedrock)
@@ -123,12 +134,16 @@ int ss_relax_heights(const struct ss_relax_options *o, int nx, int ny, double dx
 	if (!(dy > 0.0 && isfinite(dy)))
 		return ss_error_input("dy '%g': expected m > 0", dy);
 
-	struct ss_raster in, rock, out;
+	struct ss_raster in, rock, angle, out;
 	memset(&rock, 0, sizeof rock);
+	memset(&angle, 0, sizeof angle);
 	memset(&out, 0, sizeof out);
-	int err = raster_from(local.dem, nx, ny, dx, dy, heights, &in);
+	int err = raster_from(local.dem, "a finite height", nx, ny, dx, dy, heights, &in);
+	if (!err && angles)   /* a path would be read: the array is the angles */
+		err = raster_from(local.model.angle_file, "degrees in (0, 90)", nx, ny, dx, dy,
+		                  angles, &angle);
 	if (!err && bedrock) {
-		err = raster_from(local.bedrock, nx, ny, dx, dy, bedrock, &rock);
+		err = raster_from(local.bedrock, "a finite height", nx, ny, dx, dy, bedrock, &rock);
 		/* no bedrock under no data is fine (nothing moves there); under
 		 * sand, NaN goes on to the stepper, which refuses it naming the cell */
 		for (size_t m = 0; !err && m < (size_t)nx * ny; m++)
@@ -140,6 +155,7 @@ int ss_relax_heights(const struct ss_relax_options *o, int nx, int ny, double dx
 	if (!err) {
 		local.input_raster = &in;
 		local.bedrock_raster = bedrock ? &rock : NULL;
+		local.angle_raster = angles ? &angle : NULL;
 		local.output_raster = &out;
 		struct ss_relax_report rep;
 		err = ss_relax_run(&local, &rep);
@@ -150,6 +166,7 @@ int ss_relax_heights(const struct ss_relax_options *o, int nx, int ny, double dx
 		for (size_t m = 0; m < (size_t)nx * ny; m++)
 			relaxed[m] = in.nodata && in.nodata[m] ? NAN : out.values[m];
 	ss_raster_release(&out);
+	ss_raster_release(&angle);
 	ss_raster_release(&rock);
 	ss_raster_release(&in);
 	return err;

@@ -128,6 +128,34 @@ def test_relax_gives_the_cli_bits(tmp_path, dx, dy, bedrock):
     assert report["input"] == "heights" and report["output"] == "(array)", report
 
 
+def test_an_angle_array_gives_the_cli_bits_of_its_raster(tmp_path):
+    """angle= an array is --angle FILE (doc/model.md#materials): 30 degrees
+    in the north half, 40 in the south, so flipped rows would differ."""
+    h0 = pile_on_ramp()
+    angles = np.where(np.arange(h0.shape[0])[:, None] < h0.shape[0] // 2, 30.0, 40.0)
+    angles = np.broadcast_to(angles, h0.shape).copy()
+    write_asc(tmp_path / "dem.asc", h0, 1.0, None)
+    write_asc(tmp_path / "angles.asc", angles, 1.0, None)
+    cli(["relax", "dem.asc", "--angle", "angles.asc", "--threads", "1", "-q", "-o", "out.asc"],
+        tmp_path)
+    _, want = read_asc(tmp_path / "out.asc")
+    got, report = sandslide.relax(h0, 1.0, angle=angles, threads=1)
+    flipped, _ = sandslide.relax(h0, 1.0, angle=angles[::-1].copy(), threads=1)
+    assert same_bits(got, want), \
+        f"angle=array differs from --angle angles.asc in {np.sum(got != want)} cells"
+    assert not same_bits(flipped, want), "the angles' rows flipped give the same bits"
+    assert report["materials"] == 2 and report["steady"], report
+    uniform, _ = sandslide.relax(h0, 1.0, angle=33, threads=1)
+    same, _ = sandslide.relax(h0, 1.0, angle=np.full(h0.shape, 33.0), threads=1)
+    assert same_bits(same, uniform), "an array of one angle differs from the number"
+    bad = angles.copy()
+    bad[3, 4] = 95.0
+    with pytest.raises(sandslide.InputError, match=r"angle.*95.*expected degrees in \(0, 90\)"):
+        sandslide.relax(h0, 1.0, angle=bad)
+    with pytest.raises(sandslide.InputError, match="angle: shape"):
+        sandslide.relax(h0, 1.0, angle=angles[1:])
+
+
 def test_threads_give_the_same_bits():
     h0 = pile_on_ramp(20, 24)
     one, _ = sandslide.relax(h0, 1.0, threads=1)
