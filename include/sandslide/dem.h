@@ -199,6 +199,18 @@ int ss_dem_format_from_path(const char *path, const char *context,
 /* "ESRI ASCII grid", "sandslide HDF5", ... for messages. */
 const char *ss_dem_format_name(enum ss_dem_format format);
 
+/*
+ * Whether r (`what`, e.g. "--angle angles.tif") lies on the cells of dem
+ * (`dem_name`), as a raster read beside a DEM must: the same size (the
+ * callers check it first), and where both files say, the same cell size,
+ * lower-left corner (within a millionth of a cell) and CRS (GDAL's
+ * OSRIsSame; without GDAL the same WKT).  What only one of them says is
+ * not compared: an .asc without a .prj has no CRS.  SS_ERR_INPUT names
+ * both values.
+ */
+int ss_dem_check_aligned(const struct ss_raster *dem, const char *dem_name,
+                         const struct ss_raster *r, const char *what);
+
 /* 1 when this build reads and writes GDAL rasters, else 0. */
 int ss_dem_gdal_available(void);
 

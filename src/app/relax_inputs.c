@@ -133,6 +133,10 @@ static int read_here(const struct ss_relax_options *o, struct ss_relax_inputs *i
 			err = ss_error_input("%s %s is %d x %d cells: expected the DEM's %d x %d",
 			                     option, field, in->angles.nx, in->angles.ny, in->dem.nx,
 			                     in->dem.ny);
+		char what[4200];
+		snprintf(what, sizeof what, "%s %s", option, field);
+		if (!err)
+			err = ss_dem_check_aligned(&in->dem, o->dem, &in->angles, what);
 	}
 	if (err || !o->bedrock)
 		return err;
@@ -144,7 +148,9 @@ static int read_here(const struct ss_relax_options *o, struct ss_relax_inputs *i
 		return ss_error_input("--bedrock %s is %d x %d cells: expected the DEM's %d x %d",
 		                      o->bedrock, in->bedrock.nx, in->bedrock.ny, in->dem.nx,
 		                      in->dem.ny);
-	return SS_OK;
+	char what[4200];
+	snprintf(what, sizeof what, "--bedrock %s", o->bedrock);
+	return ss_dem_check_aligned(&in->dem, o->dem, &in->bedrock, what);
 }
 
 int ss_relax_inputs_read(const struct ss_relax_options *o, struct ss_relax_inputs *in)

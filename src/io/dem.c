@@ -124,6 +124,48 @@ int ss_dem_gdal_available(void)
 #endif
 }
 
+/* Whether x and y, both known (not NaN), differ by more than tol. */
+static int differ(double x, double y, double tol)
+{
+	return !isnan(x) && !isnan(y) && fabs(x - y) > tol;
+}
+
+/* The name of a CRS for a message: its WKT's first quoted name. */
+static const char *crs_name(const char *wkt, char *buf, size_t size)
+{
+	const char *q = strchr(wkt, '"');
+	const char *end = q ? strchr(q + 1, '"') : NULL;
+	if (!end)
+		return wkt;
+	snprintf(buf, size, "%.*s", (int)(end - q - 1), q + 1);
+	return buf;
+}
+
+int ss_dem_check_aligned(const struct ss_raster *dem, const char *dem_name,
+                         const struct ss_raster *r, const char *what)
+{
+	const double dx = dem->cellsize, dy = dem->cellsize_y;
+	if (differ(r->cellsize, dx, 1e-9 * dx) || differ(r->cellsize_y, dy, 1e-9 * dy))
+		return ss_error_input("%s has cells of %.10g x %.10g m: expected the DEM's (%s) "
+		                      "%.10g x %.10g m", what, r->cellsize, r->cellsize_y, dem_name,
+		                      dx, dy);
+	const double cell = isnan(dx) ? 1.0 : fmin(dx, isnan(dy) ? dx : dy);
+	if (differ(r->x0, dem->x0, 1e-6 * cell) || differ(r->y0, dem->y0, 1e-6 * cell))
+		return ss_error_input("%s has its lower-left corner at (%.10g, %.10g): expected the "
+		                      "DEM's (%s) (%.10g, %.10g)", what, r->x0, r->y0, dem_name,
+		                      dem->x0, dem->y0);
+	if (!r->crs_wkt || !dem->crs_wkt)
+		return SS_OK;
+	const int same = ss_dem_gdal_available() ? ss_dem_gdal_same_crs(r->crs_wkt, dem->crs_wkt)
+	                                         : strcmp(r->crs_wkt, dem->crs_wkt) == 0;
+	char a[128], b[128];
+	return same ? SS_OK
+	            : ss_error_input("%s is in the CRS %s: expected the DEM's (%s), %s (gdalwarp "
+	                             "-t_srs puts it in the DEM's)", what,
+	                             crs_name(r->crs_wkt, a, sizeof a), dem_name,
+	                             crs_name(dem->crs_wkt, b, sizeof b));
+}
+
 static int has_suffix(const char *s, const char *suffix)
 {
 	size_t a = strlen(s), b = strlen(suffix);

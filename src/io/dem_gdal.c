@@ -86,6 +86,18 @@ static int geographic(const char *wkt, char *name, size_t size)
 	return g;
 }
 
+int ss_dem_gdal_same_crs(const char *a, const char *b)
+{
+	OGRSpatialReferenceH sa = OSRNewSpatialReference(a), sb = OSRNewSpatialReference(b);
+	/* WKT GDAL cannot read is compared as text */
+	const int same = sa && sb ? OSRIsSame(sa, sb) != 0 : strcmp(a, b) == 0;
+	if (sa)
+		OSRDestroySpatialReference(sa);
+	if (sb)
+		OSRDestroySpatialReference(sb);
+	return same;
+}
+
 /* x (> 0) rounded to two significant digits: 82.4 -> 82, 772 -> 770,
  * 0.927 -> 0.93 (divided by a power of ten, not multiplied by its
  * inexact inverse, so that the text is short). */
@@ -436,6 +448,12 @@ int ss_dem_gdal_end(struct ss_dem_writer *w)
 }
 
 #else /* !SS_HAVE_GDAL: dem.c never calls these */
+
+int ss_dem_gdal_same_crs(const char *a, const char *b)
+{
+	(void)a, (void)b;
+	SS_BUG("GDAL's CRS comparison called in a build without GDAL");
+}
 
 int ss_dem_gdal_identify(const char *path)
 {

@@ -96,6 +96,9 @@ int ss_dem_prj_check_not_source(const char *path, const struct ss_raster *r);
 
 /* dem_gdal.c's refusal of a raster in degrees (crs: its name), from r's
  * geotransform; GDAL builds only. */
+/* 1 when the CRSes of WKT a and b are the same (dem_gdal.c: OSRIsSame). */
+int ss_dem_gdal_same_crs(const char *a, const char *b);
+
 int ss_dem_refuse_degrees(const char *path, const char *context, const char *crs,
                           const struct ss_raster *r, int nx, int ny);
 

@@ -200,17 +200,28 @@ int ss_setup_read_window(const char *spec, const char *context,
 	return ss_dem_read(spec, context, &opt, r);
 }
 
-/* This rank's rows of the raster `path`, which must be the grid's size;
- * `what` ("initial file", "bedrock") names it. */
+/* This rank's rows of the raster `path`, which must be the grid's size
+ * and, where the file says, have its cells (square: one cellsize is
+ * compared with both dx and dy); `what` ("initial file", "bedrock") names
+ * it. */
 static int read_slab(const char *path, const char *where, const char *what,
                      const struct ss_stepper *st, struct ss_raster *r)
 {
+	const struct ss_grid *g = &st->grid;
 	struct ss_dem_read_options o;
 	ss_dem_read_options_init(&o);
 	int tile_nx, tile_ny;
 	ss_stepper_tile_size(st, &tile_nx, &tile_ny);
-	const int err = ss_setup_read_window(path, where, o, tile_nx, tile_ny, r);
-	return err ? err : check_grid_size(path, where, what, &st->grid, r);
+	int err = ss_setup_read_window(path, where, o, tile_nx, tile_ny, r);
+	if (!err)
+		err = check_grid_size(path, where, what, g, r);
+	if (!err && !isnan(r->cellsize) &&
+	    (fabs(r->cellsize - g->dx) > 1e-9 * g->dx || fabs(r->cellsize - g->dy) > 1e-9 * g->dy))
+		err = ss_error_input("%s: %s '%s' has cellsize %g m: expected the grid's dx = %g m, "
+		                     "dy = %g m", where, what, path, r->cellsize, g->dx, g->dy);
+	if (err)
+		ss_raster_release(r);
+	return err;
 }
 
 static int initial_heights(const struct ss_case *c, struct ss_stepper *st)
@@ -218,16 +229,9 @@ static int initial_heights(const struct ss_case *c, struct ss_stepper *st)
 	const struct ss_grid *g = &st->grid;
 	if (c->initial == SS_INITIAL_FILE) {
 		struct ss_raster r;
-		int err = read_slab(c->initial_file, c->initial_where, "initial file", st, &r);
-		if (!err && !isnan(r.cellsize) &&
-		    (fabs(r.cellsize - g->dx) > 1e-9 * g->dx || fabs(r.cellsize - g->dy) > 1e-9 * g->dy))
-			err = ss_error_input("%s: initial file '%s' has cellsize %g m: expected the "
-			                     "grid's dx = %g m, dy = %g m", c->initial_where,
-			                     c->initial_file, r.cellsize, g->dx, g->dy);
-		if (err) {
-			ss_raster_release(&r);
+		const int err = read_slab(c->initial_file, c->initial_where, "initial file", st, &r);
+		if (err)
 			return err;
-		}
 		/* the window: this rank's rows */
 		for (int j = 0; j < g->ny; j++) {
 			for (int i = 0; i < g->nx; i++) {

@@ -156,6 +156,49 @@ def test_bad_angle_rasters(tmp_path):
     assert r.returncode == 2 and "(0, 90)" in r.stderr, r.stderr
 
 
+# What GDAL 3.6 writes as the .prj of EPSG:32633 (as test_crs.py), and the
+# zone west of it.
+UTM33N = (
+    'PROJCS["WGS_1984_UTM_Zone_33N",GEOGCS["GCS_WGS_1984",DATUM["D_WGS_1984",'
+    'SPHEROID["WGS_1984",6378137.0,298.257223563]],PRIMEM["Greenwich",0.0],'
+    'UNIT["Degree",0.0174532925199433]],PROJECTION["Transverse_Mercator"],'
+    'PARAMETER["False_Easting",500000.0],PARAMETER["False_Northing",0.0],'
+    'PARAMETER["Central_Meridian",15.0],PARAMETER["Scale_Factor",0.9996],'
+    'PARAMETER["Latitude_Of_Origin",0.0],UNIT["Meter",1.0]]')
+UTM32N = UTM33N.replace("Zone_33N", "Zone_32N").replace('Meridian",15.0', 'Meridian",9.0')
+
+
+def test_a_raster_beside_the_dem_must_lie_on_its_cells(tmp_path):
+    """The angles, classes and bedrock are read on the DEM's cells: another
+    cell size, corner or CRS is refused, naming both (doc/dem.md)."""
+    h0 = ridge(24, 20, 8.0)
+    x0, y0 = 500000.0, 5200000.0
+    write_asc(tmp_path / "ridge.asc", h0, cellsize=DX, x0=x0, y0=y0)
+    (tmp_path / "ridge.prj").write_text(UTM33N)
+    a = np.full(h0.shape, 33.0)
+    write_asc(tmp_path / "coarse.asc", a, cellsize=2.0, x0=x0, y0=y0)
+    write_asc(tmp_path / "shifted.asc", a, cellsize=DX, x0=x0 + 5.0, y0=y0)
+    write_asc(tmp_path / "zone32.asc", a, cellsize=DX, x0=x0, y0=y0)
+    (tmp_path / "zone32.prj").write_text(UTM32N)
+    write_asc(tmp_path / "same.asc", a, cellsize=DX, x0=x0, y0=y0)
+    (tmp_path / "same.prj").write_text(UTM33N)
+    write_asc(tmp_path / "bare.asc", a, cellsize=DX, x0=x0, y0=y0)   # no .prj: not compared
+    write_asc(tmp_path / "rock.asc", h0 - 1.0, cellsize=DX, x0=x0 + 1.0, y0=y0)
+    for args, words in ((["--angle", "coarse.asc"], ["--angle coarse.asc", "2 x 2 m", "1 x 1 m"]),
+                        (["--angle", "shifted.asc"], ["shifted.asc", "corner", "500005"]),
+                        (["--angle", "zone32.asc"], ["zone32.asc", "32N", "33N", "CRS"]),
+                        (["--bedrock", "rock.asc"], ["--bedrock rock.asc", "corner", "500001"])):
+        r = run(["relax", "ridge.asc", "-o", "out.asc"] + args, cwd=tmp_path)
+        assert r.returncode == 2, f"{args}: exit {r.returncode}\n{r.stderr}"
+        line = r.stderr.strip()
+        assert len(line.splitlines()) == 1, f"{args}: not one line:\n{r.stderr}"
+        for w in words:
+            assert w in line, f"{args}: '{w}' not in the message: {line}"
+    for angle in ("same.asc", "bare.asc"):
+        relax_ok(["ridge.asc", "-o", f"out-{angle}", "--angle", angle, "--max-time", "1"],
+                 tmp_path)
+
+
 # ---- hysteresis (doc/model.md#hysteresis) ----------------------------------
 
 POUR = """[grid]
