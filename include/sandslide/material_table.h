@@ -25,6 +25,7 @@ struct ss_material_spec {
 	char where[SS_MATERIAL_WHERE_SIZE];   /* "file:line" of its section */
 	long long class_value;                /* -1: not given */
 	double angle_deg;                     /* NaN: not given */
+	double static_deg;                    /* hysteresis; NaN: angle_deg */
 	int has_closure;
 	enum ss_closure_kind closure;
 	double nu, gamma;                     /* NaN: the model's */

@@ -101,7 +101,8 @@ double ss_snapshot_bytes(const struct ss_grid *g);
 
 /* Append one snapshot (height with the grid's halo layout; walls and
  * cells without data are written as NaN, the _FillValue, so cell_types in
- * the same layout; moving, in the same layout, nonzero where sand moves:
+ * the same layout; moving, in the same layout, odd where sand moves (the
+ * stepper's material numbers with hysteresis, stepper.h):
  * /moving of a file created with meta->moving, else not used) and, when
  * state is not NULL, the restart state (root
  * attribute restart_state_even or _odd by the snapshot's index), flushed

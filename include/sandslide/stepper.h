@@ -133,9 +133,10 @@ struct ss_stepper {
 	int material_count;
 	uint16_t *material;           /* each cell's material, with halo */
 	int hysteresis;               /* ss_stepper_set_hysteresis: materials
-	                               * 0 (sand at rest, a_s) and 1 (moving
-	                               * sand, a_d); `material` is then each
-	                               * cell's state (doc/model.md#hysteresis) */
+	                               * 2n (material n's sand at rest, a_s) and
+	                               * 2n + 1 (moving, a_d); the low bit of
+	                               * `material` is then each cell's state
+	                               * (doc/model.md#hysteresis) */
 	long long flowing_cells;      /*   flow cells moving, all ranks */
 	double time;                  /* s */
 	long long steps;              /* substeps (RKL2: super-steps) taken */
@@ -285,6 +286,21 @@ int ss_stepper_change_materials(struct ss_stepper *st, const struct ss_closure *
  * bits.  Before ss_stepper_prepare; not with ss_stepper_set_materials.
  */
 int ss_stepper_set_hysteresis(struct ss_stepper *st, double static_deg);
+
+/*
+ * Several materials with hysteresis: ss_stepper_set_materials where
+ * material m of the given also has its static angle static_deg[m] (at
+ * least its repose angle).  Each flow cell then carries its material and
+ * its state, `material` = 2 n + state (n the material's number by angle,
+ * state 1 moving): a face takes the larger material of its two cells and,
+ * of one material, the moving state.  Static angles equal to the repose
+ * angles are ss_stepper_set_materials, the same bits; one material is
+ * ss_stepper_set_hysteresis.  Before ss_stepper_prepare.
+ */
+int ss_stepper_set_hysteresis_materials(struct ss_stepper *st,
+                                        const struct ss_closure *closures,
+                                        const double *static_deg, int count,
+                                        const uint16_t *material_of_cell);
 
 /* A non-erodible bedrock (nx * ny values, m, row-major, south row first):
  * only the sand above it moves, each face limited by the thickness of the

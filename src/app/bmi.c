@@ -572,7 +572,7 @@ static double grid_value(const struct bmi_state *s, const struct var *v, int c)
 		const ptrdiff_t at = at_of(&s->st, c);
 		if (ss_cell_type_get(s->st.cell_types, at) != SS_CELL_FLOW)
 			return NAN;
-		return s->st.material[at] != 0 ? 1.0 : 0.0;
+		return s->st.material[at] & 1 ? 1.0 : 0.0;
 	}
 	case VAR_BEDROCK: {
 		const double b = s->st.bedrock[at_of(&s->st, c)];

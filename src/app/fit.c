@@ -65,7 +65,8 @@ static void set_material_param(const struct ss_fit_param *p, struct ss_material_
 	for (int k = 0; t && k < t->count; k++) {
 		struct ss_material_spec *m = &t->item[k];
 		if (strlen(m->name) == (size_t)(dot - name) && !strncmp(m->name, name, dot - name)) {
-			*(!strcmp(dot + 1, "nu") ? &m->nu : &m->angle_deg) = value;
+			*(!strcmp(dot + 1, "nu") ? &m->nu
+			  : !strcmp(dot + 1, "static_angle") ? &m->static_deg : &m->angle_deg) = value;
 			return;
 		}
 	}

@@ -127,8 +127,9 @@ static void fittable_names(char *buf, size_t size)
 	}
 }
 
-/* Whether name (len bytes) is "material NAME.repose_angle" or
- * "material NAME.nu": a class's angle or nu (doc/fit.md#parameters). */
+/* Whether name (len bytes) is "material NAME.repose_angle",
+ * "material NAME.static_angle" or "material NAME.nu": a class's angle,
+ * static angle or nu (doc/fit.md#parameters). */
 static int fittable_material(const char *name, size_t len)
 {
 	char section[96];
@@ -137,9 +138,11 @@ static int fittable_material(const char *name, size_t len)
 		return 0;
 	snprintf(section, sizeof section, "%.*s", (int)(dot - name), name);
 	const size_t key = len - (size_t)(dot + 1 - name);
-	return ss_material_section(section) &&
-	       ((key == strlen("repose_angle") && !strncmp(dot + 1, "repose_angle", key)) ||
-	        (key == 2 && !strncmp(dot + 1, "nu", 2)));
+	static const char *const keys[] = {"repose_angle", "static_angle", "nu"};
+	int known = 0;
+	for (size_t k = 0; k < sizeof keys / sizeof *keys; k++)
+		known |= key == strlen(keys[k]) && !strncmp(dot + 1, keys[k], key);
+	return ss_material_section(section) && known;
 }
 
 /* Whether name (len bytes) is a key --param takes. */
@@ -161,7 +164,7 @@ int ss_fit_param_parse(const char *text, struct ss_fit_param *p)
 	char names[256], expected[512];
 	fittable_names(names, sizeof names);
 	snprintf(expected, sizeof expected, "NAME=LO:HI or NAME=LO:HI:log with NAME one of %s, or "
-	         "'material NAME.repose_angle' or 'material NAME.nu', and LO < HI, e.g. "
+	         "'material NAME.KEY' with KEY repose_angle, static_angle or nu, and LO < HI, e.g. "
 	         "nu=0.01:1:log", names);
 	memset(p, 0, sizeof *p);
 	const char *eq = strchr(text, '=');

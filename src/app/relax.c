@@ -278,10 +278,9 @@ static void measure_after(struct relax *x, enum ss_drive_end end, struct ss_rela
 	rep->outflow = ss_stepper_outflow(st);
 	rep->volume_after = flow_volume(st);
 	rep->max_slope_after_deg = steepest_sand_face_deg(st);
-	rep->materials = st->material && !st->hysteresis ? st->material_count : 1;
+	/* with hysteresis each material is two states (stepper.h) */
+	rep->materials = st->material ? st->material_count >> st->hysteresis : 1;
 	ss_stepper_repose_range(st, &rep->repose_min_deg, &rep->repose_max_deg);
-	if (st->hysteresis)   /* one material: the two angles are its states' */
-		rep->repose_max_deg = rep->repose_min_deg;
 	rep->model.angle_deg = rep->repose_min_deg;   /* an angle raster's smallest */
 	/* in row order, carried from rank to rank (comm.h) */
 	double moved = 0.0, cells_moved = 0.0, none = 0.0;

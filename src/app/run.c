@@ -174,10 +174,9 @@ static int start_stepper(struct run *r)
 		                     r->o->restart);
 	else if (r->st.hysteresis && !rows.moving)
 		/* written before /moving was: which cells move is not known */
-		err = ss_error_input("--restart %s: its case has hysteresis ([model] static_angle "
-		                     "%g above repose_angle %g), but the file does not say which "
-		                     "cells move (no /moving): run it again from the start",
-		                     r->o->restart, r->c.model.static_angle_deg, r->c.model.angle_deg);
+		err = ss_error_input("--restart %s: its case has hysteresis (a static_angle above "
+		                     "its repose_angle), but the file does not say which cells move "
+		                     "(no /moving): run it again from the start", r->o->restart);
 	else
 		ss_stepper_restore(&r->st, rows.time, rows.height, rows.moving, &rows.state);
 	ss_restart_info_release(&rows);

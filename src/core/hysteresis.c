@@ -2,9 +2,10 @@
  * SPDX-License-Identifier: BSD-3-Clause
  *
  * hysteresis.c - sand at rest and moving sand (doc/model.md#hysteresis,
- * stepper.h): each flow cell's state, kept as its material number (0: at
- * rest, angle a_s; 1: moving, angle a_d).  A face takes the larger number
- * of its two cells (face.h), so a face beside moving sand slides at a_d.
+ * stepper.h): each flow cell's state, kept in its material number (2n: at
+ * rest, material n's static angle a_s; 2n + 1: moving, its repose angle
+ * a_d).  A face takes the larger number of its two cells (face.h), so a
+ * face beside moving sand of the same material slides at a_d.
  *
  * The states change between steps, from the heights the step left:
  *
@@ -34,8 +35,9 @@
 #include "sandslide/comm.h"
 #include "sandslide/error.h"
 
-/* a face takes the larger number of its two cells (face.h): a face beside
- * moving sand slides at a_d, as the avalanche takes the sand at its edge */
+/* the state bit of a number: a face takes the larger number of its two
+ * cells (face.h), so a face beside moving sand slides at a_d, as the
+ * avalanche takes the sand at its edge */
 enum { AT_REST = 0, MOVING = 1 };
 
 int ss_stepper_set_hysteresis(struct ss_stepper *st, double static_deg)
@@ -106,36 +108,36 @@ long long ss_hysteresis_update(struct ss_stepper *st, double slope_tol)
 {
 	const struct ss_grid *g = &st->grid;
 	const struct ss_face_table *rules = &st->sweeper->materials;
-	const struct ss_closure *moving_law = &st->materials[MOVING];
-	const double start2 = rules->tan_cr2[AT_REST];
-	/* the steady rule's tolerance (stepper.h): the flux of a Coulomb face
-	 * steeper than a_d by slope_tol */
-	const double e = slope_tol, te = moving_law->tan_cr + e;
-	const double flux_tol = e / sqrt(1.0 + te * te);
+	const double e = slope_tol;
 	const uint8_t *t = st->cell_types;
 	const double *h = st->height;
 	uint16_t *state = st->material;
-	long long changed = 0, moving = 0;
+	long long changed = 0, moving_cells = 0;
 
 	ss_boundary_fill_heights(g, &st->boundary, st->height);
-	#pragma omp parallel for schedule(static) reduction(+:changed, moving)
+	#pragma omp parallel for schedule(static) reduction(+:changed, moving_cells)
 	for (int j = 0; j < g->ny; j++) {
 		for (int i = 0; i < g->nx; i++) {
 			const ptrdiff_t k = ss_grid_index(g, i, j);
 			if (ss_cell_type_get(t, k) != SS_CELL_FLOW)
 				continue;
+			const uint16_t old = state[k], rest = old & ~MOVING, moving = old | MOVING;
+			const struct ss_closure *moving_law = &st->materials[moving];
 			double s2;
 			const double flux = cell_faces(g, h, t, k, moving_law, &s2);
-			const uint16_t old = state[k];
+			/* the steady rule's tolerance (stepper.h): the flux of a
+			 * Coulomb face steeper than a_d by slope_tol */
+			const double te = moving_law->tan_cr + e;
+			const double flux_tol = e / sqrt(1.0 + te * te);
 			/* a NaN slope leaves the state: the guard stops the run */
-			const uint16_t now = old == AT_REST ? (s2 > start2 ? MOVING : AT_REST)
-			                                    : (flux > flux_tol ? MOVING : AT_REST);
+			const uint16_t now = old == rest ? (s2 > rules->tan_cr2[rest] ? moving : rest)
+			                                 : (flux > flux_tol ? moving : rest);
 			state[k] = now;
 			changed += now != old;
-			moving += now == MOVING;
+			moving_cells += now == moving;
 		}
 	}
-	double sums[2] = {(double)changed, (double)moving};
+	double sums[2] = {(double)changed, (double)moving_cells};
 	ss_comm_reduce(NULL, 0, sums, 2);
 	st->flowing_cells = (long long)sums[1];
 	if (sums[0] > 0.0) {
@@ -149,8 +151,10 @@ long long ss_hysteresis_update(struct ss_stepper *st, double slope_tol)
 
 void ss_hysteresis_start(struct ss_stepper *st)
 {
-	const struct ss_grid *g = &st->grid;
-	memset(st->material, AT_REST, ss_grid_storage_cells(g) * sizeof *st->material);
+	const size_t n = ss_grid_storage_cells(&st->grid);
+	for (size_t k = 0; k < n; k++)
+		st->material[k] &= (uint16_t)~MOVING;
+	ss_boundary_fill_materials(&st->grid, &st->boundary, st->material);
 }
 
 void ss_hysteresis_restore(struct ss_stepper *st, const uint8_t *moving)
@@ -163,7 +167,7 @@ void ss_hysteresis_restore(struct ss_stepper *st, const uint8_t *moving)
 			const ptrdiff_t k = ss_grid_index(g, i, j);
 			const int flows = ss_cell_type_get(st->cell_types, k) == SS_CELL_FLOW;
 			const int now = flows && moving[(size_t)j * g->nx + i];
-			st->material[k] = now ? MOVING : AT_REST;
+			st->material[k] = (uint16_t)(st->material[k] | (now ? MOVING : AT_REST));
 			count += now;
 		}
 	ss_comm_reduce(NULL, 0, &count, 1);

@@ -49,7 +49,8 @@ double ss_stepper_bytes(const struct ss_stepper *st)
 void ss_stepper_repose_range(const struct ss_stepper *st, double *min_deg, double *max_deg)
 {
 	*min_deg = *max_deg = st->closure.repose_angle_deg;
-	for (int m = 0; m < st->material_count; m++) {
+	/* with hysteresis the odd numbers are the moving states, at a_d */
+	for (int m = st->hysteresis; m < st->material_count; m += 1 + st->hysteresis) {
 		*min_deg = fmin(*min_deg, st->materials[m].repose_angle_deg);
 		*max_deg = fmax(*max_deg, st->materials[m].repose_angle_deg);
 	}
@@ -173,20 +174,22 @@ int ss_stepper_set_bedrock(struct ss_stepper *st, const double *bedrock)
 	return SS_OK;
 }
 
-/* A material while they are numbered: its closure and its number given. */
+/* A material while they are numbered: its closure, its static angle
+ * (hysteresis; 0 without) and its number given. */
 struct material_entry {
 	const struct ss_closure *c;
+	double static_deg;
 	int given;
 };
 
-/* By angle, then kind, gamma and nu (equal closures side by side), then
- * as given: the order of the materials' numbers. */
+/* By angle, then kind, gamma, nu and static angle (equal materials side
+ * by side), then as given: the order of the materials' numbers. */
 static int compare_materials(const void *pa, const void *pb)
 {
 	const struct material_entry *a = pa, *b = pb;
-	const double ka[4] = {a->c->tan_cr, a->c->kind, a->c->gamma, a->c->nu};
-	const double kb[4] = {b->c->tan_cr, b->c->kind, b->c->gamma, b->c->nu};
-	for (int k = 0; k < 4; k++)
+	const double ka[5] = {a->c->tan_cr, a->c->kind, a->c->gamma, a->c->nu, a->static_deg};
+	const double kb[5] = {b->c->tan_cr, b->c->kind, b->c->gamma, b->c->nu, b->static_deg};
+	for (int k = 0; k < 5; k++)
 		if (ka[k] != kb[k])
 			return ka[k] < kb[k] ? -1 : 1;
 	return (a->given > b->given) - (a->given < b->given);
@@ -198,13 +201,22 @@ static int same_closure(const struct ss_closure *a, const struct ss_closure *b)
 	       a->nu == b->nu;
 }
 
+static int same_material(const struct material_entry *a, const struct material_entry *b)
+{
+	return same_closure(a->c, b->c) && a->static_deg == b->static_deg;
+}
+
 /* The materials of set_materials into *out_materials, *out_count and
- * *out_material (NULL and 0 when they are one closure, which goes to
- * *smallest); st is not changed.  Collective. */
+ * *out_material (NULL and 0 when they are one material, whose closure goes
+ * to *smallest); st is not changed.  static_deg: each given material's
+ * static angle, part of what makes materials distinct, and the distinct
+ * ones' into *out_static (owned; both NULL: none).  Collective. */
 static int build_materials(const struct ss_stepper *st, const struct ss_closure *closures,
-                           int count, const uint16_t *material_of_cell,
+                           const double *static_deg, int count,
+                           const uint16_t *material_of_cell,
                            struct ss_closure **out_materials, int *out_count,
-                           uint16_t **out_material, struct ss_closure *smallest)
+                           uint16_t **out_material, struct ss_closure *smallest,
+                           double **out_static)
 {
 	const struct ss_grid *g = &st->grid;
 	*out_materials = NULL;
@@ -217,12 +229,12 @@ static int build_materials(const struct ss_stepper *st, const struct ss_closure 
 	double *used = ss_alloc((size_t)count, sizeof *used, "materials");
 	int err = order && number && used ? SS_OK : SS_ERR_FAIL;
 	for (int m = 0; !err && m < count; m++)
-		order[m] = (struct material_entry){&closures[m], m};
+		order[m] = (struct material_entry){&closures[m], static_deg ? static_deg[m] : 0.0, m};
 	if (!err)
 		qsort(order, (size_t)count, sizeof *order, compare_materials);
 	int places = 0;
 	for (int k = 0; !err && k < count; k++) {
-		if (k > 0 && !same_closure(order[k - 1].c, order[k].c))
+		if (k > 0 && !same_material(&order[k - 1], &order[k]))
 			places++;
 		number[order[k].given] = (uint16_t)places;
 		used[k] = 0.0;
@@ -245,16 +257,25 @@ static int build_materials(const struct ss_stepper *st, const struct ss_closure 
 		used[k] = used[k] != 0.0 ? (double)distinct++ : -1.0;
 	struct ss_closure *materials = NULL;
 	uint16_t *material = NULL;
+	double *statics = NULL;
+	int allocated = 1;
 	if (!err && distinct > 1) {
 		materials = ss_alloc((size_t)distinct, sizeof *materials, "materials");
 		material = ss_alloc(ss_grid_storage_cells(g), sizeof *material, "materials");
-		err = ss_comm_agree(materials && material ? SS_OK : SS_ERR_FAIL);
+		allocated = materials && material;
 	}
+	if (!err && out_static)
+		allocated &= (statics = ss_alloc((size_t)distinct, sizeof *statics,
+		                                 "static angles")) != NULL;
+	if (!err)
+		err = ss_comm_agree(allocated ? SS_OK : SS_ERR_FAIL);
 	if (!err) {
 		for (int k = 0; k < count; k++) {
 			const int n = (int)used[number[order[k].given]];
 			if (n >= 0 && distinct > 1)
 				materials[n] = *order[k].c;
+			if (n >= 0 && statics)
+				statics[n] = order[k].static_deg;
 			if (n == 0)   /* the smallest angle: the rules' scale */
 				*smallest = *order[k].c;
 		}
@@ -272,6 +293,10 @@ static int build_materials(const struct ss_stepper *st, const struct ss_closure 
 		ss_free(material);
 		ss_free(materials);
 	}
+	if (!err && out_static)
+		*out_static = statics;
+	else
+		ss_free(statics);
 	ss_free(used);
 	ss_free(number);
 	ss_free(order);
@@ -320,8 +345,8 @@ int ss_stepper_set_materials(struct ss_stepper *st, const struct ss_closure *clo
 	struct ss_closure *materials, smallest = st->closure;
 	uint16_t *material;
 	int distinct;
-	if ((err = build_materials(st, closures, count, material_of_cell, &materials, &distinct,
-	                           &material, &smallest)))
+	if ((err = build_materials(st, closures, NULL, count, material_of_cell, &materials,
+	                           &distinct, &material, &smallest, NULL)))
 		return err;
 	ss_free(st->material);
 	ss_free(st->materials);
@@ -330,6 +355,74 @@ int ss_stepper_set_materials(struct ss_stepper *st, const struct ss_closure *clo
 	st->material_count = distinct;
 	st->closure = smallest;
 	return SS_OK;
+}
+
+int ss_stepper_set_hysteresis_materials(struct ss_stepper *st,
+                                        const struct ss_closure *closures,
+                                        const double *static_deg, int count,
+                                        const uint16_t *material_of_cell)
+{
+	int err = check_count(st, count);
+	for (int m = 0; !err && m < count; m++)
+		if (!(static_deg[m] >= closures[m].repose_angle_deg && static_deg[m] < 90.0))
+			err = ss_error_input("material %d: static angle %g deg: expected degrees from its "
+			                     "repose angle, %g, to 90 (sand at rest starts to slide at an "
+			                     "angle at least the one where moving sand stops)", m,
+			                     static_deg[m], closures[m].repose_angle_deg);
+	if (err)
+		return err;
+	struct ss_closure *materials, smallest = st->closure;
+	uint16_t *material;
+	double *statics;
+	int distinct;
+	if ((err = build_materials(st, closures, static_deg, count, material_of_cell, &materials,
+	                           &distinct, &material, &smallest, &statics)))
+		return err;
+	int any = 0;
+	for (int n = 0; n < distinct; n++)
+		any |= statics[n] != (material ? materials[n] : smallest).repose_angle_deg;
+	if (!any || !material) {   /* one material, or none with hysteresis */
+		const double a_s = statics[0];
+		ss_free(statics);
+		ss_free(st->material);
+		ss_free(st->materials);
+		st->materials = materials;
+		st->material = material;
+		st->material_count = distinct;
+		st->closure = smallest;
+		return material ? SS_OK : ss_stepper_set_hysteresis(st, a_s);
+	}
+	/* material n at rest is 2n (its static angle), moving 2n + 1 (its
+	 * repose angle): a face takes the larger material of its two cells,
+	 * and of one material the moving state (face.h, hysteresis.c) */
+	struct ss_closure *states = distinct <= UINT16_MAX / 2
+		? ss_alloc(2 * (size_t)distinct, sizeof *states, "hysteresis") : NULL;
+	if (!states)
+		err = distinct > UINT16_MAX / 2
+			? ss_error_input("%d materials with hysteresis: at most %d are accepted",
+			                 distinct, UINT16_MAX / 2) : SS_ERR_FAIL;
+	for (int n = 0; !err && n < distinct; n++) {
+		const struct ss_closure *c = &materials[n];
+		states[2 * n + 1] = *c;
+		err = ss_closure_init(&states[2 * n], c->kind, statics[n], c->gamma, c->nu);
+	}
+	if (!err) {
+		for (size_t k = 0; k < ss_grid_storage_cells(&st->grid); k++)
+			material[k] = (uint16_t)(2 * material[k]);
+		ss_free(st->material);
+		ss_free(st->materials);
+		st->materials = states;
+		st->material = material;
+		st->material_count = 2 * distinct;
+		st->closure = smallest;
+		st->hysteresis = 1;
+	} else {
+		ss_free(states);
+		ss_free(material);
+	}
+	ss_free(materials);
+	ss_free(statics);
+	return ss_comm_agree(err);
 }
 
 int ss_stepper_change_materials(struct ss_stepper *st, const struct ss_closure *closures,
@@ -341,8 +434,8 @@ int ss_stepper_change_materials(struct ss_stepper *st, const struct ss_closure *
 	struct ss_closure *materials, smallest = st->closure;
 	uint16_t *material;
 	int distinct;
-	if ((err = build_materials(st, closures, count, material_of_cell, &materials, &distinct,
-	                           &material, &smallest)))
+	if ((err = build_materials(st, closures, NULL, count, material_of_cell, &materials,
+	                           &distinct, &material, &smallest, NULL)))
 		return err;
 	if (same_materials(st, materials, distinct, material, &smallest)) {
 		ss_free(material);

@@ -690,7 +690,7 @@ static int write_heights(struct ss_snapshot *s, long long k, const double *heigh
 				const ptrdiff_t row = ss_grid_index(g, 0, (int)(j - first));
 				uint8_t *out = bytes + (size_t)(j - lo) * (size_t)g->nx;
 				for (int i = 0; i < g->nx; i++)
-					out[i] = moving[row + i] != 0;
+					out[i] = moving[row + i] & 1;
 			}
 			for (long long j = lo; j < hi && !moving; j++) {
 				const ptrdiff_t row = ss_grid_index(g, 0, (int)(j - first));

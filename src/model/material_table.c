@@ -50,7 +50,7 @@ static struct ss_material_spec *find(struct ss_material_table *t, const char *na
 	snprintf(m->name, sizeof m->name, "%s", name);
 	snprintf(m->where, sizeof m->where, "%s", where);
 	m->class_value = -1;
-	m->angle_deg = m->nu = m->gamma = NAN;
+	m->angle_deg = m->static_deg = m->nu = m->gamma = NAN;
 	return m;
 }
 
@@ -68,11 +68,11 @@ int ss_material_table_set(struct ss_material_table *t, const char *name, const c
 			                      "(the class raster's value of its cells)", where, name,
 			                      value);
 		m->class_value = v;
-	} else if (!strcmp(key, "repose_angle")) {
+	} else if (!strcmp(key, "repose_angle") || !strcmp(key, "static_angle")) {
 		if (ss_parse_real(value, 0.0, 90.0, &x) || x == 0.0 || x == 90.0)
-			return ss_error_input("%s: [material %s] repose_angle = '%s': expected degrees "
-			                      "in (0, 90)", where, name, value);
-		m->angle_deg = x;
+			return ss_error_input("%s: [material %s] %s = '%s': expected degrees in (0, 90)",
+			                      where, name, key, value);
+		*(key[0] == 'r' ? &m->angle_deg : &m->static_deg) = x;
 	} else if (!strcmp(key, "closure")) {
 		if (ss_closure_parse(value, &m->closure))
 			return ss_error_input("%s: [material %s] closure = '%s': expected "
@@ -85,7 +85,8 @@ int ss_material_table_set(struct ss_material_table *t, const char *name, const c
 		*(key[0] == 'n' ? &m->nu : &m->gamma) = x;
 	} else {
 		return ss_error_input("%s: unknown key '%s' in [material %s]: expected class, "
-		                      "repose_angle, closure, nu, gamma", where, key, name);
+		                      "repose_angle, static_angle, closure, nu, gamma", where, key,
+		                      name);
 	}
 	return SS_OK;
 }
@@ -141,6 +142,12 @@ int ss_material_table_check(const struct ss_material_table *t, const char *what)
 				return ss_error_input("%s: [material %s] has class %lld, as [material %s] "
 				                      "has: each class one material", m->where, m->name,
 				                      m->class_value, t->item[e].name);
+		if (m->static_deg < m->angle_deg)
+			return ss_error_input("%s: [material %s] static_angle %g is below its "
+			                      "repose_angle %g: sand at rest starts to slide at an angle "
+			                      "at least the one where moving sand stops "
+			                      "(doc/model.md#hysteresis)", m->where, m->name,
+			                      m->static_deg, m->angle_deg);
 	}
 	return t->count ? SS_OK : ss_error_input("%s: no [material NAME] section", what);
 }

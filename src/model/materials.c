@@ -202,9 +202,11 @@ int ss_materials_from_classes(struct ss_stepper *st, const struct ss_model_optio
 	if (g->offset_j < r->row_first || g->offset_j + g->ny > r->row_first + r->rows)
 		SS_BUG("the classes hold rows %d + %d: not the slab's", r->row_first, r->rows);
 	struct ss_closure closures[SS_MATERIAL_MAX];
+	double static_deg[SS_MATERIAL_MAX];   /* hysteresis: a class's own, or none */
 	int err = SS_OK;
 	for (int k = 0; k < t->count && !err; k++) {
 		const struct ss_material_spec *s = &t->item[k];
+		static_deg[k] = isnan(s->static_deg) ? s->angle_deg : s->static_deg;
 		err = ss_closure_init(&closures[k], s->has_closure ? s->closure : m->closure,
 		                      s->angle_deg, isnan(s->gamma) ? m->gamma : s->gamma,
 		                      isnan(s->nu) ? m->nu : s->nu);
@@ -228,7 +230,8 @@ int ss_materials_from_classes(struct ss_stepper *st, const struct ss_model_optio
 				material[(size_t)j * g->nx + i] = (uint16_t)k;
 		}
 	if (!(err = ss_comm_agree(err)))
-		err = ss_stepper_set_materials(st, closures, t->count, material);
+		err = ss_stepper_set_hysteresis_materials(st, closures, static_deg, t->count,
+		                                          material);
 	ss_free(material);
 	return ss_comm_agree(err);
 }

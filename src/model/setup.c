@@ -124,8 +124,9 @@ static int start(const struct start *s, struct ss_stepper *st)
 	err = ss_model_closure(m, &closure);
 	const double a_s = m->static_angle_deg;
 	if (!err && !isnan(a_s) && (m->angle_file || m->materials_file))
-		err = ss_error_input("%s %g with %s: hysteresis takes one repose angle (an angle "
-		                     "raster with it is not supported yet)", s->static_what, a_s,
+		err = ss_error_input("%s %g with %s: one static angle is for one repose angle; "
+		                     "give each [material NAME] of a material table its "
+		                     "static_angle (doc/model.md#hysteresis)", s->static_what, a_s,
 		                     s->angle_what);
 	if (!err && !isnan(a_s) && a_s < m->angle_deg)
 		err = ss_error_input("%s %g is below the repose angle %g: sand at rest starts to "

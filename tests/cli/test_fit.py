@@ -439,6 +439,30 @@ def test_a_poured_twin_gives_both_angles_of_hysteresis(tmp_path):
         f"{best['static_angle']:.3f}: the twin's are 30 and 36")
 
 
+def test_a_class_with_hysteresis_gives_both_its_angles(tmp_path):
+    """The poured twin above with its sand as a class ([material sand]
+    static_angle) beside loose sand at 25 degrees in the east: fit frees
+    the class's repose and static angles ('material NAME.static_angle')
+    and finds each within 0.5 degree."""
+    classes = np.full((8, 60), 3.0)
+    classes[:, 40:] = 7.0
+    (tmp_path / "classes.asc").write_text(asc(classes).replace("cellsize 1.0",
+                                                               "cellsize 0.025"))
+    case = HYSTERESIS_TWIN.replace("repose_angle = 30\nstatic_angle = 36\n",
+                                   "materials = classes.asc\n")
+    case += ("[material sand]\nclass = 3\nrepose_angle = 30\nstatic_angle = 36\n"
+             "[material loose]\nclass = 7\nrepose_angle = 25\n")
+    (tmp_path / "twin.ini").write_text(case)
+    run_ok(["run", "twin.ini", "-o", "twin.h5", "-q"], cwd=tmp_path)
+    run_ok(["fit", "twin.ini", "twin.h5", "--param", "material sand.repose_angle=27:33",
+            "--param", "material sand.static_angle=33.5:39", "-o", "fit.json", "-q"],
+           cwd=tmp_path, timeout=300)
+    best = json.loads((tmp_path / "fit.json").read_text())["best"]["params"]
+    a_d, a_s = best["material sand.repose_angle"], best["material sand.static_angle"]
+    assert abs(a_d - 30.0) <= 0.5 and abs(a_s - 36.0) <= 0.5, (
+        f"fit found repose_angle {a_d:.3f}, static_angle {a_s:.3f}: the twin's are 30 and 36")
+
+
 def asc(values):
     ny, nx = values.shape
     rows = "\n".join(" ".join(repr(float(v)) for v in values[j]) for j in range(ny - 1, -1, -1))

@@ -268,12 +268,7 @@ def test_slow_pour_avalanches_between_the_two_angles(tmp_path):
     assert "(steady)" in out, f"the pile did not come to rest:\n{out}"
     steepest = [steepest_deg(h) for h in heights]
     # an avalanche: the steepest face from near a_s down to near a_d
-    avalanches, high = 0, False
-    for s in steepest:
-        if s >= a_s - 1.0:
-            high = True
-        elif high and s <= a_d + 1.5:
-            avalanches, high = avalanches + 1, False
+    avalanches = count_avalanches(steepest, a_d, a_s)
     assert avalanches >= 3, f"{avalanches} avalanches: steepest faces {steepest}"
     first = next(k for k, s in enumerate(steepest) if s >= a_s - 1.0)
     after = steepest[first:]
@@ -307,11 +302,61 @@ def test_bad_static_angles(tmp_path):
     for args, words in ((["--angle", "35", "--static-angle", "30"],
                          ["--static-angle", "30", "35"]),
                         (["--angle", "angles.asc", "--static-angle", "45"],
-                         ["--static-angle", "--angle", "not supported"])):
+                         ["--static-angle", "--angle", "[material NAME]"])):
         r = run(["relax", "ridge.asc", "-o", "out.asc"] + args, cwd=tmp_path)
         assert r.returncode == 2 and len(r.stderr.splitlines()) == 1, (args, r.stderr)
         for w in words:
             assert w in r.stderr, f"{args}: '{w}' not in: {r.stderr}"
+
+
+def count_avalanches(steepest, a_d, a_s):
+    """Falls of the steepest face from near a_s to near a_d."""
+    avalanches, high = 0, False
+    for s in steepest:
+        if s >= a_s - 1.0:
+            high = True
+        elif high and s <= a_d + 1.5:
+            avalanches, high = avalanches + 1, False
+    return avalanches
+
+
+def test_a_class_with_a_static_angle_avalanches_beside_one_without(tmp_path):
+    """Hysteresis per material ([material NAME] static_angle): sand of 30
+    and 36 degrees poured inside a ring of loose sand at 25 without
+    hysteresis (so the poured sand's states are materials 2 and 3, not 0
+    and 1) avalanches between its two angles and comes to rest; the same bits on
+    1 thread and another tile size; a class's static angle below its
+    repose angle is refused."""
+    c = np.full((41, 41), 7.0)
+    c[3:-3, 3:-3] = 3.0
+    write_asc(tmp_path / "classes.asc", c, cellsize=0.05, x0=-1.025, y0=-1.025)
+    sections = ("[material sand]\nclass = 3\nrepose_angle = 30\nstatic_angle = {a_s}\n\n"
+                "[material loose]\nclass = 7\nrepose_angle = 25\n")
+    case = POUR.format(static="materials = classes.asc").replace("repose_angle = 30\n", "")
+    case += "\n" + sections
+    (tmp_path / "c.ini").write_text(case.format(a_s=36))
+    runs = []
+    for name, args in (("c", []), ("c1", ["--threads", "1", "--tile", "16x8"])):
+        r = run(["run", "c.ini", "-o", f"{name}.h5"] + args, cwd=tmp_path, timeout=300)
+        assert r.returncode == 0, f"run c.ini exited {r.returncode}:\n{r.stderr}"
+        assert "(steady)" in r.stdout, f"the pile did not come to rest:\n{r.stdout}"
+        with h5open(tmp_path / f"{name}.h5") as f:
+            runs.append((f["height"][:], f["moving"][:]))
+    (heights, moving), (other, other_moving) = runs
+    steepest = [steepest_deg(h) for h in heights]
+    assert count_avalanches(steepest, 30.0, 36.0) >= 3, f"steepest faces {steepest}"
+    first = next(k for k, s in enumerate(steepest) if s >= 35.0)
+    assert 29.8 <= min(steepest[first:]) and max(steepest[first:]) <= 36.2, (
+        f"after the first avalanche the steepest face ran from {min(steepest[first:]):.3f} "
+        f"to {max(steepest[first:]):.3f} deg")
+    assert moving.max() == 1 and moving[-1].max() == 0, "no sand moved, or some moves at rest"
+    assert same_bits(heights, other) and np.array_equal(moving, other_moving), \
+        "hysteresis with classes: another thread count or tile size gave other bits"
+    (tmp_path / "low.ini").write_text(case.format(a_s=25))
+    r = run(["run", "low.ini", "-o", "low.h5"], cwd=tmp_path)
+    assert r.returncode == 2 and len(r.stderr.splitlines()) == 1, r.stderr
+    for w in ("[material sand]", "static_angle 25", "repose_angle 30"):
+        assert w in r.stderr, f"'{w}' not in: {r.stderr}"
 
 
 def test_restart_mid_avalanche_gives_the_uninterrupted_bits(tmp_path):

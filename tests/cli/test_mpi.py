@@ -624,9 +624,15 @@ dx = 0.05
 origin = -1.025 -1.025
 [model]
 closure = coulomb
+materials = classes.asc
+nu = 0.1
+[material sand]
+class = 3
 repose_angle = 30
 static_angle = 36
-nu = 0.1
+[material loose]
+class = 7
+repose_angle = 25
 [time]
 end = 12
 output_every = 1
@@ -642,12 +648,16 @@ rate = 0.02
 
 
 def test_hysteresis_under_3_ranks_has_the_serial_bits(tmp_path):
-    """Each cell at rest or moving (doc/model.md#hysteresis): the states of
-    the halo rows from the ranks beside, the same avalanches."""
+    """Each cell at rest or moving (doc/model.md#hysteresis), of two
+    materials, one of them with a static angle: the states of the halo rows
+    from the ranks beside, the same avalanches."""
+    classes = [[7 if min(i, j, 40 - i, 40 - j) < 3 else 3 for i in range(41)]
+               for j in range(41)]
     serial, mpi = tmp_path / "serial", tmp_path / "mpi"
     for d in (serial, mpi):
         d.mkdir()
         (d / "pour.ini").write_text(HYSTERESIS_CASE)
+        (d / "classes.asc").write_text(asc_text(np.array(classes, dtype=float)))
     args = ["run", "pour.ini", "-o", "pour.h5", "-q", "--tile", "16x8"]
     serial_run_ok(args, serial)
     mpi_run_ok(3, args, mpi)
