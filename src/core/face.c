@@ -309,11 +309,59 @@ int SS_PATH_FN(ss_face_fluxes)(const struct ss_face_rule *r, int n,
  * expressions with each face's numbers, so the bits of a face are those of
  * ss_face_fluxes with its rule.  Faces of different forms evaluate each
  * form present and keep their own. */
+#if SS_PATH == SS_PATH_AVX512
+/* Coulomb faces of at most 8 rules in one pass, each face's numbers
+ * permuted out of registers and nothing stored but the flux: the
+ * expressions of slopes_and_rsqrt, f_over_s and the flux below, in their
+ * order, so the same bits (test_sweep compares them with single rules).
+ * The chunked passes stored and reloaded six numbers a face. */
+static int coulomb_in_registers(const struct ss_face_table *t, int n,
+                                const uint16_t *restrict rule, const double *restrict g_n,
+                                const double *restrict g_t, double *restrict flux)
+{
+	const __mmask8 rules = tail_mask(t->count);
+	const __m512d tan_cr2s = _mm512_maskz_loadu_pd(rules, t->tan_cr2);
+	const __m512d tan_crs = _mm512_maskz_loadu_pd(rules, t->tan_cr);
+	const __m512d nus = _mm512_maskz_loadu_pd(rules, t->nu);
+	const __m512d one = _mm512_set1_pd(1.0), zero = _mm512_setzero_pd();
+	const __m512d sign = _mm512_set1_pd(-0.0);
+	__mmask8 any = 0;
+	for (int k = 0; k < n; k += 8) {
+		const __mmask8 lanes = tail_mask(n - k);
+		const __m512i r = _mm512_cvtepu16_epi64(_mm_maskz_loadu_epi16(lanes, rule + k));
+		const __m512d a = _mm512_maskz_loadu_pd(lanes, g_n + k);
+		const __m512d b = _mm512_maskz_loadu_pd(lanes, g_t + k);
+		/* s^2 where the face slides, 1 elsewhere; 1/s, 1/w */
+		const __m512d q = _mm512_add_pd(_mm512_mul_pd(a, a), _mm512_mul_pd(b, b));
+		const __mmask8 slides =
+			_mm512_cmp_pd_mask(q, _mm512_permutexvar_pd(r, tan_cr2s), _CMP_GT_OQ) & lanes;
+		const __m512d e = _mm512_mask_blend_pd(slides, one, q);
+		any |= slides;
+		const __m512d inv_s = rsqrt_newton(e), inv_w = rsqrt_newton(_mm512_add_pd(one, e));
+		/* f/s = (s - tan a_cr)_+ / w / s, s = s^2 / s */
+		const __m512d d = _mm512_sub_pd(_mm512_mul_pd(e, inv_s),
+		                                _mm512_permutexvar_pd(r, tan_crs));
+		const __m512d positive = _mm512_maskz_mov_pd(_mm512_cmp_pd_mask(d, zero, _CMP_GT_OQ), d);
+		const __m512d fos = _mm512_mul_pd(_mm512_mul_pd(positive, inv_w), inv_s);
+		/* F = -(nu g_n) f/s where it slides, 0 elsewhere */
+		const __m512d nu = t->one_nu ? _mm512_set1_pd(t->nu[0]) : _mm512_permutexvar_pd(r, nus);
+		const __m512d minus = _mm512_xor_pd(_mm512_mul_pd(nu, a), sign);
+		_mm512_mask_storeu_pd(flux + k, lanes,
+		                      _mm512_maskz_mov_pd(slides, _mm512_mul_pd(minus, fos)));
+	}
+	return any != 0;
+}
+#endif
+
 int SS_PATH_FN(ss_face_fluxes_mixed)(const struct ss_face_table *t, int n,
                                      const uint16_t *restrict rule,
                                      const double *restrict g_n, const double *restrict g_t,
                                      double *restrict flux)
 {
+#if SS_PATH == SS_PATH_AVX512
+	if (t->forms == 1u << SS_FACE_COULOMB && t->count <= 8)
+		return coulomb_in_registers(t, n, rule, g_n, g_t, flux);
+#endif
 	double s2[CHUNK], inv_s[CHUNK], inv_w[CHUNK], fos[CHUNK], slides[CHUNK];
 	double nu[CHUNK], tan_cr2[CHUNK], tan_cr[CHUNK], sin_cr[CHUNK], inv_sin_cr[CHUNK];
 	double gamma[CHUNK], power[CHUNK], other[CHUNK];
