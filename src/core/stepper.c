@@ -336,24 +336,40 @@ static int check_count(const struct ss_stepper *st, int count)
 	return SS_OK;
 }
 
-int ss_stepper_set_materials(struct ss_stepper *st, const struct ss_closure *closures,
-                             int count, const uint16_t *material_of_cell)
+/* check_count, then build_materials without static angles. */
+static int checked_materials(const struct ss_stepper *st, const struct ss_closure *closures,
+                             int count, const uint16_t *material_of_cell,
+                             struct ss_closure **materials, int *distinct,
+                             uint16_t **material, struct ss_closure *smallest)
 {
-	int err = check_count(st, count);
-	if (err)
-		return err;
-	struct ss_closure *materials, smallest = st->closure;
-	uint16_t *material;
-	int distinct;
-	if ((err = build_materials(st, closures, NULL, count, material_of_cell, &materials,
-	                           &distinct, &material, &smallest, NULL)))
-		return err;
+	const int err = check_count(st, count);
+	return err ? err : build_materials(st, closures, NULL, count, material_of_cell, materials,
+	                                   distinct, material, smallest, NULL);
+}
+
+/* st's materials become these (st takes them), its old ones freed. */
+static void install_materials(struct ss_stepper *st, struct ss_closure *materials,
+                              uint16_t *material, int count, const struct ss_closure *smallest)
+{
 	ss_free(st->material);
 	ss_free(st->materials);
 	st->materials = materials;
 	st->material = material;
-	st->material_count = distinct;
-	st->closure = smallest;
+	st->material_count = count;
+	st->closure = *smallest;
+}
+
+int ss_stepper_set_materials(struct ss_stepper *st, const struct ss_closure *closures,
+                             int count, const uint16_t *material_of_cell)
+{
+	struct ss_closure *materials, smallest = st->closure;
+	uint16_t *material;
+	int distinct;
+	const int err = checked_materials(st, closures, count, material_of_cell, &materials,
+	                                  &distinct, &material, &smallest);
+	if (err)
+		return err;
+	install_materials(st, materials, material, distinct, &smallest);
 	return SS_OK;
 }
 
@@ -384,12 +400,7 @@ int ss_stepper_set_hysteresis_materials(struct ss_stepper *st,
 	if (!any || !material) {   /* one material, or none with hysteresis */
 		const double a_s = statics[0];
 		ss_free(statics);
-		ss_free(st->material);
-		ss_free(st->materials);
-		st->materials = materials;
-		st->material = material;
-		st->material_count = distinct;
-		st->closure = smallest;
+		install_materials(st, materials, material, distinct, &smallest);
 		return material ? SS_OK : ss_stepper_set_hysteresis(st, a_s);
 	}
 	/* material n at rest is 2n (its static angle), moving 2n + 1 (its
@@ -409,12 +420,7 @@ int ss_stepper_set_hysteresis_materials(struct ss_stepper *st,
 	if (!err) {
 		for (size_t k = 0; k < ss_grid_storage_cells(&st->grid); k++)
 			material[k] = (uint16_t)(2 * material[k]);
-		ss_free(st->material);
-		ss_free(st->materials);
-		st->materials = states;
-		st->material = material;
-		st->material_count = 2 * distinct;
-		st->closure = smallest;
+		install_materials(st, states, material, 2 * distinct, &smallest);
 		st->hysteresis = 1;
 	} else {
 		ss_free(states);
@@ -428,14 +434,12 @@ int ss_stepper_set_hysteresis_materials(struct ss_stepper *st,
 int ss_stepper_change_materials(struct ss_stepper *st, const struct ss_closure *closures,
                                 int count, const uint16_t *material_of_cell)
 {
-	int err = check_count(st, count);
-	if (err)
-		return err;
 	struct ss_closure *materials, smallest = st->closure;
 	uint16_t *material;
 	int distinct;
-	if ((err = build_materials(st, closures, NULL, count, material_of_cell, &materials,
-	                           &distinct, &material, &smallest, NULL)))
+	int err = checked_materials(st, closures, count, material_of_cell, &materials, &distinct,
+	                            &material, &smallest);
+	if (err)
 		return err;
 	if (same_materials(st, materials, distinct, material, &smallest)) {
 		ss_free(material);
@@ -454,12 +458,7 @@ int ss_stepper_change_materials(struct ss_stepper *st, const struct ss_closure *
 		ss_free(materials);
 		return err;
 	}
-	ss_free(st->material);
-	ss_free(st->materials);
-	st->materials = materials;
-	st->material = material;
-	st->material_count = distinct;
-	st->closure = smallest;
+	install_materials(st, materials, material, distinct, &smallest);
 	if (st->material)
 		ss_boundary_fill_materials(&st->grid, &st->boundary, st->material);
 	/* what the CFL table sizes starts over: RKL2's super-steps and the

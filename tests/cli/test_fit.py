@@ -424,16 +424,22 @@ rate = 0.01
 """
 
 
+def fit_twin(tmp_path, *params):
+    """Run twin.ini into twin.h5, fit it freeing params ("NAME=LO:HI"); the
+    best parameters found."""
+    run_ok(["run", "twin.ini", "-o", "twin.h5", "-q"], cwd=tmp_path)
+    args = [w for p in params for w in ("--param", p)]
+    run_ok(["fit", "twin.ini", "twin.h5", *args, "-o", "fit.json", "-q"], cwd=tmp_path,
+           timeout=300)
+    return json.loads((tmp_path / "fit.json").read_text())["best"]["params"]
+
+
 def test_a_poured_twin_gives_both_angles_of_hysteresis(tmp_path):
     """A pour against a wall under hysteresis (30 and 36 degrees): fit frees
     repose_angle and static_angle and finds each within 0.5 degree
     (doc/fit.md#parameters)."""
     (tmp_path / "twin.ini").write_text(HYSTERESIS_TWIN)
-    run_ok(["run", "twin.ini", "-o", "twin.h5", "-q"], cwd=tmp_path)
-    run_ok(["fit", "twin.ini", "twin.h5", "--param", "repose_angle=27:33",
-            "--param", "static_angle=33.5:39", "-o", "fit.json", "-q"], cwd=tmp_path,
-           timeout=300)
-    best = json.loads((tmp_path / "fit.json").read_text())["best"]["params"]
+    best = fit_twin(tmp_path, "repose_angle=27:33", "static_angle=33.5:39")
     assert abs(best["repose_angle"] - 30.0) <= 0.5 and abs(best["static_angle"] - 36.0) <= 0.5, (
         f"fit found repose_angle {best['repose_angle']:.3f}, static_angle "
         f"{best['static_angle']:.3f}: the twin's are 30 and 36")
@@ -453,11 +459,8 @@ def test_a_class_with_hysteresis_gives_both_its_angles(tmp_path):
     case += ("[material sand]\nclass = 3\nrepose_angle = 30\nstatic_angle = 36\n"
              "[material loose]\nclass = 7\nrepose_angle = 25\n")
     (tmp_path / "twin.ini").write_text(case)
-    run_ok(["run", "twin.ini", "-o", "twin.h5", "-q"], cwd=tmp_path)
-    run_ok(["fit", "twin.ini", "twin.h5", "--param", "material sand.repose_angle=27:33",
-            "--param", "material sand.static_angle=33.5:39", "-o", "fit.json", "-q"],
-           cwd=tmp_path, timeout=300)
-    best = json.loads((tmp_path / "fit.json").read_text())["best"]["params"]
+    best = fit_twin(tmp_path, "material sand.repose_angle=27:33",
+                    "material sand.static_angle=33.5:39")
     a_d, a_s = best["material sand.repose_angle"], best["material sand.static_angle"]
     assert abs(a_d - 30.0) <= 0.5 and abs(a_s - 36.0) <= 0.5, (
         f"fit found repose_angle {a_d:.3f}, static_angle {a_s:.3f}: the twin's are 30 and 36")
@@ -504,11 +507,8 @@ def test_one_angle_per_class_of_a_twin(tmp_path):
     (tmp_path / "ridge.asc").write_text(asc(ridge))
     (tmp_path / "classes.asc").write_text(asc(classes))
     (tmp_path / "twin.ini").write_text(CLASS_TWIN)
-    run_ok(["run", "twin.ini", "-o", "twin.h5", "-q"], cwd=tmp_path)
-    run_ok(["fit", "twin.ini", "twin.h5", "--param", "material sand.repose_angle=27:33",
-            "--param", "material gravel.repose_angle=37:43", "-o", "fit.json", "-q"],
-           cwd=tmp_path, timeout=300)
-    best = json.loads((tmp_path / "fit.json").read_text())["best"]["params"]
+    best = fit_twin(tmp_path, "material sand.repose_angle=27:33",
+                    "material gravel.repose_angle=37:43")
     sand, gravel = best["material sand.repose_angle"], best["material gravel.repose_angle"]
     assert abs(sand - 30.0) <= 0.5 and abs(gravel - 40.0) <= 0.5, (
         f"fit found sand {sand:.3f}, gravel {gravel:.3f} degrees: the twin's are 30 and 40")

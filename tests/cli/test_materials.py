@@ -14,6 +14,7 @@ import subprocess
 import numpy as np
 
 from conftest import SANDSLIDE_PAUSE, h5open, hook_binary, pause_env, run, same_bits, wait_paused
+from test_crs import UTM33N_ESRI
 from test_relax import read_asc, write_asc
 
 DX = 1.0
@@ -156,15 +157,8 @@ def test_bad_angle_rasters(tmp_path):
     assert r.returncode == 2 and "(0, 90)" in r.stderr, r.stderr
 
 
-# What GDAL 3.6 writes as the .prj of EPSG:32633 (as test_crs.py), and the
-# zone west of it.
-UTM33N = (
-    'PROJCS["WGS_1984_UTM_Zone_33N",GEOGCS["GCS_WGS_1984",DATUM["D_WGS_1984",'
-    'SPHEROID["WGS_1984",6378137.0,298.257223563]],PRIMEM["Greenwich",0.0],'
-    'UNIT["Degree",0.0174532925199433]],PROJECTION["Transverse_Mercator"],'
-    'PARAMETER["False_Easting",500000.0],PARAMETER["False_Northing",0.0],'
-    'PARAMETER["Central_Meridian",15.0],PARAMETER["Scale_Factor",0.9996],'
-    'PARAMETER["Latitude_Of_Origin",0.0],UNIT["Meter",1.0]]')
+# What GDAL 3.6 writes as the .prj of EPSG:32633, and the zone west of it.
+UTM33N = UTM33N_ESRI
 UTM32N = UTM33N.replace("Zone_33N", "Zone_32N").replace('Meridian",15.0', 'Meridian",9.0')
 
 
