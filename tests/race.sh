@@ -102,20 +102,25 @@ rate = 0.05
 start = 0
 stop = 0.2
 EOF
-{
-	printf 'ncols 48\nnrows 40\nxllcorner 0\nyllcorner 0\ncellsize 0.025\n'
+# An ESRI ASCII grid of $1 x $2 cells of $3 m on stdout: the value of cell
+# (i, j), j counted from the north row, is the v that function $4 sets for i j.
+raster() {
+	printf 'ncols %s\nnrows %s\nxllcorner 0\nyllcorner 0\ncellsize %s\n' "$1" "$2" "$3"
 	j=0
-	while [ $j -lt 40 ]; do
+	while [ $j -lt "$2" ]; do
 		i=0
 		row=""
-		while [ $i -lt 48 ]; do
-			row="$row 0.02"
+		while [ $i -lt "$1" ]; do
+			$4 $i $j
+			row="$row $v"
 			i=$((i + 1))
 		done
 		echo "$row"
 		j=$((j + 1))
 	done
-} >bed.asc
+}
+flat_bed() { v=0.02; }
+raster 48 40 0.025 flat_bed >bed.asc
 
 check "run, fast kernel, tiles 8x4" "$bin" run case.ini -o fast.h5 -q --tile 8x4
 check "run, reference kernel" "$bin" run case.ini -o ref.h5 -q --reference-kernel
@@ -125,39 +130,15 @@ check "run, periodic sides" "$bin" run case.ini -o per.h5 -q --tile 8x4 \
 check "render series" "$bin" render fast.h5 -o frames --contour 0.02 --label
 check "render oblique" "$bin" render fast.h5 -o oblique --frames -1 --style oblique
 # a cliff: the western third 0.5 m higher
-{
-	printf 'ncols 40\nnrows 24\nxllcorner 0\nyllcorner 0\ncellsize 0.05\n'
-	j=0
-	while [ $j -lt 24 ]; do
-		i=0
-		row=""
-		while [ $i -lt 40 ]; do
-			if [ $i -lt 13 ]; then row="$row 0.5"; else row="$row 0"; fi
-			i=$((i + 1))
-		done
-		echo "$row"
-		j=$((j + 1))
-	done
-} >cliff.asc
+cliff() { if [ "$1" -lt 13 ]; then v=0.5; else v=0; fi; }
+raster 40 24 0.05 cliff >cliff.asc
 check "relax" "$bin" relax cliff.asc -o cliff-relaxed.asc --max-time 2
 # until steady: forward Euler, then the approach to rest's super-steps
 check "relax to rest, tiles 8x4" "$bin" relax cliff.asc -o cliff-rest.asc --tile 8x4
 # materials: 30 and 40 degrees in bands of rows (doc/model.md#materials);
 # hysteresis: the states updated between steps, a reduction of the threads
-{
-	printf 'ncols 40\nnrows 24\nxllcorner 0\nyllcorner 0\ncellsize 0.05\n'
-	j=0
-	while [ $j -lt 24 ]; do
-		i=0
-		row=""
-		while [ $i -lt 40 ]; do
-			if [ $((j / 6 % 2)) -eq 0 ]; then row="$row 30"; else row="$row 40"; fi
-			i=$((i + 1))
-		done
-		echo "$row"
-		j=$((j + 1))
-	done
-} >angles.asc
+bands() { if [ $(($2 / 6 % 2)) -eq 0 ]; then v=30; else v=40; fi; }
+raster 40 24 0.05 bands >angles.asc
 check "relax, two materials, tiles 8x4" "$bin" relax cliff.asc -o cliff-angles.asc \
 	--angle angles.asc --tile 8x4
 check "relax, hysteresis, tiles 8x4" "$bin" relax cliff.asc -o cliff-hysteresis.asc \

@@ -305,10 +305,6 @@ int SS_PATH_FN(ss_face_fluxes)(const struct ss_face_rule *r, int n,
 	return any;
 }
 
-/* The same, the rule of face k gathered from the table: the same
- * expressions with each face's numbers, so the bits of a face are those of
- * ss_face_fluxes with its rule.  Faces of different forms evaluate each
- * form present and keep their own. */
 #if SS_PATH == SS_PATH_AVX512
 /* Coulomb faces of at most 8 rules in one pass, each face's numbers
  * permuted out of registers and nothing stored but the flux: the
@@ -353,6 +349,10 @@ static int coulomb_in_registers(const struct ss_face_table *t, int n,
 }
 #endif
 
+/* The same, the rule of face k gathered from the table: the same
+ * expressions with each face's numbers, so the bits of a face are those of
+ * ss_face_fluxes with its rule.  Faces of different forms evaluate each
+ * form present and keep their own. */
 int SS_PATH_FN(ss_face_fluxes_mixed)(const struct ss_face_table *t, int n,
                                      const uint16_t *restrict rule,
                                      const double *restrict g_n, const double *restrict g_t,

@@ -82,9 +82,9 @@ void ss_face_table_release(struct ss_face_table *t);
 /* The rule number of the face between cells a and b (storage indices):
  * the larger of the two.  Materials are numbered by angle, smallest first
  * (stepper.h), so a face holds up to the larger angle of its two cells;
- * hysteresis numbers moving sand above sand at rest, so a face beside
- * moving sand slides at the dynamic angle (doc/model.md#materials,
- * #hysteresis). */
+ * hysteresis numbers material n's moving sand 2n + 1, above its sand at
+ * rest, 2n, so a face beside moving sand of its material slides at the
+ * dynamic angle (doc/model.md#materials, #hysteresis). */
 static inline uint16_t ss_face_material(const uint16_t *material, ptrdiff_t a, ptrdiff_t b)
 {
 	return material[b] > material[a] ? material[b] : material[a];
@@ -98,8 +98,9 @@ int ss_face_fluxes(const struct ss_face_rule *r, int n,
                     const double *restrict g_n, const double *restrict g_t,
                     double *restrict flux);
 
-/* The same with the table's rule rule[k] for face k (ss_face_material): the arithmetic of ss_face_fluxes with that rule's
- * numbers, so one rule everywhere gives ss_face_fluxes' bits. */
+/* The same with the table's rule rule[k] for face k (ss_face_material):
+ * the arithmetic of ss_face_fluxes with that rule's numbers, so one rule
+ * everywhere gives ss_face_fluxes' bits. */
 int ss_face_fluxes_mixed(const struct ss_face_table *t, int n, const uint16_t *restrict rule,
                          const double *restrict g_n, const double *restrict g_t,
                          double *restrict flux);

@@ -86,17 +86,9 @@ static double cell_faces(const struct ss_grid *g, const double *h, const uint8_t
 	const double inv_2a[4] = {inv_2dy, inv_2dy, inv_2dx, inv_2dx};
 	double q_max = 0.0, flux_max = 0.0;
 	for (int f = 0; f < 4; f++) {
-		const ptrdiff_t p = a[f], q = p + normal[f], l = along[f];
-		if (!ss_face_carries(ss_cell_type_get(t, p), ss_cell_type_get(t, q)))
-			continue;
-#define H_ALONG(c, d) (ss_cell_type_get(t, (c) + (d)) == SS_CELL_WALL ? h[c] : h[(c) + (d)])
-		const double cdp = (H_ALONG(p, l) - H_ALONG(p, -l)) * inv_2a[f];
-		const double cdq = (H_ALONG(q, l) - H_ALONG(q, -l)) * inv_2a[f];
-#undef H_ALONG
-		const double gn = (h[q] - h[p]) * inv_n[f], gt = 0.5 * (cdp + cdq);
-		const double s2 = gn * gn + gt * gt, slope = sqrt(s2);
-		const double flux = slope > 0.0 ? ss_closure_eval(moving, slope) * fabs(gn) / slope
-		                                : 0.0;
+		double s2;
+		const double flux = ss_sweep_face_sliding(h, t, a[f], normal[f], along[f], inv_n[f],
+		                                          inv_2a[f], moving, &s2);
 		q_max = s2 > q_max || s2 != s2 ? s2 : q_max;
 		flux_max = flux > flux_max || flux != flux ? flux : flux_max;
 	}

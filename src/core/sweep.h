@@ -206,6 +206,18 @@ double ss_sweep_max_sand_slope(const struct ss_grid *g, const double *restrict h
                                const double *restrict bedrock, double bare);
 
 /*
+ * One face between cells a and b = a + normal (storage indices; `along`
+ * the neighbour offset along it, the spacings' inverses): its s^2 into
+ * *s2 (0 where it cannot carry flux) and, returned, its sliding flux over
+ * nu at closure c, f(s) |g_n| / s (0 where s is 0 or NaN).  The kernel's
+ * expressions (a wall neighbour mirrored), for single faces: the steady
+ * measure with materials and hysteresis's states.
+ */
+double ss_sweep_face_sliding(const double *h, const uint8_t *t, ptrdiff_t a, ptrdiff_t normal,
+                             ptrdiff_t along, double inv_spacing, double inv_2along,
+                             const struct ss_closure *c, double *s2);
+
+/*
  * Several materials (doc/model.md#materials): the largest over the faces
  * that carry flux (with a bedrock, those whose stencil lies in sand, as
  * above) of f_d(s) |g_n| / s / f_tol_d, the sliding flux across the face

@@ -392,6 +392,15 @@ double SS_PATH_FN(ss_sweep_max_sand_slope)(const struct ss_grid *g,
 }
 
 #if SS_PATH == SS_PATH_GENERIC
+double ss_sweep_face_sliding(const double *h, const uint8_t *t, ptrdiff_t a, ptrdiff_t normal,
+                             ptrdiff_t along, double inv_spacing, double inv_2along,
+                             const struct ss_closure *c, double *s2)
+{
+	*s2 = double_of(face_slope2_bits(h, t, a, normal, along, inv_spacing, inv_2along));
+	const double s = sqrt(*s2), g_n = (h[a + normal] - h[a]) * inv_spacing;
+	return s > 0.0 ? ss_closure_eval(c, s) * fabs(g_n) / s : 0.0;
+}
+
 /* f_d(s) |g_n| / s / f_tol_d of one face (ss_sweep_material_excess); 0 where it
  * carries nothing or lies on rock. */
 static double face_excess(const double *h, const uint8_t *t, const uint16_t *material,
@@ -401,17 +410,16 @@ static double face_excess(const double *h, const uint8_t *t, const uint16_t *mat
 {
 	if (bedrock && !stencil_in_sand(h, bedrock, t, a, normal, along, bare))
 		return 0.0;
-	const double s = sqrt(double_of(face_slope2_bits(h, t, a, normal, along, inv_spacing,
-	                                                 inv_2along)));
-	const double g_n = (h[a + normal] - h[a]) * inv_spacing;
 	const uint16_t d = ss_face_material(material, a, a + normal);
 	const double tol_slope = materials[d].tan_cr + slope_tol;
 	const double f_tol = slope_tol / sqrt(1.0 + tol_slope * tol_slope);   /* f_coulomb */
-	/* the sliding flux across the face, |F| / nu = f(s) |g_n| / s: a face
-	 * beside a steeper material may be steeper than its own angle along
-	 * the face (g_t) and still carry nothing across it */
-	const double e = s > 0.0 ? ss_closure_eval(&materials[d], s) * fabs(g_n) / s / f_tol : 0.0;
-	return s != s ? NAN : e;
+	/* the sliding flux across the face: a face beside a steeper material
+	 * may be steeper than its own angle along the face (g_t) and still
+	 * carry nothing across it */
+	double s2;
+	const double e = ss_sweep_face_sliding(h, t, a, normal, along, inv_spacing, inv_2along,
+	                                       &materials[d], &s2) / f_tol;
+	return s2 != s2 ? NAN : e;
 }
 
 double ss_sweep_material_excess(const struct ss_grid *g, const double *restrict height,

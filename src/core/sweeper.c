@@ -64,21 +64,20 @@ int ss_sweeper_rules(struct ss_stepper *st)
 int ss_sweeper_change_rules(struct ss_stepper *st)
 {
 	struct ss_sweeper *w = st->sweeper;
-	const struct ss_face_table table = w->materials;
+	struct ss_face_table old = w->materials;
 	const struct ss_face_rule rule = w->face_rule;
 	const struct ss_cfl_bound bound = w->cfl_bound;
 	memset(&w->materials, 0, sizeof w->materials);
 	const int err = ss_sweeper_rules(st);
-	if (err) {
+	if (err) {   /* the new table goes, the old one stays */
 		ss_face_table_release(&w->materials);
-		w->materials = table;
+		w->materials = old;
 		w->face_rule = rule;
 		w->cfl_bound = bound;
-		return err;
+	} else {
+		ss_face_table_release(&old);
 	}
-	struct ss_face_table old = table;
-	ss_face_table_release(&old);
-	return SS_OK;
+	return err;
 }
 
 int ss_sweeper_prepare(struct ss_stepper *st)

@@ -9,13 +9,13 @@ number; bad rasters are refused with the file, the cell and the value.
 import json
 import math
 import signal
-import subprocess
 
 import numpy as np
 
-from conftest import SANDSLIDE_PAUSE, h5open, hook_binary, pause_env, run, same_bits, wait_paused
+from conftest import h5open, run, same_bits
 from test_crs import UTM33N_ESRI
 from test_relax import read_asc, write_asc
+from test_reliability import start_paused
 
 DX = 1.0
 
@@ -223,20 +223,6 @@ disk = 0 0 0.06
 rate = 0.02
 stop = 45
 """
-
-
-def start_paused(args, cwd, step):
-    """sandslide-pause with args, paused after substep `step` (conftest)."""
-    marker = cwd / "paused"
-    p = subprocess.Popen([hook_binary(SANDSLIDE_PAUSE)] + args, cwd=cwd, stdout=subprocess.PIPE,
-                         stderr=subprocess.PIPE, text=True, env=pause_env(step, marker))
-    try:
-        wait_paused(p, marker, step)
-    except BaseException:
-        p.kill()
-        p.communicate()
-        raise
-    return p
 
 
 def steepest_deg(h, dx=0.05):
