@@ -179,6 +179,12 @@ struct ss_cfl_bound {
 void ss_cfl_bound_init(struct ss_cfl_bound *t, const struct ss_closure *c);
 /* Lambda(S)/nu for the largest face slope S >= 0 (0 when S <= tan a_cr). */
 double ss_cfl_bound_lookup(const struct ss_cfl_bound *t, double s_max);
+/* bound[k], k < SS_CFL_TABLE_SIZE: the largest slope whose entry of the
+ * table is at most k, so that the entry ss_cfl_bound_lookup picks for s is
+ * the first k with s <= bound[k] (SS_CFL_TABLE_SIZE if none), found by
+ * comparisons: how the GPU looks it up without atan(), whose last bit
+ * differs between C libraries (doc/gpu.md).  The same for every closure. */
+void ss_cfl_bound_thresholds(double bound[SS_CFL_TABLE_SIZE]);
 /* Widen t to bound closure c too, whose nu is c->nu where t's is nu_t:
  * Lambda_t(S) >= (c->nu / nu_t) Lambda_c(S) for every S (several materials,
  * doc/model.md#materials). */

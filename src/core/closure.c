@@ -7,6 +7,8 @@
 #include "sandslide/closure.h"
 
 #include <math.h>
+#include <stdint.h>
+#include <string.h>
 
 #include "base/strings.h"
 #include "sandslide/error.h"
@@ -93,6 +95,33 @@ double ss_cfl_bound_lookup(const struct ss_cfl_bound *t, double s_max)
 	if (k > SS_CFL_TABLE_SIZE)
 		k = SS_CFL_TABLE_SIZE;
 	return t->lambda_max[(int)k];
+}
+
+/* The entry of the table for slope s >= 0, unclamped from above. */
+static double cfl_entry(double s)
+{
+	const double dangle = (M_PI / 2.0) / SS_CFL_TABLE_SIZE;
+	const double k = ceil(atan(s) / dangle);
+	return k > SS_CFL_TABLE_SIZE ? SS_CFL_TABLE_SIZE : k;
+}
+
+void ss_cfl_bound_thresholds(double bound[SS_CFL_TABLE_SIZE])
+{
+	/* non-negative doubles are ordered as their bits: bisect on them for
+	 * the last s whose entry is <= k (the entry never falls as s grows) */
+	for (int k = 0; k < SS_CFL_TABLE_SIZE; k++) {
+		uint64_t lo = 0, hi = 0x7ff0000000000000u;     /* entry(0) = 0 <= k < entry(inf) */
+		while (hi - lo > 1) {
+			const uint64_t mid = lo + (hi - lo) / 2;
+			double s;
+			memcpy(&s, &mid, sizeof s);
+			if (cfl_entry(s) <= k)
+				lo = mid;
+			else
+				hi = mid;
+		}
+		memcpy(&bound[k], &lo, sizeof lo);
+	}
 }
 
 void ss_cfl_bound_widen(struct ss_cfl_bound *t, const struct ss_closure *c, double nu_t)

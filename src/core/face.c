@@ -9,6 +9,10 @@
  * compiler vectorises it; a face below the critical slope is evaluated at
  * s^2 = 1 (where every formula is finite) and its result replaced by 0.
  *
+ * Each face's expressions are face_point.h's functions (ss_point_coulomb,
+ * ...), which the GPU's kernels compile too (doc/gpu.md#the-same-bits):
+ * called in these loops they are inlined and vectorised as before.
+ *
  * Compiled once per instruction-set path (core/cpu_paths.h): the AVX-512
  * copy computes the reciprocal square roots with vrsqrt14pd, the others
  * with 1/sqrt; the rest is the same source, vectorised for each path.  The
@@ -34,13 +38,6 @@ enum { CHUNK = 128 };
  * face (step 1): inlined into each caller so that step and the form are
  * constants there, and the uniform copy keeps its numbers in registers. */
 #define FACE_INLINE static inline __attribute__((always_inline))
-
-/* max(x, 0) as a select: fmax() is a library call unless -ffast-math, and
- * stops vectorisation.  A NaN gives 0, as fmax(NaN, 0) does. */
-static inline double positive_part(double x)
-{
-	return x > 0.0 ? x : 0.0;
-}
 
 #if SS_PATH == SS_PATH_GENERIC
 void ss_face_rule_init(struct ss_face_rule *r, const struct ss_closure *c)
@@ -141,7 +138,7 @@ FACE_INLINE int slopes_and_rsqrt(int m, const double *restrict tan_cr2, int step
 void SS_PATH_FN(ss_face_rsqrt)(int n, const double *restrict x, double *restrict y)
 {
 	for (int k = 0; k < n; k++)
-		y[k] = 1.0 / sqrt(x[k]);
+		y[k] = ss_point_rsqrt(x[k]);
 }
 
 FACE_INLINE int slopes_and_rsqrt(int m, const double *restrict tan_cr2, int step,
@@ -153,15 +150,15 @@ FACE_INLINE int slopes_and_rsqrt(int m, const double *restrict tan_cr2, int step
 	const double tan_cr2_one = tan_cr2[0];
 	int any = 0;
 	for (int k = 0; k < m; k++) {
-		const double q = gn[k] * gn[k] + gt[k] * gt[k];
+		const double q = gn[k] * gn[k] + gt[k] * gt[k];   /* ss_point_flux's s^2 */
 		const int sl = q > (step ? tan_cr2[k] : tan_cr2_one);
 		s2[k] = sl ? q : 1.0;
 		slides[k] = sl ? 1.0 : 0.0;
 		any |= sl;
 	}
 	for (int k = 0; k < m; k++) {
-		inv_s[k] = 1.0 / sqrt(s2[k]);
-		inv_w[k] = 1.0 / sqrt(1.0 + s2[k]);
+		inv_s[k] = ss_point_rsqrt(s2[k]);
+		inv_w[k] = ss_point_rsqrt(1.0 + s2[k]);
 	}
 	return any;
 }
@@ -215,50 +212,32 @@ FACE_INLINE void f_over_s(enum ss_face_form form, const struct numbers *p, int s
 #define GAMMA (step ? gammas[k] : gamma)
 	switch (form) {
 	case SS_FACE_COULOMB:
-		for (int k = 0; k < m; k++) {
-			const double s = s2[k] * inv_s[k];
-			out[k] = positive_part(s - TAN_CR) * inv_w[k] * inv_s[k];
-		}
+		for (int k = 0; k < m; k++)
+			out[k] = ss_point_coulomb(s2[k], inv_s[k], inv_w[k], TAN_CR);
 		break;
 	case SS_FACE_BINGHAM:
-		for (int k = 0; k < m; k++) {
-			const double s = s2[k] * inv_s[k], w = (1.0 + s2[k]) * inv_w[k];
-			const double b = s * inv_w[k] * INV_SIN_CR, rb = w * inv_s[k] * SIN_CR;
-			const double e = positive_part(b - 1.0);
-			out[k] = rb * (2.0 + rb) * (e * e) * inv_s[k];
-		}
+		for (int k = 0; k < m; k++)
+			out[k] = ss_point_bingham(s2[k], inv_s[k], inv_w[k], SIN_CR, INV_SIN_CR);
 		break;
 	case SS_FACE_HB_CUBE:
 	case SS_FACE_HB_THREE_HALVES:
 	case SS_FACE_HB_POW:
-		for (int k = 0; k < m; k++) {
-			const double s = s2[k] * inv_s[k], w = (1.0 + s2[k]) * inv_w[k];
-			const double b = s * inv_w[k] * INV_SIN_CR, rb = w * inv_s[k] * SIN_CR;
-			const double e = positive_part(b - 1.0);
-			const double ep = form == SS_FACE_HB_CUBE ? e * e * e
-			                : form == SS_FACE_HB_THREE_HALVES ? e * sqrt(e)
-			                : e;   /* raised to the power below */
-			out[k] = rb * (1.0 + GAMMA + GAMMA * rb) * ep * inv_s[k];
-		}
+		for (int k = 0; k < m; k++)
+			out[k] = ss_point_herschel_bulkley(form, s2[k], inv_s[k], inv_w[k], SIN_CR,
+			                                   INV_SIN_CR, GAMMA);
 		if (form == SS_FACE_HB_POW) {
 			/* out = coefficient * e: divide e back out only where it is
 			 * positive, i.e. apply e^(p-1) to the sliding faces */
 			for (int k = 0; k < m; k++) {
-				const double s = s2[k] * inv_s[k];
-				const double e = positive_part(s * inv_w[k] * INV_SIN_CR - 1.0);
+				const double e = ss_point_excess(s2[k], inv_s[k], inv_w[k], INV_SIN_CR);
 				if (e > 0.0)
 					out[k] *= pow(e, (step ? powers[k] : powers[0]) - 1.0);
 			}
 		}
 		break;
 	case SS_FACE_CASSON:
-		for (int k = 0; k < m; k++) {
-			const double s = s2[k] * inv_s[k], w = (1.0 + s2[k]) * inv_w[k];
-			const double b = s * inv_w[k] * INV_SIN_CR, rb = w * inv_s[k] * SIN_CR;
-			const double q = sqrt(b), e = positive_part(q - 1.0);
-			out[k] = rb * rb * (10.0 * b * q + 6.0 * b + 3.0 * q + 1.0) *
-			         (e * e * e) * inv_s[k];
-		}
+		for (int k = 0; k < m; k++)
+			out[k] = ss_point_casson(s2[k], inv_s[k], inv_w[k], SIN_CR, INV_SIN_CR);
 		break;
 	}
 #undef TAN_CR
@@ -300,7 +279,7 @@ int SS_PATH_FN(ss_face_fluxes)(const struct ss_face_rule *r, int n,
 		any |= slopes_and_rsqrt(m, &r->tan_cr2, 0, gn, g_t + base, s2, inv_s, inv_w, slides);
 		f_over_s_of(r->form, &one, 0, m, s2, inv_s, inv_w, fos);
 		for (int k = 0; k < m; k++)
-			flux[base + k] = slides[k] != 0.0 ? -(nu * gn[k]) * fos[k] : 0.0;
+			flux[base + k] = ss_point_flux_of(slides[k] != 0.0, nu, gn[k], fos[k]);
 	}
 	return any;
 }
@@ -411,10 +390,10 @@ int SS_PATH_FN(ss_face_fluxes_mixed)(const struct ss_face_table *t, int n,
 		}
 		if (t->one_nu)
 			for (int k = 0; k < m; k++)
-				flux[base + k] = slides[k] != 0.0 ? -(nu_one * gn[k]) * fos[k] : 0.0;
+				flux[base + k] = ss_point_flux_of(slides[k] != 0.0, nu_one, gn[k], fos[k]);
 		else
 			for (int k = 0; k < m; k++)
-				flux[base + k] = slides[k] != 0.0 ? -(nu[k] * gn[k]) * fos[k] : 0.0;
+				flux[base + k] = ss_point_flux_of(slides[k] != 0.0, nu[k], gn[k], fos[k]);
 	}
 	return any;
 }

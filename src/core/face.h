@@ -34,18 +34,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "core/face_point.h"
 #include "sandslide/closure.h"
-
-/* The formula a sweep instantiates; a Herschel-Bulkley power with a short
- * exact form gets its own. */
-enum ss_face_form {
-	SS_FACE_COULOMB,
-	SS_FACE_BINGHAM,
-	SS_FACE_HB_POW,            /* e^p by pow() */
-	SS_FACE_HB_CUBE,           /* gamma = 1/2: e^3 */
-	SS_FACE_HB_THREE_HALVES,   /* gamma = 2: e sqrt(e) */
-	SS_FACE_CASSON,
-};
 
 /*
  * The rules of a grid of several materials (doc/model.md#materials), by
@@ -74,6 +64,22 @@ struct ss_face_rule {
 };
 
 void ss_face_rule_init(struct ss_face_rule *r, const struct ss_closure *c);
+
+/* The rule's numbers by value, as the device's kernels and
+ * ss_point_flux take them (face_point.h). */
+static inline struct ss_point_rule ss_face_point_rule(const struct ss_face_rule *r)
+{
+	struct ss_point_rule p;
+	p.form = (int)r->form;
+	p.nu = r->nu;
+	p.tan_cr = r->tan_cr;
+	p.tan_cr2 = r->tan_cr2;
+	p.sin_cr = r->sin_cr;
+	p.inv_sin_cr = r->inv_sin_cr;
+	p.gamma = r->gamma;
+	p.power = r->power;
+	return p;
+}
 
 /* The table of count closures; SS_ERR_FAIL if out of memory. */
 int ss_face_table_create(struct ss_face_table *t, const struct ss_closure *c, int count);

@@ -11,6 +11,10 @@
 #include <math.h>
 #include <stddef.h>
 
+/* face_point.h spells the cell types as its own constants (nvcc reads it) */
+_Static_assert((int)SS_POINT_FLOW == (int)SS_CELL_FLOW && (int)SS_POINT_WALL == (int)SS_CELL_WALL &&
+               (int)SS_POINT_OPEN == (int)SS_CELL_OPEN, "face_point.h's cell types are grid.h's");
+
 void ss_tiling_init(struct ss_tiling *t, const struct ss_grid *g,
                     int tile_nx, int tile_ny)
 {
@@ -54,23 +58,12 @@ static inline struct face_ends faces_of(const struct ss_grid *g, struct ss_tile_
 	return e;
 }
 
-/* Central difference of h at cell k along the direction with neighbour
- * offset `step`, a wall neighbour replaced by the cell itself (doc/model.md
- * #mirror-ghost-at-walls), times 1/(2 spacing). */
-static inline double central_difference(const double *restrict h,
-                                        const uint8_t *restrict type,
-                                        ptrdiff_t k, ptrdiff_t step,
-                                        double inv_2spacing)
-{
-	const double hp = type[k + step] == SS_CELL_WALL ? h[k] : h[k + step];
-	const double hm = type[k - step] == SS_CELL_WALL ? h[k] : h[k - step];
-	return (hp - hm) * inv_2spacing;
-}
-
 /*
  * The flux through the face between cells a (west/south) and b = a + normal
  * (east/north): g_n across the face, g_t the mean of both cells' central
- * differences along it (offset `along`).  sweep_fast.c spells the same
+ * differences along it (offset `along`; face_point.h, the formulas the GPU's
+ * kernels share).  The flux is the path's (ss_face_fluxes: the AVX-512
+ * path's reciprocal square roots are its own).  sweep_fast.c spells the same
  * expressions again, a row of faces at a time so that they vectorise: two
  * copies on purpose, this one the plain statement the other is tested
  * against bit for bit.
@@ -85,9 +78,8 @@ static inline double face_flux(const struct ss_face_rule *rule,
 	const ptrdiff_t b = a + normal;
 	if (!ss_face_carries(type[a], type[b]))
 		return 0.0;
-	const double g_n = (h[b] - h[a]) * inv_spacing;
-	const double g_t = 0.5 * (central_difference(h, type, a, along, inv_2along) +
-	                          central_difference(h, type, b, along, inv_2along));
+	double g_n, g_t;
+	ss_point_gradients(h, type, a, normal, along, inv_spacing, inv_2along, &g_n, &g_t);
 	const double s2 = g_n * g_n + g_t * g_t;
 	/* a NaN slope must not vanish in the maximum */
 	if (s2 > *s2_max || s2 != s2)
@@ -177,8 +169,8 @@ static inline double rate_at(const double *restrict flux_x, const double *restri
                              const double *restrict source_rate, ptrdiff_t k,
                              ptrdiff_t stride, double inv_dx, double inv_dy)
 {
-	const double rate = (flux_x[k] - flux_x[k + 1]) * inv_dx +
-	                    (flux_y[k] - flux_y[k + stride]) * inv_dy;
+	const double rate = ss_point_rate(flux_x[k], flux_x[k + 1], flux_y[k], flux_y[k + stride],
+	                                  inv_dx, inv_dy);
 	return source_rate ? rate + source_rate[k] : rate;
 }
 
@@ -203,7 +195,7 @@ double ss_sweep_update(const struct ss_grid *g, const struct ss_tiling *t,
 				const double rate = rate_at(flux_x, flux_y, source_rate, k, stride,
 				                            inv_dx, inv_dy);
 				const int flows = cell_type[k] == SS_CELL_FLOW;
-				height[k] = flows ? height[k] + dt * rate : height[k];
+				height[k] = ss_point_euler(height[k], dt, rate, flows);
 				const double a = flows ? fabs(rate) : 0.0;
 				/* a NaN rate must not vanish in the maximum */
 				if (a > rate_max || a != a)

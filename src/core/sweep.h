@@ -29,17 +29,6 @@
 #include "core/face.h"
 #include "sandslide/grid.h"
 
-/*
- * A face carries flux when neither side is a wall and one side flows: a
- * face between two open cells, or touching a wall, carries 0.  Both kernels
- * ask it of every face (the fast one also as wide_carries, sweep_fast.c).
- */
-static inline int ss_face_carries(uint8_t a, uint8_t b)
-{
-	return a != SS_CELL_WALL && b != SS_CELL_WALL &&
-	       (a == SS_CELL_FLOW || b == SS_CELL_FLOW);
-}
-
 struct ss_tiling {
 	int tile_nx, tile_ny;    /* cells per tile */
 	int tiles_x, tiles_y;    /* tiles covering the block */
