@@ -33,6 +33,12 @@
 #                   runs the distributed tests, tests/cli/test_mpi.py;
 #                   `make MPI=1 test-slurm` runs doc/cluster.md's Slurm job
 #                   on a one-node Slurm started here, as root)
+#   make CUDA=1     build-cuda/sandslide with the GPU backend (nvcc from
+#                   CUDA_HOME, /usr/local/cuda; CUDA_ARCHS=90, the H100's
+#                   and H200's sm_90, as a list: CUDA_ARCHS="80 90");
+#                   `make CUDA=1 test-cuda` checks the kernels' PTX and
+#                   runs tests/gpu/, whose GPU tests skip without a GPU
+#                   (doc/gpu.md)
 #   make check-layering  the tiers of src/README.md, by their #includes
 #   make FONT=FILE  build with another default font for the text of pictures
 #                   (DejaVu Sans of fonts-dejavu-core otherwise; SANDSLIDE_FONT
@@ -48,10 +54,14 @@ endif
 ifeq ($(MPI),1)
   BUILD    ?= build-mpi
 endif
+ifeq ($(CUDA),1)
+  BUILD    ?= build-cuda
+endif
 BUILD      ?= build
 PKG_CONFIG ?= pkg-config
 PYTHON     ?= /usr/bin/python3
 MPI        ?= 0
+CUDA       ?= 0
 ifeq ($(MPI),1)
   # Open MPI, Debian's default MPI, named explicitly: mpicc is an
   # alternative that another MPI may have taken
@@ -224,6 +234,30 @@ endif
 ifeq ($(MPI),1)
   MPIFLAG := -DSS_HAVE_MPI
 endif
+# The GPU backend (doc/gpu.md): src/cuda/*.cu compiled by nvcc for each
+# architecture in CUDA_ARCHS (machine code, and PTX for newer GPUs to
+# compile at load), the CUDA runtime linked statically (no path to find
+# at run time; the driver, libcuda, is loaded by it when there is one).
+# -fmad=false: no a * b + c fused into an FMA (the CPU's -ffp-contract=off);
+# IEEE division and square root (nvcc's defaults, named): the device's bits
+# are the CPU's generic path's (face_point.h, tests/gpu/check_ptx.sh).
+CUDA_HOME  ?= /usr/local/cuda
+NVCC       ?= $(CUDA_HOME)/bin/nvcc
+CUDA_ARCHS ?= 90
+NVCC_FP    := -fmad=false -prec-div=true -prec-sqrt=true -ftz=false
+ifeq ($(CUDA),1)
+  ifeq ($(wildcard $(NVCC)),)
+    ifneq ($(filter-out $(NO_PROBE_GOALS),$(or $(MAKECMDGOALS),all)),)
+      $(error make CUDA=1: no nvcc at $(NVCC): set CUDA_HOME to the CUDA toolkit (Debian has none; NVIDIA's, 12 or later))
+    endif
+  endif
+  CUDAFLAG  := -DSS_HAVE_CUDA
+  CU_SRC    := $(wildcard src/cuda/*.cu)
+  NVCC_FLAGS := -std=c++17 -O3 $(NVCC_FP) \
+                $(foreach a,$(CUDA_ARCHS),-gencode arch=compute_$(a),code=[sm_$(a),compute_$(a)]) \
+                -Xcompiler -fPIC,-Wall,-Wextra -Iinclude -Isrc $(CUDAFLAG) -MMD -MP
+  CUDA_LIBS := -L$(CUDA_HOME)/lib64 -L$(CUDA_HOME)/lib -lcudart_static -lstdc++ -ldl -lrt -lpthread
+endif
 # Sources made by the build (the viewer's script as a C array): GEN, on
 # the include path of every build of the library.  The top folder is on it
 # too, for the renderer's headers that other tiers include as
@@ -233,12 +267,12 @@ GEN      := $(BUILD)/gen
 # -fPIC: the same objects make the static and the shared library (on
 # x86-64 the kernel's loops make no calls through the PLT or GOT, so the
 # sweep runs as fast: doc/performance.md#how-the-figures-were-measured).
-ALL_CFLAGS  := $(BASE) -fPIC $(WARN) $(OMPFLAG) $(SANFLAG) $(MPIFLAG) $(PATHDEF) -Iinclude -Isrc \
+ALL_CFLAGS  := $(BASE) -fPIC $(WARN) $(OMPFLAG) $(SANFLAG) $(MPIFLAG) $(CUDAFLAG) $(PATHDEF) -Iinclude -Isrc \
                -I. -I$(GEN) \
                -DSS_VERSION='"$(VERSION)"' $(FONT_FLAG) \
                $(DEP_CFLAGS) -MMD -MP $(CFLAGS)
 ALL_LDFLAGS := $(OMPFLAG) $(SANFLAG) $(LDFLAGS)
-LIBS        := $(DEP_LIBS) -lm
+LIBS        := $(DEP_LIBS) $(CUDA_LIBS) -lm
 
 ifeq ($(V),1)
   Q :=
@@ -255,7 +289,7 @@ RENDER_SRC := $(wildcard render/*.c)
 LIB_OBJ  := $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o) $(RENDER_SRC:render/%.c=$(BUILD)/obj/render/%.o)
 # the kernel's copies per instruction-set path: FILE-avx2.o, FILE-avx512.o
 KERNEL_OBJ := $(foreach p,$(KERNEL_PATHS),$(KERNEL_SRC:src/%.c=$(BUILD)/obj/%-$(p).o))
-LIB_OBJ  += $(KERNEL_OBJ)
+LIB_OBJ  += $(KERNEL_OBJ) $(CU_SRC:src/%.cu=$(BUILD)/obj/%.cu.o)
 MAIN_OBJ := $(CLI_SRC:src/%.c=$(BUILD)/obj/%.o)
 TEST_SRC := $(wildcard tests/test_*.c)
 TEST_BIN := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
@@ -271,7 +305,7 @@ all: $(BUILD)/sandslide $(BUILD)/libsandslide.a $(BUILD)/libsandslide.so $(BUILD
 lib: $(BUILD)/libsandslide.so
 
 # A flags stamp: objects rebuild when the flags change (git's GIT-CFLAGS).
-STAMP := $(ALL_CFLAGS) $(PATHFLAGS_avx2) $(PATHFLAGS_avx512) $(ALL_LDFLAGS) $(LIBS)
+STAMP := $(ALL_CFLAGS) $(PATHFLAGS_avx2) $(PATHFLAGS_avx512) $(ALL_LDFLAGS) $(LIBS) $(NVCC_FLAGS)
 $(BUILD)/.flags: FORCE
 	@mkdir -p $(@D)
 	@echo '$(STAMP)' | cmp -s - $@ || echo '$(STAMP)' > $@
@@ -291,6 +325,11 @@ $(BUILD)/obj/%-avx512.o: src/%.c $(BUILD)/.flags
 	@mkdir -p $(@D)
 	@$(if $(Q),echo '  CC      $< (avx512)')
 	$(Q)$(CC) $(ALL_CFLAGS) $(PATHFLAGS_avx512) -c $< -o $@
+
+$(BUILD)/obj/%.cu.o: src/%.cu $(BUILD)/.flags
+	@mkdir -p $(@D)
+	@$(if $(Q),echo '  NVCC    $<')
+	$(Q)$(NVCC) $(NVCC_FLAGS) -c $< -o $@
 
 $(BUILD)/obj/render/%.o: render/%.c $(BUILD)/.flags
 	@mkdir -p $(@D)
@@ -504,6 +543,25 @@ test-mpi: all $(BUILD)/tests/test_comm $(HOOK_PAUSE) $(HOOK_BATCH)
 	  $(MPI_ENV) SANDSLIDE_MPI=$(abspath $(BUILD)/sandslide) SANDSLIDE=$(abspath build/sandslide) \
 	  SANDSLIDE_MPI_PAUSE=$(abspath $(HOOK_PAUSE)) SANDSLIDE_MPI_BATCH=$(abspath $(HOOK_BATCH)) \
 	  $(PYTHON) -m pytest -q -rs tests/cli/test_mpi.py
+
+# The GPU backend's checks (make CUDA=1 test-cuda; doc/gpu.md), on any
+# machine: the kernels' PTX has no fused multiply-add
+# (tests/gpu/check_ptx.sh, with the build's nvcc flags), then
+# tests/gpu/test_cuda (the device's loop against the CPU's generic path,
+# bit for bit) and tests/gpu/test_gpu_bench.py (bench on the GPU, the CLI's
+# refusals), whose GPU checks skip with the reason where there is no GPU;
+# tests/cli/test_device.py with this build's binary.  On the GPU machine
+# tools/gpu_check.sh runs it, and the measurements.
+NVCC_PTX_FLAGS := -std=c++17 -O3 $(NVCC_FP) -arch=compute_$(firstword $(CUDA_ARCHS)) \
+                  -Iinclude -Isrc -DSS_HAVE_CUDA
+.PHONY: test-cuda
+test-cuda: all $(BUILD)/tests/gpu/test_cuda
+	@[ "$(CUDA)" = 1 ] || { echo "test-cuda: run it as make CUDA=1 test-cuda"; exit 2; }
+	@echo "== tests/gpu/check_ptx.sh"; sh tests/gpu/check_ptx.sh $(NVCC) $(NVCC_PTX_FLAGS)
+	@echo "== $(BUILD)/tests/gpu/test_cuda"; ./$(BUILD)/tests/gpu/test_cuda
+	@echo "== tests/gpu, tests/cli/test_device.py (pytest)"; \
+	  SANDSLIDE=$(abspath $(BUILD)/sandslide) \
+	  $(PYTHON) -m pytest -q -rs tests/gpu tests/cli/test_device.py
 
 # A real Slurm on this machine (make MPI=1 test-slurm; make deps-slurm
 # installs it): tests/slurm/run.sh starts munged, slurmctld and slurmd as

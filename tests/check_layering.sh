@@ -4,6 +4,9 @@
 # of each file (`make check-layering`, run by `make test`):
 #
 #   src/core    the kernel: no file format, no printing, no upper tier
+#   src/cuda    the GPU (make CUDA=1): the kernel's formulas on the device;
+#               no file format, no upper tier
+#   <cuda_runtime.h>  only in src/cuda/*.cu, the only code that calls CUDA
 #   src/io      file formats: nothing of the stencil
 #   src/model   case and set-up: no app or CLI
 #   render/     pictures from the HDF5 output: not the kernel, not HDF5
@@ -39,17 +42,27 @@ upper="sandslide/(snapshot|dem|render|run|relax|bench|case|shape|progress)\.h"
 
 # shellcheck disable=SC2086
 check "the kernel (src/core) includes a file format, stdio or an upper tier" \
-	"hdf5\.h|hdf5_hl\.h|png\.h|gdal.*\.h|cpl_.*\.h|ini\.h|stdio\.h|(io|model|app|cli)/.*|$upper" \
+	"hdf5\.h|hdf5_hl\.h|png\.h|gdal.*\.h|cpl_.*\.h|ini\.h|stdio\.h|(cuda|io|model|app|cli)/.*|$upper" \
 	src/core/* $core_headers
+# shellcheck disable=SC2086
+check "the GPU tier (src/cuda) includes a file format or an upper tier" \
+	"hdf5\.h|hdf5_hl\.h|png\.h|gdal.*\.h|cpl_.*\.h|ini\.h|(io|model|app|cli)/.*|$upper" src/cuda/*
+cuda=$(grep -lE '^[[:space:]]*#[[:space:]]*include[[:space:]]*<cuda' -r src render include tests \
+       | grep -vE '^src/cuda/[a-z0-9_]+\.cu$')
+if [ -n "$cuda" ]; then
+	echo "check-layering: a CUDA header outside src/cuda/*.cu:"
+	echo "$cuda" | sed 's/^/    /'
+	fail=1
+fi
 check "I/O (src/io) includes the stencil or an upper tier" \
-	"sandslide/stepper\.h|core/.*|(model|app|cli)/.*" src/io/*
+	"sandslide/stepper\.h|core/.*|cuda/.*|(model|app|cli)/.*" src/io/*
 check "the model set-up (src/model) includes an upper tier" "(app|cli)/.*" src/model/*
 check "the renderer (render/) includes the kernel, HDF5 or an upper tier" \
 	"hdf5\.h|hdf5_hl\.h|sandslide/(stepper|closure)\.h|core/.*|(model|app|cli)/.*" render/*
 check "the library includes the command line (src/cli)" "cli/.*" \
 	src/base/* src/core/* src/model/* src/io/* src/app/* render/* include/sandslide/*
 check "a public header (include/sandslide) includes an internal one, which is not installed" \
-	"(base|core|io|model|app|cli|render)/.*" include/sandslide/*
+	"(base|core|cuda|io|model|app|cli|render)/.*" include/sandslide/*
 
 hdf5=$(grep -lE '^[[:space:]]*#[[:space:]]*include[[:space:]]*(<hdf5|"io/h5_)' -r src render include \
        tests/*.c | grep -vE '^src/io/h5_[a-z0-9_]+\.[ch]$')

@@ -909,6 +909,28 @@ static void config_names_a_case_or_a_dem(void)
 	ss_bmi_destroy(a);
 	ss_bmi_destroy(b);
 
+	/* device = cpu is the default; a GPU is refused with the reason (this
+	 * build has no CUDA, the machine no GPU, or the BMI's loop is not on
+	 * one yet: doc/gpu.md) */
+	check_write_file(check_file("case.cfg"), "[bmi]\ncase = cone.ini\ndevice = cpu\n");
+	m = ss_bmi_create();
+	CHECK(m && m->initialize(m, check_file("case.cfg")) == BMI_SUCCESS,
+	      "case with device = cpu: %s", ss_error_last_message());
+	ss_bmi_destroy(m);
+	static const char *const gpus[] = {"[bmi]\ncase = cone.ini\ndevice = cuda\n",
+	                                   "[bmi]\ndem = pile.asc\ntime_step = 1\ndevice = cuda:1\n"};
+	for (size_t k = 0; k < sizeof gpus / sizeof *gpus; k++) {
+		check_write_file(check_file("bad.cfg"), gpus[k]);
+		m = ss_bmi_create();
+		CHECK(m && m->initialize(m, check_file("bad.cfg")) == BMI_FAILURE && !m->data,
+		      "%s accepted", gpus[k]);
+		CHECK(strstr(ss_error_last_message(), "[bmi] device = cuda") &&
+		      (strstr(ss_error_last_message(), "no CUDA") ||
+		       strstr(ss_error_last_message(), "GPU")),
+		      "%s: the refusal does not say why: %s", gpus[k], ss_error_last_message());
+		ss_bmi_destroy(m);
+	}
+
 	/* refused, each with nothing kept */
 	static const char *const bad[] = {
 		"[bmi]\ndem = pile.asc\n",                                   /* no time_step */
@@ -920,6 +942,7 @@ static void config_names_a_case_or_a_dem(void)
 		"[bmi]\ndem = missing.asc\ntime_step = 1\n",
 		"[bmi]\nend = 3\n",
 		"[bmi]\ncase = cone.ini\n[grid]\nnx = 3\n",
+		"[bmi]\ncase = cone.ini\ndevice = gpu\n",
 	};
 	for (size_t k = 0; k < sizeof bad / sizeof *bad; k++) {
 		check_write_file(check_file("bad.cfg"), bad[k]);

@@ -22,6 +22,12 @@
  * per cell are those the sweep's design moves (heights read and written,
  * the ring rows, the type byte on tiles that need it); the roofline is the
  * probe's bandwidth over them.
+ *
+ * On a GPU (--device cuda[:N], a build with CUDA; doc/gpu.md) a case is
+ * the device's forward-Euler loop (src/cuda/cuda.h): every cell every
+ * step, 26 B per cell-update, against a device-to-device copy's bandwidth;
+ * the thread counts do not apply, and the room (RKL2) and materials are
+ * not on the device yet.
  */
 #ifndef SANDSLIDE_BENCH_H
 #define SANDSLIDE_BENCH_H
@@ -29,6 +35,7 @@
 #include <stddef.h>
 
 #include "sandslide/closure.h"
+#include "sandslide/device.h"
 #include "sandslide/option.h"
 
 #define SS_BENCH_MAX_CASES 8
@@ -58,13 +65,18 @@ struct ss_bench_header {
 	const int *threads;                /* thread_count entries */
 	const double *bandwidth;           /* bytes/s, read+write, per entry */
 	int angles;                        /* repose angles (materials) */
+	const char *device;                /* NULL: the CPU; else the GPU,
+	                                    * "cuda:0: NVIDIA H200, ..." (its
+	                                    * bandwidth: a device-to-device
+	                                    * copy, the one entry of bandwidth) */
+	const char *note;                  /* NULL, or what was left out */
 };
 
 /* One case: a surface, closure and thread count. */
 struct ss_bench_result {
 	enum ss_bench_surface surface;
 	const char *closure;               /* its label */
-	int threads;
+	int threads;                       /* 0 on a GPU */
 	double median, min, max;           /* cell-updates/s over the repeats */
 	long long steps;                   /* timed steps per repeat */
 	double active_fraction;            /* tiles swept / tiles */
@@ -87,6 +99,9 @@ struct ss_bench_options {
 	int angles;                                        /* repose angles over
 	                                                    * the grid (materials,
 	                                                    * doc/model.md); 1: one */
+	struct ss_device device;                           /* the CPU, or a GPU:
+	                                                    * forward Euler on the
+	                                                    * device (doc/gpu.md) */
 	/* the figures, as they come (the caller prints them) */
 	void (*on_header)(void *context, const struct ss_bench_header *h);
 	void (*on_result)(void *context, const struct ss_bench_result *r);

@@ -15,6 +15,7 @@
 
 #include <signal.h>
 
+#include "sandslide/device.h"
 #include "sandslide/option.h"
 #include "sandslide/progress.h"
 
@@ -29,6 +30,8 @@ struct ss_job {
 	int tile[2];                 /* cells per tile of the sweep, nx and ny;
 	                              * <= 0: the defaults (the same bits for
 	                              * any tile size) */
+	struct ss_device device;     /* where it computes (device.h): the CPU
+	                              * unless --device names a GPU */
 	const char *history;         /* the command line, for the output */
 	const volatile sig_atomic_t *stop_signal; /* when it becomes non-zero,
 	                              * the command stops after its substep and
@@ -38,8 +41,8 @@ struct ss_job {
 };
 
 /* The job's options (option.h): force and threads, a part of the run,
- * relax, fit and render tables; tile and history, of the commands that
- * step a model (run, relax, fit; at the same struct).  The output is each
+ * relax, fit and render tables; tile, device and history, of the commands
+ * that step a model (run, relax, fit; at the same struct).  The output is each
  * command's own row (its meaning and default differ), stored in the job. */
 extern const struct ss_option_table ss_job_option_table;
 extern const struct ss_option_table ss_job_stepping_option_table;

@@ -24,6 +24,7 @@
 #include "sandslide/option.h"
 #include "sandslide/comm.h"
 #include "sandslide/cpu.h"
+#include "sandslide/device.h"
 
 #include "sandslide/grid.h"
 #include "sandslide/boundary.h"

@@ -246,7 +246,7 @@ def relax(heights: np.typing.ArrayLike, dx: float, dy: Optional[float] = None,
           cfl: Optional[float] = None, nodata: Optional[str] = None, open_level: Optional[float] = None,
           add_sand: Optional[str] = None, sand_rate: Optional[float] = None,
           sand_duration: Optional[float] = None,
-          tile: Union[str, Tuple[int, int], None] = None,
+          tile: Union[str, Tuple[int, int], None] = None, device: Optional[str] = None,
           progress: bool = False) -> Tuple[np.ndarray, Dict[str, Any]]:
     """Relax a DEM array to the angle of repose, as ``sandslide relax`` does.
 
@@ -351,7 +351,7 @@ def relax(heights: np.typing.ArrayLike, dx: float, dy: Optional[float] = None,
              "rkl2_tol": rkl2_tol, "rkl2_pouring_tol": rkl2_pouring_tol,
              "static_angle": static_angle, "max_time": max_time, "cfl": cfl, "nodata": nodata,
              "open_level": open_level, "add_sand": add_sand, "sand_rate": sand_rate,
-             "sand_duration": sand_duration, "tile": _tile_word(tile)}
+             "sand_duration": sand_duration, "tile": _tile_word(tile), "device": device}
     report = ctypes.create_string_buffer(_JSON_BYTES)
     ny, nx = h.shape
     keywords = _keywords("relax", extra=(("dem", "heights", False), ("dy", "dy", False)))
@@ -380,7 +380,8 @@ relax.__doc__ = relax.__doc__.format(
 def run(case: PathLike, out: PathLike,
         set: Union[Mapping[str, Any], Sequence[str], str, None] = None, *,
         unset: Union[str, Sequence[str], None] = None, threads: Optional[int] = None,
-        force: bool = False, progress: bool = False) -> Dict[str, Any]:
+        force: bool = False, device: Optional[str] = None,
+        progress: bool = False) -> Dict[str, Any]:
     """Run a case file, as ``sandslide run CASE -o OUT [--set ...]`` does.
 
     Parameters
@@ -400,6 +401,10 @@ def run(case: PathLike, out: PathLike,
     {threads}
     force : bool, optional
         Replace an existing output; without it an existing out is refused.
+    device : str, optional
+        "cpu" (the default), or "cuda" / "cuda:N" in a build with CUDA
+        (doc/gpu.md): a GPU that is not there, or a build without CUDA, is
+        an InputError with the reason.
     {progress}
 
     Returns
@@ -450,7 +455,7 @@ def run(case: PathLike, out: PathLike,
     summary = ctypes.create_string_buffer(_JSON_BYTES)
     # the library's run options that are run()'s keywords: restart is not
     keywords = _keywords("run", rename=(("output", "out"),),
-                         only=("case", "output", "set", "unset", "threads", "force"))
+                         only=("case", "output", "set", "unset", "threads", "force", "device"))
     with _native.Options("run", keywords) as o:
         o.set("case", os.fspath(case))
         o.set("output", os.fspath(out))
@@ -463,6 +468,8 @@ def run(case: PathLike, out: PathLike,
             o.set("threads", _word(threads))
         if force:
             o.set("force", "1")
+        if device is not None:
+            o.set("device", _word(device))
         _native.call(o, _native.lib.ss_run_case_json,
                      (o.ptr, summary, len(summary)), progress="run" if progress else None,
                      keywords=keywords, hdf5=True)

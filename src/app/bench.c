@@ -18,6 +18,7 @@
 #include "core/rkl2.h"
 #include "core/sources.h"
 #include "core/sweeper.h"
+#include "cuda/cuda.h"
 #include "sandslide/boundary.h"
 #include "sandslide/error.h"
 #include "sandslide/parallel.h"
@@ -224,6 +225,97 @@ struct case_result {
 	long long steps;             /* timed steps per repeat */
 };
 
+/* Steps per timing: about 0.3 s worth, from one step taking `one` s. */
+static long long steps_for(double one)
+{
+	const long long steps = (long long)ceil(0.3 / fmax(one, 1e-6));
+	return steps < 1 ? 1 : steps > 2000 ? 2000 : steps;
+}
+
+/* The median, min and max of rates[0 .. repeats - 1] into res. */
+static void rate_summary(double *rates, int repeats, struct case_result *res)
+{
+	res->min = res->max = rates[0];
+	for (int r = 1; r < repeats; r++) {
+		res->min = fmin(res->min, rates[r]);
+		res->max = fmax(res->max, rates[r]);
+	}
+	res->median = median(rates, repeats);
+}
+
+/* The device's loop set up from the prepared stepper: its heights (halo
+ * filled), cell types a byte each, one rule, the CFL table and its
+ * thresholds (closure.h). */
+static int gpu_create(const struct ss_bench_options *o, struct ss_stepper *st,
+                      double lambda_idle, struct ss_cuda_euler **e)
+{
+	const struct ss_grid *g = &st->grid;
+	const size_t n = ss_grid_storage_cells(g);
+	uint8_t *types = ss_alloc(n, 1, "cell types");
+	double *bound = ss_alloc(SS_CFL_TABLE_SIZE, sizeof *bound, "CFL table thresholds");
+	int err = types && bound ? SS_OK : SS_ERR_FAIL;
+	if (!err) {
+		ss_cell_types_unpack(st->cell_types, 0, n, types);
+		ss_cfl_bound_thresholds(bound);
+		ss_boundary_fill_heights(g, &st->boundary, st->height);
+		struct ss_cuda_euler_setup s = {
+			.device = o->device.index, .nx = g->nx, .ny = g->ny, .stride = g->stride,
+			.dx = g->dx, .dy = g->dy, .open_level = st->boundary.open_level,
+			.rule = ss_face_point_rule(&st->sweeper->face_rule), .cfl = st->cfl,
+			.lambda_idle = lambda_idle, .lambda = st->sweeper->cfl_bound.lambda_max,
+			.bound = bound, .table_size = SS_CFL_TABLE_SIZE, .height = st->height,
+			.type = types,
+		};
+		for (int k = 0; k < 4; k++)
+			s.side[k] = (int)st->boundary.side[k];
+		err = ss_cuda_euler_create(e, &s);
+	}
+	ss_free(types);
+	ss_free(bound);
+	return err;
+}
+
+/* A case on the GPU: the steps queued and timed to their end (the wall
+ * clock around them and the wait). */
+static int run_case_gpu(const struct ss_bench_options *o, struct ss_stepper *st,
+                        enum ss_bench_surface surface, const struct ss_bench_closure *bc,
+                        double lambda_idle, struct case_result *res)
+{
+	struct ss_cuda_euler *e = NULL;
+	int nonfinite = 0;
+	int err = gpu_create(o, st, lambda_idle, &e);
+	/* warm-up (the graph's capture), then one step timed */
+	if (!err && !(err = ss_cuda_euler_steps(e, 1)))
+		err = ss_cuda_euler_finish(e, &nonfinite);
+	long long steps = o->steps;
+	if (!err && steps <= 0) {
+		const double t0 = ss_parallel_wall_seconds();
+		if (!(err = ss_cuda_euler_steps(e, 16)) && !(err = ss_cuda_euler_finish(e, &nonfinite)))
+			steps = steps_for((ss_parallel_wall_seconds() - t0) / 16.0);
+	}
+	double rates[64];
+	const int repeats = o->repeats < 64 ? o->repeats : 64;
+	const double cells = (double)st->grid.nx * st->grid.ny;
+	for (int r = 0; r < repeats && !err; r++) {
+		const double t0 = ss_parallel_wall_seconds();
+		if (!(err = ss_cuda_euler_steps(e, steps)))
+			err = ss_cuda_euler_finish(e, &nonfinite);
+		rates[r] = cells * (double)steps / (ss_parallel_wall_seconds() - t0);
+	}
+	ss_cuda_euler_destroy(e);
+	if (err)
+		return err;
+	if (nonfinite)
+		return ss_error_fail("bench %s %s on the GPU: a height became NaN or infinite",
+		                     surface_names[surface], bc->label);
+	res->active_fraction = 1.0;
+	res->plain_fraction = 1.0;
+	res->tile_ny = 0;
+	res->steps = steps;
+	rate_summary(rates, repeats, res);
+	return SS_OK;
+}
+
 static int run_case(const struct ss_bench_options *o, enum ss_bench_surface surface,
                     const struct ss_bench_closure *bc, struct case_result *res)
 {
@@ -264,6 +356,11 @@ static int run_case(const struct ss_bench_options *o, enum ss_bench_surface surf
 
 	struct ss_sweeper *w = st.sweeper;
 	const double lambda_idle = st.closure.nu * ss_cfl_bound_lookup(&w->cfl_bound, 2.0 * c.tan_cr);
+	if (o->device.kind == SS_DEVICE_CUDA) {
+		err = run_case_gpu(o, &st, surface, bc, lambda_idle, res);
+		ss_stepper_release(&st);
+		return err;
+	}
 	/* a step: a substep, or for the room a super-step of ROOM_STAGES + 1
 	 * evaluations, which the rate counts */
 	const int per_step = room ? ROOM_STAGES + 1 : 1;
@@ -274,9 +371,7 @@ static int run_case(const struct ss_bench_options *o, enum ss_bench_surface surf
 		/* enough steps for about 0.3 s per timing */
 		const double t0 = ss_parallel_wall_seconds();
 		bench_one(&st, room, lambda_idle, &nonfinite);
-		const double one = ss_parallel_wall_seconds() - t0;
-		steps = (long long)ceil(0.3 / fmax(one, 1e-6));
-		steps = steps < 1 ? 1 : steps > 2000 ? 2000 : steps;
+		steps = steps_for(ss_parallel_wall_seconds() - t0);
 	}
 	double rates[64];
 	const int repeats = o->repeats < 64 ? o->repeats : 64;
@@ -300,12 +395,7 @@ static int run_case(const struct ss_bench_options *o, enum ss_bench_surface surf
 	res->plain_fraction = plain / w->fast.tiles;
 	res->tile_ny = w->tiling.tile_ny;
 	res->steps = steps;
-	res->min = res->max = rates[0];
-	for (int r = 1; r < repeats; r++) {
-		res->min = fmin(res->min, rates[r]);
-		res->max = fmax(res->max, rates[r]);
-	}
-	res->median = median(rates, repeats);
+	rate_summary(rates, repeats, res);
 	ss_stepper_release(&st);
 	return SS_OK;
 }
@@ -362,40 +452,80 @@ static int probe_bandwidth(const struct ss_bench_options *o, size_t *probe_n,
 	return SS_OK;
 }
 
+/* The GPU's side of the header: its name, a copy's bandwidth, and the
+ * surfaces it leaves out. */
+static int gpu_header(const struct ss_bench_options *o, char *device, size_t device_size,
+                      size_t *probe_n, double *bandwidth, int *surfaces)
+{
+	char what[32], name[16];
+	snprintf(what, sizeof what, "--device %s", ss_device_format(&o->device, name, sizeof name));
+	int err = SS_OK;
+	if (o->angles > 1)
+		err = ss_error_input("--angles %d with %s: materials do not run on the GPU yet "
+		                     "(doc/gpu.md#what-runs-on-the-gpu)", o->angles, what);
+	char description[160];
+	if (!err)
+		err = ss_cuda_device_describe(o->device.index, description, sizeof description);
+	if (err)
+		return err;
+	snprintf(device, device_size, "%s: %s", name, description);
+	const size_t n = (size_t)o->nx * (size_t)o->ny;
+	*probe_n = n > ((size_t)1 << 25) ? n : (size_t)1 << 25;
+	surfaces[SS_BENCH_ROOM] = 0;
+	return ss_cuda_copy_bandwidth(o->device.index, *probe_n * sizeof(double), bandwidth);
+}
+
 int ss_bench_run(const struct ss_bench_options *o)
 {
 	struct ss_tiling tiling;
 	struct ss_grid g;
 	double bandwidth[SS_BENCH_MAX_CASES];
 	size_t probe_n;
-	int err = check_size(o);
+	int surfaces[SS_BENCH_SURFACES];
+	char device[192];
+	const int gpu = o->device.kind == SS_DEVICE_CUDA;
+	memcpy(surfaces, o->surfaces, sizeof surfaces);
+	char name[16], what[32];
+	snprintf(what, sizeof what, "--device %s", ss_device_format(&o->device, name, sizeof name));
+	int err = ss_device_check(&o->device, what);
+	if (!err)
+		err = check_size(o);
 	if (err)
 		return err;
 	if (ss_grid_init(&g, o->nx, o->ny, SPACING_M, SPACING_M, 0.0, 0.0))
 		return SS_ERR_INPUT;
 	ss_tiling_init(&tiling, &g, o->tile[0], o->tile[1]);
-	if ((err = probe_bandwidth(o, &probe_n, bandwidth)))
+	if ((err = gpu ? gpu_header(o, device, sizeof device, &probe_n, bandwidth, surfaces)
+	               : probe_bandwidth(o, &probe_n, bandwidth)))
 		return err;
+	/* on a GPU one case per surface and closure: its threads are its own */
+	static const int no_threads[1] = {0};
+	const int thread_count = gpu ? 1 : o->thread_count;
+	const int *threads = gpu ? no_threads : o->threads;
 	const struct ss_bench_header h = {
 		.nx = o->nx, .ny = o->ny, .tile_nx = tiling.tile_nx, .tile_ny = tiling.tile_ny,
-		.repeats = o->repeats, .rsqrt = ss_face_rsqrt_method(), .probe_doubles = probe_n,
-		.thread_count = o->thread_count, .threads = o->threads, .bandwidth = bandwidth,
-		.angles = o->angles,
+		.repeats = o->repeats, .rsqrt = gpu ? "1/sqrt (IEEE, CUDA)" : ss_face_rsqrt_method(),
+		.probe_doubles = probe_n, .thread_count = thread_count, .threads = threads,
+		.bandwidth = bandwidth, .angles = o->angles, .device = gpu ? device : NULL,
+		.note = gpu && o->surfaces[SS_BENCH_ROOM]
+		        ? "the room (RKL2 with a source) is not on the GPU yet: left out" : NULL,
 	};
 	if (o->on_header)
 		o->on_header(o->context, &h);
 	for (int s = 0; s < SS_BENCH_SURFACES; s++) {
-		for (int c = 0; c < o->closure_count && o->surfaces[s]; c++) {
-			for (int t = 0; t < o->thread_count; t++) {
+		for (int c = 0; c < o->closure_count && surfaces[s]; c++) {
+			for (int t = 0; t < thread_count; t++) {
 				struct case_result r = {0};
-				ss_parallel_set_threads(o->threads[t]);
+				if (!gpu)
+					ss_parallel_set_threads(threads[t]);
 				if ((err = run_case(o, (enum ss_bench_surface)s, &o->closures[c], &r)))
 					return err;
-				const double bytes = bytes_per_cell((enum ss_bench_surface)s, r.tile_ny,
-				                                    r.plain_fraction, o->angles);
+				const double bytes = gpu ? ss_cuda_euler_bytes_per_update()
+				                         : bytes_per_cell((enum ss_bench_surface)s, r.tile_ny,
+				                                          r.plain_fraction, o->angles);
 				const struct ss_bench_result res = {
 					.surface = (enum ss_bench_surface)s, .closure = o->closures[c].label,
-					.threads = o->threads[t], .median = r.median, .min = r.min,
+					.threads = threads[t], .median = r.median, .min = r.min,
 					.max = r.max, .steps = r.steps, .active_fraction = r.active_fraction,
 					.bytes_per_cell = bytes, .roofline = bandwidth[t] / bytes,
 				};
@@ -483,6 +613,11 @@ static int parse_tile(const char *value, void *field)
 	return ss_parse_tile(value, field);
 }
 
+static int parse_device(const char *value, void *field)
+{
+	return ss_device_parse(value, field);
+}
+
 #define AT(m) offsetof(struct ss_bench_options, m)
 #define CELLS(n, m, h)                                                                 \
 	{.name = n, .value_name = "N", .kind = SS_OPTION_INT, .offset = AT(m),          \
@@ -516,6 +651,11 @@ static const struct ss_option options[] = {
 	{.name = "tile", .value_name = "NXxNY", .kind = SS_OPTION_WORD, .offset = AT(tile),
 	 .parse = parse_tile, .expected = "NXxNY, e.g. 256x64",
 	 .help = "tile size of the sweep (default 256x128)"},
+	{.name = "device", .value_name = "cpu|cuda[:N]", .kind = SS_OPTION_WORD,
+	 .offset = AT(device), .parse = parse_device, .default_value = "cpu",
+	 .expected = "cpu, cuda or cuda:N (N from 0 to 63)",
+	 .help = "the CPU, or GPU N of a build with CUDA: forward\n"
+	         "Euler on the device, --threads not used (doc/gpu.md)"},
 	{.name = "angles", .value_name = "N", .kind = SS_OPTION_INT, .offset = AT(angles),
 	 .default_value = "1", .lo = 1, .hi = 64, .expected = "1 to 64",
 	 .help = "repose angles from 30 to 40 deg in stripes 16 cells\n"

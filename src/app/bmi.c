@@ -20,6 +20,7 @@
 #include "model/setup.h"
 #include "sandslide/case.h"
 #include "sandslide/dem.h"
+#include "sandslide/device.h"
 #include "sandslide/error.h"
 #include "sandslide/relax.h"
 #include "sandslide/stepper.h"
@@ -102,8 +103,9 @@ static const struct var *find_var_of(const struct bmi_state *s, const char *name
  *     time_step = 10       ; s: what update advances (needed with dem)
  *     end = 600            ; s: the end time (default: max_time, else none)
  *     angle = 33           ; any other key: relax's option of that name
+ *     device = cpu         ; where it computes (device.h): only the CPU yet
  *
- * or `case = room.ini` alone.  File names are relative to the config's
+ * or `case = room.ini` (and device) alone.  File names are relative to the config's
  * folder.  A file without a [bmi] section is a case file.
  */
 #define CONFIG_MAX_KEYS 64
@@ -225,8 +227,8 @@ static int setup_dem(struct bmi_state *s, const struct config *cf)
 	int err = SS_OK;
 	for (int k = 0; !err && k < cf->count; k++) {
 		const char *key = cf->key[k], *value = cf->value[k];
-		if (!strcmp(key, "time_step") || !strcmp(key, "end"))
-			continue;
+		if (!strcmp(key, "time_step") || !strcmp(key, "end") || !strcmp(key, "device"))
+			continue;   /* device: setup's, checked */
 		if (!strcmp(key, "case"))
 			err = ss_error_input("%s: [bmi] names a case or a dem, not both", cf->path);
 		else if (!strcmp(key, "output") || !strcmp(key, "report") ||
@@ -266,6 +268,23 @@ static int setup_dem(struct bmi_state *s, const struct config *cf)
 	return err;
 }
 
+/* [bmi] device = cpu|cuda[:N] (device.h): the CPU, or the reason the
+ * BMI cannot have the GPU it names. */
+static int check_device(const char *config_file, const char *value)
+{
+	struct ss_device d;
+	if (ss_device_parse(value, &d))
+		return ss_error_input("%s: [bmi] device '%s': expected cpu, cuda or cuda:N (N from "
+		                      "0 to 63)", config_file, value);
+	char what[4200];
+	snprintf(what, sizeof what, "%s: [bmi] device = %s", config_file, value);
+	const int err = ss_device_check(&d, what);
+	if (err || d.kind == SS_DEVICE_CPU)
+		return err;
+	return ss_error_input("%s: the BMI does not run on a GPU yet, only bench does "
+	                      "(doc/gpu.md#what-runs-on-the-gpu)", what);
+}
+
 /* The model config_file describes (above) into s. */
 static int setup(struct bmi_state *s, const char *config_file)
 {
@@ -284,13 +303,16 @@ static int setup(struct bmi_state *s, const char *config_file)
 		err = ss_error_input("%s: a BMI config has one section, [bmi] (a case file has "
 		                     "none)", config_file);
 	const char *case_name = config_get(&cf, "case"), *dem = config_get(&cf, "dem");
+	const char *device = config_get(&cf, "device");
+	if (!err && device)
+		err = check_device(config_file, device);
 	if (!err && !case_name == !dem)
 		err = ss_error_input("%s: [bmi] needs case = CASE.ini or dem = DEM", config_file);
 	if (!err && case_name) {
 		char path[4096];
-		if (cf.count > 1)
-			err = ss_error_input("%s: [bmi] with case takes no other key: the case "
-			                     "file says the rest", config_file);
+		if (cf.count > 1 + (device != NULL))
+			err = ss_error_input("%s: [bmi] with case takes no other key but device: "
+			                     "the case file says the rest", config_file);
 		if (!err)
 			err = config_path(&cf, case_name, path, sizeof path);
 		if (!err)

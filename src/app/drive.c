@@ -25,6 +25,19 @@ void ss_drive_init(struct ss_drive *d, struct ss_stepper *st, double started)
 	d->trouble.good_snapshot = -1;
 }
 
+int ss_drive_check_device(const struct ss_device *d, const char *command)
+{
+	char name[16], what[32];
+	snprintf(what, sizeof what, "--device %s", ss_device_format(d, name, sizeof name));
+	const int err = ss_device_check(d, what);
+	if (err || d->kind == SS_DEVICE_CPU)
+		return err;
+	/* the GPU's loop is forward Euler on one closure, what bench measures;
+	 * the rest of the time loop is not on the device yet (doc/gpu.md) */
+	return ss_error_input("%s: %s does not run on a GPU yet, only bench does "
+	                      "(doc/gpu.md#what-runs-on-the-gpu)", what, command);
+}
+
 void ss_drive_set_threads(int threads)
 {
 	if (threads > 0)

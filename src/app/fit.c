@@ -1081,6 +1081,8 @@ int ss_fit_run(const struct ss_fit_options *o, char **report, char **summary)
 		*summary = NULL;
 	if (ss_comm_size() > 1)
 		return ss_error_input("fit runs on one rank: start it without mpirun");
+	if (ss_drive_check_device(&o->job.device, "fit"))
+		return SS_ERR_INPUT;
 	struct fit f;
 	memset(&f, 0, sizeof f);
 	f.o = o;

@@ -372,6 +372,8 @@ static void summarise(const struct run *r, enum ss_drive_end end, struct ss_run_
 
 int ss_run_case(const struct ss_run_options *o, struct ss_run_summary *summary)
 {
+	if (ss_drive_check_device(&o->job.device, "run"))
+		return SS_ERR_INPUT;
 	const double started = ss_parallel_wall_seconds();
 	struct run r;
 	memset(&r, 0, sizeof r);

@@ -15,6 +15,11 @@ static int parse_tile(const char *value, void *field)
 	return ss_parse_tile(value, field);
 }
 
+static int parse_device(const char *value, void *field)
+{
+	return ss_device_parse(value, field);
+}
+
 #define AT(m) offsetof(struct ss_job, m)
 
 static const struct ss_option options[] = {
@@ -38,6 +43,11 @@ static const struct ss_option stepping[] = {
 	 .help = "cells per tile of the sweep (default 256x128, smaller\n"
 	         "on small grids); results are the same bits for any\n"
 	         "tile size and thread count"},
+	{.name = "device", .value_name = "cpu|cuda[:N]", .kind = SS_OPTION_WORD,
+	 .offset = AT(device), .parse = parse_device, .default_value = "cpu",
+	 .expected = "cpu, cuda or cuda:N (N from 0 to 63)",
+	 .help = "where to compute: the CPU, or GPU N of a build\n"
+	         "with CUDA (make CUDA=1; doc/gpu.md)"},
 	{.name = "history", .kind = SS_OPTION_TEXT, .offset = AT(history),
 	 .flags = SS_OPTION_NAMED_ONLY, .expected = "a text",
 	 .help = "the output's history attribute (the command line)"},

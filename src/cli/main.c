@@ -21,6 +21,7 @@
 #include "cli/options.h"
 #include "cli/print.h"
 #include "sandslide/bench.h"
+#include "sandslide/device.h"
 #include "sandslide/dem.h"
 #include "sandslide/comm.h"
 #include "sandslide/cpu.h"
@@ -495,7 +496,7 @@ static int command(int argc, char **argv)
 	}
 	if (!strcmp(cmd, "--version") || !strcmp(cmd, "version")) {
 		printf("sandslide %s (OpenMP: %s, %d processors, wait policy %s; GDAL: %s; MPI: %s; "
-		       "kernel: %s)\n",
+		       "CUDA: %s; kernel: %s)\n",
 		       ss_version(),
 #ifdef _OPENMP
 		       "on",
@@ -504,7 +505,17 @@ static int command(int argc, char **argv)
 #endif
 		       ss_parallel_processors(), ss_parallel_wait_policy(),
 		       ss_dem_gdal_available() ? "on" : "off",
-		       ss_comm_library() ? ss_comm_library() : "off", ss_cpu_path_name(ss_cpu_path()));
+		       ss_comm_library() ? ss_comm_library() : "off",
+		       ss_device_cuda_built() ? "on" : "off", ss_cpu_path_name(ss_cpu_path()));
+		/* the devices --device may name, each on a line of its own */
+		char devices[2048];
+		ss_device_list(devices, sizeof devices);
+		printf("devices (--device):\n");
+		for (const char *line = devices; *line;) {
+			const size_t n = strcspn(line, "\n");
+			printf("  %.*s\n", (int)n, line);
+			line += n + (line[n] == '\n');
+		}
 		return 0;
 	}
 	/* the distributed commands: the others work on one block */

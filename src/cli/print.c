@@ -200,11 +200,21 @@ void cli_bench_header(void *context, const struct ss_bench_header *h)
 	const struct cli_bench *b = context;
 	if (b->json) {
 		printf("{\n  \"nx\": %d, \"ny\": %d, \"tile_nx\": %d, \"tile_ny\": %d,\n"
-		       "  \"repeats\": %d, \"rsqrt\": \"%s\", \"angles\": %d,\n"
-		       "  \"bandwidth_bytes_per_s\": {",
+		       "  \"repeats\": %d, \"rsqrt\": \"%s\", \"angles\": %d,\n",
 		       h->nx, h->ny, h->tile_nx, h->tile_ny, h->repeats, h->rsqrt, h->angles);
+		if (h->device) {
+			/* the GPU's name, and its bandwidth under "gpu" */
+			char text[512];
+			struct ss_strbuf json = {text, sizeof text, 0};
+			ss_strbuf_json_string(&json, h->device);
+			printf("  \"device\": %s,\n", text);
+		}
+		printf("  \"bandwidth_bytes_per_s\": {");
 		for (int t = 0; t < h->thread_count; t++)
-			printf("%s\"%d\": %.6g", t ? ", " : "", h->threads[t], h->bandwidth[t]);
+			if (h->device)
+				printf("\"gpu\": %.6g", h->bandwidth[t]);
+			else
+				printf("%s\"%d\": %.6g", t ? ", " : "", h->threads[t], h->bandwidth[t]);
 		printf("},\n  \"cases\": [");
 	} else {
 		char angles[64] = "";
@@ -213,10 +223,19 @@ void cli_bench_header(void *context, const struct ss_bench_header *h)
 		printf("sandslide bench: %d x %d cells, tiles %dx%d, %d repeats per case, "
 		       "reciprocal sqrt: %s%s\n", h->nx, h->ny, h->tile_nx, h->tile_ny, h->repeats,
 		       h->rsqrt, angles);
-		printf("memory bandwidth (read+write one array of %zu doubles):", h->probe_doubles);
-		for (int t = 0; t < h->thread_count; t++)
-			printf(" %d thread%s %.1f GB/s%s", h->threads[t], h->threads[t] > 1 ? "s" : "",
-			       h->bandwidth[t] * 1e-9, t + 1 < h->thread_count ? "," : "\n");
+		if (h->device) {
+			printf("device %s\n", h->device);
+			printf("memory bandwidth (device-to-device copy of %zu doubles): %.1f GB/s\n",
+			       h->probe_doubles, h->bandwidth[0] * 1e-9);
+		} else {
+			printf("memory bandwidth (read+write one array of %zu doubles):", h->probe_doubles);
+			for (int t = 0; t < h->thread_count; t++)
+				printf(" %d thread%s %.1f GB/s%s", h->threads[t],
+				       h->threads[t] > 1 ? "s" : "", h->bandwidth[t] * 1e-9,
+				       t + 1 < h->thread_count ? "," : "\n");
+		}
+		if (h->note)
+			printf("note: %s\n", h->note);
 		printf("\n%-14s %-22s %7s  %-34s %6s %6s %6s %8s\n", "surface", "closure", "threads",
 		       "cell-updates/s median [min, max]", "steps", "active", "B/cell", "roofline");
 	}
@@ -238,8 +257,10 @@ void cli_bench_result(void *context, const struct ss_bench_result *r)
 	} else {
 		char range[64];
 		snprintf(range, sizeof range, "%.3g [%.3g, %.3g]", r->median, r->min, r->max);
-		printf("%-14s %-22s %7d  %-34s %6lld %6.3f %6.2f %8.3f\n", surface, r->closure,
-		       r->threads, range, r->steps, r->active_fraction, r->bytes_per_cell,
+		char threads[16];
+		snprintf(threads, sizeof threads, r->threads > 0 ? "%d" : "gpu", r->threads);
+		printf("%-14s %-22s %7s  %-34s %6lld %6.3f %6.2f %8.3f\n", surface, r->closure,
+		       threads, range, r->steps, r->active_fraction, r->bytes_per_cell,
 		       r->median / r->roofline);
 	}
 	b->rows++;

@@ -98,6 +98,9 @@ SKIP = [
     (r"tools/busy_bench\.py",
      "a benchmark of minutes with two busy loops beside it, measured against another "
      "checkout (DIR): run by hand"),
+    (r"\bCUDA=1\b|tools/gpu_check\.sh|--device cuda",
+     "the GPU backend: `make CUDA=1 test-cuda` builds and checks it (CI), "
+     "tools/gpu_check.sh runs it on a GPU machine (doc/gpu.md)"),
     (r"--dems DIR\b",
      "the real DEMs of `make deps-bench` (R's and OpenFOAM's packages, not in CI; "
      "tools/real_dems.py writes them to DIR)"),

@@ -439,3 +439,33 @@ def test_relax_raster_refuses_degrees_and_an_existing_output(tmp_path):
     assert (tmp_path / "out.tif").read_bytes() == b"keep", "the existing output was touched"
     sandslide.relax_raster(tmp_path / "dem.tif", tmp_path / "out.tif", threads=1, force=True)
     assert g.Open(str(tmp_path / "out.tif")).RasterXSize == 20, "force=True did not replace it"
+
+
+# ---- device ---------------------------------------------------------------
+
+def test_device_keyword_refuses_a_gpu_it_cannot_have(tmp_path):
+    """device= of relax, run, relax_raster and fit: "cpu" is the default
+    and changes no bit; a GPU this build or machine cannot give is an
+    InputError naming the keyword and the reason (doc/gpu.md)."""
+    h = rough(12, 3)
+    plain, _ = sandslide.relax(h, 1.0)
+    on_cpu, _ = sandslide.relax(h, 1.0, device="cpu")
+    assert same_bits(plain, on_cpu), "device='cpu' gives other bits than the default"
+    (tmp_path / "tiny.ini").write_text(CASE)
+    calls = {
+        "relax": lambda d: sandslide.relax(h, 1.0, device=d),
+        "run": lambda d: sandslide.run(tmp_path / "tiny.ini", tmp_path / "t.h5", device=d),
+        "fit": lambda d: sandslide.fit(tmp_path / "tiny.ini", tmp_path / "obs.h5",
+                                       {"nu": "0.1:1"}, device=d),
+    }
+    for name, call in calls.items():
+        with pytest.raises(sandslide.InputError) as e:
+            call("cuda")
+        said = str(e.value)
+        assert said.startswith("device=cuda:0: ") and ("no CUDA" in said or "GPU" in said), \
+            f"{name}(device='cuda'): {said!r} should name device= and the reason"
+        with pytest.raises(sandslide.InputError) as e:
+            call("gpu")
+        assert str(e.value).startswith("device='gpu': expected cpu, cuda or cuda:N"), \
+            f"{name}(device='gpu'): {str(e.value)!r}"
+    assert not (tmp_path / "t.h5").exists(), "a refused run wrote its output"
