@@ -11,9 +11,9 @@
  *   cfl entry        ss_point_cfl_entry on ss_cfl_bound_thresholds picks the
  *                    entry ss_cfl_bound_lookup picks (atan), at random slopes
  *                    and next to every threshold
- *   device loop      the GPU's forward-Euler loop (src/cuda/euler.cu: halo,
- *                    the largest slope by a maximum over the faces each cell
- *                    owns, the step size from the thresholds, each cell's
+ *   device loop      the GPU's forward-Euler loop (src/cuda/euler.cu: halo
+ *                    by ss_point_ghost, the largest slope by a maximum of
+ *                    ss_point_cell_slope2, ss_point_step_size, each cell's
  *                    update from its four faces into a second buffer),
  *                    written here on the host with the same functions, gives
  *                    the reference sweep's bits at every step (euler_cases.h:
@@ -36,11 +36,6 @@
 #include "sandslide/parallel.h"
 
 static uint64_t seed = 20261205;
-
-static int same_bits(double a, double b)
-{
-	return memcmp(&a, &b, sizeof a) == 0;
-}
 
 /* ---- flux ----------------------------------------------------------------- */
 
@@ -145,16 +140,17 @@ static void host_fill_sides(const struct euler_case *c, double *h)
 	const int nx = g->nx, ny = g->ny;
 	const enum ss_side_kind *side = c->st.boundary.side;
 	const double open = c->st.boundary.open_level;
-#define GHOST(kind, far) ((kind) == SS_SIDE_PERIODIC ? h[far] : (kind) == SS_SIDE_WALL ? 0.0 : open)
 	for (int j = 0; j < ny; j++) {
-		h[ss_grid_index(g, -1, j)] = GHOST(side[SS_WEST], ss_grid_index(g, nx - 1, j));
-		h[ss_grid_index(g, nx, j)] = GHOST(side[SS_EAST], ss_grid_index(g, 0, j));
+		h[ss_grid_index(g, -1, j)] = ss_point_ghost(side[SS_WEST], h[ss_grid_index(g, nx - 1, j)],
+		                                            open);
+		h[ss_grid_index(g, nx, j)] = ss_point_ghost(side[SS_EAST], h[ss_grid_index(g, 0, j)], open);
 	}
 	for (int i = -1; i <= nx; i++) {
-		h[ss_grid_index(g, i, -1)] = GHOST(side[SS_SOUTH], ss_grid_index(g, i, ny - 1));
-		h[ss_grid_index(g, i, ny)] = GHOST(side[SS_NORTH], ss_grid_index(g, i, 0));
+		h[ss_grid_index(g, i, -1)] = ss_point_ghost(side[SS_SOUTH],
+		                                            h[ss_grid_index(g, i, ny - 1)], open);
+		h[ss_grid_index(g, i, ny)] = ss_point_ghost(side[SS_NORTH], h[ss_grid_index(g, i, 0)],
+		                                            open);
 	}
-#undef GHOST
 }
 
 static double host_step(const struct euler_case *c, const struct ss_point_rule *rule,
@@ -169,27 +165,14 @@ static double host_step(const struct euler_case *c, const struct ss_point_rule *
 	double *h = d->h[d->current], *next = d->h[1 - d->current];
 	host_fill_sides(c, h);
 	double s2 = 0.0;
-	for (int j = 0; j < g->ny; j++) {
-		for (int i = 0; i < g->nx; i++) {
-			const ptrdiff_t k = ss_grid_index(g, i, j);
-			double f[4];
-			f[0] = ss_point_face_slope2(h, type, k - 1, 1, stride, inv_dx, inv_2dy);
-			f[1] = ss_point_face_slope2(h, type, k - stride, stride, 1, inv_dy, inv_2dx);
-			f[2] = i == g->nx - 1 ? ss_point_face_slope2(h, type, k, 1, stride, inv_dx, inv_2dy)
-			                      : 0.0;
-			f[3] = j == g->ny - 1 ? ss_point_face_slope2(h, type, k, stride, 1, inv_dy, inv_2dx)
-			                      : 0.0;
-			for (int m = 0; m < 4; m++)
-				s2 = f[m] != f[m] ? INFINITY : f[m] > s2 ? f[m] : s2;
-		}
-	}
-	const double s_max = sqrt(s2);
-	double rate = s_max > rule->tan_cr
-	            ? rule->nu * c->st.sweeper->cfl_bound.lambda_max[ss_point_cfl_entry(
-	                  c->bound, SS_CFL_TABLE_SIZE, s_max)]
-	            : 0.0;
-	rate = rate > 0.0 ? rate : c->lambda_idle;
-	const double dt = c->st.cfl / (2.0 * rate * inv_d2);
+	for (int j = 0; j < g->ny; j++)
+		for (int i = 0; i < g->nx; i++)
+			s2 = fmax(s2, ss_point_cell_slope2(h, type, ss_grid_index(g, i, j), stride,
+			                                   i == g->nx - 1, j == g->ny - 1, inv_dx, inv_dy,
+			                                   inv_2dx, inv_2dy));
+	const double dt = ss_point_step_size(s2, c->st.sweeper->cfl_bound.lambda_max, c->bound,
+	                                     SS_CFL_TABLE_SIZE, rule->tan_cr, rule->nu,
+	                                     c->lambda_idle, c->st.cfl, inv_d2);
 	for (int j = 0; j < g->ny; j++) {
 		for (int i = 0; i < g->nx; i++) {
 			const ptrdiff_t k = ss_grid_index(g, i, j);
@@ -258,12 +241,7 @@ static void test_device_loop(void)
 
 int main(void)
 {
-	const char *env = getenv("SANDSLIDE_TEST_SEED");
-	if (env && *env)
-		seed = strtoull(env, NULL, 10);
-	ss_parallel_set_threads(2);
-	/* the device's bits are the generic path's (face.h) */
-	if (ss_cpu_select("generic")) {
+	if (euler_cases_start(&seed)) {
 		printf("test_point: the generic path refused\n");
 		return 1;
 	}

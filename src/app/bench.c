@@ -454,11 +454,10 @@ static int probe_bandwidth(const struct ss_bench_options *o, size_t *probe_n,
 
 /* The GPU's side of the header: its name, a copy's bandwidth, and the
  * surfaces it leaves out. */
-static int gpu_header(const struct ss_bench_options *o, char *device, size_t device_size,
-                      size_t *probe_n, double *bandwidth, int *surfaces)
+static int gpu_header(const struct ss_bench_options *o, const char *name, const char *what,
+                      char *device, size_t device_size, size_t *probe_n, double *bandwidth,
+                      int *surfaces)
 {
-	char what[32], name[16];
-	snprintf(what, sizeof what, "--device %s", ss_device_format(&o->device, name, sizeof name));
 	int err = SS_OK;
 	if (o->angles > 1)
 		err = ss_error_input("--angles %d with %s: materials do not run on the GPU yet "
@@ -495,7 +494,8 @@ int ss_bench_run(const struct ss_bench_options *o)
 	if (ss_grid_init(&g, o->nx, o->ny, SPACING_M, SPACING_M, 0.0, 0.0))
 		return SS_ERR_INPUT;
 	ss_tiling_init(&tiling, &g, o->tile[0], o->tile[1]);
-	if ((err = gpu ? gpu_header(o, device, sizeof device, &probe_n, bandwidth, surfaces)
+	if ((err = gpu ? gpu_header(o, name, what, device, sizeof device, &probe_n, bandwidth,
+	                            surfaces)
 	               : probe_bandwidth(o, &probe_n, bandwidth)))
 		return err;
 	/* on a GPU one case per surface and closure: its threads are its own */

@@ -14,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "app/drive.h"
 #include "app/relax_inputs.h"
 #include "base/strings.h"
 #include "model/materials.h"
@@ -278,11 +279,7 @@ static int check_device(const char *config_file, const char *value)
 		                      "0 to 63)", config_file, value);
 	char what[4200];
 	snprintf(what, sizeof what, "%s: [bmi] device = %s", config_file, value);
-	const int err = ss_device_check(&d, what);
-	if (err || d.kind == SS_DEVICE_CPU)
-		return err;
-	return ss_error_input("%s: the BMI does not run on a GPU yet, only bench does "
-	                      "(doc/gpu.md#what-runs-on-the-gpu)", what);
+	return ss_drive_check_device(&d, what, "the BMI");
 }
 
 /* The model config_file describes (above) into s. */

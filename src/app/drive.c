@@ -25,10 +25,13 @@ void ss_drive_init(struct ss_drive *d, struct ss_stepper *st, double started)
 	d->trouble.good_snapshot = -1;
 }
 
-int ss_drive_check_device(const struct ss_device *d, const char *command)
+int ss_drive_check_device(const struct ss_device *d, const char *what, const char *command)
 {
-	char name[16], what[32];
-	snprintf(what, sizeof what, "--device %s", ss_device_format(d, name, sizeof name));
+	char name[16], option[32];
+	if (!what) {
+		snprintf(option, sizeof option, "--device %s", ss_device_format(d, name, sizeof name));
+		what = option;
+	}
 	const int err = ss_device_check(d, what);
 	if (err || d->kind == SS_DEVICE_CPU)
 		return err;

@@ -104,10 +104,11 @@ void ss_drive_init(struct ss_drive *d, struct ss_stepper *st, double started);
  * lowers for a small grid (ss_parallel_threads_for). */
 void ss_drive_set_threads(int threads);
 
-/* SS_OK when `command` (run, relax, fit) can compute on device d here:
- * the CPU; else the reason (no CUDA in this build, no such GPU, or what
- * the GPU does not run yet) as bad input. */
-int ss_drive_check_device(const struct ss_device *d, const char *command);
+/* SS_OK when `command` (run, relax, fit, the BMI) can compute on device d
+ * here: the CPU; else the reason (no CUDA in this build, no such GPU, or
+ * that the command's loop is not on the GPU yet) as bad input, after
+ * `what`, the setting that named d (NULL: "--device NAME"). */
+int ss_drive_check_device(const struct ss_device *d, const char *what, const char *command);
 
 /* Claim `output` for this run (unless it already holds the claim): make
  * its folder first when make_folder (a default output's out/), then refuse

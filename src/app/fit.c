@@ -1081,7 +1081,7 @@ int ss_fit_run(const struct ss_fit_options *o, char **report, char **summary)
 		*summary = NULL;
 	if (ss_comm_size() > 1)
 		return ss_error_input("fit runs on one rank: start it without mpirun");
-	if (ss_drive_check_device(&o->job.device, "fit"))
+	if (ss_drive_check_device(&o->job.device, NULL, "fit"))
 		return SS_ERR_INPUT;
 	struct fit f;
 	memset(&f, 0, sizeof f);

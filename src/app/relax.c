@@ -329,7 +329,7 @@ static int nonfinite(struct relax *x, const char *path)
 
 int ss_relax_run(const struct ss_relax_options *o, struct ss_relax_report *rep)
 {
-	if (ss_drive_check_device(&o->job.device, "relax"))
+	if (ss_drive_check_device(&o->job.device, NULL, "relax"))
 		return SS_ERR_INPUT;
 	const double started = ss_parallel_wall_seconds();
 	struct relax x;

@@ -372,7 +372,7 @@ static void summarise(const struct run *r, enum ss_drive_end end, struct ss_run_
 
 int ss_run_case(const struct ss_run_options *o, struct ss_run_summary *summary)
 {
-	if (ss_drive_check_device(&o->job.device, "run"))
+	if (ss_drive_check_device(&o->job.device, NULL, "run"))
 		return SS_ERR_INPUT;
 	const double started = ss_parallel_wall_seconds();
 	struct run r;

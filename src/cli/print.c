@@ -257,8 +257,9 @@ void cli_bench_result(void *context, const struct ss_bench_result *r)
 	} else {
 		char range[64];
 		snprintf(range, sizeof range, "%.3g [%.3g, %.3g]", r->median, r->min, r->max);
-		char threads[16];
-		snprintf(threads, sizeof threads, r->threads > 0 ? "%d" : "gpu", r->threads);
+		char threads[16] = "gpu";
+		if (r->threads > 0)
+			snprintf(threads, sizeof threads, "%d", r->threads);
 		printf("%-14s %-22s %7s  %-34s %6lld %6.3f %6.2f %8.3f\n", surface, r->closure,
 		       threads, range, r->steps, r->active_fraction, r->bytes_per_cell,
 		       r->median / r->roofline);

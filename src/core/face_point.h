@@ -40,6 +40,8 @@
 
 /* The cell types of grid.h, as bytes (sweep.h unpacks them). */
 enum { SS_POINT_FLOW = 0, SS_POINT_WALL = 1, SS_POINT_OPEN = 2 };
+/* The side kinds of boundary.h (sweep.c checks both). */
+enum { SS_POINT_SIDE_WALL = 0, SS_POINT_SIDE_OPEN = 1, SS_POINT_SIDE_PERIODIC = 2 };
 
 /* The formula a sweep instantiates; a Herschel-Bulkley power with a short
  * exact form gets its own. */
@@ -178,6 +180,15 @@ SS_POINT int ss_face_carries(uint8_t a, uint8_t b)
 	       (a == SS_POINT_FLOW || b == SS_POINT_FLOW);
 }
 
+/* The height of a ghost cell beyond a side of kind `kind`, as boundary.c
+ * fills it: the far cell's (`far`) beyond a periodic side, 0 beyond a wall
+ * (the stencil mirrors across a wall by its type), the open level beyond
+ * an open side. */
+SS_POINT double ss_point_ghost(int kind, double far, double open_level)
+{
+	return kind == SS_POINT_SIDE_PERIODIC ? far : kind == SS_POINT_SIDE_WALL ? 0.0 : open_level;
+}
+
 /* Central difference of h at cell k along the direction with neighbour
  * offset `step`, a wall neighbour replaced by the cell itself
  * (doc/model.md#mirror-ghost-at-walls), times 1/(2 spacing). */
@@ -190,18 +201,22 @@ SS_POINT double ss_point_central_difference(const double *SS_POINT_RESTRICT h,
 	return (hp - hm) * inv_2spacing;
 }
 
-/* The gradients of the face between cells a (west/south) and a + normal
- * (east/north): g_n across it, g_t the mean of both cells' central
- * differences along it (neighbour offset `along`). */
-SS_POINT void ss_point_gradients(const double *SS_POINT_RESTRICT h,
-                                 const uint8_t *SS_POINT_RESTRICT type, ptrdiff_t a,
-                                 ptrdiff_t normal, ptrdiff_t along, double inv_spacing,
-                                 double inv_2along, double *g_n, double *g_t)
+/* Whether the face between cells a (west/south) and a + normal
+ * (east/north) carries flux, and if so its gradients: g_n across it, g_t
+ * the mean of both cells' central differences along it (neighbour offset
+ * `along`). */
+SS_POINT int ss_point_face_gradients(const double *SS_POINT_RESTRICT h,
+                                     const uint8_t *SS_POINT_RESTRICT type, ptrdiff_t a,
+                                     ptrdiff_t normal, ptrdiff_t along, double inv_spacing,
+                                     double inv_2along, double *g_n, double *g_t)
 {
 	const ptrdiff_t b = a + normal;
+	if (!ss_face_carries(type[a], type[b]))
+		return 0;
 	*g_n = (h[b] - h[a]) * inv_spacing;
 	*g_t = 0.5 * (ss_point_central_difference(h, type, a, along, inv_2along) +
 	              ss_point_central_difference(h, type, b, along, inv_2along));
+	return 1;
 }
 
 /* s^2 of a face that carries flux, 0 of one that does not (the maximum
@@ -212,10 +227,8 @@ SS_POINT double ss_point_face_slope2(const double *SS_POINT_RESTRICT h,
                                      double inv_2along)
 {
 	double g_n, g_t;
-	if (!ss_face_carries(type[a], type[a + normal]))
-		return 0.0;
-	ss_point_gradients(h, type, a, normal, along, inv_spacing, inv_2along, &g_n, &g_t);
-	return g_n * g_n + g_t * g_t;
+	return ss_point_face_gradients(h, type, a, normal, along, inv_spacing, inv_2along, &g_n,
+	                               &g_t) ? g_n * g_n + g_t * g_t : 0.0;
 }
 
 /* The flux of the face between a and a + normal under one rule. */
@@ -225,10 +238,31 @@ SS_POINT double ss_point_face(const struct ss_point_rule *r, const double *SS_PO
                               double inv_2along)
 {
 	double g_n, g_t;
-	if (!ss_face_carries(type[a], type[a + normal]))
-		return 0.0;
-	ss_point_gradients(h, type, a, normal, along, inv_spacing, inv_2along, &g_n, &g_t);
-	return ss_point_flux(r, g_n, g_t);
+	return ss_point_face_gradients(h, type, a, normal, along, inv_spacing, inv_2along, &g_n,
+	                               &g_t) ? ss_point_flux(r, g_n, g_t) : 0.0;
+}
+
+/*
+ * The largest s^2 of the faces cell k owns: its west and south ones, and
+ * the block's east (north) face in the last column (row), as the
+ * reference sweep's tiles own them; a NaN counts as +inf, so that it
+ * cannot vanish in a maximum.  The GPU's slope pass reduces these.
+ */
+SS_POINT double ss_point_cell_slope2(const double *SS_POINT_RESTRICT h,
+                                     const uint8_t *SS_POINT_RESTRICT type, ptrdiff_t k,
+                                     ptrdiff_t stride, int last_column, int last_row,
+                                     double inv_dx, double inv_dy, double inv_2dx,
+                                     double inv_2dy)
+{
+	double f[4];
+	f[0] = ss_point_face_slope2(h, type, k - 1, 1, stride, inv_dx, inv_2dy);
+	f[1] = ss_point_face_slope2(h, type, k - stride, stride, 1, inv_dy, inv_2dx);
+	f[2] = last_column ? ss_point_face_slope2(h, type, k, 1, stride, inv_dx, inv_2dy) : 0.0;
+	f[3] = last_row ? ss_point_face_slope2(h, type, k, stride, 1, inv_dy, inv_2dx) : 0.0;
+	double s2 = 0.0;
+	for (int m = 0; m < 4; m++)
+		s2 = f[m] != f[m] ? INFINITY : f[m] > s2 ? f[m] : s2;
+	return s2;
 }
 
 /* dh/dt from a cell's four face fluxes: -(F_e - F_w)/dx - (F_n - F_s)/dy,
@@ -284,6 +318,25 @@ SS_POINT int ss_point_cfl_entry(const double *SS_POINT_RESTRICT bound, int size,
 			lo = mid + 1;
 	}
 	return lo;
+}
+
+/*
+ * The forward-Euler step from the largest face slope's square s2_max
+ * (doc/model.md#forward-euler, (11); bench's rule): Lambda = nu table[entry]
+ * above tan a_cr, the idle rate lambda_idle when nothing slides,
+ * dt = cfl / (2 Lambda (1/dx^2 + 1/dy^2)), inv_d2 the bracket.  lambda:
+ * the CFL table /nu (closure.h), bound its thresholds.
+ */
+SS_POINT double ss_point_step_size(double s2_max, const double *SS_POINT_RESTRICT lambda,
+                                   const double *SS_POINT_RESTRICT bound, int table_size,
+                                   double tan_cr, double nu, double lambda_idle, double cfl,
+                                   double inv_d2)
+{
+	const double s_max = sqrt(s2_max);
+	double rate = s_max > tan_cr ? nu * lambda[ss_point_cfl_entry(bound, table_size, s_max)]
+	                             : 0.0;
+	rate = rate > 0.0 ? rate : lambda_idle;
+	return cfl / (2.0 * rate * inv_d2);
 }
 
 #endif

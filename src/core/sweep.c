@@ -8,12 +8,19 @@
  */
 #include "core/sweep.h"
 
+#include "sandslide/boundary.h"
+
 #include <math.h>
 #include <stddef.h>
 
-/* face_point.h spells the cell types as its own constants (nvcc reads it) */
+/* face_point.h spells the cell types and side kinds as its own constants
+ * (nvcc reads it) */
 _Static_assert((int)SS_POINT_FLOW == (int)SS_CELL_FLOW && (int)SS_POINT_WALL == (int)SS_CELL_WALL &&
                (int)SS_POINT_OPEN == (int)SS_CELL_OPEN, "face_point.h's cell types are grid.h's");
+_Static_assert((int)SS_POINT_SIDE_WALL == (int)SS_SIDE_WALL &&
+               (int)SS_POINT_SIDE_OPEN == (int)SS_SIDE_OPEN &&
+               (int)SS_POINT_SIDE_PERIODIC == (int)SS_SIDE_PERIODIC,
+               "face_point.h's side kinds are boundary.h's");
 
 void ss_tiling_init(struct ss_tiling *t, const struct ss_grid *g,
                     int tile_nx, int tile_ny)
@@ -76,10 +83,10 @@ static inline double face_flux(const struct ss_face_rule *rule,
                                double *restrict s2_max)
 {
 	const ptrdiff_t b = a + normal;
-	if (!ss_face_carries(type[a], type[b]))
-		return 0.0;
 	double g_n, g_t;
-	ss_point_gradients(h, type, a, normal, along, inv_spacing, inv_2along, &g_n, &g_t);
+	if (!ss_point_face_gradients(h, type, a, normal, along, inv_spacing, inv_2along, &g_n,
+	                             &g_t))
+		return 0.0;
 	const double s2 = g_n * g_n + g_t * g_t;
 	/* a NaN slope must not vanish in the maximum */
 	if (s2 > *s2_max || s2 != s2)

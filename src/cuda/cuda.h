@@ -47,14 +47,13 @@ int ss_cuda_copy_bandwidth(int index, size_t bytes, double *bytes_per_s);
 /* One block stepped by forward Euler on a GPU. */
 struct ss_cuda_euler;
 
-enum { SS_CUDA_SIDE_WALL = 0, SS_CUDA_SIDE_OPEN = 1, SS_CUDA_SIDE_PERIODIC = 2 };
-
 struct ss_cuda_euler_setup {
 	int device;                 /* cuda:N */
 	int nx, ny;                 /* cells, halo not included */
 	ptrdiff_t stride;           /* elements between rows (grid.h) */
 	double dx, dy;              /* m */
-	int side[4];                /* west, east, south, north: SS_CUDA_SIDE_* */
+	int side[4];                /* west, east, south, north: SS_POINT_SIDE_*
+	                             * (boundary.h's kinds) */
 	double open_level;          /* m: the open sides' ghost heights */
 	struct ss_point_rule rule;  /* one closure everywhere */
 	double cfl;                 /* the step: cfl / (2 Lambda (1/dx^2 + 1/dy^2)) */
@@ -69,12 +68,18 @@ struct ss_cuda_euler_setup {
 
 /* Bytes of device memory per cell of storage (halo included) the loop
  * holds: two height buffers and the type byte. */
-size_t ss_cuda_euler_bytes_per_cell(void);
+static inline size_t ss_cuda_euler_bytes_per_cell(void)
+{
+	return 2 * sizeof(double) + 1;
+}
 
 /* Bytes of memory each step moves per cell: the slope pass reads the
  * heights and types (9 B), the update reads them and writes the heights
  * (17 B). */
-double ss_cuda_euler_bytes_per_update(void);
+static inline double ss_cuda_euler_bytes_per_update(void)
+{
+	return (double)(sizeof(double) + 1) + (double)(2 * sizeof(double) + 1);
+}
 
 /* Copy the setup's arrays to device memory.  SS_ERR_INPUT when the grid
  * does not fit in the device's free memory (the message says what would),

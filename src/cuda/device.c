@@ -108,16 +108,6 @@ int ss_cuda_copy_bandwidth(int index, size_t bytes, double *bytes_per_s)
 	return ss_error_input("%s", NO_CUDA);
 }
 
-size_t ss_cuda_euler_bytes_per_cell(void)
-{
-	return 2 * sizeof(double) + 1;
-}
-
-double ss_cuda_euler_bytes_per_update(void)
-{
-	return 26.0;
-}
-
 int ss_cuda_euler_create(struct ss_cuda_euler **e, const struct ss_cuda_euler_setup *s)
 {
 	(void)s;

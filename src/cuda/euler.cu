@@ -78,38 +78,36 @@ struct ss_cuda_euler {
 	int graph_ready, use_graph;
 };
 
+/* ss_grid_index (grid.h) on the device: one ghost cell each side */
 static __device__ ptrdiff_t cell(ptrdiff_t stride, int i, int j)
 {
 	return (ptrdiff_t)(j + 1) * stride + (i + 1);
 }
 
+/* The ghost columns of rows 0 .. ny - 1 (ss_point_ghost). */
 __global__ void fill_west_east(double *__restrict__ h, int nx, int ny, ptrdiff_t stride,
                                int west, int east, double open_level)
 {
 	const int j = blockIdx.x * blockDim.x + threadIdx.x;
 	if (j >= ny)
 		return;
-	h[cell(stride, -1, j)] = west == SS_CUDA_SIDE_PERIODIC ? h[cell(stride, nx - 1, j)]
-	                       : west == SS_CUDA_SIDE_WALL ? 0.0 : open_level;
-	h[cell(stride, nx, j)] = east == SS_CUDA_SIDE_PERIODIC ? h[cell(stride, 0, j)]
-	                       : east == SS_CUDA_SIDE_WALL ? 0.0 : open_level;
+	h[cell(stride, -1, j)] = ss_point_ghost(west, h[cell(stride, nx - 1, j)], open_level);
+	h[cell(stride, nx, j)] = ss_point_ghost(east, h[cell(stride, 0, j)], open_level);
 }
 
+/* The ghost rows, columns -1 .. nx: the corners after the columns. */
 __global__ void fill_south_north(double *__restrict__ h, int nx, int ny, ptrdiff_t stride,
                                  int south, int north, double open_level)
 {
 	const int i = (int)(blockIdx.x * blockDim.x + threadIdx.x) - 1;
 	if (i > nx)
 		return;
-	h[cell(stride, i, -1)] = south == SS_CUDA_SIDE_PERIODIC ? h[cell(stride, i, ny - 1)]
-	                       : south == SS_CUDA_SIDE_WALL ? 0.0 : open_level;
-	h[cell(stride, i, ny)] = north == SS_CUDA_SIDE_PERIODIC ? h[cell(stride, i, 0)]
-	                       : north == SS_CUDA_SIDE_WALL ? 0.0 : open_level;
+	h[cell(stride, i, -1)] = ss_point_ghost(south, h[cell(stride, i, ny - 1)], open_level);
+	h[cell(stride, i, ny)] = ss_point_ghost(north, h[cell(stride, i, 0)], open_level);
 }
 
-/* The faces a cell owns: its west and south ones, and the block's east
- * (north) face in its last column (row), as the reference sweep's tiles
- * own them. */
+/* The largest s^2 of the faces each cell owns (ss_point_cell_slope2),
+ * reduced over the block and then the grid. */
 __global__ void slope_max(const double *__restrict__ h, const uint8_t *__restrict__ type,
                           int nx, int ny, ptrdiff_t stride, double inv_dx, double inv_dy,
                           double inv_2dx, double inv_2dy, unsigned long long *s2_bits)
@@ -117,18 +115,9 @@ __global__ void slope_max(const double *__restrict__ h, const uint8_t *__restric
 	const int i = blockIdx.x * blockDim.x + threadIdx.x;
 	const int j = blockIdx.y * blockDim.y + threadIdx.y;
 	double s2 = 0.0;
-	if (i < nx && j < ny) {
-		const ptrdiff_t k = cell(stride, i, j);
-		double f[4];
-		f[0] = ss_point_face_slope2(h, type, k - 1, 1, stride, inv_dx, inv_2dy);
-		f[1] = ss_point_face_slope2(h, type, k - stride, stride, 1, inv_dy, inv_2dx);
-		f[2] = i == nx - 1 ? ss_point_face_slope2(h, type, k, 1, stride, inv_dx, inv_2dy)
-		                   : 0.0;
-		f[3] = j == ny - 1 ? ss_point_face_slope2(h, type, k, stride, 1, inv_dy, inv_2dx)
-		                   : 0.0;
-		for (int m = 0; m < 4; m++)
-			s2 = f[m] != f[m] ? INFINITY : f[m] > s2 ? f[m] : s2;
-	}
+	if (i < nx && j < ny)
+		s2 = ss_point_cell_slope2(h, type, cell(stride, i, j), stride, i == nx - 1,
+		                          j == ny - 1, inv_dx, inv_dy, inv_2dx, inv_2dy);
 	/* the block's maximum: the warps', then the first warp's */
 	__shared__ double warp_max[BLOCK_X * BLOCK_Y / 32];
 	const int lane = (threadIdx.y * blockDim.x + threadIdx.x) % 32;
@@ -147,18 +136,17 @@ __global__ void slope_max(const double *__restrict__ h, const uint8_t *__restric
 	}
 }
 
-/* One thread: the step size from the largest slope (bench.c's rule, the
- * CFL bound of doc/model.md#the-cfl-bound). */
+/* One thread: the step size from the largest slope (ss_point_step_size,
+ * the CFL bound of doc/model.md#the-cfl-bound); the maximum cleared for the
+ * next step. */
 __global__ void step_size(unsigned long long *s2_bits, const double *__restrict__ lambda,
                           const double *__restrict__ bound, int table_size, double tan_cr,
                           double nu, double lambda_idle, double cfl, double inv_d2, double *dt)
 {
-	const double s_max = sqrt(__longlong_as_double((long long)*s2_bits));
+	const double s2_max = __longlong_as_double((long long)*s2_bits);
 	*s2_bits = 0;
-	double rate = s_max > tan_cr ? nu * lambda[ss_point_cfl_entry(bound, table_size, s_max)]
-	                             : 0.0;
-	rate = rate > 0.0 ? rate : lambda_idle;
-	*dt = cfl / (2.0 * rate * inv_d2);
+	*dt = ss_point_step_size(s2_max, lambda, bound, table_size, tan_cr, nu, lambda_idle, cfl,
+	                         inv_d2);
 }
 
 __global__ void update(struct ss_point_rule rule, const double *__restrict__ h,
@@ -290,16 +278,6 @@ extern "C" int ss_cuda_copy_bandwidth(int index, size_t bytes, double *bytes_per
 	CHECK(err, "the bandwidth probe");
 	*bytes_per_s = 2.0 * (double)bytes * COPIES / (ms * 1e-3);
 	return OK;
-}
-
-extern "C" size_t ss_cuda_euler_bytes_per_cell(void)
-{
-	return 2 * sizeof(double) + 1;
-}
-
-extern "C" double ss_cuda_euler_bytes_per_update(void)
-{
-	return 26.0;
 }
 
 extern "C" void ss_cuda_euler_destroy(struct ss_cuda_euler *e)

@@ -21,6 +21,7 @@ import numpy as np
 import pytest
 
 from conftest import CASES, SANDSLIDE, edit, run, run_ok
+from test_relax import write_asc
 
 TIMING_KEYS = {"seconds", "seconds_per_run"}
 # Under the sanitizers (SANDSLIDE_TEST_SCALE < 1, tests/scale.h) the largest
@@ -452,8 +453,7 @@ def test_a_class_with_hysteresis_gives_both_its_angles(tmp_path):
     and finds each within 0.5 degree."""
     classes = np.full((8, 60), 3.0)
     classes[:, 40:] = 7.0
-    (tmp_path / "classes.asc").write_text(asc(classes).replace("cellsize 1.0",
-                                                               "cellsize 0.025"))
+    write_asc(tmp_path / "classes.asc", classes, cellsize=0.025)
     case = HYSTERESIS_TWIN.replace("repose_angle = 30\nstatic_angle = 36\n",
                                    "materials = classes.asc\n")
     case += ("[material sand]\nclass = 3\nrepose_angle = 30\nstatic_angle = 36\n"
@@ -464,12 +464,6 @@ def test_a_class_with_hysteresis_gives_both_its_angles(tmp_path):
     a_d, a_s = best["material sand.repose_angle"], best["material sand.static_angle"]
     assert abs(a_d - 30.0) <= 0.5 and abs(a_s - 36.0) <= 0.5, (
         f"fit found repose_angle {a_d:.3f}, static_angle {a_s:.3f}: the twin's are 30 and 36")
-
-
-def asc(values):
-    ny, nx = values.shape
-    rows = "\n".join(" ".join(repr(float(v)) for v in values[j]) for j in range(ny - 1, -1, -1))
-    return f"ncols {nx}\nnrows {ny}\nxllcorner 0\nyllcorner 0\ncellsize 1.0\n{rows}\n"
 
 
 CLASS_TWIN = """[grid]
@@ -504,8 +498,8 @@ def test_one_angle_per_class_of_a_twin(tmp_path):
                     (1, 32))
     classes = np.full((24, 32), 7.0)
     classes[:, :16] = 3.0
-    (tmp_path / "ridge.asc").write_text(asc(ridge))
-    (tmp_path / "classes.asc").write_text(asc(classes))
+    write_asc(tmp_path / "ridge.asc", ridge, cellsize=1.0)
+    write_asc(tmp_path / "classes.asc", classes, cellsize=1.0)
     (tmp_path / "twin.ini").write_text(CLASS_TWIN)
     best = fit_twin(tmp_path, "material sand.repose_angle=27:33",
                     "material gravel.repose_angle=37:43")

@@ -37,11 +37,6 @@
 
 static uint64_t seed = 20261205;
 
-static int same_bits(double a, double b)
-{
-	return memcmp(&a, &b, sizeof a) == 0;
-}
-
 static int create(struct euler_case *c, struct ss_cuda_euler **e)
 {
 	const struct ss_grid *g = &c->st.grid;
@@ -196,11 +191,7 @@ static void test_too_big(void)
 
 int main(void)
 {
-	const char *env = getenv("SANDSLIDE_TEST_SEED");
-	if (env && *env)
-		seed = strtoull(env, NULL, 10);
-	ss_parallel_set_threads(2);
-	if (ss_cpu_select("generic")) {
+	if (euler_cases_start(&seed)) {
 		printf("test_cuda: the generic path refused\n");
 		return 1;
 	}
